@@ -1,0 +1,233 @@
+"""B-spline basis functions, vectorized over many parameter values.
+
+The functions here work on a full (flat) knot vector ``knots`` of length
+``n + degree + 1`` for ``n`` control points, and on arrays of parameters at once:
+the loops run over the degree (at most a few tens of numpy operations), never
+over the points.
+
+References
+----------
+.. [PT] L. Piegl, W. Tiller, *The NURBS Book*, 2nd ed., Springer 1997:
+   algorithms A2.1 (span), A2.2 (basis functions), A2.3 (derivatives).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InvalidGeometryError
+
+__all__ = [
+    "validate_knots",
+    "find_span",
+    "basis_functions",
+    "basis_derivatives",
+    "collocation_matrix",
+    "greville_abscissae",
+    "distinct_knots",
+]
+
+
+def validate_knots(knots: ArrayLike, degree: int, n_control: int, name: str = "knots") -> NDArray:
+    """Check a full knot vector and return it as a float array.
+
+    Parameters
+    ----------
+    knots : (n_control + degree + 1,) float
+        Non-decreasing knot values.
+    degree : int
+        Polynomial degree, >= 1.
+    n_control : int
+        Number of control points, >= degree + 1.
+
+    Raises
+    ------
+    InvalidGeometryError
+        With a message that says which condition failed.
+    """
+    if int(degree) != degree or degree < 1:
+        raise InvalidGeometryError(f"{name}: degree must be an integer >= 1, got {degree!r}")
+    knots = np.asarray(knots, dtype=float)
+    if knots.ndim != 1:
+        raise InvalidGeometryError(f"{name} must be one-dimensional, got shape {knots.shape}")
+    if n_control < degree + 1:
+        raise InvalidGeometryError(
+            f"{name}: need at least degree + 1 = {degree + 1} control points, got {n_control}")
+    if knots.size != n_control + degree + 1:
+        raise InvalidGeometryError(
+            f"{name}: expected n_control + degree + 1 = {n_control + degree + 1} knots "
+            f"for {n_control} control points of degree {degree}, got {knots.size}")
+    if not np.all(np.isfinite(knots)):
+        raise InvalidGeometryError(f"{name} contain NaN or infinite values")
+    if np.any(np.diff(knots) < 0):
+        raise InvalidGeometryError(f"{name} must be non-decreasing")
+    if knots[n_control] <= knots[degree]:
+        raise InvalidGeometryError(
+            f"{name}: empty parameter domain [{knots[degree]}, {knots[n_control]}]")
+    inner = knots[1:-1]
+    _, counts = np.unique(inner, return_counts=True)
+    if counts.size and counts.max() > degree + 1:
+        raise InvalidGeometryError(
+            f"{name}: an interior knot has multiplicity {counts.max()} > degree + 1 = {degree + 1}")
+    return knots
+
+
+def find_span(knots: NDArray, degree: int, t: ArrayLike) -> NDArray:
+    """Index ``i`` of the knot span ``knots[i] <= t < knots[i + 1]`` for every ``t``.
+
+    Parameters outside the domain ``[knots[degree], knots[n]]`` are assigned to
+    the first or last non-empty span (the polynomial piece is extended), and the
+    domain's right end belongs to the last non-empty span (A2.1 of [PT]).
+
+    Returns
+    -------
+    (...) int, same shape as ``t``; values in ``[degree, n - 1]``.
+    """
+    t = np.asarray(t, dtype=float)
+    n = knots.size - degree - 1
+    span = np.searchsorted(knots, t, side="right") - 1
+    # last non-empty span: largest i <= n-1 with knots[i] < knots[i+1]
+    last = n - 1
+    while knots[last] == knots[last + 1]:
+        last -= 1
+    first = degree
+    while knots[first] == knots[first + 1]:
+        first += 1
+    return np.clip(span, first, last)
+
+
+def basis_functions(knots: NDArray, degree: int, t: ArrayLike,
+                    span: NDArray | None = None) -> tuple[NDArray, NDArray]:
+    """Non-zero basis functions ``N[span - degree + j](t)``, ``j = 0..degree`` (A2.2).
+
+    Returns
+    -------
+    span : (m,) int
+    values : (m, degree + 1) float
+    """
+    ders, span = basis_derivatives(knots, degree, t, 0, span)
+    return span, ders[:, 0, :]
+
+
+def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
+                      span: NDArray | None = None) -> tuple[NDArray, NDArray]:
+    """Basis functions and their derivatives up to ``order`` (A2.3 of [PT]), vectorized.
+
+    Parameters
+    ----------
+    knots : (n + degree + 1,) float
+    degree : int
+    t : array_like, flattened to (m,)
+    order : int >= 0
+        Derivatives above ``degree`` are zero.
+    span : (m,) int, optional
+        Precomputed :func:`find_span` result.
+
+    Returns
+    -------
+    ders : (m, order + 1, degree + 1) float
+        ``ders[i, k, j]`` is the k-th derivative of basis function
+        ``span[i] - degree + j`` at ``t[i]``.
+    span : (m,) int
+    """
+    p = int(degree)
+    t = np.asarray(t, dtype=float).reshape(-1)
+    if span is None:
+        span = find_span(knots, p, t)
+    m = t.size
+    # left[j] = t - knots[span + 1 - j], right[j] = knots[span + j] - t, j = 1..p
+    j = np.arange(1, p + 1)
+    left = t[:, None] - knots[span[:, None] + 1 - j]        # (m, p)
+    right = knots[span[:, None] + j] - t[:, None]           # (m, p)
+    # ndu[:, r, c]: upper triangle c >= r basis values, lower triangle knot differences
+    ndu = np.empty((m, p + 1, p + 1))
+    ndu[:, 0, 0] = 1.0
+    for jj in range(1, p + 1):
+        saved = np.zeros(m)
+        for r in range(jj):
+            ndu[:, jj, r] = right[:, r] + left[:, jj - r - 1]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                temp = np.where(ndu[:, jj, r] != 0.0, ndu[:, r, jj - 1] / ndu[:, jj, r], 0.0)
+            ndu[:, r, jj] = saved + right[:, r] * temp
+            saved = left[:, jj - r - 1] * temp
+        ndu[:, jj, jj] = saved
+    n_order = max(int(order), 0)
+    ders = np.zeros((m, n_order + 1, p + 1))
+    ders[:, 0, :] = ndu[:, :, p]
+    top = min(n_order, p)
+    if top == 0:
+        return ders, span
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_ndu = np.where(ndu != 0.0, 1.0 / ndu, 0.0)
+    for r in range(p + 1):
+        a = np.zeros((2, m, p + 1))
+        s1, s2 = 0, 1
+        a[0, :, 0] = 1.0
+        for k in range(1, top + 1):
+            d = np.zeros(m)
+            rk, pk = r - k, p - k
+            if r >= k:
+                a[s2, :, 0] = a[s1, :, 0] * inv_ndu[:, pk + 1, rk]
+                d = a[s2, :, 0] * ndu[:, rk, pk]
+            j1 = 1 if rk >= -1 else -rk
+            j2 = k - 1 if r - 1 <= pk else p - r
+            for jj in range(j1, j2 + 1):
+                a[s2, :, jj] = (a[s1, :, jj] - a[s1, :, jj - 1]) * inv_ndu[:, pk + 1, rk + jj]
+                d = d + a[s2, :, jj] * ndu[:, rk + jj, pk]
+            if r <= pk:
+                a[s2, :, k] = -a[s1, :, k - 1] * inv_ndu[:, pk + 1, r]
+                d = d + a[s2, :, k] * ndu[:, r, pk]
+            ders[:, k, r] = d
+            s1, s2 = s2, s1
+    factor = float(p)
+    for k in range(1, top + 1):
+        ders[:, k, :] *= factor
+        factor *= p - k
+    return ders, span
+
+
+def collocation_matrix(knots: NDArray, degree: int, t: ArrayLike, order: int = 0) -> NDArray:
+    """Dense matrix ``B[i, j] = N_j^{(order)}(t[i])`` of all ``n`` basis functions.
+
+    Returns
+    -------
+    (m, n) float
+    """
+    t = np.asarray(t, dtype=float).reshape(-1)
+    n = knots.size - degree - 1
+    ders, span = basis_derivatives(knots, degree, t, order)
+    out = np.zeros((t.size, n))
+    cols = span[:, None] - degree + np.arange(degree + 1)
+    np.put_along_axis(out, cols, ders[:, order, :], axis=1)
+    return out
+
+
+def greville_abscissae(knots: NDArray, degree: int) -> NDArray:
+    """Greville abscissae ``(t[i+1] + ... + t[i+degree]) / degree``, one per control point.
+
+    Returns
+    -------
+    (n,) float
+    """
+    n = knots.size - degree - 1
+    c = np.concatenate([[0.0], np.cumsum(knots)])
+    i = np.arange(n)
+    return (c[i + degree + 1] - c[i + 1]) / degree
+
+
+def distinct_knots(knots: NDArray, degree: int) -> tuple[NDArray, NDArray]:
+    """Breakpoints of the domain and their multiplicities.
+
+    Returns
+    -------
+    values : (k,) float
+        Distinct knot values inside ``[knots[degree], knots[n]]``.
+    multiplicities : (k,) int
+        Multiplicity of each value in the full knot vector.
+    """
+    n = knots.size - degree - 1
+    lo, hi = knots[degree], knots[n]
+    values, counts = np.unique(knots, return_counts=True)
+    keep = (values >= lo) & (values <= hi)
+    return values[keep], counts[keep]

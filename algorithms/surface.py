@@ -1,0 +1,206 @@
+"""The immutable NURBS surface type and its vectorized evaluation.
+
+A tensor-product surface of degrees ``(p, q)`` with control net ``P_ij``
+(``control_points[i, j]``), optional positive weights and full knot vectors
+``knots_u``, ``knots_v``:
+
+.. math:: S(u, v) = \\frac{\\sum_{i,j} N_{i,p}(u) N_{j,q}(v)\\, w_{ij} P_{ij}}
+                          {\\sum_{i,j} N_{i,p}(u) N_{j,q}(v)\\, w_{ij}}.
+
+Evaluation comes in two forms: on broadcast arrays of (u, v) pairs
+(:meth:`NurbsSurface.evaluate`, :meth:`NurbsSurface.derivatives`) and on tensor
+grids (:meth:`NurbsSurface.evaluate_grid`, :meth:`NurbsSurface.derivatives_grid`),
+which evaluates each direction's basis once and contracts with BLAS.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InvalidGeometryError
+from .basis import basis_derivatives, find_span, validate_knots
+from .curve import _check_weights, _frozen
+from .rational import surface_derivatives_from_homogeneous
+
+__all__ = ["NurbsSurface"]
+
+
+@dataclass(frozen=True, eq=False)
+class NurbsSurface:
+    """A NURBS (or non-rational B-spline) tensor-product surface.
+
+    Parameters
+    ----------
+    control_points : (n_u, n_v, 3) float
+        Control net in Cartesian coordinates.
+    knots_u : (n_u + degree_u + 1,) float
+    knots_v : (n_v + degree_v + 1,) float
+    degree_u, degree_v : int
+    weights : (n_u, n_v) float, optional
+        Positive weights; ``None`` for a non-rational surface.
+
+    The arrays are copied and made read-only.
+    """
+
+    control_points: NDArray
+    knots_u: NDArray
+    knots_v: NDArray
+    degree_u: int
+    degree_v: int
+    weights: NDArray | None = None
+
+    def __post_init__(self) -> None:
+        cp = _frozen(self.control_points)
+        if cp.ndim != 3 or cp.shape[2] < 1:
+            raise InvalidGeometryError(
+                f"control_points must have shape (n_u, n_v, d), got {cp.shape}")
+        if not np.all(np.isfinite(cp)):
+            raise InvalidGeometryError("control_points contain NaN or infinite values")
+        ku = _frozen(validate_knots(self.knots_u, self.degree_u, cp.shape[0], "knots_u"))
+        kv = _frozen(validate_knots(self.knots_v, self.degree_v, cp.shape[1], "knots_v"))
+        w = None if self.weights is None else _frozen(self.weights)
+        w = _check_weights(w, cp.shape[:2], "weights")
+        object.__setattr__(self, "control_points", cp)
+        object.__setattr__(self, "knots_u", ku)
+        object.__setattr__(self, "knots_v", kv)
+        object.__setattr__(self, "degree_u", int(self.degree_u))
+        object.__setattr__(self, "degree_v", int(self.degree_v))
+        object.__setattr__(self, "weights", w)
+
+    # ------------------------------------------------------------------ shape
+    @property
+    def n_control(self) -> tuple[int, int]:
+        """Control net size ``(n_u, n_v)``."""
+        return self.control_points.shape[0], self.control_points.shape[1]
+
+    @property
+    def dimension(self) -> int:
+        return self.control_points.shape[2]
+
+    @property
+    def is_rational(self) -> bool:
+        """True when the weights are not all equal."""
+        return self.weights is not None and bool(np.ptp(self.weights) > 0)
+
+    @property
+    def domain(self) -> tuple[float, float, float, float]:
+        """Parameter rectangle ``(u0, u1, v0, v1)``."""
+        nu, nv = self.n_control
+        return (float(self.knots_u[self.degree_u]), float(self.knots_u[nu]),
+                float(self.knots_v[self.degree_v]), float(self.knots_v[nv]))
+
+    def homogeneous_points(self) -> NDArray:
+        """Control net as ``(w x, w y, w z, w)``: (n_u, n_v, d + 1) float."""
+        w = np.ones(self.n_control) if self.weights is None else self.weights
+        return np.concatenate([self.control_points * w[..., None], w[..., None]], axis=2)
+
+    @classmethod
+    def from_homogeneous(cls, points_w: ArrayLike, knots_u: ArrayLike, knots_v: ArrayLike,
+                         degree_u: int, degree_v: int, rational: bool = True) -> NurbsSurface:
+        """Build from a homogeneous net ``(n_u, n_v, d + 1)`` (last channel the weights)."""
+        pw = np.asarray(points_w, dtype=float)
+        w = pw[..., -1]
+        if np.any(w <= 0):
+            raise InvalidGeometryError("homogeneous weights must be > 0")
+        return cls(pw[..., :-1] / w[..., None], knots_u, knots_v, degree_u, degree_v,
+                   w if rational else None)
+
+    # ------------------------------------------------------- scattered points
+    def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray:
+        """Points ``S(u, v)`` for broadcast arrays ``u``, ``v``.
+
+        Returns
+        -------
+        (..., d) float, ``...`` the broadcast shape of ``u`` and ``v``.
+        """
+        return self.derivatives(u, v, 0)[..., 0, 0, :]
+
+    def derivatives(self, u: ArrayLike, v: ArrayLike, order: int = 1) -> NDArray:
+        """Partial derivatives ``d^{k+l} S / du^k dv^l`` for ``k, l = 0..order``.
+
+        Parameters
+        ----------
+        u, v : (...) float, broadcast together
+        order : int >= 0
+
+        Returns
+        -------
+        (..., order + 1, order + 1, d) float
+            ``[..., k, l, :]`` is the k-th u- and l-th v-derivative.
+        """
+        if order < 0:
+            raise ValueError(f"order must be >= 0, got {order}")
+        u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+        shape = u.shape
+        u, v = u.reshape(-1), v.reshape(-1)
+        p, q = self.degree_u, self.degree_v
+        su = find_span(self.knots_u, p, u)
+        sv = find_span(self.knots_v, q, v)
+        du, _ = basis_derivatives(self.knots_u, p, u, order, su)    # (m, o+1, p+1)
+        dv, _ = basis_derivatives(self.knots_v, q, v, order, sv)    # (m, o+1, q+1)
+        iu = su[:, None] - p + np.arange(p + 1)
+        iv = sv[:, None] - q + np.arange(q + 1)
+        pw = self.homogeneous_points()[iu[:, :, None], iv[:, None, :]]   # (m, p+1, q+1, d+1)
+        hom = np.einsum("mki,mlj,mijc->mklc", du, dv, pw, optimize=True)
+        out = self._project(hom)
+        return out.reshape(shape + out.shape[1:])
+
+    # ------------------------------------------------------------ tensor grid
+    def evaluate_grid(self, u: ArrayLike, v: ArrayLike) -> NDArray:
+        """Points on the tensor grid ``u x v``.
+
+        Parameters
+        ----------
+        u : (a,) float
+        v : (b,) float
+
+        Returns
+        -------
+        (a, b, d) float
+        """
+        return self.derivatives_grid(u, v, 0)[:, :, 0, 0, :]
+
+    def derivatives_grid(self, u: ArrayLike, v: ArrayLike, order: int = 1) -> NDArray:
+        """Partial derivatives on the tensor grid ``u x v``.
+
+        The basis of each direction is evaluated once, then contracted with the
+        control net span by span, so the cost is about ``(p+1)(q+1)`` multiply-adds
+        per grid point and derivative.
+
+        Returns
+        -------
+        (a, b, order + 1, order + 1, d) float
+        """
+        if order < 0:
+            raise ValueError(f"order must be >= 0, got {order}")
+        u = np.asarray(u, dtype=float).reshape(-1)
+        v = np.asarray(v, dtype=float).reshape(-1)
+        p, q = self.degree_u, self.degree_v
+        du, su = basis_derivatives(self.knots_u, p, u, order)      # (a, o+1, p+1)
+        dv, sv = basis_derivatives(self.knots_v, q, v, order)      # (b, o+1, q+1)
+        iu = su[:, None] - p + np.arange(p + 1)                    # (a, p+1)
+        pw = self.homogeneous_points()
+        # contract u first: (a, o+1, n_v, d+1)
+        tmp = np.einsum("aki,aijc->akjc", du, pw[iu], optimize=True)
+        iv = sv[:, None] - q + np.arange(q + 1)                    # (b, q+1)
+        hom = np.einsum("blj,akbjc->abklc", dv, tmp[:, :, iv], optimize=True)
+        a, b = u.size, v.size
+        out = self._project(hom.reshape((a * b,) + hom.shape[2:]))
+        return out.reshape((a, b) + out.shape[1:])
+
+    def _project(self, hom: NDArray) -> NDArray:
+        """Homogeneous derivatives (m, o+1, o+1, d+1) to Cartesian ones."""
+        if self.weights is None:
+            return hom[..., :-1]
+        return surface_derivatives_from_homogeneous(hom[..., :-1], hom[..., -1])
+
+    def __call__(self, u: ArrayLike, v: ArrayLike) -> NDArray:
+        return self.evaluate(u, v)
+
+    def __repr__(self) -> str:
+        kind = "rational" if self.weights is not None else "polynomial"
+        return (f"NurbsSurface(degree=({self.degree_u}, {self.degree_v}), "
+                f"n_control={self.n_control}, {kind}, domain={self.domain})")

@@ -1,0 +1,1 @@
+"""The OpenCascade side of surfprep: conversion, STEP/IGES, CLI, OpenCascade references."""
