@@ -161,6 +161,55 @@ class NurbsCurve:
     def __call__(self, t: ArrayLike) -> NDArray:
         return self.evaluate(t)
 
+    # ------------------------------------------------- operations (facades)
+    # Thin delegations to the algorithm modules, imported lazily (they import
+    # this module).
+    def insert_knot(self, t: float, r: int = 1) -> NurbsCurve:
+        """Same curve with knot ``t`` inserted ``r`` times (:func:`.knots.insert_knot`)."""
+        from .knots import insert_knot
+        return insert_knot(self, t, r)
+
+    def refine(self, new_knots: ArrayLike) -> NurbsCurve:
+        """Same curve with all of ``new_knots`` inserted (:func:`.knots.refine`)."""
+        from .knots import refine
+        return refine(self, new_knots)
+
+    def split(self, t: float) -> tuple[NurbsCurve, NurbsCurve]:
+        """Pieces over ``[t0, t]`` and ``[t, t1]`` (:func:`.knots.split`)."""
+        from .knots import split
+        return split(self, t)
+
+    def restrict(self, a: float, b: float) -> NurbsCurve:
+        """Piece over ``[a, b]``, original parameters (:func:`.knots.restrict`)."""
+        from .knots import restrict
+        return restrict(self, a, b)
+
+    def clamp(self) -> NurbsCurve:
+        """Clamped form over the same domain (:func:`.knots.clamp`)."""
+        from .knots import clamp
+        return clamp(self)
+
+    def elevate_degree(self, t: int = 1) -> NurbsCurve:
+        """Same curve with degree ``p + t`` (:func:`.degree.elevate_degree`)."""
+        from .degree import elevate_degree
+        return elevate_degree(self, t)
+
+    def bezier_segments(self) -> tuple[NDArray, NDArray]:
+        """Homogeneous Bézier segments ``(k, p+1, d+1)`` and intervals ``(k, 2)``."""
+        from .bezier import bezier_segments
+        return bezier_segments(self)
+
+    def bounding_box(self) -> NDArray:
+        """Control-point bounding box ``(2, d)`` (:func:`.measure.bounding_box`)."""
+        from .measure import bounding_box
+        return bounding_box(self)
+
+    def arc_length(self, t0: float | None = None, t1: float | None = None,
+                   tol: float = 1e-12) -> float:
+        """Length between ``t0`` and ``t1`` (:func:`.measure.arc_length`)."""
+        from .measure import arc_length
+        return arc_length(self, t0, t1, tol)
+
     def __repr__(self) -> str:
         kind = "rational" if self.weights is not None else "polynomial"
         return (f"NurbsCurve(degree={self.degree}, n_control={self.n_control}, "

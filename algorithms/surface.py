@@ -200,6 +200,69 @@ class NurbsSurface:
     def __call__(self, u: ArrayLike, v: ArrayLike) -> NDArray:
         return self.evaluate(u, v)
 
+    # ------------------------------------------------- operations (facades)
+    # Thin delegations to the algorithm modules, imported lazily (they import
+    # this module). ``direction`` is a ``knots.Direction`` (or "u"/"v").
+    def insert_knot(self, value: float, direction, r: int = 1) -> NurbsSurface:
+        """Same surface with ``value`` inserted ``r`` times in ``direction``."""
+        from .knots import insert_knot_surface
+        return insert_knot_surface(self, value, direction, r)
+
+    def refine(self, new_knots: ArrayLike, direction) -> NurbsSurface:
+        """Same surface with all of ``new_knots`` inserted in ``direction``."""
+        from .knots import refine_surface
+        return refine_surface(self, new_knots, direction)
+
+    def split(self, value: float, direction) -> tuple[NurbsSurface, NurbsSurface]:
+        """Two patches split at ``direction = value`` (:func:`.knots.split_surface`)."""
+        from .knots import split_surface
+        return split_surface(self, value, direction)
+
+    def restrict(self, u0: float | None = None, u1: float | None = None,
+                 v0: float | None = None, v1: float | None = None) -> NurbsSurface:
+        """Patch over ``[u0, u1] x [v0, v1]``, original parameters."""
+        from .knots import restrict_surface
+        return restrict_surface(self, u0, u1, v0, v1)
+
+    def clamp(self) -> NurbsSurface:
+        """Clamped form in both directions over the same domain."""
+        from .knots import clamp_surface
+        return clamp_surface(self)
+
+    def elevate_degree(self, t_u: int = 0, t_v: int = 0) -> NurbsSurface:
+        """Same surface with degrees ``(p + t_u, q + t_v)``."""
+        from .degree import elevate_degree_surface
+        return elevate_degree_surface(self, t_u, t_v)
+
+    def bezier_patches(self) -> tuple[NDArray, NDArray, NDArray]:
+        """Homogeneous patches ``(ku, kv, p+1, q+1, d+1)`` and their u, v intervals."""
+        from .bezier import bezier_patches
+        return bezier_patches(self)
+
+    def patch_bounding_boxes(self) -> tuple[NDArray, NDArray, NDArray]:
+        """Control-net box ``(ku, kv, 2, d)`` of every Bézier patch, with intervals."""
+        from .bezier import patch_bounding_boxes
+        return patch_bounding_boxes(self)
+
+    def bounding_box(self) -> NDArray:
+        """Control-net bounding box ``(2, d)``."""
+        from .measure import bounding_box
+        return bounding_box(self)
+
+    def normals(self, u: ArrayLike, v: ArrayLike) -> NDArray:
+        """Unit normals ``(..., 3)``, limit direction at degenerate points."""
+        from .measure import normals
+        return normals(self, u, v)
+
+    def isocurve(self, value: float, direction):
+        """Exact isoparametric curve (:func:`.isocurve.isocurve`).
+
+        ``Direction.U``: the curve ``u = value`` running in v (OpenCascade's
+        ``UIso``); ``Direction.V``: the curve ``v = value`` running in u.
+        """
+        from .isocurve import isocurve
+        return isocurve(self, value, direction)
+
     def __repr__(self) -> str:
         kind = "rational" if self.weights is not None else "polynomial"
         return (f"NurbsSurface(degree=({self.degree_u}, {self.degree_v}), "
