@@ -1,0 +1,407 @@
+"""Reading and writing STEP and IGES files: :func:`read`, :func:`write`, :class:`CadModel`.
+
+``read`` checks the file before OpenCascade sees it (exists, is a regular file,
+not empty, extension known, content matches the extension, not truncated), then
+translates it through XDE to keep face names and colours (plain readers as a
+fallback) and refuses a file without faces. Every failure is one of the package
+exceptions (:mod:`surfprep.errors`) with a one-line message naming the file.
+
+``write`` converts what it is given (a :class:`CadModel`, OCC shapes,
+cadquery/build123d objects, :class:`~surfprep.algorithms.NurbsSurface` /
+:class:`~surfprep.algorithms.NurbsCurve`, or a list of them) to one shape,
+writes it to a temporary file in the target directory and moves that into
+place with ``os.replace``, so a failed write never leaves a partial file or a
+temporary behind. It never overwrites the file a :class:`CadModel` was read
+from, and refuses any other existing file unless ``overwrite=True``.
+
+Coordinates: OpenCascade converts the file's length unit to millimetres while
+reading (and writes millimetres), so ``CadModel.shape`` is always in mm;
+``CadModel.length_unit`` is the unit the file *declares*, kept for reports and
+for spotting unit slips. Use :attr:`CadModel.size` (the bounding-box diagonal)
+to derive tolerances.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+from OCP.Bnd import Bnd_Box
+from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
+from OCP.ShapeFix import ShapeFix_Shape
+from OCP.Standard import Standard_Failure
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+
+from ..algorithms import NurbsCurve, NurbsSurface
+from ..errors import (ConversionError, InputFileError, NoFacesError, OpenCascadeError,
+                      OutputFileError)
+from .geom import curve_to_occ, surface_to_occ
+from .step_iges import (FileFormat, Rgb, TranslationError, _all_faces, _compound,
+                        _FaceNames, read_file, write_file)
+
+__all__ = ["CadModel", "FileFormat", "read", "write", "MAKE_FACE_TOLERANCE"]
+
+#: Tolerance given to ``BRepBuilderAPI_MakeFace`` for faces built from NurbsSurface.
+MAKE_FACE_TOLERANCE = 1e-7
+#: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
+MODEL_UNIT = "mm"
+
+_HEAD_BYTES = 4096
+_TAIL_BYTES = 2048
+_STEP_MAGIC = b"ISO-10303-21"
+_STEP_TRAILER = b"END-ISO-10303-21"
+
+
+@dataclass(frozen=True, eq=False)
+class CadModel:
+    """A CAD model read from (or destined for) a STEP/IGES file.
+
+    Attributes
+    ----------
+    shape : TopoDS_Shape
+        Everything the file holds, in millimetres (see module docstring).
+    faces : tuple of TopoDS_Face
+        Every face occurrence in file (exploration) order.
+    face_names : tuple of (str or None)
+        Name of each face from the file's XDE labels, None where it has none.
+    face_colors : tuple of ((r, g, b) or None)
+        Surface colour of each face (components in [0, 1]), None where unset.
+    length_unit : str
+        Length unit the file declares ("mm", "m", "in", "ft", ...; "unspecified"
+        when it declares none; comma-joined when a STEP file declares several).
+    path : Path or None
+        The file read, resolved; None for a model built in memory.
+    file_format : FileFormat or None
+    """
+
+    shape: TopoDS_Shape
+    faces: tuple[TopoDS_Face, ...]
+    face_names: tuple[str | None, ...]
+    face_colors: tuple[Rgb | None, ...]
+    length_unit: str = MODEL_UNIT
+    path: Path | None = None
+    file_format: FileFormat | None = None
+    model_unit: str = field(default=MODEL_UNIT)
+
+    def __post_init__(self) -> None:
+        n = len(self.faces)
+        if len(self.face_names) != n or len(self.face_colors) != n:
+            raise ValueError(
+                f"CadModel needs one name and one colour per face: {n} faces, "
+                f"{len(self.face_names)} names, {len(self.face_colors)} colours")
+
+    @classmethod
+    def from_shape(cls, shape: TopoDS_Shape) -> CadModel:
+        """A model of an in-memory shape, without names or colours."""
+        faces = _all_faces(shape)
+        return cls(shape, faces, (None,) * len(faces), (None,) * len(faces))
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    @cached_property
+    def bounding_box(self) -> tuple[float, float, float, float, float, float]:
+        """Tight box ``(xmin, ymin, zmin, xmax, ymax, zmax)`` of the shape, in mm."""
+        return bounding_box(self.shape)
+
+    @property
+    def size(self) -> float:
+        """Diagonal of :attr:`bounding_box`: the model's length scale for tolerances."""
+        x0, y0, z0, x1, y1, z1 = self.bounding_box
+        return float(((x1 - x0) ** 2 + (y1 - y0) ** 2 + (z1 - z0) ** 2) ** 0.5)
+
+    def __repr__(self) -> str:
+        where = self.path.name if self.path is not None else "in memory"
+        return (f"CadModel({where}, {self.n_faces} faces, declared unit "
+                f"{self.length_unit!r}, size {self.size:.6g} {self.model_unit})")
+
+
+def bounding_box(shape: TopoDS_Shape) -> tuple[float, float, float, float, float, float]:
+    """Tight axis-aligned box of a shape (exact geometry, no triangulation, no tolerances)."""
+    box = Bnd_Box()
+    try:
+        BRepBndLib.AddOptimal_s(shape, box, False, False)
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"bounding box computation failed: {exc}") from exc
+    if box.IsVoid():
+        raise OpenCascadeError("the shape has an empty bounding box")
+    return tuple(float(x) for x in box.Get())
+
+
+# ===================================================================== read
+def read(path: str | os.PathLike, *, heal: bool = False) -> CadModel:
+    """Read a STEP (.step/.stp) or IGES (.igs/.iges) file.
+
+    Parameters
+    ----------
+    path : path-like
+    heal : bool
+        Run OpenCascade's generic ``ShapeFix_Shape`` on the result (face names
+        and colours follow the faces it keeps).
+
+    Raises
+    ------
+    InputFileError
+        Missing file, a directory, empty file, unknown extension, content of the
+        other format (a STEP file named .igs), truncated or unreadable file.
+    NoFacesError
+        The file was read but holds no face.
+    """
+    file = Path(path)
+    fmt = _check_input_file(file)
+    try:
+        translated = read_file(file, fmt)
+    except TranslationError as exc:
+        raise InputFileError(f"cannot read {fmt.value} file {file}: {exc}") from None
+    except Standard_Failure as exc:
+        raise InputFileError(
+            f"cannot read {fmt.value} file {file}: OpenCascade failed: {exc}") from None
+    if not translated.faces:
+        raise NoFacesError(f"{fmt.value} file {file} holds no faces "
+                           f"(shape type {translated.shape.ShapeType().name.removeprefix('TopAbs_')})")
+    model = CadModel(translated.shape, translated.faces, translated.face_names,
+                     translated.face_colors, translated.length_unit, file.resolve(), fmt)
+    return _healed(model) if heal else model
+
+
+def _check_input_file(file: Path) -> FileFormat:
+    if not file.exists():
+        raise InputFileError(f"input file {file} does not exist")
+    if file.is_dir():
+        raise InputFileError(f"input {file} is a directory, not a STEP/IGES file")
+    if not file.is_file():
+        raise InputFileError(f"input {file} is not a regular file")
+    fmt = FileFormat.from_suffix(file)
+    if fmt is None:
+        raise InputFileError(
+            f"input file {file} has unknown extension {file.suffix!r}; "
+            f"expected one of {_known_suffixes()}")
+    try:
+        size = file.stat().st_size
+        with file.open("rb") as stream:
+            head = stream.read(_HEAD_BYTES)
+            stream.seek(max(0, size - _TAIL_BYTES))
+            tail = stream.read()
+    except OSError as exc:
+        raise InputFileError(f"cannot open input file {file}: {exc.strerror or exc}") from None
+    if size == 0:
+        raise InputFileError(f"input file {file} is empty (0 bytes)")
+    content = sniff_format(head)
+    if content is None:
+        raise InputFileError(
+            f"input file {file} is not a {fmt.value} file (no {_format_signature(fmt)} "
+            "at its start): corrupt or of another type")
+    if content is not fmt:
+        raise InputFileError(
+            f"input file {file} holds {content.value} data but is named {file.suffix}; "
+            f"rename it to {content.suffixes[0]}")
+    if not _has_trailer(content, tail):
+        raise InputFileError(
+            f"{fmt.value} file {file} is truncated (no {_format_trailer(fmt)} at its end)")
+    return fmt
+
+
+def _known_suffixes() -> str:
+    return ", ".join(s for fmt in FileFormat for s in fmt.suffixes)
+
+
+def _format_signature(fmt: FileFormat) -> str:
+    return ("'ISO-10303-21;' header" if fmt is FileFormat.STEP
+            else "80-column start/global section record")
+
+
+def _format_trailer(fmt: FileFormat) -> str:
+    return "'END-ISO-10303-21;' line" if fmt is FileFormat.STEP else "terminate (T) record"
+
+
+def sniff_format(head: bytes) -> FileFormat | None:
+    """The format the first bytes of a file are written in, or None if neither.
+
+    STEP (ISO 10303-21) files start with ``ISO-10303-21``; IGES files are
+    80-column records whose column 73 holds the section letter (``S`` start,
+    ``G`` global) and columns 74-80 a sequence number.
+    """
+    text = head.removeprefix(b"\xef\xbb\xbf")
+    if text.lstrip(b" \t\r\n").startswith(_STEP_MAGIC):
+        return FileFormat.STEP
+    if b"\x00" in head:
+        return None
+    first = text.lstrip(b"\r\n").split(b"\n", 1)[0].rstrip(b"\r")
+    if len(first) >= 73 and first[72:73] in (b"S", b"G") and first[73:80].strip().isdigit():
+        return FileFormat.IGES
+    return None
+
+
+def _has_trailer(fmt: FileFormat, tail: bytes) -> bool:
+    if fmt is FileFormat.STEP:
+        return _STEP_TRAILER in tail
+    lines = [ln.rstrip(b"\r") for ln in tail.split(b"\n") if ln.strip()]
+    return bool(lines) and len(lines[-1]) >= 73 and lines[-1][72:73] == b"T"
+
+
+def _healed(model: CadModel) -> CadModel:
+    try:
+        fixer = ShapeFix_Shape(model.shape)
+        fixer.Perform()
+        shape = fixer.Shape()
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"ShapeFix_Shape failed on {model.path}: {exc}") from exc
+    if shape.IsNull():
+        raise OpenCascadeError(f"ShapeFix_Shape returned a null shape for {model.path}")
+    context = fixer.Context()
+    names, colors = _FaceNames(), _FaceNames()
+    for face, name, color in zip(model.faces, model.face_names, model.face_colors):
+        new = context.Apply(face)
+        if name is not None:
+            names.add(new, name)
+        if color is not None:
+            colors.add(new, color)
+    faces = _all_faces(shape)
+    if not faces:
+        raise NoFacesError(f"no faces left after healing {model.path}")
+    return CadModel(shape, faces, tuple(names.get(f) for f in faces),
+                    tuple(colors.get(f) for f in faces), model.length_unit, model.path,
+                    model.file_format)
+
+
+# ==================================================================== write
+def write(obj: Any, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+    """Write geometry to a STEP or IGES file, atomically.
+
+    Parameters
+    ----------
+    obj
+        A :class:`CadModel` (its face names/colours are written through XDE), a
+        ``TopoDS_Shape``, an object with a ``.wrapped`` shape (cadquery Shape,
+        build123d objects), a cadquery ``Workplane``, a
+        :class:`~surfprep.algorithms.NurbsSurface` (becomes a face) or 3D
+        :class:`~surfprep.algorithms.NurbsCurve` (an edge), or a list/tuple of these.
+    path : path-like
+        Target; the extension (.step/.stp/.igs/.iges, any case) picks the format.
+    overwrite : bool
+        Replace an existing file. The file a CadModel was read from is never
+        overwritten.
+
+    Returns
+    -------
+    Path
+        The resolved path written.
+
+    Raises
+    ------
+    OutputFileError
+        Unknown extension, missing target directory, existing target without
+        ``overwrite``, target is the model's input file, or the writer failed.
+    ConversionError
+        An object that cannot be turned into a shape.
+    OpenCascadeError
+        A face/edge builder failed.
+    """
+    target = Path(path)
+    fmt = FileFormat.from_suffix(target)
+    if fmt is None:
+        raise OutputFileError(
+            f"output file {target} has unknown extension {target.suffix!r}; "
+            f"expected one of {_known_suffixes()}")
+    _check_output_file(target, obj, overwrite)
+    model = obj if isinstance(obj, CadModel) else CadModel.from_shape(to_shape(obj))
+    if model.shape.IsNull():
+        raise OutputFileError(f"nothing to write to {target}: the shape is empty")
+
+    directory = target.resolve().parent
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        write_file(tmp, fmt, model.shape, model.faces, model.face_names, model.face_colors)
+        if not tmp.is_file() or tmp.stat().st_size == 0:
+            raise TranslationError("the writer reported success but wrote nothing")
+        os.replace(tmp, target)
+    except TranslationError as exc:
+        raise OutputFileError(f"cannot write {fmt.value} file {target}: {exc}") from None
+    except Standard_Failure as exc:
+        raise OutputFileError(
+            f"cannot write {fmt.value} file {target}: OpenCascade failed: {exc}") from None
+    except OSError as exc:
+        raise OutputFileError(f"cannot write {target}: {exc.strerror or exc}") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return target.resolve()
+
+
+def _check_output_file(target: Path, obj: Any, overwrite: bool) -> None:
+    if target.is_dir():
+        raise OutputFileError(f"output {target} is a directory")
+    parent = target.resolve().parent
+    if not parent.is_dir():
+        raise OutputFileError(f"output directory {parent} does not exist")
+    if not target.exists():
+        return
+    source = obj.path if isinstance(obj, CadModel) else None
+    if source is not None and Path(source).exists() and os.path.samefile(source, target):
+        raise OutputFileError(
+            f"refusing to overwrite the input file {target}; choose another output path")
+    if not overwrite:
+        raise OutputFileError(
+            f"output file {target} already exists (pass overwrite=True to replace it)")
+
+
+# ========================================================== object -> shape
+def to_shape(obj: Any) -> TopoDS_Shape:
+    """One ``TopoDS_Shape`` for anything :func:`write` accepts (lists become a compound)."""
+    if isinstance(obj, CadModel):
+        return obj.shape
+    if isinstance(obj, TopoDS_Shape):
+        if obj.IsNull():
+            raise ConversionError("cannot write a null TopoDS_Shape")
+        return obj
+    if isinstance(obj, NurbsSurface):
+        return face_from_surface(obj)
+    if isinstance(obj, NurbsCurve):
+        return edge_from_curve(obj)
+    wrapped = getattr(obj, "wrapped", None)
+    if isinstance(wrapped, TopoDS_Shape):
+        return to_shape(wrapped)
+    vals = getattr(obj, "vals", None)  # cadquery Workplane
+    if callable(vals) and not isinstance(obj, (str, bytes)):
+        return to_shape(list(vals()))
+    if isinstance(obj, Iterable) and not isinstance(obj, (str, bytes, os.PathLike)):
+        shapes = [to_shape(item) for item in obj]
+        if not shapes:
+            raise ConversionError("cannot write an empty list of objects")
+        return shapes[0] if len(shapes) == 1 else _compound(shapes)
+    raise ConversionError(
+        f"cannot write a {type(obj).__name__}: expected a CadModel, TopoDS_Shape, "
+        "cadquery/build123d object, NurbsSurface, NurbsCurve or a list of them")
+
+
+def face_from_surface(surface: NurbsSurface) -> TopoDS_Face:
+    """A natural-boundary face on ``surface`` (``BRepBuilderAPI_MakeFace``)."""
+    try:
+        maker = BRepBuilderAPI_MakeFace(surface_to_occ(surface), MAKE_FACE_TOLERANCE)
+        if not maker.IsDone():
+            raise OpenCascadeError(
+                f"BRepBuilderAPI_MakeFace failed for {surface!r} (error {maker.Error().name})")
+        return maker.Face()
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"BRepBuilderAPI_MakeFace failed for {surface!r}: {exc}") from exc
+
+
+def edge_from_curve(curve: NurbsCurve):
+    """An edge on a 3D ``curve`` (``BRepBuilderAPI_MakeEdge``)."""
+    try:
+        maker = BRepBuilderAPI_MakeEdge(curve_to_occ(curve))
+        if not maker.IsDone():
+            raise OpenCascadeError(
+                f"BRepBuilderAPI_MakeEdge failed for {curve!r} (error {maker.Error().name})")
+        return maker.Edge()
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"BRepBuilderAPI_MakeEdge failed for {curve!r}: {exc}") from exc
+
