@@ -275,6 +275,11 @@ def restrict_array(points_w: ArrayLike, knots: ArrayLike, degree: int, a: float,
 
 
 # -------------------------------------------------------------------- curves
+def _is_clamped_over(knots: NDArray, degree: int, a: float, b: float) -> bool:
+    """True when the knot vector already has end knots ``a`` and ``b`` of multiplicity p + 1."""
+    return bool(np.all(knots[:degree + 1] == a) and np.all(knots[-degree - 1:] == b))
+
+
 def _curve_result(curve: NurbsCurve, points_w: NDArray, knots: NDArray,
                   degree: int | None = None) -> NurbsCurve:
     return NurbsCurve.from_homogeneous(points_w, knots,
@@ -302,7 +307,12 @@ def refine(curve: NurbsCurve, new_knots: ArrayLike) -> NurbsCurve:
 
 
 def restrict(curve: NurbsCurve, a: float, b: float) -> NurbsCurve:
-    """The piece of ``curve`` over ``[a, b]``, clamped, with the original parameter values."""
+    """The piece of ``curve`` over ``[a, b]``, clamped, with the original parameter values.
+
+    A curve already clamped over ``[a, b]`` is returned as is (it is immutable).
+    """
+    if _is_clamped_over(curve.knots, curve.degree, a, b):
+        return curve
     pw, knots = restrict_array(curve.homogeneous_points(), curve.knots, curve.degree, a, b)
     return _curve_result(curve, pw, knots)
 
@@ -440,6 +450,8 @@ def refine_surface(surface: NurbsSurface, new_knots: ArrayLike,
 def _restrict_direction(surface: NurbsSurface, direction: Direction, a: float, b: float
                         ) -> NurbsSurface:
     knots, degree = _knots_along(surface, direction)
+    if _is_clamped_over(knots, degree, a, b):
+        return surface
     pw, new = restrict_array(_net_along(surface, direction), knots, degree, a, b)
     return _surface_result(surface, direction, pw, new)
 
