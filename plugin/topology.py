@@ -37,7 +37,8 @@ from OCP.Geom2d import Geom2d_BezierCurve, Geom2d_BSplineCurve, Geom2d_Line, Geo
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_Face
 from OCP.Standard import Standard_Failure
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopAbs import (TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX,
+                        TopAbs_WIRE)
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Vertex, TopoDS_Wire
@@ -59,6 +60,10 @@ __all__ = [
 
 #: Default tolerance of built edges, vertices and faces (OpenCascade's Precision::Confusion).
 DEFAULT_TOLERANCE = 1e-7
+#: make_face refuses a loop whose consecutive edge ends are further apart than this many
+#: times ``tol``, or this many times the largest edge or vertex tolerance of the two edges.
+_MAX_GAP_IN_TOLERANCES = 100.0
+_MAX_GAP_IN_EDGE_TOLERANCES = 10.0
 
 
 # ------------------------------------------------------------------ data types
@@ -82,6 +87,9 @@ class TrimEdge:
     tolerance : float
         OpenCascade's edge tolerance (max. distance between the 3D curve and
         the pcurve mapped through the surface).
+    vertex_tolerance : float
+        The larger tolerance of the edge's two vertices (how far the curve
+        ends may be from the loop's corners).
     seam_pcurve : NurbsCurve (d=2) or None
         For a seam edge (one edge used twice on a closed surface) the pcurve
         of the other side; ``None`` otherwise.
@@ -97,6 +105,7 @@ class TrimEdge:
     tolerance: float = DEFAULT_TOLERANCE
     seam_pcurve: NurbsCurve | None = None
     degenerated: bool = False
+    vertex_tolerance: float = DEFAULT_TOLERANCE
 
     def __post_init__(self) -> None:
         if self.pcurve.dimension != 2:
@@ -114,6 +123,11 @@ class TrimEdge:
     def is_seam(self) -> bool:
         return self.seam_pcurve is not None
 
+    def __repr__(self) -> str:
+        kind = "degenerated" if self.degenerated else ("seam" if self.is_seam else "edge")
+        return (f"TrimEdge({kind}, range=({self.t0:g}, {self.t1:g}), reversed={self.reversed}, "
+                f"tolerance={self.tolerance:g})")
+
     def uv_ends(self) -> tuple[np.ndarray, np.ndarray]:
         """Start and end of this occurrence in ``(u, v)``, in loop direction."""
         a, b = self.pcurve.evaluate(np.array([self.t0, self.t1]))
@@ -130,6 +144,9 @@ class TrimLoop:
         object.__setattr__(self, "edges", tuple(self.edges))
         if not self.edges:
             raise InvalidGeometryError("a trimming loop needs at least one edge")
+
+    def __repr__(self) -> str:
+        return f"TrimLoop({len(self.edges)} edges)"
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,6 +179,11 @@ class TrimmedFace:
         if self.loops and not 0 <= self.outer_loop_index < len(self.loops):
             raise InvalidGeometryError(
                 f"outer_loop_index {self.outer_loop_index} out of range for {len(self.loops)} loops")
+
+    def __repr__(self) -> str:
+        return (f"TrimmedFace({self.surface!r}, loops={[len(lp.edges) for lp in self.loops]}, "
+                f"outer_loop_index={self.outer_loop_index}, reversed={self.reversed}, "
+                f"name={self.name!r})")
 
     @property
     def edges(self) -> tuple[TrimEdge, ...]:
@@ -287,14 +309,25 @@ def _wire_edges(wire: TopoDS_Wire, face: TopoDS_Face) -> list[TopoDS_Edge]:
     return stored
 
 
+def _vertex_tolerance(edge: TopoDS_Edge) -> float:
+    tolerances = [DEFAULT_TOLERANCE]
+    explorer = TopExp_Explorer(edge, TopAbs_VERTEX)
+    while explorer.More():
+        tolerances.append(BRep_Tool.Tolerance_s(TopoDS.Vertex_s(explorer.Current())))
+        explorer.Next()
+    return max(tolerances)
+
+
 def _read_edge(edge: TopoDS_Edge, face: TopoDS_Face,
                seam_curves: list[tuple[TopoDS_Edge, NurbsCurve]]) -> TrimEdge:
     tolerance = BRep_Tool.Tolerance_s(edge)
+    vertex_tolerance = _vertex_tolerance(edge)
     reversed_ = edge.Orientation() == TopAbs_REVERSED
     if BRep_Tool.Degenerated_s(edge) or BRep_Tool.Curve_s(edge, 0.0, 0.0) is None:
         t0, t1 = BRep_Tool.Range_s(edge, face)
         return TrimEdge(None, _read_pcurve(edge, face, t0, t1), t0, t1, reversed_, tolerance,
-                        degenerated=BRep_Tool.Degenerated_s(edge))
+                        degenerated=BRep_Tool.Degenerated_s(edge),
+                        vertex_tolerance=vertex_tolerance)
     t0, t1 = BRep_Tool.Range_s(edge)
     is_seam = BRep_Tool.IsClosed_s(edge, face)
     curve3d = None
@@ -308,7 +341,8 @@ def _read_edge(edge: TopoDS_Edge, face: TopoDS_Face,
     seam_pcurve = None
     if is_seam:
         seam_pcurve = _read_pcurve(TopoDS.Edge_s(edge.Reversed()), face, t0, t1)
-    return TrimEdge(curve3d, pcurve, t0, t1, reversed_, tolerance, seam_pcurve)
+    return TrimEdge(curve3d, pcurve, t0, t1, reversed_, tolerance, seam_pcurve,
+                    vertex_tolerance=vertex_tolerance)
 
 
 # ----------------------------------------------------------------- building
@@ -415,8 +449,9 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
         face = TopoDS_Face()
         brep = BRep_Builder()
         brep.MakeFace(face, occ_surface, TopLoc_Location(), tol)
+        corners: list[tuple[np.ndarray, float, TopoDS_Vertex]] = []
         for loop in loops:
-            brep.Add(face, _make_wire(surface, occ_surface, loop, tol))
+            brep.Add(face, _make_wire(surface, occ_surface, loop, tol, corners))
         face = _checked_or_fixed(face, tol)
     if reversed:
         face = TopoDS.Face_s(face.Reversed())
@@ -463,7 +498,11 @@ def _edge_deviation(edge: TrimEdge, surface: NurbsSurface, samples: int = 33) ->
     return dev
 
 
-def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float) -> TopoDS_Wire:
+def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float,
+               corners: list[tuple[np.ndarray, float, TopoDS_Vertex]]) -> TopoDS_Wire:
+    """A wire for ``loop``; ``corners`` holds the vertices of the face's loops built
+    so far and is extended: loops touching at a corner share its vertex, as
+    BRepCheck requires (else the wires count as intersecting)."""
     brep = BRep_Builder()
     edges = loop.edges
     n = len(edges)
@@ -487,9 +526,26 @@ def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float) -
         pts = np.array([q for k in range(n) if group[k] == g
                         for q in (*ends[k - 1][1], *ends[k][0])])
         centre = pts.mean(axis=0)
-        vtol = max(tol, 1.001 * float(np.max(np.linalg.norm(pts - centre, axis=1))))
+        gap = float(np.max(np.linalg.norm(pts - centre, axis=1)))
+        members = [k for k in range(n) if group[k] == g]
+        allowed = max(_MAX_GAP_IN_TOLERANCES * tol,
+                      _MAX_GAP_IN_EDGE_TOLERANCES * max(
+                          max(edges[k - 1].tolerance, edges[k].tolerance,
+                              edges[k - 1].vertex_tolerance, edges[k].vertex_tolerance)
+                          for k in members))
+        if gap > allowed:
+            raise InvalidGeometryError(
+                f"trimming loop not closed: gap {2 * gap:.3g} at the start of edge {members[0]} "
+                f"(allowed {2 * allowed:.3g} from the tolerances)")
+        vtol = max(tol, 1.001 * gap)
         vertex = TopoDS_Vertex()
-        brep.MakeVertex(vertex, gp_Pnt(*centre.tolist()), vtol)
+        shared = next((c for c in corners if np.linalg.norm(c[0] - centre) <= max(c[1], vtol)), None)
+        if shared is None:
+            brep.MakeVertex(vertex, gp_Pnt(*centre.tolist()), vtol)
+            corners.append((centre, vtol, vertex))
+        else:
+            vertex = shared[2]
+            brep.UpdateVertex(vertex, max(shared[1], vtol + float(np.linalg.norm(shared[0] - centre))))
         by_group[g] = vertex
     vertices = [by_group[g] for g in group]
 

@@ -1,0 +1,178 @@
+"""OpenCascade's own answers, for cross-checks and benchmarks.
+
+Thin wrappers: every function calls the OpenCascade method named in its
+docstring once per point, in a Python loop, and returns numpy arrays in the
+layout of the matching surfprep function. Nothing is approximated or repaired
+here; OpenCascade failures raise :class:`~surfprep.errors.OpenCascadeError`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from OCP.Geom import Geom_Curve, Geom_Surface
+from OCP.Geom2d import Geom2d_Curve
+from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
+from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec, gp_Vec2d
+from OCP.Standard import Standard_Failure
+
+from ..algorithms import NurbsCurve, NurbsSurface
+from ..errors import ConversionError, OpenCascadeError
+from .geom import curve2d_to_occ, curve_to_occ, surface_to_occ
+
+__all__ = ["evaluate_surface", "evaluate_curve", "project_point_on_surface"]
+
+#: Which ``[k, l]`` entries of a surface derivative array OpenCascade fills, per order:
+#: D0 gives S; D1 adds S_u, S_v; D2 adds S_uu, S_uv, S_vv. ``[1, 2]``, ``[2, 1]``
+#: and ``[2, 2]`` (third and fourth total order) are left NaN.
+SURFACE_ENTRIES = {
+    0: ((0, 0),),
+    1: ((0, 0), (1, 0), (0, 1)),
+    2: ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)),
+}
+
+
+def _occ_surface(surface: NurbsSurface | Geom_Surface) -> Geom_Surface:
+    if isinstance(surface, NurbsSurface):
+        return surface_to_occ(surface)
+    if isinstance(surface, Geom_Surface):
+        return surface
+    raise ConversionError(f"expected a NurbsSurface or Geom_Surface, got {type(surface).__name__}")
+
+
+def _check_order(order: int) -> int:
+    if order not in (0, 1, 2):
+        raise ValueError(f"OpenCascade reference evaluation supports order 0, 1, 2; got {order}")
+    return order
+
+
+def evaluate_surface(surface: NurbsSurface | Geom_Surface, u: ArrayLike, v: ArrayLike,
+                     order: int = 0) -> NDArray:
+    """Surface point and partial derivatives by ``Geom_Surface.D0/D1/D2``.
+
+    Parameters
+    ----------
+    surface : NurbsSurface or Geom_Surface
+    u, v : (...) float, broadcast together
+    order : 0, 1 or 2
+
+    Returns
+    -------
+    (..., order + 1, order + 1, 3) float
+        Same layout as :meth:`NurbsSurface.derivatives`: ``[..., k, l, :]`` is
+        ``d^{k+l} S / du^k dv^l``. Only the entries of total order <= ``order``
+        are filled (see :data:`SURFACE_ENTRIES`); the others are NaN.
+    """
+    order = _check_order(order)
+    occ = _occ_surface(surface)
+    u, v = np.broadcast_arrays(np.asarray(u, dtype=float), np.asarray(v, dtype=float))
+    shape = u.shape
+    out = np.full((u.size, order + 1, order + 1, 3), np.nan)
+    p = gp_Pnt()
+    d1u, d1v, d2u, d2v, d2uv = gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec(), gp_Vec()
+    for i, (a, b) in enumerate(zip(u.reshape(-1).tolist(), v.reshape(-1).tolist())):
+        if order == 0:
+            occ.D0(a, b, p)
+        elif order == 1:
+            occ.D1(a, b, p, d1u, d1v)
+        else:
+            occ.D2(a, b, p, d1u, d1v, d2u, d2v, d2uv)
+        out[i, 0, 0] = p.Coord()
+        if order >= 1:
+            out[i, 1, 0] = d1u.Coord()
+            out[i, 0, 1] = d1v.Coord()
+        if order >= 2:
+            out[i, 2, 0] = d2u.Coord()
+            out[i, 1, 1] = d2uv.Coord()
+            out[i, 0, 2] = d2v.Coord()
+    return out.reshape(shape + out.shape[1:])
+
+
+def evaluate_curve(curve: NurbsCurve | Geom_Curve | Geom2d_Curve, t: ArrayLike,
+                   order: int = 0) -> NDArray:
+    """Curve point and derivatives by ``Geom_Curve`` / ``Geom2d_Curve`` ``.D0/D1/D2``.
+
+    Parameters
+    ----------
+    curve : NurbsCurve (d = 2 or 3), Geom_Curve or Geom2d_Curve
+    t : (...) float
+    order : 0, 1 or 2
+
+    Returns
+    -------
+    (..., order + 1, d) float
+        Same layout as :meth:`NurbsCurve.derivatives`, every entry filled.
+    """
+    order = _check_order(order)
+    if isinstance(curve, NurbsCurve):
+        if curve.dimension not in (2, 3):
+            raise ConversionError(f"curves of dimension {curve.dimension} have no OpenCascade type")
+        curve = curve2d_to_occ(curve) if curve.dimension == 2 else curve_to_occ(curve)
+    if isinstance(curve, Geom2d_Curve):
+        dim, p, d1, d2 = 2, gp_Pnt2d(), gp_Vec2d(), gp_Vec2d()
+    elif isinstance(curve, Geom_Curve):
+        dim, p, d1, d2 = 3, gp_Pnt(), gp_Vec(), gp_Vec()
+    else:
+        raise ConversionError(f"expected a NurbsCurve, Geom_Curve or Geom2d_Curve, got "
+                              f"{type(curve).__name__}")
+    t = np.asarray(t, dtype=float)
+    out = np.empty((t.size, order + 1, dim))
+    for i, a in enumerate(t.reshape(-1).tolist()):
+        if order == 0:
+            curve.D0(a, p)
+        elif order == 1:
+            curve.D1(a, p, d1)
+        else:
+            curve.D2(a, p, d1, d2)
+        out[i, 0] = p.Coord()
+        if order >= 1:
+            out[i, 1] = d1.Coord()
+        if order >= 2:
+            out[i, 2] = d2.Coord()
+    return out.reshape(t.shape + out.shape[1:])
+
+
+def project_point_on_surface(surface: NurbsSurface | Geom_Surface,
+                             points: ArrayLike) -> tuple[NDArray, NDArray]:
+    """Closest point on the surface by ``GeomAPI_ProjectPointOnSurf``.
+
+    The search is restricted to the surface's parameter bounds
+    (``Geom_Surface.Bounds``); the nearest of the extrema found
+    (``LowerDistanceParameters``) is returned.
+
+    Parameters
+    ----------
+    surface : NurbsSurface or Geom_Surface (finite)
+    points : (..., 3) float
+
+    Returns
+    -------
+    uv : (..., 2) float
+    distance : (...) float
+
+    Raises
+    ------
+    OpenCascadeError
+        When OpenCascade finds no projection for a point (``IsDone()`` false or
+        ``NbPoints() == 0``), naming the point.
+    """
+    occ = _occ_surface(surface)
+    points = np.asarray(points, dtype=float)
+    if points.shape[-1] != 3:
+        raise ValueError(f"points must have shape (..., 3), got {points.shape}")
+    flat = points.reshape(-1, 3)
+    uv = np.empty((flat.shape[0], 2))
+    distance = np.empty(flat.shape[0])
+    u0, u1, v0, v1 = occ.Bounds()
+    projector = GeomAPI_ProjectPointOnSurf()
+    projector.Init(occ, u0, u1, v0, v1)
+    for i, xyz in enumerate(flat.tolist()):
+        try:
+            projector.Perform(gp_Pnt(*xyz))
+        except Standard_Failure as exc:
+            raise OpenCascadeError(f"GeomAPI_ProjectPointOnSurf failed on point {xyz}: {exc}") from exc
+        if not projector.IsDone() or projector.NbPoints() == 0:
+            raise OpenCascadeError(f"GeomAPI_ProjectPointOnSurf found no projection of point {xyz}")
+        uv[i] = projector.LowerDistanceParameters()
+        distance[i] = projector.LowerDistance()
+    return uv.reshape(points.shape[:-1] + (2,)), distance.reshape(points.shape[:-1])
