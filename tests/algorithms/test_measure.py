@@ -1,0 +1,212 @@
+"""Bounding boxes, surface normals and arc length."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from nurbs_strategies import curve_samples, curves, make_curve, surfaces
+from scipy.integrate import quad
+
+from surfprep.algorithms import (NurbsCurve, NurbsSurface, arc_length, bounding_box,
+                                 cumulative_arc_length, normals)
+from surfprep.errors import DegenerateGeometryError, InvalidGeometryError, InvalidToleranceError
+
+S2 = np.sqrt(0.5)
+
+
+def nurbs_circle(radius=1.0, center=(0.0, 0.0, 0.0)):
+    """Full circle in the xy plane: rational quadratic, 9 poles, domain [0, 4] (P&T 7.5)."""
+    square = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1],
+                       [1, -1], [1, 0]], dtype=float)
+    points = np.concatenate([square * radius, np.zeros((9, 1))], axis=1) + center
+    weights = np.array([1, S2, 1, S2, 1, S2, 1, S2, 1])
+    knots = [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+    return NurbsCurve(points, knots, 2, weights)
+
+
+def nurbs_sphere(radius=1.0, center=(0.0, 0.0, 0.0)):
+    """Sphere: u the longitude (full circle), v the latitude (half circle from -z to +z)."""
+    circle = nurbs_circle()
+    # meridian half circle in the (r, z) plane from the south pole to the north pole
+    meridian = np.array([[0, -1], [1, -1], [1, 0], [1, 1], [0, 1]], dtype=float)
+    w_v = np.array([1, S2, 1, S2, 1])
+    ring = circle.control_points[:, :2]
+    net = np.empty((9, 5, 3))
+    net[:, :, :2] = ring[:, None, :] * meridian[None, :, 0, None]
+    net[:, :, 2] = meridian[None, :, 1]
+    weights = circle.weights[:, None] * w_v[None, :]
+    return NurbsSurface(net * radius + np.asarray(center), circle.knots,
+                        [0, 0, 0, 1, 1, 2, 2, 2], 2, 2, weights)
+
+
+# ------------------------------------------------------------- bounding box
+@settings(max_examples=50, deadline=None)
+@given(curves())
+def test_curve_box_contains_curve(curve):
+    box = bounding_box(curve)
+    assert box.shape == (2, curve.dimension)
+    points = curve.evaluate(curve_samples(curve))
+    assert np.all(points >= box[0] - 1e-12 * 10) and np.all(points <= box[1] + 1e-12 * 10)
+    np.testing.assert_array_equal(box[0], curve.control_points.min(axis=0))
+
+
+@settings(max_examples=30, deadline=None)
+@given(surfaces())
+def test_surface_box_contains_surface(surface):
+    box = surface.bounding_box()
+    assert box.shape == (2, 3)
+    points = surface.evaluate_grid(np.linspace(*surface.domain[:2], 40),
+                                   np.linspace(*surface.domain[2:], 40))
+    assert np.all(points >= box[0] - 1e-10) and np.all(points <= box[1] + 1e-10)
+
+
+# ------------------------------------------------------------------ normals
+@pytest.mark.parametrize("rational", [False, True])
+def test_plane_normals(rational):
+    rng = np.random.default_rng(1)
+    x, y = np.meshgrid(np.arange(5.0), np.arange(4.0), indexing="ij")
+    net = np.stack([x + rng.uniform(-0.2, 0.2, x.shape), y + rng.uniform(-0.2, 0.2, x.shape),
+                    np.zeros_like(x)], axis=2)
+    weights = rng.uniform(0.5, 2, x.shape) if rational else None
+    plane = NurbsSurface(net, [0, 0, 0, 0.3, 0.6, 1, 1, 1], [2, 2, 2, 3, 4, 4, 4], 2, 2,
+                         weights)
+    u, v = np.meshgrid(np.linspace(0, 1, 40), np.linspace(2, 4, 40), indexing="ij")
+    n = normals(plane, u, v)
+    assert n.shape == (40, 40, 3)
+    np.testing.assert_allclose(n, np.broadcast_to([0, 0, 1.0], n.shape), atol=1e-12)
+
+
+@pytest.mark.parametrize("radius, center", [(1.0, (0, 0, 0)), (2.5, (1.0, -3.0, 0.5))])
+def test_sphere_normals_are_radial_including_poles(radius, center):
+    sphere = nurbs_sphere(radius, center)
+    u = np.linspace(0, 4, 40)
+    v = np.concatenate([np.linspace(0, 2, 40), [0.0, 2.0]])   # both poles, twice
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    n = sphere.normals(uu, vv)
+    radial = (sphere.evaluate(uu, vv) - np.asarray(center)) / radius
+    np.testing.assert_allclose(np.linalg.norm(n, axis=-1), 1.0, atol=1e-14)
+    # outward or inward consistently: the parametrization fixes the sign
+    sign = np.sign(np.sum(n[5, 20] * radial[5, 20]))
+    np.testing.assert_allclose(n, sign * radial, atol=1e-9)
+    poles = sphere.normals(np.array([0.0, 1.3, 4.0, 0.0, 2.7]), np.array([0, 0, 0, 2, 2.0]))
+    expected = sign * np.array([[0, 0, -1], [0, 0, -1], [0, 0, -1], [0, 0, 1], [0, 0, 1.0]])
+    np.testing.assert_allclose(poles, expected, atol=1e-12)
+
+
+def test_collapsed_edge_of_triangle_patch():
+    # bilinear patch with the edge u = 0 collapsed to one point: a planar triangle
+    net = np.array([[[0, 0, 0], [0, 0, 0]], [[1, 0, 0], [1, 1, 0]]], dtype=float)
+    tri = NurbsSurface(net, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    n = tri.normals(np.zeros(5), np.linspace(0, 1, 5))
+    np.testing.assert_allclose(n, np.tile([0, 0, 1.0], (5, 1)), atol=1e-14)
+
+
+def test_surface_collapsed_to_a_curve_has_no_normal():
+    net = np.zeros((3, 3, 3))
+    net[:, :, 0] = np.arange(3.0)[:, None]                # every v column identical
+    ribbon = NurbsSurface(net, [0, 0, 0, 1, 1, 1], [0, 0, 0, 1, 1, 1], 2, 2)
+    with pytest.raises(DegenerateGeometryError, match="no normal direction"):
+        ribbon.normals(0.5, 0.5)
+
+
+@settings(max_examples=30, deadline=None)
+@given(surfaces(max_degree=4))
+def test_normals_are_unit_and_orthogonal_to_tangents(surface):
+    u = np.linspace(*surface.domain[:2], 7)[1:-1]
+    v = np.linspace(*surface.domain[2:], 7)[1:-1]
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    d = surface.derivatives(uu, vv, 1)
+    cross = np.cross(d[..., 1, 0, :], d[..., 0, 1, :])
+    ok = np.linalg.norm(cross, axis=-1) > 1e-6 * np.abs(surface.control_points).max() ** 2
+    n = normals(surface, uu, vv)
+    np.testing.assert_allclose(np.linalg.norm(n, axis=-1), 1.0, atol=1e-12)
+    dots = np.abs(np.einsum("...c,...c->...", n, cross / np.linalg.norm(cross, axis=-1,
+                                                                       keepdims=True)))
+    assert np.all(dots[ok] > 1 - 1e-9)
+
+
+def test_normals_reject_bad_input():
+    sphere = nurbs_sphere()
+    with pytest.raises(InvalidGeometryError, match="finite"):
+        sphere.normals(np.nan, 0.5)
+    flat = NurbsSurface(np.zeros((2, 2, 2)), [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    with pytest.raises(InvalidGeometryError, match="3D"):
+        normals(flat, 0.5, 0.5)
+
+
+# --------------------------------------------------------------- arc length
+@pytest.mark.parametrize("radius", [0.01, 1.0, 37.5])
+def test_circle_length_is_two_pi_r(radius):
+    circle = nurbs_circle(radius, (3.0, -1.0, 2.0))
+    assert arc_length(circle) == pytest.approx(2 * np.pi * radius, rel=1e-12)
+    # a quarter of the circle is one knot span pair: [0, 1]
+    assert circle.arc_length(0, 1) == pytest.approx(0.5 * np.pi * radius, rel=1e-12)
+
+
+@pytest.mark.parametrize("degree", [1, 2, 3, 7])
+def test_straight_line_length(degree):
+    rng = np.random.default_rng(degree)
+    n = degree + 5
+    direction = rng.normal(size=3)
+    # increasing collinear poles: a monotone (variation-diminishing) parametrization
+    positions = np.sort(rng.uniform(0, 4, n))
+    line = NurbsCurve(positions[:, None] * direction + [1, 2, 3], np.concatenate(
+        [np.zeros(degree), np.linspace(0, 2, n - degree + 1), np.full(degree, 2.0)]), degree)
+    expected = (positions[-1] - positions[0]) * np.linalg.norm(direction)
+    assert arc_length(line) == pytest.approx(expected, rel=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(curves(max_degree=6), st.floats(0.1, 0.9))
+def test_arc_length_matches_scipy_quad_and_is_additive(curve, fraction):
+    lo, hi = curve.domain
+    mid = lo + fraction * (hi - lo)
+    breaks = np.unique(np.concatenate([[lo, hi], curve.knots[(curve.knots > lo)
+                                                             & (curve.knots < hi)]]))
+
+    def speed(t):
+        return np.linalg.norm(curve.derivatives(t, 1)[1])
+
+    reference = sum(quad(speed, a, b, epsabs=0, epsrel=1e-13, limit=200)[0]
+                    for a, b in zip(breaks[:-1], breaks[1:]))
+    total = arc_length(curve)
+    assert total == pytest.approx(reference, rel=1e-9)
+    assert arc_length(curve, lo, mid) + arc_length(curve, mid, hi) == pytest.approx(
+        total, rel=1e-11)
+
+
+@settings(max_examples=30, deadline=None)
+@given(curves(max_degree=5))
+def test_cumulative_arc_length(curve):
+    lo, hi = curve.domain
+    t = np.random.default_rng(0).permutation(np.linspace(lo, hi, 23))
+    s = cumulative_arc_length(curve, t)
+    assert s.shape == t.shape
+    order = np.argsort(t)
+    assert np.all(np.diff(s[order]) >= 0)
+    assert s[order[0]] == 0.0
+    assert s[order[-1]] == pytest.approx(arc_length(curve), rel=1e-11)
+    k = order[11]
+    assert s[k] == pytest.approx(arc_length(curve, lo, t[k]), rel=1e-10, abs=1e-12)
+    # knot insertion does not change the length function
+    refined = curve.insert_knot(t[order[5]]) if np.count_nonzero(
+        curve.knots == t[order[5]]) < curve.degree else curve
+    np.testing.assert_allclose(cumulative_arc_length(refined, t), s, rtol=1e-10, atol=1e-12)
+
+
+def test_arc_length_rejects_bad_arguments():
+    curve = make_curve(0, 3, 1, 1, False)
+    lo, hi = curve.domain
+    with pytest.raises(InvalidGeometryError, match="t0 <= t1"):
+        arc_length(curve, hi, lo)
+    with pytest.raises(InvalidGeometryError, match="outside the domain"):
+        arc_length(curve, lo - 1, hi)
+    with pytest.raises(InvalidGeometryError, match="finite"):
+        cumulative_arc_length(curve, [lo, np.nan])
+    with pytest.raises(InvalidToleranceError, match="> 0"):
+        arc_length(curve, tol=0)
+    with pytest.raises(InvalidToleranceError, match="positive number"):
+        arc_length(curve, tol="x")
+    assert arc_length(curve, lo, lo) == 0.0
