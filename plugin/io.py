@@ -45,7 +45,8 @@ from .geom import curve_to_occ, surface_to_occ
 from .step_iges import (FileFormat, Rgb, TranslationError, _all_faces, _compound,
                         _FaceNames, read_file, write_file)
 
-__all__ = ["CadModel", "FileFormat", "read", "write", "MAKE_FACE_TOLERANCE"]
+__all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "face_from_surface",
+           "edge_from_curve", "bounding_box", "sniff_format", "MAKE_FACE_TOLERANCE"]
 
 #: Tolerance given to ``BRepBuilderAPI_MakeFace`` for faces built from NurbsSurface.
 MAKE_FACE_TOLERANCE = 1e-7
@@ -323,6 +324,7 @@ def write(obj: Any, path: str | os.PathLike, *, overwrite: bool = False) -> Path
         write_file(tmp, fmt, model.shape, model.faces, model.face_names, model.face_colors)
         if not tmp.is_file() or tmp.stat().st_size == 0:
             raise TranslationError("the writer reported success but wrote nothing")
+        os.chmod(tmp, new_file_mode())
         os.replace(tmp, target)
     except TranslationError as exc:
         raise OutputFileError(f"cannot write {fmt.value} file {target}: {exc}") from None
@@ -351,6 +353,22 @@ def _check_output_file(target: Path, obj: Any, overwrite: bool) -> None:
     if not overwrite:
         raise OutputFileError(
             f"output file {target} already exists (pass overwrite=True to replace it)")
+
+
+def new_file_mode() -> int:
+    """Permission bits of a newly created file under the process umask (0o644 for 022).
+
+    ``tempfile.mkstemp`` creates files readable by the owner only; outputs get
+    the mode ``open()`` would have given them.
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("Umask:"):
+                    return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    return 0o644
 
 
 # ========================================================== object -> shape

@@ -1,0 +1,137 @@
+"""The ``surfprep`` command line: one argparse parser, one subcommand per module.
+
+Subcommands live in :mod:`surfprep.plugin.commands` (see its docstring for how
+to add one). This module builds the parser from that list, dispatches, and turns
+failures into exit codes:
+
+* 0 success;
+* 1 an unexpected internal error (one line; the traceback with ``--debug``), or
+  a check a command reports as failed;
+* 2 a usage error (argparse) or an expected failure
+  (:class:`~surfprep.errors.SurfprepError`: bad input file, refused output...),
+  printed as one line ``surfprep: error: <message>`` on stderr.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import traceback
+from collections.abc import Sequence
+
+from ..errors import SurfprepError
+from .commands import COMMANDS, Console
+
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAILURE", "EXIT_ERROR"]
+
+EXIT_OK = 0
+EXIT_FAILURE = 1
+EXIT_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+PROG = "surfprep"
+
+DESCRIPTION = """\
+Prepare B-spline CAD geometry for grid generation: read STEP/IGES files through
+OpenCascade, inspect how their surfaces are parametrized, convert faces to
+surfprep's NURBS types and back, cross-checked against OpenCascade."""
+
+EPILOG = """\
+examples:
+  surfprep info part.step              faces, surface types, degrees, areas,
+                                       parametrization quality
+  surfprep info part.igs --json -      the same as JSON on stdout
+  surfprep demo -o out/                the whole pipeline on a bundled sample
+  surfprep COMMAND --help              options of one command
+
+exit codes: 0 ok, 1 internal error or failed check, 2 bad usage or input/output
+error (one line on stderr; add --debug for a traceback).
+Progress ("face 12/255") goes to stderr when it is a terminal or with --progress."""
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+        return version("surfprep")
+    except Exception:  # not installed as a distribution: fall back to the package
+        from .. import __version__
+        return __version__
+
+
+def _common_options(defaults: bool) -> argparse.ArgumentParser:
+    """--debug/--progress, accepted before and after the subcommand name."""
+    default = (lambda value: value) if defaults else (lambda value: argparse.SUPPRESS)
+    parent = argparse.ArgumentParser(add_help=False)
+    group = parent.add_argument_group("general options")
+    group.add_argument("--debug", action="store_true", default=default(False),
+                       help="show the Python traceback of an error")
+    group.add_argument("--progress", action="store_true", default=default(None),
+                       help="report progress on stderr even when it is not a terminal")
+    return parent
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full parser: global options plus one subparser per registered command."""
+    parser = argparse.ArgumentParser(
+        prog=PROG, description=DESCRIPTION, epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        parents=[_common_options(defaults=True)])
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND")
+    for command in COMMANDS:
+        cmd_parser = sub.add_parser(
+            command.name, help=command.summary, description=command.description,
+            epilog=command.epilog, formatter_class=argparse.RawDescriptionHelpFormatter,
+            parents=[_common_options(defaults=False)])
+        command.add_arguments(cmd_parser)
+        cmd_parser.set_defaults(run=command.run)
+    return parser
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit code.
+
+    Never raises ``SystemExit``, so tests can call ``main([...])`` in-process.
+    """
+    err = sys.stderr
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # --help, --version, usage errors
+        code = exit_.code
+        return code if isinstance(code, int) else (EXIT_OK if code is None else EXIT_ERROR)
+    run = getattr(args, "run", None)
+    if run is None:
+        parser.print_usage(err)
+        print(f"{PROG}: error: no command given (try '{PROG} --help')", file=err)
+        return EXIT_ERROR
+    console = Console.for_streams(progress=True if args.progress else None)
+    try:
+        return int(run(args, console))
+    except SurfprepError as exc:
+        if args.debug:
+            traceback.print_exc(file=err)
+        print(f"{PROG}: error: {_one_line(exc)}", file=err)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=err)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # e.g. `surfprep info x.step | head`
+        return EXIT_OK
+    except Exception as exc:  # noqa: BLE001 - the CLI's last line of defence
+        if args.debug:
+            traceback.print_exc(file=err)
+            print(f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)}", file=err)
+        else:
+            print(f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)} "
+                  "(run with --debug for the traceback)", file=err)
+        return EXIT_FAILURE
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

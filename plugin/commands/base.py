@@ -1,0 +1,150 @@
+"""What every subcommand shares: the :class:`Command` record, console output, JSON reports.
+
+A subcommand is a module in :mod:`surfprep.plugin.commands` that defines one
+``COMMAND = Command(...)``: its name, one-line help, description, epilog with
+examples, a function adding its arguments to an ``argparse`` parser and a
+function running it. :mod:`surfprep.plugin.commands` lists the commands;
+:mod:`surfprep.plugin.cli` builds the parser from that list and handles errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, TextIO
+
+from ...errors import OutputFileError
+from ..io import new_file_mode
+
+__all__ = ["Command", "Console", "write_json_report", "to_jsonable", "STDOUT"]
+
+#: Value of a report-path option meaning "print to standard output".
+STDOUT = "-"
+
+
+@dataclass(frozen=True)
+class Console:
+    """Where a command writes: results to ``out``, progress and notes to ``err``."""
+
+    out: TextIO
+    err: TextIO
+    show_progress: bool = False
+
+    @classmethod
+    def for_streams(cls, out: TextIO | None = None, err: TextIO | None = None,
+                    progress: bool | None = None) -> Console:
+        """Streams default to ``sys.stdout``/``sys.stderr``; progress to "stderr is a TTY"."""
+        out = sys.stdout if out is None else out
+        err = sys.stderr if err is None else err
+        if progress is None:
+            progress = bool(getattr(err, "isatty", lambda: False)())
+        return cls(out, err, progress)
+
+    def print(self, *parts: Any) -> None:
+        print(*parts, file=self.out)
+
+    def note(self, *parts: Any) -> None:
+        print(*parts, file=self.err)
+
+    def progress(self, done: int, total: int, what: str) -> None:
+        """``what done/total`` on one refreshed line (TTY) or one line per call."""
+        if not self.show_progress:
+            return
+        tty = bool(getattr(self.err, "isatty", lambda: False)())
+        end = "\n" if (not tty or done >= total) else ""
+        prefix = "\r" if tty else ""
+        self.err.write(f"{prefix}{what} {done}/{total}{end}")
+        self.err.flush()
+
+
+@dataclass(frozen=True)
+class Command:
+    """One subcommand of ``surfprep``.
+
+    Attributes
+    ----------
+    name : str
+        Word typed after ``surfprep``.
+    summary : str
+        One line for ``surfprep --help``.
+    description : str
+        What the command does, for ``surfprep NAME --help``.
+    epilog : str
+        Examples and notes, printed after the options.
+    add_arguments : callable(parser)
+        Adds the command's arguments.
+    run : callable(args, console) -> int
+        Runs the command; returns the exit code. Raises
+        :class:`~surfprep.errors.SurfprepError` for expected failures.
+    """
+
+    name: str
+    summary: str
+    description: str
+    epilog: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace, Console], int]
+
+
+def to_jsonable(value: Any) -> Any:
+    """Plain JSON types: tuples to lists, Paths to str, enums to values, NaN/inf to None."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    if hasattr(value, "value") and hasattr(type(value), "__members__"):  # Enum
+        return value.value
+    if hasattr(value, "item") and callable(value.item):  # numpy scalar
+        return to_jsonable(value.item())
+    return value
+
+
+def write_json_report(report: dict, destination: str | os.PathLike, console: Console,
+                      protected: tuple[Path, ...] = ()) -> Path | None:
+    """Write ``report`` as JSON to a file (atomically) or, for ``"-"``, to stdout.
+
+    ``protected`` are input files the report must never replace.
+
+    Returns the path written, or None for stdout.
+    """
+    text = json.dumps(to_jsonable(report), indent=2, allow_nan=False) + "\n"
+    if str(destination) == STDOUT:
+        console.out.write(text)
+        return None
+    target = Path(destination)
+    refuse_overwriting_inputs(target, protected)
+    if target.is_dir():
+        raise OutputFileError(f"report path {target} is a directory")
+    parent = target.resolve().parent
+    if not parent.is_dir():
+        raise OutputFileError(f"report directory {parent} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.chmod(tmp, new_file_mode())
+        os.replace(tmp, target)
+    except OSError as exc:
+        raise OutputFileError(f"cannot write report {target}: {exc.strerror or exc}") from None
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+    return target.resolve()
+
+
+def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:
+    """Raise OutputFileError if ``target`` is one of the ``inputs`` files."""
+    if not target.exists():
+        return
+    for source in inputs:
+        if source.exists() and os.path.samefile(source, target):
+            raise OutputFileError(f"refusing to overwrite the input file {target}")
