@@ -210,6 +210,11 @@ class NurbsCurve:
         from .measure import arc_length
         return arc_length(self, t0, t1, tol)
 
+    def cumulative_arc_length(self, t: ArrayLike, tol: float = 1e-12) -> NDArray:
+        """Length from the domain start to each of ``t`` (:func:`.measure.cumulative_arc_length`)."""
+        from .measure import cumulative_arc_length
+        return cumulative_arc_length(self, t, tol)
+
     def __repr__(self) -> str:
         kind = "rational" if self.weights is not None else "polynomial"
         return (f"NurbsCurve(degree={self.degree}, n_control={self.n_control}, "

@@ -44,18 +44,33 @@ def bounding_box(geometry: NurbsCurve | NurbsSurface) -> NDArray:
 
 
 # -------------------------------------------------------------------- normals
-def _toward_interior(x: NDArray, lo: float, hi: float) -> NDArray:
-    """+1 at the lower end, -1 at the upper end, 0 inside (per point)."""
-    return np.where(x <= lo, 1.0, np.where(x >= hi, -1.0, 0.0))
+def _toward_center(u: NDArray, v: NDArray, box: tuple[float, float, float, float]
+                   ) -> tuple[NDArray, NDArray]:
+    """Step direction ``(a, b)`` (normalized parameters, max-norm 1) toward the domain center.
+
+    It enters the domain from every boundary point, and from an interior point
+    near a degenerate boundary it points away from that boundary.
+    """
+    u0, u1, v0, v1 = box
+    a = (0.5 * (u0 + u1) - u) / (u1 - u0)
+    b = (0.5 * (v0 + v1) - v) / (v1 - v0)
+    size = np.maximum(np.abs(a), np.abs(b))
+    at_center = size == 0
+    size = np.where(at_center, 1.0, size)
+    return (np.where(at_center, 1.0, a / size)[:, None],
+            np.where(at_center, 1.0, b / size)[:, None])
 
 
 def normals(surface: NurbsSurface, u: ArrayLike, v: ArrayLike) -> NDArray:
     """Unit normals ``Su x Sv / |Su x Sv|`` at broadcast parameters ``u``, ``v``.
 
-    Where ``Su x Sv`` vanishes (relative to the surface size), the normal is
-    the limit of the normal along a step ``(a h, b h)`` into the domain, with
-    ``a, b`` pointing away from the domain edges the point lies on (``(1, 1)``
-    at an interior point). Writing ``S_u(h) = S_u + h (a S_uu + b S_uv) + ...``
+    Where ``|Su x Sv|`` is below ``sqrt(eps) L^2`` (``L`` the control-net box
+    diagonal, derivatives taken in domain-normalized parameters), the normal is
+    the limit of the normal along a step ``(a h, b h)`` from the point toward
+    the center of the domain (which enters the domain from any boundary point).
+    Exactly at a degenerate point the limit is exact to rounding; close to one
+    (within ~sqrt(eps) of the parameter range) the direction is accurate to
+    about ``sqrt(eps)``, the conditioning of ``Su x Sv`` there. Writing ``S_u(h) = S_u + h (a S_uu + b S_uv) + ...``
     and likewise for ``S_v``,
 
     .. math:: S_u \\times S_v (h) = n_0 + h\\, n_1 + h^2 n_2 + O(h^3),
@@ -91,17 +106,18 @@ def normals(surface: NurbsSurface, u: ArrayLike, v: ArrayLike) -> NDArray:
     # derivatives in domain-normalized parameters, so every term scales like length^2
     su, sv = d[:, 1, 0] * du, d[:, 0, 1] * dv
     suu, suv, svv = d[:, 2, 0] * du * du, d[:, 1, 1] * du * dv, d[:, 0, 2] * dv * dv
-    a = _toward_interior(u, u0, u1)[:, None]
-    b = _toward_interior(v, v0, v1)[:, None]
-    inside = (a == 0) & (b == 0)
-    a, b = np.where(inside, 1.0, a), np.where(inside, 1.0, b)
+    a, b = _toward_center(u, v, (u0, u1, v0, v1))
     step_u = a * suu + b * suv          # d(Su)/dh
     step_v = a * suv + b * svv          # d(Sv)/dh
     terms = (np.cross(su, sv),
              np.cross(su, step_v) + np.cross(step_u, sv),
              np.cross(step_u, step_v))
     box = bounding_box(surface)
-    threshold = 1e-10 * max(float(np.sum((box[1] - box[0]) ** 2)), np.finfo(float).tiny)
+    # below ~sqrt(eps) L^2 the rounding error of Su x Sv (about eps L^2 / |Su x Sv|
+    # in angle) exceeds that of the limit direction (about the distance to the
+    # degenerate point, ~ |Su x Sv| / L^2)
+    size2 = max(float(np.sum((box[1] - box[0]) ** 2)), np.finfo(float).tiny)
+    threshold = np.sqrt(np.finfo(float).eps) * size2
     out = np.zeros_like(su)
     done = np.zeros(u.size, dtype=bool)
     for term in terms:

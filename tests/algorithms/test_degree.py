@@ -101,3 +101,11 @@ def test_surface_facade_and_errors():
         curve.elevate_degree(0)
     with pytest.raises(InvalidGeometryError, match="integer >= 1"):
         curve.elevate_degree(1.5)
+
+
+@pytest.mark.parametrize("degrees", [(9, 1), (1, 9), (7, 8)])
+def test_high_degree_surface_elevation(degrees):
+    from nurbs_strategies import make_surface
+    surface = make_surface(sum(degrees), *degrees, 2, 1, 3, rational=True)
+    result = surface.elevate_degree(1, 1)
+    assert_same_surface(result, surface, *surface_samples(surface))

@@ -326,3 +326,15 @@ def test_curve_facades_delegate():
     assert_same_curve(curve.restrict(lo, mid), curve, t[t <= mid])
     assert curve.split(mid)[1].domain == (mid, hi)
     assert_same_curve(curve.clamp(), curve, t)
+
+
+@pytest.mark.parametrize("degrees", [(9, 1), (1, 9), (8, 7)])
+def test_high_degree_surface_restrict_and_insert(degrees):
+    surface = make_surface(sum(degrees), *degrees, 2, 2, 3, rational=True)
+    u0, u1, v0, v1 = surface.domain
+    box = (u0 + 0.1 * (u1 - u0), u1 - 0.3 * (u1 - u0), v0 + 0.25 * (v1 - v0), v1)
+    assert_same_surface(surface.restrict(*box), surface, *surface_samples(surface, 40, box))
+    mid_v = 0.5 * (v0 + v1)
+    inserted = surface.insert_knot(mid_v, Direction.V, degrees[1] - multiplicity(
+        surface.knots_v, mid_v))
+    assert_same_surface(inserted, surface, *surface_samples(surface))
