@@ -165,8 +165,9 @@ def read(path: str | os.PathLike, *, heal: bool = False) -> CadModel:
         raise InputFileError(
             f"cannot read {fmt.value} file {file}: OpenCascade failed: {exc}") from None
     if not translated.faces:
-        raise NoFacesError(f"{fmt.value} file {file} holds no faces "
-                           f"(shape type {translated.shape.ShapeType().name.removeprefix('TopAbs_')})")
+        kind = translated.shape.ShapeType().name.removeprefix("TopAbs_").lower()
+        raise NoFacesError(f"{fmt.value} file {file} holds no faces (OpenCascade read it "
+                           f"as a {kind} without faces)")
     model = CadModel(translated.shape, translated.faces, translated.face_names,
                      translated.face_colors, translated.length_unit, file.resolve(), fmt)
     return _healed(model) if heal else model

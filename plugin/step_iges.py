@@ -27,7 +27,7 @@ from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.IGESCAFControl import IGESCAFControl_Reader, IGESCAFControl_Writer
 from OCP.IGESControl import IGESControl_Reader, IGESControl_Writer
 from OCP.Interface import Interface_Static
-from OCP.Message import Message, Message_Gravity
+from OCP.Message import Message
 from OCP.Quantity import Quantity_Color, Quantity_TypeOfColor
 from OCP.STEPCAFControl import STEPCAFControl_Reader, STEPCAFControl_Writer
 from OCP.STEPControl import STEPControl_Reader, STEPControl_StepModelType, STEPControl_Writer
@@ -101,18 +101,22 @@ class TranslatedModel:
 # --------------------------------------------------------------- OCCT state
 @contextmanager
 def _quiet_occt() -> Iterator[None]:
-    """Raise the trace level of OCCT's default printers to 'fail' for the duration."""
-    printers = Message.DefaultMessenger_s().Printers()
-    saved = []
-    for i in range(1, printers.Length() + 1):
-        printer = printers.Value(i)
-        saved.append((printer, printer.GetTraceLevel()))
-        printer.SetTraceLevel(Message_Gravity.Message_Fail)
+    """Detach OCCT's default message printers for the duration, then reattach them.
+
+    OCCT prints parser errors and progress lines ("Total number of loaded
+    entities", "**** ERR StepFile ...") to stdout; surfprep reports failures as
+    exceptions instead.
+    """
+    messenger = Message.DefaultMessenger_s()
+    printers = messenger.Printers()
+    detached = [printers.Value(i) for i in range(1, printers.Length() + 1)]
+    for printer in detached:
+        messenger.RemovePrinter(printer)
     try:
         yield
     finally:
-        for printer, level in saved:
-            printer.SetTraceLevel(level)
+        for printer in detached:
+            messenger.AddPrinter(printer)
 
 
 @contextmanager
@@ -188,13 +192,15 @@ def read_file(path: Path, fmt: FileFormat) -> TranslatedModel:
             try:
                 return _read_plain(path, fmt)
             except TranslationError as plain_error:
+                if str(plain_error) == str(xde_error):
+                    raise plain_error from None
                 raise TranslationError(f"{plain_error} (XDE reader: {xde_error})") from None
 
 
 def _check_read_status(status, what: str) -> None:
     if status != _DONE:
         name = getattr(status, "name", str(status)).replace("IFSelect_Ret", "")
-        raise TranslationError(f"{what} reader failed to parse the file (status {name})")
+        raise TranslationError(f"the {what} reader cannot parse it (status {name})")
 
 
 def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
@@ -204,9 +210,9 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
         reader.SetNameMode(True)
         reader.SetColorMode(True)
         with _static_int(_SUBSHAPE_NAMES_READ, 1):
-            _check_read_status(reader.ReadFile(str(path)), "STEP (XDE)")
+            _check_read_status(reader.ReadFile(str(path)), "STEP")
             if reader.NbRootsForTransfer() < 1:
-                raise TranslationError("STEP file has no root entity to transfer")
+                raise TranslationError("it has no root entity to transfer")
             if not reader.Transfer(doc):
                 raise TranslationError("STEP (XDE) transfer failed")
         unit = _step_length_unit(reader.Reader())
@@ -214,9 +220,9 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
         reader = IGESCAFControl_Reader()
         reader.SetNameMode(True)
         reader.SetColorMode(True)
-        _check_read_status(reader.ReadFile(str(path)), "IGES (XDE)")
+        _check_read_status(reader.ReadFile(str(path)), "IGES")
         if reader.NbRootsForTransfer() < 1:
-            raise TranslationError("IGES file has no root entity to transfer")
+            raise TranslationError("it has no root entity to transfer")
         if not reader.Transfer(doc):
             raise TranslationError("IGES (XDE) transfer failed")
         unit = _iges_length_unit(reader)
@@ -248,7 +254,7 @@ def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
         _check_read_status(reader.ReadFile(str(path)), "IGES")
         unit = _iges_length_unit(reader)
     if reader.NbRootsForTransfer() < 1:
-        raise TranslationError(f"{fmt.value} file has no root entity to transfer")
+        raise TranslationError("it has no root entity to transfer")
     if reader.TransferRoots() < 1 or reader.NbShapes() < 1:
         raise TranslationError(f"{fmt.value} transfer produced no shape")
     shape = reader.OneShape()
