@@ -211,7 +211,7 @@ class NurbsCurve:
         return arc_length(self, t0, t1, tol)
 
     def cumulative_arc_length(self, t: ArrayLike, tol: float = 1e-12) -> NDArray:
-        """Length from the domain start to each of ``t`` (:func:`.measure.cumulative_arc_length`)."""
+        """Length from the domain start to each of ``t`` (same shape as ``t``)."""
         from .measure import cumulative_arc_length
         return cumulative_arc_length(self, t, tol)
 

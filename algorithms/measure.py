@@ -70,8 +70,8 @@ def normals(surface: NurbsSurface, u: ArrayLike, v: ArrayLike) -> NDArray:
     the center of the domain (which enters the domain from any boundary point).
     Exactly at a degenerate point the limit is exact to rounding; close to one
     (within ~sqrt(eps) of the parameter range) the direction is accurate to
-    about ``sqrt(eps)``, the conditioning of ``Su x Sv`` there. Writing ``S_u(h) = S_u + h (a S_uu + b S_uv) + ...``
-    and likewise for ``S_v``,
+    about ``sqrt(eps)``, the conditioning of ``Su x Sv`` there. Writing
+    ``S_u(h) = S_u + h (a S_uu + b S_uv) + ...`` and likewise for ``S_v``,
 
     .. math:: S_u \\times S_v (h) = n_0 + h\\, n_1 + h^2 n_2 + O(h^3),
 

@@ -8,8 +8,8 @@ from nurbs_strategies import (assert_same_curve, assert_same_surface, curve_samp
                               make_curve, make_surface, scale_of, surfaces)
 from scipy.special import comb
 
-from surfprep.algorithms import (NurbsCurve, NurbsSurface, bezier_curves, bezier_patches, bezier_segments,
-                                 bezier_surfaces, patch_bounding_boxes)
+from surfprep.algorithms import (NurbsCurve, NurbsSurface, bezier_curves, bezier_patches,
+                                 bezier_segments, bezier_surfaces, patch_bounding_boxes)
 
 SETTINGS = settings(max_examples=50, deadline=None)
 

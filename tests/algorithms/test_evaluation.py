@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 from nurbs_strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from scipy.interpolate import BSpline
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import curve_samples, curves, make_curve, surfaces
+from nurbs_strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from scipy.integrate import quad
 
 from surfprep.algorithms import (NurbsCurve, NurbsSurface, arc_length, bounding_box,
@@ -48,7 +48,8 @@ def test_curve_box_contains_curve(curve):
     box = bounding_box(curve)
     assert box.shape == (2, curve.dimension)
     points = curve.evaluate(curve_samples(curve))
-    assert np.all(points >= box[0] - 1e-12 * 10) and np.all(points <= box[1] + 1e-12 * 10)
+    tol = 1e-12 * scale_of(curve)
+    assert np.all(points >= box[0] - tol) and np.all(points <= box[1] + tol)
     np.testing.assert_array_equal(box[0], curve.control_points.min(axis=0))
 
 
@@ -59,7 +60,8 @@ def test_surface_box_contains_surface(surface):
     assert box.shape == (2, 3)
     points = surface.evaluate_grid(np.linspace(*surface.domain[:2], 40),
                                    np.linspace(*surface.domain[2:], 40))
-    assert np.all(points >= box[0] - 1e-10) and np.all(points <= box[1] + 1e-10)
+    tol = 1e-12 * scale_of(surface)
+    assert np.all(points >= box[0] - tol) and np.all(points <= box[1] + tol)
 
 
 # ------------------------------------------------------------------ normals
