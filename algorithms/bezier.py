@@ -1,10 +1,9 @@
 """Bézier decomposition of NURBS curves and surfaces.
 
-Every interior knot is inserted up to multiplicity ``p`` (and the ends are
-clamped), after which the poles of each non-empty knot span are the Bernstein
-coefficients of that polynomial piece (A5.6 and A5.7 of [PT], done here by knot
-refinement of the whole net at once in homogeneous coordinates, so rational
-pieces are exact).
+The Bernstein coefficients of every polynomial piece are what inserting every
+interior knot up to multiplicity ``p`` would give (A5.6 and A5.7 of [PT]); they
+are computed here as blossom values by one vectorized de Boor triangle over
+all spans at once, in homogeneous coordinates, so rational pieces are exact.
 
 The decomposition gives the per-patch control-net bounding boxes used to cull
 pairs of patches in surface-surface intersection: with positive weights a
@@ -22,7 +21,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .curve import NurbsCurve
-from .knots import _domain, _raise_to_multiplicity, _trim_end, _trim_start
 from .surface import NurbsSurface
 
 __all__ = [
@@ -39,11 +37,20 @@ def bezier_decompose_array(points_w: NDArray, knots: NDArray, degree: int
                            ) -> tuple[NDArray, NDArray]:
     """Bézier pieces of a homogeneous control array along axis 0.
 
+    The Bernstein coefficients of the piece on the span ``[a, b]`` are the
+    blossom values ``f(a^{p-k}, b^k)``, ``k = 0..p`` (Ramshaw; section 5.4 of
+    [PT]); each is a de Boor triangle on the span's ``p + 1`` poles with ``a``
+    or ``b`` as the argument of each level. All spans and all ``k`` are done
+    together, so the work is ``p`` vectorized steps whatever the number of
+    knots (the same result as inserting every interior knot up to
+    multiplicity ``p``, A5.6). The convex weights lie in ``[0, 1]``.
+
     Parameters
     ----------
     points_w : (n, ...) float
         Homogeneous poles along axis 0, arbitrary trailing axes.
     knots : (n + degree + 1,) float
+        Clamped or not; only the domain ``[knots[degree], knots[n]]`` is decomposed.
     degree : int
 
     Returns
@@ -55,17 +62,23 @@ def bezier_decompose_array(points_w: NDArray, knots: NDArray, degree: int
     """
     points_w = np.asarray(points_w, dtype=float)
     knots = np.asarray(knots, dtype=float)
-    p = int(degree)
-    lo, hi = _domain(knots, p)
-    points_w, knots = _trim_start(points_w, knots, p, lo)
-    points_w, knots = _trim_end(points_w, knots, p, hi)
-    for x in np.unique(knots[(knots > lo) & (knots < hi)]):
-        points_w, knots = _raise_to_multiplicity(points_w, knots, p, float(x), p)
-    n = points_w.shape[0]
-    spans = np.flatnonzero(knots[p:n] < knots[p + 1:n + 1]) + p       # non-empty spans
-    index = spans[:, None] - p + np.arange(p + 1)                      # (k, p+1)
-    intervals = np.stack([knots[spans], knots[spans + 1]], axis=1)
-    return points_w[index], intervals
+    p, n = int(degree), points_w.shape[0]
+    spans = np.flatnonzero(knots[p:n] < knots[p + 1:n + 1]) + p        # non-empty spans
+    a, b = knots[spans], knots[spans + 1]
+    extra = (1,) * (points_w.ndim - 1)
+    k = np.arange(p + 1)
+    # level r of the triangle for coefficient k uses a while r <= p - k, else b
+    current = points_w[spans[:, None] - p + k][:, None]                  # (K, 1, p+1, ...)
+    for r in range(1, p + 1):
+        x = np.where(r <= p - k, a[:, None], b[:, None])                 # (K, p+1)
+        local = np.arange(r, p + 1)
+        lo = knots[spans[:, None] - p + local]                           # (K, p+1-r)
+        hi = knots[spans[:, None] + 1 - r + local]
+        alpha = (x[:, :, None] - lo[:, None, :]) / (hi - lo)[:, None, :]  # (K, p+1, p+1-r)
+        alpha = alpha.reshape(alpha.shape + extra)
+        current = (1.0 - alpha) * current[:, :, :-1] + alpha * current[:, :, 1:]
+    intervals = np.stack([a, b], axis=1)
+    return current[:, :, 0], intervals
 
 
 def bezier_segments(curve: NurbsCurve) -> tuple[NDArray, NDArray]:

@@ -16,7 +16,7 @@ every knot's multiplicity by ``t`` (section 5.5 of [PT]). It is computed as
    (degree ``p + t``, multiplicities ``+ t``) are recovered from the elevated
    Bézier poles ``R`` by solving ``A Q = R``, where ``A`` is the knot-insertion
    (Oslo) matrix from the target knot vector to the fully separated Bézier knot
-   vector, built by the same insertion kernel applied to the identity. The
+   vector, i.e. the Bézier decomposition of the identity in the target space. The
    system is consistent (``R`` lies in the range of ``A``), ``A`` has full column
    rank and is well conditioned (rows are convex combinations), so the
    least-squares solution is the exact one up to rounding; there is no
@@ -40,7 +40,7 @@ from scipy.special import comb
 from ..errors import InvalidGeometryError
 from .bezier import bezier_decompose_array
 from .curve import NurbsCurve
-from .knots import Direction, _insert_many, _knots_along, _net_along, _surface_result
+from .knots import Direction, _knots_along, _net_along, _surface_result
 from .surface import NurbsSurface
 
 __all__ = [
@@ -90,20 +90,19 @@ def elevate_degree_array(points_w: NDArray, knots: NDArray, degree: int, t: int
     knots = np.asarray(knots, dtype=float)
     pieces, intervals = bezier_decompose_array(points_w, knots, p)      # (k, p+1, ...)
     elevated = np.einsum("ij,kj...->ki...", bezier_elevation_matrix(p, t), pieces)
-    k, big = intervals.shape[0], p + t
+    k, new_degree = intervals.shape[0], p + t
     breaks = np.concatenate([intervals[:, 0], intervals[-1:, 1]])       # (k+1,)
-    # target space: original multiplicities inside the domain, + t; ends p + 1 + t
-    lo, hi = breaks[0], breaks[-1]
-    interior = knots[(knots > lo) & (knots < hi)]
-    mult = np.array([0] + [int(np.count_nonzero(interior == x)) for x in breaks[1:-1]] + [0])
-    mult = np.minimum(mult + t, big + 1)
-    mult[0] = mult[-1] = big + 1
+    # target space: the original multiplicities + t inside, clamped ends
+    mult = np.searchsorted(knots, breaks, "right") - np.searchsorted(knots, breaks, "left")
+    mult = np.minimum(mult + t, new_degree + 1)
+    mult[0] = mult[-1] = new_degree + 1
     target = np.repeat(breaks, mult)
-    n_target = target.size - big - 1
-    # insertion matrix from the target space to the fully separated Bezier space
-    missing = np.repeat(breaks[1:-1], big + 1 - mult[1:-1])
-    oslo, _ = _insert_many(np.eye(n_target), target, big, missing)   # (k (p+t+1), n_target)
-    rhs = elevated.reshape(k * (big + 1), -1)
+    n_target = target.size - new_degree - 1
+    # Oslo matrix from the target space to the fully separated Bezier space: the
+    # Bezier pieces of every target basis function (decomposition of the identity)
+    oslo = bezier_decompose_array(np.eye(n_target), target, new_degree)[0]
+    oslo = oslo.reshape(k * (new_degree + 1), n_target)                # (k (p+t+1), n_t)
+    rhs = elevated.reshape(k * (new_degree + 1), -1)
     solution = np.linalg.lstsq(oslo, rhs, rcond=None)[0]
     return solution.reshape((n_target,) + points_w.shape[1:]), target
 
