@@ -340,3 +340,25 @@ def test_high_degree_surface_restrict_and_insert(degrees):
     inserted = surface.insert_knot(mid_v, Direction.V, degrees[1] - multiplicity(
         surface.knots_v, mid_v))
     assert_same_surface(inserted, surface, *surface_samples(surface))
+
+
+@pytest.mark.parametrize("degree", range(1, 10))
+@pytest.mark.parametrize("rational", [False, True])
+def test_every_degree_keeps_geometry(degree, rational):
+    # deterministic sweep next to the hypothesis tests: multiple interior knots
+    # (multiplicities up to the degree), non-unit domain, rational or not
+    curve = make_curve(1000 + degree, degree, 4, degree, rational)
+    unclamped = make_curve(2000 + degree, degree, 3, degree, rational, clamped=False)
+    t = curve_samples(curve)
+    lo, hi = curve.domain
+    mid = lo + 0.37 * (hi - lo)
+    r = max(degree - multiplicity(curve.knots, mid), 1)
+    if multiplicity(curve.knots, mid) < degree:
+        assert_same_curve(insert_knot(curve, mid, r), curve, t)
+    assert_same_curve(refine(curve, np.linspace(lo, hi, 7)[1:-1]), curve, t)
+    left, right = split(curve, mid)
+    assert_same_curve(left, curve, t[t <= mid])
+    assert_same_curve(right, curve, t[t >= mid])
+    clamped = clamp(unclamped)
+    assert is_clamped(clamped.knots, degree)
+    assert_same_curve(clamped, unclamped, curve_samples(unclamped))
