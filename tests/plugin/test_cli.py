@@ -1,0 +1,283 @@
+"""The surfprep command line: info, demo, exit codes and one-line errors."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from surfprep.plugin import cli
+from surfprep.plugin.commands import COMMANDS
+from surfprep.plugin.commands import info as info_command
+
+REPO = Path(__file__).resolve().parents[2]
+SAMPLES = REPO / "step_samples"
+DATA = REPO.parent / "shared" / "data"
+FUSELAGE = SAMPLES / "occt_fuselage.stp"
+SYNTHETIC = SAMPLES / "synthetic_named_faces.step"
+CAPSULE = SAMPLES / "overture_marscapsule_proe.igs"
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = cli.main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def assert_one_line_error(err: str, *words: str) -> None:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("surfprep: error: "), err
+    assert "Traceback" not in err
+    for word in words:
+        assert word in lines[0], err
+
+
+# ---------------------------------------------------------------- framework
+def test_help_teaches(capsys):
+    code, out, _ = run(capsys, "--help")
+    assert code == 0
+    assert "examples:" in out and "exit codes" in out
+    for command in COMMANDS:
+        assert command.name in out
+    code, out, _ = run(capsys, "info", "--help")
+    assert code == 0 and "--json" in out and "examples:" in out
+    code, out, _ = run(capsys, "demo", "--help")
+    assert code == 0 and "--outdir" in out
+
+
+def test_version(capsys):
+    code, out, _ = run(capsys, "--version")
+    assert code == 0
+    assert out.startswith("surfprep ")
+
+
+def test_usage_errors_exit_2(capsys):
+    code, _, err = run(capsys)
+    assert code == 2 and "no command" in err
+    code, _, err = run(capsys, "info")
+    assert code == 2 and "FILE" in err
+    code, _, err = run(capsys, "frobnicate")
+    assert code == 2
+    code, _, _ = run(capsys, "info", str(FUSELAGE), "--no-such-option")
+    assert code == 2
+
+
+def test_commands_are_registered_once():
+    names = [c.name for c in COMMANDS]
+    assert len(names) == len(set(names))
+    assert {"info", "demo"} <= set(names)
+
+
+# --------------------------------------------------------------------- info
+def test_info_text_table(capsys):
+    code, out, err = run(capsys, "info", str(SYNTHETIC))
+    assert code == 0, err
+    assert "faces: 4" in out
+    for name in ("uniform_patch", "cubic_u_patch", "plane", "cylinder"):
+        assert name in out
+    rows = [ln for ln in out.splitlines() if ln.split()[:1] in (["0"], ["1"], ["2"], ["3"])]
+    assert len(rows) == 4
+    assert "BSpline" in rows[0] and "Plane" in rows[2] and "Cylinder" in rows[3]
+    assert "7 (u)" in rows[1]  # x = u**3: worst chord ratio 7 in u
+
+
+def test_info_json_stdout(capsys):
+    code, out, _ = run(capsys, "info", str(FUSELAGE), "--json", "-")
+    assert code == 0
+    report = json.loads(out)  # stdout is pure JSON: no table, no OCCT chatter
+    assert report["n_faces"] == len(report["faces"]) == 8
+    assert report["format"] == "STEP"
+    assert report["declared_length_unit"] == "ft"
+    face = report["faces"][0]
+    assert face["surface_type"] == "BSpline"
+    assert face["degree"] == [3, 3] and face["poles"] == [10, 4] and face["knot_spans"] == [3, 1]
+    assert face["rational"] is False
+    assert len(face["uv_bounds"]) == 4 and len(face["bounding_box"]) == 6
+    assert face["area"] > 0 and face["param_quality"] > 1
+
+
+def test_info_json_file_and_analytic_faces_have_null_quality(capsys, tmp_path):
+    target = tmp_path / "report.json"
+    code, out, err = run(capsys, "info", str(SYNTHETIC), "--json", str(target))
+    assert code == 0
+    assert "faces: 4" in out and str(target.resolve()) in err
+    report = json.loads(target.read_text())
+    types = [f["surface_type"] for f in report["faces"]]
+    assert types == ["BSpline", "BSpline", "Plane", "Cylinder"]
+    assert [f["param_quality"] is None for f in report["faces"]] == [False, False, True, True]
+    assert report["faces"][1]["param_quality_u"] == pytest.approx(7.0)
+
+
+def test_info_iges_with_duplicate_faces(capsys):
+    code, out, _ = run(capsys, "info", str(CAPSULE), "--json", "-")
+    assert code == 0
+    assert json.loads(out)["n_faces"] == 36
+
+
+def test_info_progress_on_request(capsys):
+    code, _, err = run(capsys, "info", str(FUSELAGE), "--progress")
+    assert code == 0
+    assert "face 8/8" in err
+
+
+def test_info_json_refuses_to_overwrite_input(capsys, tmp_path):
+    copy = tmp_path / "part.step"
+    shutil.copyfile(FUSELAGE, copy)
+    before = copy.read_bytes()
+    code, _, err = run(capsys, "info", str(copy), "--json", str(copy))
+    assert code == 2
+    assert_one_line_error(err, "input file")
+    assert copy.read_bytes() == before
+
+
+# ------------------------------------------------------------- error cases
+def test_missing_file(capsys, tmp_path):
+    code, out, err = run(capsys, "info", str(tmp_path / "missing.step"))
+    assert code == 2 and out == ""
+    assert_one_line_error(err, "missing.step", "does not exist")
+
+
+def test_empty_file(capsys, tmp_path):
+    empty = tmp_path / "empty.stp"
+    empty.write_bytes(b"")
+    code, _, err = run(capsys, "info", str(empty))
+    assert code == 2
+    assert_one_line_error(err, "empty.stp", "empty")
+
+
+def test_corrupt_file(capsys, tmp_path):
+    cut = tmp_path / "cut.step"
+    cut.write_bytes(FUSELAGE.read_bytes()[:9000])
+    code, _, err = run(capsys, "info", str(cut))
+    assert code == 2
+    assert_one_line_error(err, "cut.step", "truncated")
+    garbage = tmp_path / "garbage.igs"
+    garbage.write_text("this is not an IGES file\n")
+    code, _, err = run(capsys, "info", str(garbage))
+    assert code == 2
+    assert_one_line_error(err, "garbage.igs")
+
+
+def test_wrong_extension(capsys, tmp_path):
+    wrong = tmp_path / "part.igs"
+    shutil.copyfile(FUSELAGE, wrong)
+    code, _, err = run(capsys, "info", str(wrong))
+    assert code == 2
+    assert_one_line_error(err, "part.igs", "STEP")
+    unknown = tmp_path / "part.dxf"
+    shutil.copyfile(FUSELAGE, unknown)
+    code, _, err = run(capsys, "info", str(unknown))
+    assert code == 2
+    assert_one_line_error(err, "unknown extension")
+
+
+def test_directory_argument(capsys, tmp_path):
+    code, _, err = run(capsys, "info", str(tmp_path))
+    assert code == 2
+    assert_one_line_error(err, "directory")
+
+
+def test_unexpected_exception_exits_1_with_one_line(capsys, monkeypatch):
+    def broken_read(*args, **kwargs):
+        raise RuntimeError("boom\nsecond line")
+
+    monkeypatch.setattr(info_command, "read", broken_read)
+    code, _, err = run(capsys, "info", str(FUSELAGE))
+    assert code == 1
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "RuntimeError: boom second line" in lines[0]
+    assert "--debug" in lines[0] and "Traceback" not in err
+    code, _, err = run(capsys, "info", str(FUSELAGE), "--debug")
+    assert code == 1 and "Traceback" in err
+
+
+def test_debug_shows_traceback_for_expected_errors(capsys, tmp_path):
+    code, _, err = run(capsys, "--debug", "info", str(tmp_path / "missing.step"))
+    assert code == 2
+    assert "Traceback" in err and err.strip().splitlines()[-1].startswith("surfprep: error:")
+
+
+# --------------------------------------------------------------------- demo
+def test_demo_writes_step_and_report(capsys, tmp_path):
+    before = hashlib.sha256(FUSELAGE.read_bytes()).hexdigest()
+    outdir = tmp_path / "out"
+    code, out, err = run(capsys, "demo", "-o", str(outdir))
+    assert code == 0, err
+    step = outdir / "occt_fuselage-rebuilt.step"
+    report_path = outdir / "occt_fuselage-report.json"
+    assert step.is_file() and report_path.is_file()
+    assert sorted(p.name for p in outdir.iterdir()) == sorted([step.name, report_path.name])
+    report = json.loads(report_path.read_text())
+    assert all(report["checks"].values())
+    assert report["info"]["n_faces"] == 8
+    assert len(report["round_trip"]["faces"]) == 8
+    assert report["round_trip"]["max_dev_nurbs_vs_occ"] < 1e-6
+    assert report["outputs"]["rebuilt_step_faces_read_back"] == 8
+    assert "summary:" in out and "faces: 8" in out
+    assert hashlib.sha256(FUSELAGE.read_bytes()).hexdigest() == before
+    # a second run replaces its own outputs
+    code, _, err = run(capsys, "demo", "-o", str(outdir))
+    assert code == 0, err
+
+
+def test_demo_on_another_bundled_sample(capsys, tmp_path):
+    code, _, err = run(capsys, "demo", "--sample", SYNTHETIC.name, "-o", str(tmp_path))
+    assert code == 0, err
+    report = json.loads((tmp_path / "synthetic_named_faces-report.json").read_text())
+    # only the two B-spline faces are converted; names go through XDE
+    assert [f["name"] for f in report["round_trip"]["faces"]] == ["uniform_patch",
+                                                                  "cubic_u_patch"]
+
+
+def test_demo_unknown_sample(capsys, tmp_path):
+    code, _, err = run(capsys, "demo", "--sample", "nope.step", "-o", str(tmp_path))
+    assert code == 2
+    assert_one_line_error(err, "nope.step", "occt_fuselage.stp")
+
+
+def test_demo_with_input_inside_outdir_leaves_it_untouched(capsys, tmp_path):
+    source = tmp_path / "occt_fuselage-rebuilt.step"
+    shutil.copyfile(FUSELAGE, source)
+    before = source.read_bytes()
+    code, _, err = run(capsys, "demo", "--input", str(source), "-o", str(tmp_path))
+    assert code == 0, err  # outputs are named after the input: <stem>-rebuilt.step
+    assert source.read_bytes() == before
+
+
+# --------------------------------------------------------------- processes
+def test_module_entry_point_subprocess():
+    done = subprocess.run(
+        [sys.executable, "-m", "surfprep.plugin.cli", "info", str(FUSELAGE), "--json", "-"],
+        capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout)["n_faces"] == 8
+
+
+def test_console_script_error_exit_code(tmp_path):
+    script = Path(sys.executable).with_name("surfprep")
+    command = [str(script)] if script.exists() else [sys.executable, "-m", "surfprep.plugin"]
+    done = subprocess.run(command + ["info", str(tmp_path / "missing.igs")],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert done.stdout == ""
+    assert done.stderr.strip().startswith("surfprep: error: input file")
+    assert len(done.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["occt_k1_catia_debis.stp", "pyiges_impeller_solidworks.igs",
+                                  "occt_cornetta.stp"])
+def test_demo_on_real_files(capsys, tmp_path, name):
+    path = DATA / name
+    if not path.is_file():
+        pytest.skip(f"{path} not available")
+    code, _, err = run(capsys, "demo", "--input", str(path), "-o", str(tmp_path))
+    assert code == 0, err
+    report = json.loads(next(tmp_path.glob("*-report.json")).read_text())
+    assert all(report["checks"].values())
