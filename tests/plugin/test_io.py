@@ -446,3 +446,30 @@ def test_real_step_face_names_survive_step_round_trip(tmp_path, name):
     again = read(write(model, tmp_path / "copy.step"))
     assert again.face_names == model.face_names
     assert area(again.faces) == pytest.approx(area(model.faces), rel=1e-4)
+
+
+# ------------------------------------------------------ fallback and OCCT state
+def test_plain_reader_fallback_when_xde_fails(monkeypatch):
+    from surfprep.plugin import step_iges
+
+    def broken_xde(path, fmt):
+        raise TranslationError("simulated XDE failure")
+
+    monkeypatch.setattr(step_iges, "_read_xde", broken_xde)
+    model = read(SYNTHETIC)
+    assert model.n_faces == 4
+    assert model.face_names == (None,) * 4  # names need XDE
+    assert model.length_unit == "mm"
+
+
+def test_occt_static_parameters_are_restored(tmp_path):
+    from OCP.Interface import Interface_Static
+
+    read(SYNTHETIC)  # makes sure the STEP controller (and its parameters) exist
+    for key in ("read.stepcaf.subshapes.name", "write.stepcaf.subshapes.name"):
+        assert Interface_Static.IsPresent_s(key)
+    before = {k: Interface_Static.IVal_s(k)
+              for k in ("read.stepcaf.subshapes.name", "write.stepcaf.subshapes.name")}
+    write(read(SYNTHETIC), tmp_path / "again.step")
+    after = {k: Interface_Static.IVal_s(k) for k in before}
+    assert after == before
