@@ -439,6 +439,9 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
     tol = _check_tolerance(tol)
     if not isinstance(surface, NurbsSurface):
         raise ConversionError(f"make_face needs a NurbsSurface, got {type(surface).__name__}")
+    for loop in loops or ():
+        for k, edge in enumerate(loop.edges):
+            _check_pcurve_in_domain(surface, edge, k)
     occ_surface = surface_to_occ(surface)
     if not loops:
         builder = BRepBuilderAPI_MakeFace(occ_surface, tol)
@@ -457,6 +460,30 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
         face = TopoDS.Face_s(face.Reversed())
     check_valid(face, "face")
     return face
+
+
+#: How far (relative to the domain's size) a pcurve may leave the surface's domain.
+#: Real files do overshoot a little (up to 0.3 % in occt_b1_euclid and
+#: pyiges_impeller_solidworks, faces valid for BRepCheck); this only catches gross errors.
+_DOMAIN_SLACK = 0.05
+
+
+def _check_pcurve_in_domain(surface: NurbsSurface, edge: TrimEdge, index: int) -> None:
+    """Refuse pcurves that leave the parameter rectangle: OpenCascade would
+    extrapolate the surface there and BRepCheck does not notice."""
+    u0, u1, v0, v1 = surface.domain
+    slack_u, slack_v = _DOMAIN_SLACK * (u1 - u0), _DOMAIN_SLACK * (v1 - v0)
+    t = np.linspace(edge.t0, edge.t1, 33)
+    for pcurve in (edge.pcurve, edge.seam_pcurve):
+        if pcurve is None:
+            continue
+        uv = pcurve.evaluate(t)
+        if (uv[:, 0].min() < u0 - slack_u or uv[:, 0].max() > u1 + slack_u
+                or uv[:, 1].min() < v0 - slack_v or uv[:, 1].max() > v1 + slack_v):
+            raise InvalidGeometryError(
+                f"the pcurve of edge {index} leaves the surface's domain "
+                f"[{u0:g}, {u1:g}] x [{v0:g}, {v1:g}]: u in [{uv[:, 0].min():g}, "
+                f"{uv[:, 0].max():g}], v in [{uv[:, 1].min():g}, {uv[:, 1].max():g}]")
 
 
 def trimmed_face_to_occ(face: TrimmedFace, tol: float = DEFAULT_TOLERANCE) -> TopoDS_Face:
