@@ -10,6 +10,7 @@ function running it. :mod:`surfprep.plugin.commands` lists the commands;
 from __future__ import annotations
 
 import argparse
+import enum
 import json
 import math
 import os
@@ -102,7 +103,7 @@ def to_jsonable(value: Any) -> Any:
         return [to_jsonable(v) for v in value]
     if isinstance(value, Path):
         return str(value)
-    if hasattr(value, "value") and hasattr(type(value), "__members__"):  # Enum
+    if isinstance(value, enum.Enum):
         return value.value
     if hasattr(value, "item") and callable(value.item):  # numpy scalar
         return to_jsonable(value.item())

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -31,13 +31,13 @@ from OCP.TopoDS import TopoDS_Face
 import surfprep
 
 from ...algorithms import NurbsSurface
-from ...errors import InputFileError, OutputFileError, SurfprepError
+from ...errors import ConversionError, InputFileError, OutputFileError, SurfprepError
 from ..geom import surface_from_occ, surface_to_occ
 from ..io import CadModel, face_from_surface, read, write
 from ..occ_reference import evaluate_surface
 from ..step_iges import _compound
 from .base import Command, Console, refuse_overwriting_inputs, write_json_report
-from .info import SPLINE_KINDS, SurfaceKind, face_area, format_table, model_report
+from .info import SPLINE_KINDS, face_area, format_table, model_report, surface_kind
 
 __all__ = ["COMMAND", "DEMO_SAMPLE", "samples_dir", "run_demo", "FaceRoundTrip",
            "DEFAULT_OUTDIR", "GRID_SIZE", "DEVIATION_TOLERANCE"]
@@ -120,8 +120,9 @@ def round_trip_face(face: TopoDS_Face, index: int, name: str | None,
     """Convert a spline face to NurbsSurface and back; measure both deviations."""
     geom_surface = BRep_Tool.Surface_s(face)
     adaptor = GeomAdaptor_Surface(geom_surface)
-    kind = SurfaceKind.BSPLINE if adaptor.GetType().name.endswith("BSplineSurface") \
-        else SurfaceKind.BEZIER
+    kind = surface_kind(adaptor)
+    if kind not in SPLINE_KINDS:
+        raise ConversionError(f"face {index} is a {kind.value} face, not a B-spline/Bezier one")
     basis = adaptor.BSpline() if kind is SurfaceKind.BSPLINE else adaptor.Bezier()
     nurbs = surface_from_occ(basis)
     u, v, u_ours, v_ours = _uv_grid(face, nurbs, basis, grid_size)
@@ -197,7 +198,7 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
             "tolerance": tolerance,
             "max_dev_nurbs_vs_occ": worst_eval,
             "max_dev_rebuilt_vs_occ": worst_rebuilt,
-            "faces": [t.__dict__ for t in trips],
+            "faces": [asdict(t) for t in trips],
         },
         "outputs": {"rebuilt_step": str(written) if written else None,
                     "rebuilt_step_faces_read_back": reread_faces,

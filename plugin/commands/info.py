@@ -24,7 +24,7 @@ from ..io import CadModel, bounding_box, read
 from .base import STDOUT, Command, Console, write_json_report
 
 __all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",
-           "format_table"]
+           "format_table", "surface_kind", "face_area", "SPLINE_KINDS"]
 
 
 class SurfaceKind(enum.Enum):
@@ -90,6 +90,11 @@ class FaceInfo:
         return out
 
 
+def surface_kind(adaptor: GeomAdaptor_Surface) -> SurfaceKind:
+    """The :class:`SurfaceKind` of an adapted surface."""
+    return _KIND_OF.get(adaptor.GetType(), SurfaceKind.OTHER)
+
+
 def face_area(face: TopoDS_Face) -> float:
     props = GProp_GProps()
     BRepGProp.SurfaceProperties_s(face, props)
@@ -101,7 +106,7 @@ def describe_face(face: TopoDS_Face, index: int, name: str | None = None) -> Fac
     try:
         geom_surface = BRep_Tool.Surface_s(face)
         adaptor = GeomAdaptor_Surface(geom_surface)
-        kind = _KIND_OF.get(adaptor.GetType(), SurfaceKind.OTHER)
+        kind = surface_kind(adaptor)
         uv = tuple(float(x) for x in BRepTools.UVBounds_s(face))
         area = face_area(face)
         degree = poles = spans = rational = None

@@ -281,3 +281,38 @@ def test_demo_on_real_files(capsys, tmp_path, name):
     assert code == 0, err
     report = json.loads(next(tmp_path.glob("*-report.json")).read_text())
     assert all(report["checks"].values())
+
+
+# ------------------------------------------------------------------ console
+class _Stream:
+    def __init__(self, tty: bool):
+        self.text = ""
+        self._tty = tty
+
+    def write(self, s: str) -> int:
+        self.text += s
+        return len(s)
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return self._tty
+
+
+def test_progress_is_shown_on_a_terminal_by_default():
+    from surfprep.plugin.commands.base import Console
+
+    tty = _Stream(tty=True)
+    console = Console.for_streams(_Stream(False), tty)
+    assert console.show_progress
+    for i in range(1, 4):
+        console.progress(i, 3, "face")
+    assert tty.text == "\rface 1/3\rface 2/3\rface 3/3\n"
+    pipe = _Stream(tty=False)
+    quiet = Console.for_streams(_Stream(False), pipe)
+    quiet.progress(1, 3, "face")
+    assert not quiet.show_progress and pipe.text == ""
+    forced = Console.for_streams(_Stream(False), pipe, progress=True)
+    forced.progress(2, 3, "face")
+    assert pipe.text == "face 2/3\n"
