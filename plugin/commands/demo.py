@@ -37,7 +37,8 @@ from ..io import CadModel, face_from_surface, read, write
 from ..occ_reference import evaluate_surface
 from ..step_iges import _compound
 from .base import Command, Console, refuse_overwriting_inputs, write_json_report
-from .info import SPLINE_KINDS, face_area, format_table, model_report, surface_kind
+from .info import (SPLINE_KINDS, SurfaceKind, face_area, format_table, model_report,
+                   surface_kind)
 
 __all__ = ["COMMAND", "DEMO_SAMPLE", "samples_dir", "run_demo", "FaceRoundTrip",
            "DEFAULT_OUTDIR", "GRID_SIZE", "DEVIATION_TOLERANCE"]
