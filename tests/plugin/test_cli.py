@@ -316,3 +316,27 @@ def test_progress_is_shown_on_a_terminal_by_default():
     forced = Console.for_streams(_Stream(False), pipe, progress=True)
     forced.progress(2, 3, "face")
     assert pipe.text == "face 2/3\n"
+
+
+# ------------------------------------- parametrization figure on OCC surfaces
+def test_parametrization_figure_of_occ_converted_cylinder_and_sphere():
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakeSphere
+
+    from surfprep.plugin.commands.info import SurfaceKind, describe_face
+    from surfprep.plugin.io import CadModel
+
+    cylinder = CadModel.from_shape(
+        BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeCylinder(1.0, 3.0).Shape(), True).Shape())
+    lateral = describe_face(cylinder.faces[0], 0)
+    assert lateral.surface_type is SurfaceKind.BSPLINE and lateral.rational
+    assert lateral.param_quality_v == pytest.approx(1.0, abs=1e-9)   # straight generators
+    assert 1.0 < lateral.param_quality_u < 1.2  # rational arcs: speed varies within a span
+    caps = [describe_face(f, i) for i, f in enumerate(cylinder.faces[1:], start=1)]
+    assert all(c.param_quality == pytest.approx(1.0) for c in caps)
+
+    sphere = CadModel.from_shape(
+        BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeSphere(2.0).Shape(), True).Shape())
+    face = describe_face(sphere.faces[0], 0)
+    # the poles collapse u-chords to zero: skipped, so the figure stays finite
+    assert 1.0 < face.param_quality_u < 1.2 and 1.0 < face.param_quality_v < 1.2
