@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 import traceback
 from collections.abc import Sequence
 
@@ -80,12 +81,18 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND")
     for command in COMMANDS:
         cmd_parser = sub.add_parser(
-            command.name, help=command.summary, description=command.description,
+            command.name, help=command.summary, description=_wrap(command.description),
             epilog=command.epilog, formatter_class=argparse.RawDescriptionHelpFormatter,
             parents=[_common_options(defaults=False)])
         command.add_arguments(cmd_parser)
         cmd_parser.set_defaults(run=command.run)
     return parser
+
+
+def _wrap(text: str, width: int = 79) -> str:
+    """Fill each blank-line separated paragraph (the epilogs stay as written)."""
+    return "\n\n".join(textwrap.fill(" ".join(par.split()), width)
+                       for par in text.split("\n\n"))
 
 
 def _one_line(exc: BaseException) -> str:

@@ -21,7 +21,7 @@ from ...algorithms.parametrization import parametrization_quality
 from ...errors import OpenCascadeError
 from ..geom import surface_from_occ
 from ..io import CadModel, bounding_box, read
-from .base import STDOUT, Command, Console, write_json_report
+from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
 
 __all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",
            "format_table", "surface_kind", "face_area", "SPLINE_KINDS"]
@@ -221,6 +221,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
+    if args.json_path not in (None, STDOUT):  # fail before the work, not after
+        refuse_overwriting_inputs(Path(args.json_path), (args.file,))
     model = read(args.file, heal=args.heal)
     report = model_report(model, console)
     if args.json_path == STDOUT:

@@ -130,8 +130,8 @@ def test_info_json_refuses_to_overwrite_input(capsys, tmp_path):
     copy = tmp_path / "part.step"
     shutil.copyfile(FUSELAGE, copy)
     before = copy.read_bytes()
-    code, _, err = run(capsys, "info", str(copy), "--json", str(copy))
-    assert code == 2
+    code, out, err = run(capsys, "info", str(copy), "--json", str(copy))
+    assert code == 2 and out == ""  # refused before any work
     assert_one_line_error(err, "input file")
     assert copy.read_bytes() == before
 
