@@ -385,12 +385,17 @@ def _write_xde(path, fmt, shape, faces, face_names, face_colors) -> None:
     doc = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
     shape_tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
     color_tool = XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
+    lone_face = shape.ShapeType() == TopAbs_FACE
+    if lone_face and fmt is FileFormat.STEP:
+        # STEP names a lone face only as a sub-shape: wrap it in a compound
+        shape = _compound([shape])
+        lone_face = False
     root = shape_tool.AddShape(shape, False)
     for face, name, color in zip(faces, face_names, face_colors):
         if name is None and color is None:
             continue
-        # a one-face file is the face itself: it cannot be its own sub-shape
-        sub = root if face.IsSame(shape) else shape_tool.AddSubShape(root, face)
+        # IGES names a lone face through its own (root) label
+        sub = root if lone_face else shape_tool.AddSubShape(root, face)
         if sub.IsNull():
             continue
         if name is not None:

@@ -292,10 +292,12 @@ def test_names_and_colours_survive_write(tmp_path, suffix):
         assert got == pytest.approx(want, abs=1e-6)
 
 
-def test_iges_face_name_survives_iges_write(tmp_path):
-    iges_named = read(CATIA_FACE)
-    again = read(write(iges_named, tmp_path / "face.igs"))
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_lone_face_name_and_colour_survive_write(tmp_path, suffix):
+    lone = read(CATIA_FACE)  # the file is one face, no shell or compound
+    again = read(write(lone, tmp_path / f"face{suffix}"))
     assert again.face_names == ("FAC418(1681)",)
+    assert again.face_colors == ((0.0, 1.0, 0.0),)
 
 
 def test_in_memory_model_with_names(tmp_path):
