@@ -318,7 +318,12 @@ def write(obj: Any, path: str | os.PathLike, *, overwrite: bool = False) -> Path
         raise OutputFileError(f"nothing to write to {target}: the shape is empty")
 
     directory = target.resolve().parent
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise OutputFileError(
+            f"cannot write {target}: cannot create a file in {directory}: "
+            f"{exc.strerror or exc}") from None
     os.close(fd)
     tmp = Path(tmp_name)
     try:
