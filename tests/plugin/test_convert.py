@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
 from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.BRepTools import BRepTools
 from OCP.Geom import (Geom_BSplineCurve, Geom_BSplineSurface, Geom_Circle, Geom_Plane,
                       Geom_SphericalSurface, Geom_TrimmedCurve)
 from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Circle

@@ -1,0 +1,312 @@
+"""Edges between OpenCascade and surfprep's NURBS types.
+
+:class:`TrimEdge` is one edge of a trimming loop in NURBS terms (3D curve,
+pcurve, range, orientation, tolerances); :func:`edge_to_nurbs` reads an edge's
+3D curve; :func:`make_edge` builds an edge with pcurves on one or two faces.
+The reading and building of edges inside a face's loops (used by
+:mod:`surfprep.plugin.faces`) live here too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.BRepLib import BRepLib
+from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve, Geom_Line
+from OCP.Geom2d import Geom2d_BezierCurve, Geom2d_BSplineCurve, Geom2d_Line
+from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopLoc import TopLoc_Location
+from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Vertex
+
+from ..algorithms import NurbsCurve, NurbsSurface
+from ..errors import ConversionError, InvalidGeometryError, InvalidToleranceError, OpenCascadeError
+from .geom import curve2d_to_occ, curve_from_occ, curve_to_occ
+
+__all__ = ["TrimEdge", "edge_to_nurbs", "make_edge", "check_valid", "DEFAULT_TOLERANCE"]
+
+#: Default tolerance of built edges, vertices and faces (OpenCascade's Precision::Confusion).
+DEFAULT_TOLERANCE = 1e-7
+
+
+@dataclass(frozen=True, eq=False)
+class TrimEdge:
+    """One edge of a trimming loop, as it is used in the loop.
+
+    Attributes
+    ----------
+    curve3d : NurbsCurve (d=3) or None
+        The edge's 3D curve restricted to ``[t0, t1]``; ``None`` for a
+        degenerated edge (a surface pole) or when only the pcurve is known.
+    pcurve : NurbsCurve (d=2)
+        The edge's curve in the surface's ``(u, v)`` parameters, over the same
+        range ``[t0, t1]`` (same parameter as ``curve3d``): for this
+        occurrence of the edge (on a seam, the pcurve of this side).
+    t0, t1 : float
+        Edge range, in the natural direction of the curves.
+    reversed : bool
+        True when the loop runs along the edge from ``t1`` to ``t0``.
+    tolerance : float
+        OpenCascade's edge tolerance (max. distance between the 3D curve and
+        the pcurve mapped through the surface).
+    vertex_tolerance : float
+        The larger tolerance of the edge's two vertices (how far the curve
+        ends may be from the loop's corners).
+    seam_pcurve : NurbsCurve (d=2) or None
+        For a seam edge (one edge used twice on a closed surface) the pcurve
+        of the other side; ``None`` otherwise.
+    degenerated : bool
+        True for an edge collapsed to a point in 3D.
+    """
+
+    curve3d: NurbsCurve | None
+    pcurve: NurbsCurve
+    t0: float
+    t1: float
+    reversed: bool = False
+    tolerance: float = DEFAULT_TOLERANCE
+    seam_pcurve: NurbsCurve | None = None
+    degenerated: bool = False
+    vertex_tolerance: float = DEFAULT_TOLERANCE
+
+    def __post_init__(self) -> None:
+        if self.pcurve.dimension != 2:
+            raise InvalidGeometryError(f"pcurve must be 2D, got dimension {self.pcurve.dimension}")
+        if self.curve3d is not None and self.curve3d.dimension != 3:
+            raise InvalidGeometryError(f"curve3d must be 3D, got dimension {self.curve3d.dimension}")
+        if self.seam_pcurve is not None and self.seam_pcurve.dimension != 2:
+            raise InvalidGeometryError("seam_pcurve must be 2D")
+        if not self.t0 < self.t1:
+            raise InvalidGeometryError(f"empty edge range [{self.t0}, {self.t1}]")
+        object.__setattr__(self, "t0", float(self.t0))
+        object.__setattr__(self, "t1", float(self.t1))
+
+    @property
+    def is_seam(self) -> bool:
+        return self.seam_pcurve is not None
+
+    def __repr__(self) -> str:
+        kind = "degenerated" if self.degenerated else ("seam" if self.is_seam else "edge")
+        return (f"TrimEdge({kind}, range=({self.t0:g}, {self.t1:g}), reversed={self.reversed}, "
+                f"tolerance={self.tolerance:g})")
+
+    def uv_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end of this occurrence in ``(u, v)``, in loop direction."""
+        a, b = self.pcurve.evaluate(np.array([self.t0, self.t1]))
+        return (b, a) if self.reversed else (a, b)
+
+
+# ----------------------------------------------------------------- reading
+EXACT_3D = (Geom_BSplineCurve, Geom_BezierCurve, Geom_Line)
+EXACT_2D = (Geom2d_BSplineCurve, Geom2d_BezierCurve, Geom2d_Line)
+
+
+def converts_exactly(curve, exact_types, trimmed_type) -> bool:
+    """True when ``curve_from_occ`` keeps the curve's parametrization."""
+    while isinstance(curve, trimmed_type):
+        curve = curve.BasisCurve()
+    return curve is None or isinstance(curve, exact_types)
+
+
+
+
+def _reparametrize(curve: NurbsCurve, t0: float, t1: float) -> NurbsCurve:
+    """The same curve with its domain mapped affinely onto ``[t0, t1]``."""
+    a, b = curve.domain
+    if (a, b) == (t0, t1):
+        return curve
+    knots = t0 + (curve.knots - a) * ((t1 - t0) / (b - a))
+    return NurbsCurve(curve.control_points, knots, curve.degree, curve.weights)
+
+
+def _read_pcurve(edge: TopoDS_Edge, face: TopoDS_Face, t0: float, t1: float) -> NurbsCurve:
+    pcurve = BRep_Tool.CurveOnSurface_s(edge, face, 0.0, 0.0)
+    if pcurve is None:
+        raise ConversionError("an edge of the face has no pcurve on it")
+    p0, p1 = BRep_Tool.Range_s(edge, face)
+    return _reparametrize(curve_from_occ(pcurve, (p0, p1)), t0, t1)
+
+
+def edge_to_nurbs(edge: TopoDS_Edge) -> NurbsCurve:
+    """The edge's 3D curve restricted to its range, location applied.
+
+    The curve keeps the curve's natural direction (the edge's orientation is
+    not applied). Raises :class:`ConversionError` for a degenerated edge or an
+    edge without 3D curve.
+    """
+    if BRep_Tool.Degenerated_s(edge):
+        raise ConversionError("a degenerated edge has no 3D curve")
+    curve = BRep_Tool.Curve_s(edge, 0.0, 0.0)
+    if curve is None:
+        raise ConversionError("the edge has no 3D curve")
+    return curve_from_occ(curve, BRep_Tool.Range_s(edge))
+
+
+
+def _vertex_tolerance(edge: TopoDS_Edge) -> float:
+    tolerances = [DEFAULT_TOLERANCE]
+    explorer = TopExp_Explorer(edge, TopAbs_VERTEX)
+    while explorer.More():
+        tolerances.append(BRep_Tool.Tolerance_s(TopoDS.Vertex_s(explorer.Current())))
+        explorer.Next()
+    return max(tolerances)
+
+
+def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
+               seam_curves: list[tuple[TopoDS_Edge, NurbsCurve]]) -> TrimEdge:
+    tolerance = BRep_Tool.Tolerance_s(edge)
+    vertex_tolerance = _vertex_tolerance(edge)
+    reversed_ = edge.Orientation() == TopAbs_REVERSED
+    if BRep_Tool.Degenerated_s(edge) or BRep_Tool.Curve_s(edge, 0.0, 0.0) is None:
+        t0, t1 = BRep_Tool.Range_s(edge, face)
+        return TrimEdge(None, _read_pcurve(edge, face, t0, t1), t0, t1, reversed_, tolerance,
+                        degenerated=BRep_Tool.Degenerated_s(edge),
+                        vertex_tolerance=vertex_tolerance)
+    t0, t1 = BRep_Tool.Range_s(edge)
+    is_seam = BRep_Tool.IsClosed_s(edge, face)
+    curve3d = None
+    if is_seam:
+        curve3d = next((c for e, c in seam_curves if e.IsSame(edge)), None)
+    if curve3d is None:
+        curve3d = edge_to_nurbs(edge)
+        if is_seam:
+            seam_curves.append((edge, curve3d))
+    pcurve = _read_pcurve(edge, face, t0, t1)
+    seam_pcurve = None
+    if is_seam:
+        seam_pcurve = _read_pcurve(TopoDS.Edge_s(edge.Reversed()), face, t0, t1)
+    return TrimEdge(curve3d, pcurve, t0, t1, reversed_, tolerance, seam_pcurve,
+                    vertex_tolerance=vertex_tolerance)
+
+
+
+
+# ----------------------------------------------------------------- building
+def check_valid(shape, what: str = "shape") -> None:
+    """Raise :class:`OpenCascadeError` unless ``BRepCheck_Analyzer`` finds ``shape`` valid."""
+    if not BRepCheck_Analyzer(shape).IsValid():
+        raise OpenCascadeError(f"the {what} built is not valid (BRepCheck_Analyzer)")
+
+
+def check_tolerance(tol: float) -> float:
+    tol = float(tol)
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidToleranceError(f"tolerance must be a finite number > 0, got {tol}")
+    return tol
+
+
+def make_edge(curve3d: NurbsCurve,
+              pcurves: Sequence[tuple[NurbsCurve, TopoDS_Face]] = (),
+              tol: float = DEFAULT_TOLERANCE) -> TopoDS_Edge:
+    """An edge on a 3D curve over its whole domain, with optional pcurves.
+
+    Parameters
+    ----------
+    curve3d : NurbsCurve, d=3
+    pcurves : sequence of (NurbsCurve d=2, TopoDS_Face)
+        Pcurves over the same parameter range as ``curve3d``. A face given
+        twice makes the edge a seam of that face: the first pcurve is the one
+        of the FORWARD edge, the second of the REVERSED edge.
+    tol : float
+        Edge tolerance.
+    """
+    tol = check_tolerance(tol)
+    if not isinstance(curve3d, NurbsCurve) or curve3d.dimension != 3:
+        raise ConversionError("make_edge needs a 3D NurbsCurve")
+    builder = BRepBuilderAPI_MakeEdge(curve_to_occ(curve3d))
+    check_edge_builder(builder)
+    edge = builder.Edge()
+    brep = BRep_Builder()
+    brep.UpdateEdge(edge, curve_to_occ(curve3d), tol)
+    by_face: list[tuple[TopoDS_Face, list[NurbsCurve]]] = []
+    for pcurve, face in pcurves:
+        if not isinstance(pcurve, NurbsCurve) or pcurve.dimension != 2:
+            raise ConversionError("pcurves must be 2D NurbsCurve objects")
+        if pcurve.domain != curve3d.domain:
+            raise InvalidGeometryError(
+                f"pcurve domain {pcurve.domain} differs from the 3D curve's {curve3d.domain}")
+        for f, curves in by_face:
+            if f.IsSame(face):
+                curves.append(pcurve)
+                break
+        else:
+            by_face.append((face, [pcurve]))
+    for face, curves in by_face:
+        if len(curves) == 1:
+            brep.UpdateEdge(edge, curve2d_to_occ(curves[0]), face, tol)
+        elif len(curves) == 2:
+            brep.UpdateEdge(edge, curve2d_to_occ(curves[0]), curve2d_to_occ(curves[1]), face, tol)
+        else:
+            raise InvalidGeometryError("an edge can carry at most two pcurves on one face")
+    check_valid(edge, "edge")
+    return edge
+
+
+def check_edge_builder(builder: BRepBuilderAPI_MakeEdge) -> None:
+    if not builder.IsDone():
+        raise OpenCascadeError(f"BRepBuilderAPI_MakeEdge failed: {builder.Error().name}")
+
+
+
+def curve3d_points(edge: TrimEdge, surface: NurbsSurface, t: np.ndarray) -> np.ndarray:
+    if edge.curve3d is not None:
+        return edge.curve3d.evaluate(t)
+    uv = edge.pcurve.evaluate(t)
+    return surface.evaluate(uv[:, 0], uv[:, 1])
+
+
+def edge_deviation(edge: TrimEdge, surface: NurbsSurface, samples: int = 33) -> float:
+    """Max distance between the 3D curve and the pcurve(s) mapped through the surface."""
+    if edge.curve3d is None:
+        return 0.0
+    t = np.linspace(edge.t0, edge.t1, samples)
+    c = edge.curve3d.evaluate(t)
+    dev = 0.0
+    for pc in (edge.pcurve, edge.seam_pcurve):
+        if pc is not None:
+            uv = pc.evaluate(t)
+            dev = max(dev, float(np.max(np.linalg.norm(surface.evaluate(uv[:, 0], uv[:, 1]) - c, axis=1))))
+    return dev
+
+
+
+
+def build_trim_edge(surface: NurbsSurface, occ_surface, e: TrimEdge,
+                    v_first: TopoDS_Vertex, v_last: TopoDS_Vertex, tol: float) -> TopoDS_Edge:
+    brep = BRep_Builder()
+    location = TopLoc_Location()
+    etol = max(tol, e.tolerance, 1.001 * edge_deviation(e, surface))
+    if e.degenerated:
+        edge = TopoDS_Edge()
+        brep.MakeEdge(edge)
+        brep.UpdateEdge(edge, curve2d_to_occ(e.pcurve), occ_surface, location, etol)
+        brep.Add(edge, v_first.Oriented(TopAbs_FORWARD))
+        brep.Add(edge, v_last.Oriented(TopAbs_REVERSED))
+        brep.Range(edge, e.t0, e.t1)
+        brep.Degenerated(edge, True)
+        return edge
+    if e.curve3d is None:
+        builder = BRepBuilderAPI_MakeEdge(curve2d_to_occ(e.pcurve), occ_surface,
+                                          v_first, v_last, e.t0, e.t1)
+        check_edge_builder(builder)
+        edge = builder.Edge()
+        if not BRepLib.BuildCurve3d_s(edge, etol):
+            raise OpenCascadeError("BRepLib.BuildCurve3d could not build a 3D curve for an edge")
+        return edge
+    curve = curve_to_occ(e.curve3d)
+    builder = BRepBuilderAPI_MakeEdge(curve, v_first, v_last, e.t0, e.t1)
+    check_edge_builder(builder)
+    edge = builder.Edge()
+    if e.is_seam:
+        first, second = (e.seam_pcurve, e.pcurve) if e.reversed else (e.pcurve, e.seam_pcurve)
+        brep.UpdateEdge(edge, curve2d_to_occ(first), curve2d_to_occ(second),
+                        occ_surface, location, etol)
+    else:
+        brep.UpdateEdge(edge, curve2d_to_occ(e.pcurve), occ_surface, location, etol)
+    return edge
+
