@@ -19,8 +19,8 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve, Geom_Line
 from OCP.Geom2d import Geom2d_BezierCurve, Geom2d_BSplineCurve, Geom2d_Line
-from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
-from OCP.TopExp import TopExp_Explorer
+from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
+from OCP.TopExp import TopExp
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Vertex
 
@@ -54,9 +54,10 @@ class TrimEdge:
     tolerance : float
         OpenCascade's edge tolerance (max. distance between the 3D curve and
         the pcurve mapped through the surface).
-    vertex_tolerance : float
-        The larger tolerance of the edge's two vertices (how far the curve
-        ends may be from the loop's corners).
+    vertex_tolerances : (float, float)
+        Tolerances of the edge's vertices at ``t0`` and at ``t1`` (how far the
+        curve ends may be from the loop's corners); kept so that a rebuilt face
+        tolerates what the original did.
     seam_pcurve : NurbsCurve (d=2) or None
         For a seam edge (one edge used twice on a closed surface) the pcurve
         of the other side; ``None`` otherwise.
@@ -72,7 +73,7 @@ class TrimEdge:
     tolerance: float = DEFAULT_TOLERANCE
     seam_pcurve: NurbsCurve | None = None
     degenerated: bool = False
-    vertex_tolerance: float = DEFAULT_TOLERANCE
+    vertex_tolerances: tuple[float, float] = (DEFAULT_TOLERANCE, DEFAULT_TOLERANCE)
 
     def __post_init__(self) -> None:
         if self.pcurve.dimension != 2:
@@ -81,6 +82,10 @@ class TrimEdge:
             raise InvalidGeometryError(f"curve3d must be 3D, got dimension {self.curve3d.dimension}")
         if self.seam_pcurve is not None and self.seam_pcurve.dimension != 2:
             raise InvalidGeometryError("seam_pcurve must be 2D")
+        object.__setattr__(self, "vertex_tolerances",
+                           tuple(float(x) for x in self.vertex_tolerances))
+        if len(self.vertex_tolerances) != 2:
+            raise InvalidGeometryError("vertex_tolerances must be (at t0, at t1)")
         if not self.t0 < self.t1:
             raise InvalidGeometryError(f"empty edge range [{self.t0}, {self.t1}]")
         object.__setattr__(self, "t0", float(self.t0))
@@ -94,6 +99,11 @@ class TrimEdge:
         kind = "degenerated" if self.degenerated else ("seam" if self.is_seam else "edge")
         return (f"TrimEdge({kind}, range=({self.t0:g}, {self.t1:g}), reversed={self.reversed}, "
                 f"tolerance={self.tolerance:g})")
+
+    def corner_tolerances(self) -> tuple[float, float]:
+        """Vertex tolerances at the start and end of this occurrence, in loop direction."""
+        a, b = self.vertex_tolerances
+        return (b, a) if self.reversed else (a, b)
 
     def uv_ends(self) -> tuple[np.ndarray, np.ndarray]:
         """Start and end of this occurrence in ``(u, v)``, in loop direction."""
@@ -148,25 +158,22 @@ def edge_to_nurbs(edge: TopoDS_Edge) -> NurbsCurve:
 
 
 
-def _vertex_tolerance(edge: TopoDS_Edge) -> float:
-    tolerances = [DEFAULT_TOLERANCE]
-    explorer = TopExp_Explorer(edge, TopAbs_VERTEX)
-    while explorer.More():
-        tolerances.append(BRep_Tool.Tolerance_s(TopoDS.Vertex_s(explorer.Current())))
-        explorer.Next()
-    return max(tolerances)
+def _vertex_tolerances(edge: TopoDS_Edge) -> tuple[float, float]:
+    """Tolerances of the vertices at the start and end of the edge's curve."""
+    ends = (TopExp.FirstVertex_s(edge), TopExp.LastVertex_s(edge))   # not cumulating orientation
+    return tuple(DEFAULT_TOLERANCE if v.IsNull() else BRep_Tool.Tolerance_s(v) for v in ends)
 
 
 def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
                seam_curves: list[tuple[TopoDS_Edge, NurbsCurve]]) -> TrimEdge:
     tolerance = BRep_Tool.Tolerance_s(edge)
-    vertex_tolerance = _vertex_tolerance(edge)
+    vertex_tolerances = _vertex_tolerances(edge)
     reversed_ = edge.Orientation() == TopAbs_REVERSED
     if BRep_Tool.Degenerated_s(edge) or BRep_Tool.Curve_s(edge, 0.0, 0.0) is None:
         t0, t1 = BRep_Tool.Range_s(edge, face)
         return TrimEdge(None, _read_pcurve(edge, face, t0, t1), t0, t1, reversed_, tolerance,
                         degenerated=BRep_Tool.Degenerated_s(edge),
-                        vertex_tolerance=vertex_tolerance)
+                        vertex_tolerances=vertex_tolerances)
     t0, t1 = BRep_Tool.Range_s(edge)
     is_seam = BRep_Tool.IsClosed_s(edge, face)
     curve3d = None
@@ -181,7 +188,7 @@ def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
     if is_seam:
         seam_pcurve = _read_pcurve(TopoDS.Edge_s(edge.Reversed()), face, t0, t1)
     return TrimEdge(curve3d, pcurve, t0, t1, reversed_, tolerance, seam_pcurve,
-                    vertex_tolerance=vertex_tolerance)
+                    vertex_tolerances=vertex_tolerances)
 
 
 

@@ -319,16 +319,17 @@ def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float,
         centre = pts.mean(axis=0)
         gap = float(np.max(np.linalg.norm(pts - centre, axis=1)))
         members = [k for k in range(n) if group[k] == g]
+        # the tolerances the input gave this corner
+        corner_tol = max(max(edges[k - 1].corner_tolerances()[1], edges[k].corner_tolerances()[0])
+                         for k in members)
+        edge_tol = max(max(edges[k - 1].tolerance, edges[k].tolerance) for k in members)
         allowed = max(_MAX_GAP_IN_TOLERANCES * tol,
-                      _MAX_GAP_IN_EDGE_TOLERANCES * max(
-                          max(edges[k - 1].tolerance, edges[k].tolerance,
-                              edges[k - 1].vertex_tolerance, edges[k].vertex_tolerance)
-                          for k in members))
+                      _MAX_GAP_IN_EDGE_TOLERANCES * max(edge_tol, corner_tol))
         if gap > allowed:
             raise InvalidGeometryError(
                 f"trimming loop not closed: gap {2 * gap:.3g} at the start of edge {members[0]} "
                 f"(allowed {2 * allowed:.3g} from the tolerances)")
-        vtol = max(tol, 1.001 * gap)
+        vtol = max(tol, 1.001 * gap, corner_tol)
         vertex = TopoDS_Vertex()
         shared = next((c for c in corners if np.linalg.norm(c[0] - centre) <= max(c[1], vtol)), None)
         if shared is None:

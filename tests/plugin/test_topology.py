@@ -120,7 +120,7 @@ def check_loops_closed(tf: TrimmedFace) -> None:
             start = nxt.uv_ends()[0]
             a = tf.surface.evaluate(end[0], end[1])
             b = tf.surface.evaluate(start[0], start[1])
-            allowed = 2 * max(edge.vertex_tolerance, nxt.vertex_tolerance,
+            allowed = 2 * max(edge.corner_tolerances()[1], nxt.corner_tolerances()[0],
                               edge.tolerance, nxt.tolerance)
             assert np.linalg.norm(a - b) <= allowed
 
@@ -198,7 +198,7 @@ def test_missing_3d_curves_are_built():
     top = next(f for f in faces_of(plate) if len(face_to_nurbs(f).loops) == 2)
     tf = face_to_nurbs(top)
     loops = [TrimLoop(tuple(TrimEdge(None, e.pcurve, e.t0, e.t1, e.reversed, e.tolerance,
-                                     vertex_tolerance=e.vertex_tolerance) for e in loop.edges))
+                                     vertex_tolerances=e.vertex_tolerances) for e in loop.edges))
              for loop in tf.loops]
     face = make_face(tf.surface, loops, reversed=tf.reversed)
     assert _area(face) == pytest.approx(16 - math.pi / 4, rel=1e-7)
