@@ -123,8 +123,6 @@ def converts_exactly(curve, exact_types, trimmed_type) -> bool:
     return curve is None or isinstance(curve, exact_types)
 
 
-
-
 def _reparametrize(curve: NurbsCurve, t0: float, t1: float) -> NurbsCurve:
     """The same curve with its domain mapped affinely onto ``[t0, t1]``."""
     a, b = curve.domain
@@ -146,8 +144,10 @@ def edge_to_nurbs(edge: TopoDS_Edge) -> NurbsCurve:
     """The edge's 3D curve restricted to its range, location applied.
 
     The curve keeps the curve's natural direction (the edge's orientation is
-    not applied). Raises :class:`ConversionError` for a degenerated edge or an
-    edge without 3D curve.
+    not applied). B-spline, Bezier and line edges keep their parameter exactly;
+    other curves (conics...) go through GeomConvert, which keeps the shape and
+    the end points but not the parametrization. Raises
+    :class:`ConversionError` for a degenerated edge or an edge without 3D curve.
     """
     if BRep_Tool.Degenerated_s(edge):
         raise ConversionError("a degenerated edge has no 3D curve")
@@ -157,7 +157,6 @@ def edge_to_nurbs(edge: TopoDS_Edge) -> NurbsCurve:
     return curve_from_occ(curve, BRep_Tool.Range_s(edge))
 
 
-
 def _vertex_tolerances(edge: TopoDS_Edge) -> tuple[float, float]:
     """Tolerances of the vertices at the start and end of the edge's curve."""
     ends = (TopExp.FirstVertex_s(edge), TopExp.LastVertex_s(edge))   # not cumulating orientation
@@ -165,7 +164,14 @@ def _vertex_tolerances(edge: TopoDS_Edge) -> tuple[float, float]:
 
 
 def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
-               seam_curves: list[tuple[TopoDS_Edge, NurbsCurve]]) -> TrimEdge:
+                   seam_curves: list[tuple[TopoDS_Edge, NurbsCurve]]) -> TrimEdge:
+    """One occurrence of ``edge`` in a wire of ``face`` (FORWARD) as a TrimEdge.
+
+    ``seam_curves`` caches the 3D curves of seam edges already read, so both
+    occurrences of a seam share one NurbsCurve object. The pcurve is mapped
+    affinely onto the 3D curve's range (exact for SameRange edges, which is
+    what OpenCascade's readers produce).
+    """
     tolerance = BRep_Tool.Tolerance_s(edge)
     vertex_tolerances = _vertex_tolerances(edge)
     reversed_ = edge.Orientation() == TopAbs_REVERSED
@@ -189,8 +195,6 @@ def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
         seam_pcurve = _read_pcurve(TopoDS.Edge_s(edge.Reversed()), face, t0, t1)
     return TrimEdge(curve3d, pcurve, t0, t1, reversed_, tolerance, seam_pcurve,
                     vertex_tolerances=vertex_tolerances)
-
-
 
 
 # ----------------------------------------------------------------- building
@@ -259,7 +263,6 @@ def check_edge_builder(builder: BRepBuilderAPI_MakeEdge) -> None:
         raise OpenCascadeError(f"BRepBuilderAPI_MakeEdge failed: {builder.Error().name}")
 
 
-
 def curve3d_points(edge: TrimEdge, surface: NurbsSurface, t: np.ndarray) -> np.ndarray:
     if edge.curve3d is not None:
         return edge.curve3d.evaluate(t)
@@ -279,8 +282,6 @@ def edge_deviation(edge: TrimEdge, surface: NurbsSurface, samples: int = 33) -> 
             uv = pc.evaluate(t)
             dev = max(dev, float(np.max(np.linalg.norm(surface.evaluate(uv[:, 0], uv[:, 1]) - c, axis=1))))
     return dev
-
-
 
 
 def build_trim_edge(surface: NurbsSurface, occ_surface, e: TrimEdge,

@@ -1,4 +1,4 @@
-"""Faces and edges between OpenCascade topology and surfprep's NURBS types.
+"""Trimmed faces between OpenCascade topology and surfprep's NURBS types.
 
 :func:`face_to_nurbs` reads a ``TopoDS_Face`` as a :class:`TrimmedFace`: one
 :class:`~surfprep.algorithms.NurbsSurface` (the face's location applied) and its
@@ -16,7 +16,7 @@ consistently (measured: pcurve mapped through the surface equals the 3D curve
 to ~1e-15 on cadquery's analytic solids). Faces already made of B-spline
 surfaces and of B-spline / Bezier / line curves are read exactly, without it.
 
-:func:`make_face` and :func:`make_edge` go the other way.
+:func:`make_face` goes the other way (edges: :mod:`surfprep.plugin.edges`).
 """
 
 from __future__ import annotations
@@ -52,7 +52,6 @@ __all__ = ["TrimLoop", "TrimmedFace", "face_to_nurbs", "make_face", "trimmed_fac
 #: times ``tol``, or this many times the largest edge or vertex tolerance of the two edges.
 _MAX_GAP_IN_TOLERANCES = 100.0
 _MAX_GAP_IN_EDGE_TOLERANCES = 10.0
-
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,8 +111,6 @@ class TrimmedFace:
         return tuple(e for loop in self.loops for e in loop.edges)
 
 
-
-
 # ----------------------------------------------------------------- reading
 def _needs_nurbs_convert(face: TopoDS_Face) -> bool:
     if not isinstance(BRep_Tool.Surface_s(face), Geom_BSplineSurface):
@@ -138,8 +135,6 @@ def _nurbs_convert(face: TopoDS_Face) -> TopoDS_Face:
     if not converter.IsDone():
         raise OpenCascadeError("BRepBuilderAPI_NurbsConvert: IsDone() is false")
     return TopoDS.Face_s(converter.Shape())
-
-
 
 
 def face_to_nurbs(face: TopoDS_Face, name: str | None = None) -> TrimmedFace:
@@ -189,8 +184,6 @@ def _wire_edges(wire: TopoDS_Wire, face: TopoDS_Face) -> list[TopoDS_Edge]:
     if wire.Orientation() == TopAbs_REVERSED:
         stored = [TopoDS.Edge_s(e.Reversed()) for e in reversed(stored)]
     return stored
-
-
 
 
 # ----------------------------------------------------------------- building
@@ -285,8 +278,6 @@ def _checked_or_fixed(face: TopoDS_Face, tol: float) -> TopoDS_Face:
     fixer.SetPrecision(tol)
     fixer.Perform()
     return TopoDS.Face_s(fixer.Face())
-
-
 
 
 def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float,
