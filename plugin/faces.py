@@ -46,7 +46,8 @@ from .edges import (DEFAULT_TOLERANCE, EXACT_2D, EXACT_3D, TrimEdge, build_trim_
                     check_tolerance, check_valid, converts_exactly, curve3d_points, read_trim_edge)
 from .geom import surface_from_occ, surface_to_occ
 
-__all__ = ["TrimLoop", "TrimmedFace", "face_to_nurbs", "make_face", "trimmed_face_to_occ"]
+__all__ = ["TrimLoop", "TrimmedFace", "face_to_nurbs", "make_face", "trimmed_face_to_occ",
+           "needs_nurbs_convert"]
 
 #: make_face refuses a loop whose consecutive edge ends are further apart than this many
 #: times ``tol``, or this many times the largest edge or vertex tolerance of the two edges.
@@ -112,7 +113,10 @@ class TrimmedFace:
 
 
 # ----------------------------------------------------------------- reading
-def _needs_nurbs_convert(face: TopoDS_Face) -> bool:
+def needs_nurbs_convert(face: TopoDS_Face) -> bool:
+    """True when :func:`face_to_nurbs` converts ``face`` with
+    BRepBuilderAPI_NurbsConvert (its surface is not a B-spline, or an edge curve
+    is not a B-spline, Bezier or line); False when the face is read exactly."""
     if not isinstance(BRep_Tool.Surface_s(face), Geom_BSplineSurface):
         return True
     explorer = TopExp_Explorer(face, TopAbs_EDGE)
@@ -143,7 +147,7 @@ def face_to_nurbs(face: TopoDS_Face, name: str | None = None) -> TrimmedFace:
         raise ConversionError(f"expected a non-null TopoDS_Face, got {type(face).__name__}")
     reversed_ = face.Orientation() == TopAbs_REVERSED
     forward = TopoDS.Face_s(face.Oriented(TopAbs_FORWARD))
-    if _needs_nurbs_convert(forward):
+    if needs_nurbs_convert(forward):
         forward = TopoDS.Face_s(_nurbs_convert(forward).Oriented(TopAbs_FORWARD))
     geom_surface = BRep_Tool.Surface_s(forward)
     surface = surface_from_occ(geom_surface, BRepTools.UVBounds_s(forward))

@@ -32,6 +32,7 @@ from surfprep.errors import ConversionError, InvalidGeometryError, InvalidTolera
 from surfprep.plugin.convert import faces_of
 from surfprep.plugin.geom import curve_from_occ, surface_to_occ
 from surfprep.plugin.occ_reference import evaluate_curve, evaluate_surface, project_point_on_surface
+from surfprep.plugin.faces import needs_nurbs_convert
 from surfprep.plugin.topology import (TrimEdge, TrimLoop, TrimmedFace, face_to_nurbs, make_edge,
                                       make_face, trimmed_face_to_occ)
 
@@ -92,7 +93,7 @@ def _perimeter(face) -> float:
 def check_pcurves_on_edges(tf: TrimmedFace, size: float, rtol: float) -> None:
     """Every pcurve mapped through the surface lies on its 3D curve (same
     parameter): distance <= max(2 * edge tolerance, rtol * size); degenerated
-    edges map to one point."""
+    edges map to one point (within their vertex tolerance)."""
     for i, edge in enumerate(tf.edges):
         t = np.linspace(edge.t0, edge.t1, 41)
         for pcurve in (edge.pcurve, edge.seam_pcurve):
@@ -101,8 +102,10 @@ def check_pcurves_on_edges(tf: TrimmedFace, size: float, rtol: float) -> None:
             uv = pcurve.evaluate(t)
             on_surface = tf.surface.evaluate(uv[:, 0], uv[:, 1])
             if edge.degenerated:
+                # a pole: its image stays within the vertex's tolerance
                 spread = np.max(np.linalg.norm(on_surface - on_surface[0], axis=1))
-                assert spread <= max(2 * edge.tolerance, rtol * size), f"edge {i}"
+                allowed = max(2 * edge.tolerance, 2 * max(edge.vertex_tolerances), rtol * size)
+                assert spread <= allowed, f"degenerated edge {i}: image spreads over {spread:.3g}"
                 continue
             dev = np.max(np.linalg.norm(on_surface - edge.curve3d.evaluate(t), axis=1))
             assert dev <= max(2 * edge.tolerance, rtol * size), \
@@ -125,13 +128,15 @@ def check_loops_closed(tf: TrimmedFace) -> None:
             assert np.linalg.norm(a - b) <= allowed
 
 
-def check_round_trip(face, tf: TrimmedFace) -> None:
+def check_round_trip(face, tf: TrimmedFace, displacement: float = 0.0) -> None:
     """make_face rebuilds a BRepCheck-valid face of the same area and orientation.
 
-    The area may differ from the input's by at most perimeter * max edge
-    tolerance: the boundary may move by the tolerance. For faces converted by
-    BRepBuilderAPI_NurbsConvert the rebuilt face must equal that conversion's
-    area to 1e-9 (surfprep itself adds nothing).
+    Faces read exactly: the area may differ from the input's by perimeter * max
+    edge tolerance (the boundary may move by the tolerance). Faces converted by
+    BRepBuilderAPI_NurbsConvert: the rebuilt face has the area of that
+    conversion to 1e-9 (surfprep adds nothing), and the input's area within
+    perimeter * max(edge tolerance, ``displacement``), for what NurbsConvert
+    moves without raising tolerances (see the slow sweep).
     """
     rebuilt = trimmed_face_to_occ(tf)
     assert BRepCheck_Analyzer(rebuilt).IsValid()
@@ -139,9 +144,11 @@ def check_round_trip(face, tf: TrimmedFace) -> None:
     assert (face.Orientation() == TopAbs_REVERSED) == tf.reversed
     a_in, a_out = _area(face), _area(rebuilt)
     max_tol = max(e.tolerance for e in tf.edges)
+    if needs_nurbs_convert(face):
+        converted = BRepBuilderAPI_NurbsConvert(face, True).Shape()
+        assert abs(_area(converted) - a_out) <= 1e-9 * a_in
+        max_tol = max(max_tol, displacement)
     assert abs(a_out - a_in) <= _perimeter(face) * max_tol + 1e-9 * a_in, (a_in, a_out)
-    converted = BRepBuilderAPI_NurbsConvert(face, True).Shape()
-    assert abs(_area(converted) - a_out) <= 1e-9 * a_in
 
 
 # ------------------------------------------------------------ analytic faces
@@ -333,3 +340,37 @@ def test_make_edge_with_pcurves_on_one_and_two_faces():
         make_edge(seam.curve3d, [(shifted, face)])
     with pytest.raises(ConversionError):
         make_edge(seam.pcurve)                 # a 2D curve is not a 3D curve
+
+
+# --------------------------------------------------------------- slow sweep
+ALL_DATA_FILES = sorted(p.name for p in (Path(__file__).resolve().parents[2] / ".." / "shared" / "data")
+                        .glob("*") if p.suffix.lower() in (".stp", ".step", ".igs", ".iges"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ALL_DATA_FILES)
+def test_every_valid_face_of_every_file_round_trips(data_dir, name):
+    """Every face BRepCheck accepts as read converts, maps pcurves onto edges
+    within the model-relative bound and rebuilds valid with the area of
+    OpenCascade's own NURBS conversion. Faces BRepCheck rejects may be refused
+    (InvalidGeometryError: loop gaps beyond their tolerances, as in
+    occt_spaceship_alias) but must not crash.
+
+    Against the input's area the bound is loose (boundary displacement up to
+    1e-5 of the model size): BRepBuilderAPI_NurbsConvert re-approximates pcurves
+    on spheres, cones and extrusions and moves the boundary by more than the
+    tolerance it leaves (nist_ctc_02: 1e-6 mm on edges of tolerance 1e-7, area
+    -1.1e-7 relative), and BRepGProp's area of analytic extrusions itself moves
+    by 1e-4 relative with its precision setting (pyocc_ventilator_catia5)."""
+    shape = read_cad(data_dir / name)
+    size = _diagonal(shape)
+    for face in faces_of(shape):
+        if not BRepCheck_Analyzer(face).IsValid():
+            try:
+                trimmed_face_to_occ(face_to_nurbs(face))
+            except InvalidGeometryError:
+                pass
+            continue
+        tf = face_to_nurbs(face)
+        check_pcurves_on_edges(tf, size, rtol=1e-3)
+        check_round_trip(face, tf, displacement=1e-5 * size)
