@@ -1,10 +1,22 @@
-"""Shared test fixtures: the real CAD files of the ``shared/data`` folder beside the repo."""
+"""Shared test fixtures: the real CAD files of the ``shared/data`` folder beside the repo,
+and the hypothesis profile.
+
+Under CI (the ``CI`` environment variable set, as ``.ci/run`` runs) hypothesis is
+derandomized, so a submission is judged on the same examples every run; locally
+each run draws new examples, which is how new failures get found.
+"""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 #: ``shared/data`` next to the repository checkout (same layout locally and in CI).
 DATA_DIR = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
