@@ -33,7 +33,6 @@ from typing import Any
 
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace
 from OCP.ShapeFix import ShapeFix_Shape
 from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
@@ -41,15 +40,13 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import (ConversionError, InputFileError, NoFacesError, OpenCascadeError,
                       OutputFileError)
-from .geom import curve_to_occ, surface_to_occ
+from .edges import make_edge
+from .faces import TrimmedFace, make_face, trimmed_face_to_occ
 from .step_iges import (FileFormat, Rgb, TranslationError, _all_faces, _compound,
                         _FaceNames, read_file, write_file)
 
-__all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "face_from_surface",
-           "edge_from_curve", "bounding_box", "sniff_format", "MAKE_FACE_TOLERANCE"]
+__all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "bounding_box", "sniff_format"]
 
-#: Tolerance given to ``BRepBuilderAPI_MakeFace`` for faces built from NurbsSurface.
-MAKE_FACE_TOLERANCE = 1e-7
 #: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
 MODEL_UNIT = "mm"
 
@@ -387,9 +384,11 @@ def to_shape(obj: Any) -> TopoDS_Shape:
             raise ConversionError("cannot write a null TopoDS_Shape")
         return obj
     if isinstance(obj, NurbsSurface):
-        return face_from_surface(obj)
+        return make_face(obj)
     if isinstance(obj, NurbsCurve):
-        return edge_from_curve(obj)
+        return make_edge(obj)
+    if isinstance(obj, TrimmedFace):
+        return trimmed_face_to_occ(obj)
     wrapped = getattr(obj, "wrapped", None)
     if isinstance(wrapped, TopoDS_Shape):
         return to_shape(wrapped)
@@ -404,28 +403,3 @@ def to_shape(obj: Any) -> TopoDS_Shape:
     raise ConversionError(
         f"cannot write a {type(obj).__name__}: expected a CadModel, TopoDS_Shape, "
         "cadquery/build123d object, NurbsSurface, NurbsCurve or a list of them")
-
-
-def face_from_surface(surface: NurbsSurface) -> TopoDS_Face:
-    """A natural-boundary face on ``surface`` (``BRepBuilderAPI_MakeFace``)."""
-    try:
-        maker = BRepBuilderAPI_MakeFace(surface_to_occ(surface), MAKE_FACE_TOLERANCE)
-        if not maker.IsDone():
-            raise OpenCascadeError(
-                f"BRepBuilderAPI_MakeFace failed for {surface!r} (error {maker.Error().name})")
-        return maker.Face()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepBuilderAPI_MakeFace failed for {surface!r}: {exc}") from exc
-
-
-def edge_from_curve(curve: NurbsCurve):
-    """An edge on a 3D ``curve`` (``BRepBuilderAPI_MakeEdge``)."""
-    try:
-        maker = BRepBuilderAPI_MakeEdge(curve_to_occ(curve))
-        if not maker.IsDone():
-            raise OpenCascadeError(
-                f"BRepBuilderAPI_MakeEdge failed for {curve!r} (error {maker.Error().name})")
-        return maker.Edge()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepBuilderAPI_MakeEdge failed for {curve!r}: {exc}") from exc
-

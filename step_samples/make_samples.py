@@ -22,7 +22,8 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.gp import gp_Ax3, gp_Cylinder, gp_Dir, gp_Pln, gp_Pnt
 
 from surfprep.algorithms import NurbsSurface
-from surfprep.plugin.io import CadModel, face_from_surface, write
+from surfprep.plugin.faces import make_face
+from surfprep.plugin.io import CadModel, write
 from surfprep.plugin.step_iges import _compound
 
 OUTPUT = Path(__file__).resolve().parent / "synthetic_named_faces.step"
@@ -56,7 +57,7 @@ def main() -> Path:
     cylinder = _done(BRepBuilderAPI_MakeFace(
         gp_Cylinder(gp_Ax3(gp_Pnt(20, 20, 0), gp_Dir(0, 0, 1)), 2.0),
         0.0, np.pi, 0.0, 3.0))
-    faces = (face_from_surface(uniform_patch()), face_from_surface(cubic_u_patch()),
+    faces = (make_face(uniform_patch()), make_face(cubic_u_patch()),
              plane, cylinder)
     names = ("uniform_patch", "cubic_u_patch", "plane", "cylinder")
     colors = ((0.8, 0.2, 0.2), (0.2, 0.8, 0.2), (0.2, 0.2, 0.8), (0.9, 0.9, 0.1))

@@ -33,7 +33,8 @@ import surfprep
 from ...algorithms import NurbsSurface
 from ...errors import ConversionError, InputFileError, OutputFileError, SurfprepError
 from ..geom import surface_from_occ, surface_to_occ
-from ..io import CadModel, face_from_surface, read, write
+from ..faces import make_face
+from ..io import CadModel, read, write
 from ..occ_reference import evaluate_surface
 from ..step_iges import _compound
 from .base import Command, Console, refuse_overwriting_inputs, write_json_report
@@ -113,7 +114,7 @@ def _rebuild(face: TopoDS_Face, surface: NurbsSurface, name: str | None):
         rebuilt = topology.trimmed_face_to_occ(topology.face_to_nurbs(face, name))
         return rebuilt, "trimmed", None
     except (SurfprepError, ImportError, AttributeError) as exc:
-        return face_from_surface(surface), "natural boundary", " ".join(str(exc).split())
+        return make_face(surface), "natural boundary", " ".join(str(exc).split())
 
 
 def round_trip_face(face: TopoDS_Face, index: int, name: str | None,

@@ -16,6 +16,7 @@ from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import (ConversionError, InputFileError, NoFacesError, OutputFileError,
                              SurfprepError)
 from surfprep.plugin import io as sio
+from surfprep.plugin.faces import make_face
 from surfprep.plugin.io import CadModel, FileFormat, read, write
 from surfprep.plugin.step_iges import TranslationError
 
@@ -248,7 +249,7 @@ def test_every_read_error_is_a_surfprep_error(tmp_path):
 @pytest.mark.parametrize("suffix", [".step", ".stp", ".igs", ".iges"])
 def test_nurbs_surfaces_round_trip(tmp_path, suffix):
     surfaces = [wavy_patch(), wavy_patch(shift=6.0), rational_patch()]
-    expected = area([sio.face_from_surface(s) for s in surfaces])
+    expected = area([make_face(s) for s in surfaces])
     path = write(surfaces, tmp_path / f"patches{suffix}")
     assert path == (tmp_path / f"patches{suffix}").resolve()
     model = read(path)
@@ -266,7 +267,7 @@ def test_single_nurbs_surface_and_shapes(tmp_path):
     assert read(write(box.val(), tmp_path / "solid.igs")).n_faces == 6
     part = read(write(bd.Box(1, 2, 3), tmp_path / "bd.stp"))
     assert area(part.faces) == pytest.approx(22.0, rel=1e-9)
-    mixed = [box.val().wrapped, sio.face_from_surface(wavy_patch(shift=5))]
+    mixed = [box.val().wrapped, make_face(wavy_patch(shift=5))]
     assert read(write(mixed, tmp_path / "mixed.step")).n_faces == 7
 
 
@@ -300,7 +301,7 @@ def test_lone_face_name_and_colour_survive_write(tmp_path, suffix):
 
 
 def test_in_memory_model_with_names(tmp_path):
-    faces = (sio.face_from_surface(wavy_patch()), sio.face_from_surface(rational_patch()))
+    faces = (make_face(wavy_patch()), make_face(rational_patch()))
     model = CadModel(sio.to_shape(list(faces)), faces, ("a", None), (None, (1.0, 0.0, 0.0)))
     again = read(write(model, tmp_path / "m.step"))
     assert again.face_names == ("a", None)
