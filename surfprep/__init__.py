@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from importlib import import_module
 
-from .algorithms import NurbsCurve, NurbsSurface
+from .algorithms import Direction, NurbsCurve, NurbsSurface
+from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
 from .errors import (ConversionError, DegenerateGeometryError, InputFileError,
                      InvalidGeometryError, InvalidToleranceError, NoFacesError,
                      OpenCascadeError, OutputFileError, SurfprepError)
@@ -27,6 +28,7 @@ _PLUGIN_EXPORTS = {
     "read": "surfprep.plugin.io",
     "write": "surfprep.plugin.io",
     "CadModel": "surfprep.plugin.io",
+    "FileFormat": "surfprep.plugin.io",
     "to_nurbs": "surfprep.plugin.convert",
     "to_occ": "surfprep.plugin.convert",
     "TrimmedFace": "surfprep.plugin.topology",
@@ -37,7 +39,8 @@ _PLUGIN_EXPORTS = {
 }
 
 __all__ = [
-    "NurbsCurve", "NurbsSurface",
+    "NurbsCurve", "NurbsSurface", "Direction",
+    "parametrization_quality", "ParametrizationQuality",
     *_PLUGIN_EXPORTS,
     "SurfprepError", "InvalidGeometryError", "DegenerateGeometryError",
     "InvalidToleranceError", "ConversionError", "InputFileError", "NoFacesError",
