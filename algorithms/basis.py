@@ -135,56 +135,74 @@ def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
     t = np.asarray(t, dtype=float).reshape(-1)
     if span is None:
         span = find_span(knots, p, t)
-    m = t.size
-    # left[j] = t - knots[span + 1 - j], right[j] = knots[span + j] - t, j = 1..p
-    j = np.arange(1, p + 1)
-    left = t[:, None] - knots[span[:, None] + 1 - j]        # (m, p)
-    right = knots[span[:, None] + j] - t[:, None]           # (m, p)
-    # ndu[:, r, c]: upper triangle c >= r basis values, lower triangle knot differences
-    ndu = np.empty((m, p + 1, p + 1))
-    ndu[:, 0, 0] = 1.0
+    top = min(max(int(order), 0), p)
+    ndu = _basis_triangle(knots, p, t, span)                 # (p+1, p+1, m)
+    ders = np.zeros((max(int(order), 0) + 1, p + 1, t.size))
+    ders[0] = ndu[:, p]
+    if top > 0:
+        ders[1:top + 1] = _derivative_rows(ndu, p, top)
+    return np.ascontiguousarray(ders.transpose(2, 0, 1)), span
+
+
+def _basis_triangle(knots: NDArray, p: int, t: NDArray, span: NDArray) -> NDArray:
+    """The ``ndu`` table of A2.3 with the point axis last (contiguous sweeps).
+
+    ``ndu[r, c]`` for ``c >= r`` holds basis values of degree ``c``;
+    ``ndu[c, r]`` for ``c > r`` the knot differences ``right + left``.
+    """
+    j = np.arange(1, p + 1)[:, None]
+    left = t[None, :] - knots[span[None, :] + 1 - j]          # (p, m): left[j-1] = t - t_{span+1-j}
+    right = knots[span[None, :] + j] - t[None, :]             # (p, m): right[j-1] = t_{span+j} - t
+    ndu = np.empty((p + 1, p + 1, t.size))
+    ndu[0, 0] = 1.0
     for jj in range(1, p + 1):
-        saved = np.zeros(m)
+        saved = np.zeros(t.size)
         for r in range(jj):
-            ndu[:, jj, r] = right[:, r] + left[:, jj - r - 1]
+            ndu[jj, r] = right[r] + left[jj - r - 1]
             with np.errstate(divide="ignore", invalid="ignore"):
-                temp = np.where(ndu[:, jj, r] != 0.0, ndu[:, r, jj - 1] / ndu[:, jj, r], 0.0)
-            ndu[:, r, jj] = saved + right[:, r] * temp
-            saved = left[:, jj - r - 1] * temp
-        ndu[:, jj, jj] = saved
-    n_order = max(int(order), 0)
-    ders = np.zeros((m, n_order + 1, p + 1))
-    ders[:, 0, :] = ndu[:, :, p]
-    top = min(n_order, p)
-    if top == 0:
-        return ders, span
+                temp = np.where(ndu[jj, r] != 0.0, ndu[r, jj - 1] / ndu[jj, r], 0.0)
+            ndu[r, jj] = saved + right[r] * temp
+            saved = left[jj - r - 1] * temp
+        ndu[jj, jj] = saved
+    return ndu
+
+
+def _derivative_rows(ndu: NDArray, p: int, top: int) -> NDArray:
+    """Derivatives 1..top of the p+1 non-zero basis functions (second half of A2.3).
+
+    Returns
+    -------
+    (top, p + 1, m) float
+    """
+    m = ndu.shape[2]
     with np.errstate(divide="ignore", invalid="ignore"):
         inv_ndu = np.where(ndu != 0.0, 1.0 / ndu, 0.0)
+    out = np.zeros((top, p + 1, m))
     for r in range(p + 1):
-        a = np.zeros((2, m, p + 1))
+        a = np.zeros((2, p + 1, m))
         s1, s2 = 0, 1
-        a[0, :, 0] = 1.0
+        a[0, 0] = 1.0
         for k in range(1, top + 1):
             d = np.zeros(m)
             rk, pk = r - k, p - k
             if r >= k:
-                a[s2, :, 0] = a[s1, :, 0] * inv_ndu[:, pk + 1, rk]
-                d = a[s2, :, 0] * ndu[:, rk, pk]
+                a[s2, 0] = a[s1, 0] * inv_ndu[pk + 1, rk]
+                d = a[s2, 0] * ndu[rk, pk]
             j1 = 1 if rk >= -1 else -rk
             j2 = k - 1 if r - 1 <= pk else p - r
             for jj in range(j1, j2 + 1):
-                a[s2, :, jj] = (a[s1, :, jj] - a[s1, :, jj - 1]) * inv_ndu[:, pk + 1, rk + jj]
-                d = d + a[s2, :, jj] * ndu[:, rk + jj, pk]
+                a[s2, jj] = (a[s1, jj] - a[s1, jj - 1]) * inv_ndu[pk + 1, rk + jj]
+                d += a[s2, jj] * ndu[rk + jj, pk]
             if r <= pk:
-                a[s2, :, k] = -a[s1, :, k - 1] * inv_ndu[:, pk + 1, r]
-                d = d + a[s2, :, k] * ndu[:, r, pk]
-            ders[:, k, r] = d
+                a[s2, k] = -a[s1, k - 1] * inv_ndu[pk + 1, r]
+                d += a[s2, k] * ndu[r, pk]
+            out[k - 1, r] = d
             s1, s2 = s2, s1
     factor = float(p)
     for k in range(1, top + 1):
-        ders[:, k, :] *= factor
+        out[k - 1] *= factor
         factor *= p - k
-    return ders, span
+    return out
 
 
 def collocation_matrix(knots: NDArray, degree: int, t: ArrayLike, order: int = 0) -> NDArray:

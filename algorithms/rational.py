@@ -49,6 +49,12 @@ def curve_derivatives_from_homogeneous(a_ders: NDArray, w_ders: NDArray) -> NDAr
 def surface_derivatives_from_homogeneous(a_ders: NDArray, w_ders: NDArray) -> NDArray:
     """Rational surface derivatives (A4.4 of [PT], eq. 4.20).
 
+    .. math:: S_{kl} = \\Big(A_{kl} - \\sum_{(i,j) \\ne (0,0)}^{i \\le k,\\, j \\le l}
+              \\binom{k}{i}\\binom{l}{j}\\, w_{ij}\\, S_{k-i,\\,l-j}\\Big) / w
+
+    The work runs on a copy with the point axis last, so every operation is one
+    contiguous sweep over all points.
+
     Parameters
     ----------
     a_ders : (m, order + 1, order + 1, d) float
@@ -60,18 +66,17 @@ def surface_derivatives_from_homogeneous(a_ders: NDArray, w_ders: NDArray) -> ND
     (m, order + 1, order + 1, d) float
     """
     order = a_ders.shape[1] - 1
-    out = np.empty_like(a_ders)
-    w0 = w_ders[:, 0, 0, None]
+    a = np.ascontiguousarray(np.moveaxis(a_ders, 0, -1))      # (o+1, o+1, d, m)
+    w = np.ascontiguousarray(np.moveaxis(w_ders, 0, -1))      # (o+1, o+1, m)
+    inv_w = 1.0 / w[0, 0]
+    out = np.empty_like(a)
     for k in range(order + 1):
         for l in range(order + 1):
-            v = a_ders[:, k, l, :].copy()
-            for j in range(1, l + 1):
-                v -= comb(l, j, exact=True) * w_ders[:, 0, j, None] * out[:, k, l - j, :]
-            for i in range(1, k + 1):
-                v -= comb(k, i, exact=True) * w_ders[:, i, 0, None] * out[:, k - i, l, :]
-                v2 = np.zeros_like(v)
-                for j in range(1, l + 1):
-                    v2 += comb(l, j, exact=True) * w_ders[:, i, j, None] * out[:, k - i, l - j, :]
-                v -= comb(k, i, exact=True) * v2
-            out[:, k, l, :] = v / w0
-    return out
+            v = a[k, l].copy()
+            for i in range(k + 1):
+                for j in range(l + 1):
+                    if i or j:
+                        coef = comb(k, i, exact=True) * comb(l, j, exact=True)
+                        v -= (coef * w[i, j]) * out[k - i, l - j]
+            out[k, l] = v * inv_w
+    return np.moveaxis(out, -1, 0)
