@@ -18,7 +18,14 @@ from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import ConversionError
-from .geom import curve2d_to_occ, curve_from_occ, curve_to_occ, surface_from_occ, surface_to_occ
+from .geom import (
+    curve2d_to_occ,
+    curve_from_occ,
+    curve_to_occ,
+    surface_from_occ,
+    surface_to_occ,
+)
+from .io import CadModel
 from .topology import TrimmedFace, edge_to_nurbs, face_to_nurbs, trimmed_face_to_occ
 
 __all__ = ["to_nurbs", "to_occ", "faces_of"]
@@ -66,6 +73,8 @@ def to_nurbs(x: Any) -> NurbsSurface | NurbsCurve | TrimmedFace | list[TrimmedFa
     ``Geom_Curve`` / ``Geom2d_Curve``            :class:`NurbsCurve` (d = 3 / 2)
     ``TopoDS_Face``, ``cadquery.Face``,          :class:`TrimmedFace`
     ``build123d.Face``
+    :class:`~surfprep.plugin.io.CadModel`        ``list[TrimmedFace]`` in file order, each
+                                                 with the face's name from the file
     ``TopoDS_Edge``, cadquery/build123d Edge     :class:`NurbsCurve` (3D, edge range,
                                                  location applied)
     any other ``TopoDS_Shape`` (shell, solid,    ``list[TrimmedFace]``, one per face
@@ -79,6 +88,8 @@ def to_nurbs(x: Any) -> NurbsSurface | NurbsCurve | TrimmedFace | list[TrimmedFa
     ConversionError
         For an unsupported type, or a shape without face.
     """
+    if isinstance(x, CadModel):
+        return [face_to_nurbs(f, name=n) for f, n in zip(x.faces, x.face_names)]
     obj = _unwrap(x)
     if isinstance(obj, Geom_Surface):
         return surface_from_occ(obj)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import build123d as bd
 import cadquery as cq
 import numpy as np
@@ -202,3 +204,13 @@ def test_shapes_without_faces():
 def test_curve_of_unsupported_dimension():
     with pytest.raises(ConversionError, match="dimension"):
         to_occ(NurbsCurve(np.zeros((2, 1)) + [[0.0], [1.0]], [0, 0, 1, 1], 1))
+
+
+def test_cad_model_faces_carry_their_names_from_the_file():
+    from surfprep.plugin.io import read
+
+    sample = Path(__file__).resolve().parents[2] / "step_samples" / "synthetic_named_faces.step"
+    model = read(sample)
+    faces = to_nurbs(model)
+    assert [f.name for f in faces] == list(model.face_names)
+    assert [f.name for f in faces][:2] == ["uniform_patch", "cubic_u_patch"]
