@@ -5,6 +5,9 @@ from .bezier import (bezier_curves, bezier_decompose_array, bezier_patches, bezi
 from .curve import NurbsCurve
 from .degree import (bezier_elevation_matrix, elevate_degree, elevate_degree_array,
                      elevate_degree_surface)
+from .fitting import (approximate_curve, approximation_knots, averaged_knots,
+                      chord_length_parameters, interpolate_curve, interpolate_surface,
+                      knots_from_breakpoints)
 from .isocurve import isocurve
 from .knots import (Direction, clamp, clamp_surface, insert_knot, insert_knot_array,
                     insert_knot_surface, periodic_to_clamped, refine, refine_knots_array,
@@ -31,4 +34,7 @@ __all__ = [
     "bounding_box", "normals", "arc_length", "cumulative_arc_length",
     # isocurve
     "isocurve",
+    # fitting
+    "chord_length_parameters", "averaged_knots", "knots_from_breakpoints",
+    "approximation_knots", "interpolate_curve", "interpolate_surface", "approximate_curve",
 ]
