@@ -1,0 +1,101 @@
+"""TriangleMesh: validation, building from plain arrays, geometry and edge counts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms.intersection.mesh import TriangleMesh, collinear_mask
+from surfprep.errors import DegenerateGeometryError, InvalidGeometryError
+
+SQUARE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+TWO = np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def test_square_geometry():
+    mesh = TriangleMesh(SQUARE, TWO, uv=SQUARE[:, :2], patch=[7, 7])
+    np.testing.assert_allclose(mesh.areas(), [0.5, 0.5])
+    np.testing.assert_allclose(mesh.normals(), [[0, 0, 1], [0, 0, 1]])
+    boxes = mesh.triangle_boxes()
+    assert boxes.shape == (2, 2, 3)
+    np.testing.assert_array_equal(boxes[0], [[0, 0, 0], [1, 1, 0]])
+    edges, counts = mesh.edges()
+    assert edges.shape == (5, 2) and counts.tolist().count(2) == 1
+    assert mesh.boundary_edges().shape == (4, 2)
+    np.testing.assert_array_equal(mesh.triangle_uv()[1], SQUARE[[0, 2, 3], :2])
+    assert mesh.n_vertices == 4 and mesh.n_triangles == 2
+    assert "4 vertices" in repr(mesh)
+
+
+def test_arrays_are_copied_and_read_only():
+    v = SQUARE.copy()
+    mesh = TriangleMesh(v, TWO)
+    v[0, 0] = 5.0
+    assert mesh.vertices[0, 0] == 0.0
+    with pytest.raises(ValueError):
+        mesh.vertices[0, 0] = 1.0
+    assert mesh.triangles.dtype == np.int64
+
+
+@pytest.mark.parametrize("vertices, triangles, kwargs, error, match", [
+    (SQUARE[:, :2], TWO, {}, InvalidGeometryError, "vertices must have shape"),
+    (np.where(SQUARE == 1, np.nan, SQUARE), TWO, {}, InvalidGeometryError, "NaN"),
+    (SQUARE, [[0, 1, 4]], {}, InvalidGeometryError, "outside"),
+    (SQUARE, [[0, 1, -1]], {}, InvalidGeometryError, "outside"),
+    (SQUARE, [[0, 1]], {}, InvalidGeometryError, "triangles must have shape"),
+    (SQUARE, [[0, 1, 1.5]], {}, InvalidGeometryError, "integer"),
+    (SQUARE, TWO, {"uv": np.zeros((3, 2))}, InvalidGeometryError, "uv must have shape"),
+    (SQUARE, TWO, {"uv": np.full((4, 2), np.inf)}, InvalidGeometryError, "uv contains"),
+    (SQUARE, TWO, {"patch": [1]}, InvalidGeometryError, "patch must have shape"),
+    (SQUARE, [[0, 1, 1]], {}, DegenerateGeometryError, "repeats"),
+    (np.array([[0, 0, 0], [1, 1, 1], [2, 2, 2.0]]), [[0, 1, 2]], {}, DegenerateGeometryError,
+     "zero area"),
+    (np.array([[0, 0, 0], [1, 1, 1], [0, 0, 0.0]]), [[0, 1, 2]], {}, DegenerateGeometryError,
+     "zero area"),
+])
+def test_validation(vertices, triangles, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        TriangleMesh(vertices, triangles, **kwargs)
+
+
+def test_degenerate_error_is_an_invalid_geometry_error():
+    with pytest.raises(InvalidGeometryError):
+        TriangleMesh(SQUARE, [[0, 0, 1]])
+
+
+def test_from_soup_merges_equal_corners():
+    soup = SQUARE[TWO]                                  # (2, 3, 3) corners
+    mesh = TriangleMesh.from_arrays(soup)
+    assert mesh.n_vertices == 4 and mesh.n_triangles == 2
+    np.testing.assert_array_equal(mesh.triangle_points(), soup)
+    edges, counts = mesh.edges()
+    assert sorted(counts.tolist()) == [1, 1, 1, 1, 2]
+    assert mesh.uv is None
+
+
+def test_from_arrays_drops_unused_vertices_and_keeps_uv():
+    v = np.concatenate([SQUARE, [[9, 9, 9]]])
+    uv = np.arange(10.0).reshape(5, 2)
+    mesh = TriangleMesh.from_arrays(v, [[4 - 4, 1, 2]], uv=uv)
+    assert mesh.n_vertices == 3
+    np.testing.assert_array_equal(mesh.uv, uv[:3])
+    np.testing.assert_array_equal(mesh.triangle_points()[0], SQUARE[:3])
+
+
+def test_from_arrays_errors():
+    with pytest.raises(InvalidGeometryError, match="soup"):
+        TriangleMesh.from_arrays(SQUARE)
+    with pytest.raises(InvalidGeometryError, match="uv needs"):
+        TriangleMesh.from_arrays(SQUARE[TWO], uv=np.zeros((4, 2)))
+
+
+def test_empty_mesh():
+    mesh = TriangleMesh(np.zeros((0, 3)), np.zeros((0, 3), int))
+    assert mesh.triangle_boxes().shape == (0, 2, 3)
+    assert mesh.bounding_box().shape == (2, 3)
+
+
+def test_collinear_mask_scale_invariant():
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [1, 1e-17, 0], [2, 0, 0]]])
+    for scale in (1e-6, 1.0, 1e6):
+        np.testing.assert_array_equal(collinear_mask(tri * scale), [False, True])
