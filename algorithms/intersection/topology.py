@@ -12,7 +12,9 @@ Step 4 of the SSI pipeline (000 §29.4.5; 004 §5), in arrays instead of linked 
   duplicates (two triangle pairs yielding the same segment across a shared edge)
   are dropped.
 
-Tracing follows the paper's algorithm: curves start at points whose use count is
+Segments keep their input direction, and each traced chain is reversed if most
+of its segments run against it (a ``SegmentSoup`` orients its segments along
+``n_a x n_b``). Tracing follows the paper's algorithm: curves start at points whose use count is
 not 2 and stop at the next such point (a point with more than 2 uses is a
 bifurcation and breaks the curves there); segments left over form closed loops.
 Before tracing, *hanging* ends (one use, not on a domain boundary) closer than
@@ -253,6 +255,19 @@ def _trace(segments: NDArray, uses: NDArray, end_kinds: NDArray) -> tuple[Chain,
     return tuple(chains)
 
 
+def _orient(chain: Chain, segments: NDArray) -> Chain:
+    """Reverse a chain when most of its segments run against it (the soup orients its
+    segments along ``n_a x n_b``, so a chain follows the curve's direction)."""
+    pts, segs = chain.point_ids, chain.segment_ids
+    ahead = np.roll(pts, -1)[: segs.size] if chain.closed else pts[1:]
+    forward = np.count_nonzero(segments[segs, 1] == ahead)
+    if 2 * forward >= segs.size:
+        return chain
+    if chain.closed:
+        return Chain(np.roll(pts[::-1], 1), segs[::-1], True, chain.end_kind, chain.start_kind)
+    return Chain(pts[::-1], segs[::-1], False, chain.end_kind, chain.start_kind)
+
+
 def _end_kinds(uses: NDArray, boundary: NDArray) -> NDArray:
     kinds = np.full(uses.size, None, dtype=object)
     kinds[uses == 1] = EndKind.OPEN
@@ -333,7 +348,7 @@ def build_topology(points: ArrayLike, uv_a: ArrayLike | None = None,
     segments = compact[segments].reshape(-1, 2)
     uses = np.bincount(segments.ravel(), minlength=pts.shape[0])
     kinds = _end_kinds(uses, boundary)
-    chains = _trace(segments, uses, kinds)
+    chains = tuple(_orient(c, segments) for c in _trace(segments, uses, kinds))
     return SegmentTopology(pts, ua, ub, segments, source, uses, kinds, chains)
 
 

@@ -84,6 +84,27 @@ def test_open_chain(seed, n):
     np.testing.assert_array_equal(np.sort(seg, axis=1), pairs)
 
 
+@pytest.mark.parametrize("closed", [False, True])
+def test_chains_follow_segment_direction(closed):
+    """Shuffled but not flipped (as the soup orients them): chains run the input way."""
+    rng = np.random.default_rng(11)
+    line = circle(16) if closed else helix(16)
+    for reverse in (False, True):
+        seq = line[::-1] if reverse else line
+        segs = np.stack([seq[:-1], seq[1:]], axis=1)[rng.permutation(15 if not closed else 16)]
+        segs[:2] = segs[:2, ::-1]                       # a few stray flips are outvoted
+        c = build_topology(segs, tol=TOL).chains[0]
+        p = build_topology(segs, tol=TOL).chain_points(c)
+        step = p[1] - p[0]
+        expected = seq[1] - seq[0] if not closed else None
+        if closed:
+            k = int(np.argmin(np.linalg.norm(seq[:-1] - p[0], axis=1)))
+            expected = seq[k + 1] - seq[k]
+        else:
+            np.testing.assert_allclose(p[0], seq[0], atol=1e-12)
+        np.testing.assert_allclose(step, expected, atol=1e-12)
+
+
 @given(st.integers(0, 2**32 - 1))
 @settings(max_examples=20, deadline=None)
 def test_two_disjoint_loops(seed):
