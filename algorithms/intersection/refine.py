@@ -21,6 +21,10 @@ vectorized over all points still active: per iteration one
   paper's form; where ``|r_w x r_t|`` vanishes (a pole) the 2x2 system is
   singular and the pseudo-inverse ``J^+ dp`` is used instead.
 
+004 §6 builds the third plane through the mesh point and its two projections
+instead; Hosaka's ``F_n`` is used here because with an anchor it fixes where along
+the curve a point lands, which the chord-midpoint insertion relies on.
+
 Iteration stops per point when ``|p - q| <= tol`` (converged points leave the
 active set); parameters are clamped to the domains, and while a step is clamped
 on one surface ``F_n`` passes through that surface's image instead of the
