@@ -26,12 +26,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
-from ..bezier import patch_bounding_boxes
+from ..bezier import bezier_patches, patch_bounding_boxes
 from ..surface import NurbsSurface
-from .tessellation import patch_rectangles
 
 __all__ = ["BoxTree", "build_tree", "tree_pairs", "candidate_pairs", "PatchOverlap",
-           "overlap_boxes", "overlap_patches", "surface_patch_boxes"]
+           "overlap_boxes", "overlap_patches", "surface_patch_boxes", "patch_rectangles",
+           "subpatch_boxes"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -226,6 +226,89 @@ class PatchOverlap:
     patches_b: NDArray
     rects_a: NDArray | None = None
     rects_b: NDArray | None = None
+
+
+def patch_rectangles(surface: NurbsSurface) -> NDArray:
+    """Parameter rectangles of the Bézier patches (knot spans) of a surface.
+
+    Returns
+    -------
+    (ku * kv, 4) float
+        ``[u0, u1, v0, v1]`` of patch ``(i, j)`` at flat index ``i * kv + j`` (the
+        order of :func:`surfprep.algorithms.bezier.patch_bounding_boxes`).
+    """
+    ku, kv = surface.knots_u, surface.knots_v
+    p, q = surface.degree_u, surface.degree_v
+    nu, nv = surface.n_control
+    su = np.flatnonzero(ku[p:nu] < ku[p + 1:nu + 1]) + p
+    sv = np.flatnonzero(kv[q:nv] < kv[q + 1:nv + 1]) + q
+    iu, iv = np.meshgrid(su, sv, indexing="ij")
+    iu, iv = iu.ravel(), iv.ravel()
+    return np.stack([ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]], axis=1)
+
+
+def _blossom_restrict(coeffs: NDArray, s0: NDArray, s1: NDArray) -> NDArray:
+    """Bernstein coefficients of Bézier pieces restricted to local ``[s0, s1]`` (axis 1).
+
+    Coefficient ``i`` of the restriction is the blossom ``f(s0^{p-i}, s1^i)``: one
+    de Casteljau triangle per output, all rows at once.
+
+    Parameters
+    ----------
+    coeffs : (k, p + 1, ...) float
+    s0, s1 : (k,) float
+
+    Returns
+    -------
+    (k, p + 1, ...) float
+    """
+    p = coeffs.shape[1] - 1
+    extra = (1,) * (coeffs.ndim - 2)
+    i = np.arange(p + 1)
+    current = np.repeat(coeffs[:, None], p + 1, axis=1)          # (k, out, p+1, ...)
+    for r in range(1, p + 1):
+        x = np.where(r <= p - i, s0[:, None], s1[:, None]).reshape((-1, p + 1, 1) + extra)
+        current = (1.0 - x) * current[:, :, :-1] + x * current[:, :, 1:]
+    return current[:, :, 0]
+
+
+def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
+    """Control-net boxes of the surface over parameter rectangles inside Bézier patches.
+
+    The restriction of a (rational) Bézier patch to a sub-rectangle is again one,
+    whose Cartesian control points bound it (positive weights), so the box
+    encloses the surface over the rectangle (004 §4.1's secondary decomposition,
+    without building the refined patches).
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+    rects : (k, 4) float
+        ``[u0, u1, v0, v1]``, each inside one knot span in u and one in v.
+
+    Returns
+    -------
+    (k, 2, d) float
+
+    Raises
+    ------
+    InvalidGeometryError
+        A rectangle spanning more than one Bézier patch.
+    """
+    rects = np.asarray(rects, dtype=float).reshape(-1, 4)
+    patches, int_u, int_v = bezier_patches(surface)
+    iu = np.clip(np.searchsorted(int_u[:, 1], rects[:, 0], side="right"), 0, len(int_u) - 1)
+    iv = np.clip(np.searchsorted(int_v[:, 1], rects[:, 2], side="right"), 0, len(int_v) - 1)
+    a, b = int_u[iu, 0], int_u[iu, 1]
+    c, d = int_v[iv, 0], int_v[iv, 1]
+    if np.any((rects[:, 0] < a) | (rects[:, 1] > b) | (rects[:, 2] < c) | (rects[:, 3] > d)):
+        raise InvalidGeometryError("every rectangle must lie inside one Bézier patch")
+    coeffs = patches[iu, iv]                                      # (k, p+1, q+1, d+1)
+    coeffs = _blossom_restrict(coeffs, (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a))
+    coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), (rects[:, 2] - c) / (d - c),
+                               (rects[:, 3] - c) / (d - c))
+    cartesian = coeffs[..., :-1] / coeffs[..., -1:]
+    return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
 
 
 def surface_patch_boxes(surface: NurbsSurface) -> tuple[NDArray, NDArray]:

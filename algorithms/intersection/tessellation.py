@@ -20,7 +20,8 @@ edge quarter points and interior), the largest distance between the surface
 point ``S(u, v)`` and the piecewise-linear interpolant of the rectangle's two
 triangles at the same ``(u, v)``, for the better of the two diagonals. It is
 the quantity the tests measure (surface at the barycentric-interpolated
-``(u, v)`` against the triangle point), in model units. A rectangle is split in
+``(u, v)`` against the triangle point), in model units. Rectangles are split
+until it is below ``0.8 tol``, a margin for what the grid misses. A rectangle is split in
 u, in v or both according to the chord errors of its u- and v-lines, so
 ruled strips are split one way only.
 
@@ -47,11 +48,17 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..surface import NurbsSurface
+from .culling import BoxTree, build_tree, patch_rectangles, subpatch_boxes, tree_pairs
 from .mesh import TriangleMesh, collinear_mask
 
 __all__ = ["Tessellation", "tessellate", "patch_rectangles"]
 
 _SAMPLES = 5                 # test grid per rectangle and direction (quarter points)
+#: leaves are split until their estimated error is below _MARGIN * tol: the margin
+#: covers what the test grid misses between its points and in fan triangles (the
+#: densely measured error exceeded the estimate by up to 7 % on 600 random
+#: bicubic tessellations)
+_MARGIN = 0.8
 _MAX_LEAVES = 4_000_000
 
 
@@ -69,7 +76,7 @@ class Tessellation:
     leaf_region : (L,) int
         Index of the input region each leaf subdivides.
     leaf_error : (L,) float
-        Estimated chord error of each leaf (<= tol unless ``max_depth`` stopped it).
+        Estimated chord error of each leaf (<= 0.8 tol unless ``max_depth`` stopped it).
     depth : int
         Number of refinement levels used.
     """
@@ -79,25 +86,6 @@ class Tessellation:
     leaf_region: NDArray
     leaf_error: NDArray
     depth: int
-
-
-def patch_rectangles(surface: NurbsSurface) -> NDArray:
-    """Parameter rectangles of the Bézier patches (knot spans) of a surface.
-
-    Returns
-    -------
-    (ku * kv, 4) float
-        ``[u0, u1, v0, v1]`` of patch ``(i, j)`` at flat index ``i * kv + j`` (the
-        order of :func:`surfprep.algorithms.bezier.patch_bounding_boxes`).
-    """
-    ku, kv = surface.knots_u, surface.knots_v
-    p, q = surface.degree_u, surface.degree_v
-    nu, nv = surface.n_control
-    su = np.flatnonzero(ku[p:nu] < ku[p + 1:nu + 1]) + p
-    sv = np.flatnonzero(kv[q:nv] < kv[q + 1:nv + 1]) + q
-    iu, iv = np.meshgrid(su, sv, indexing="ij")
-    iu, iv = iu.ravel(), iv.ravel()
-    return np.stack([ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]], axis=1)
 
 
 # ------------------------------------------------------------ chord error
@@ -174,15 +162,30 @@ def _split(rects: NDArray, region: NDArray, split_u: NDArray, split_v: NDArray
     return np.stack([ua, ub, va, vb], axis=1), region[parent]
 
 
-def _refine(surface: NurbsSurface, regions: NDArray, tol: float, max_depth: int
-            ) -> tuple[NDArray, NDArray, NDArray, NDArray, int]:
+def _near(surface: NurbsSurface, rects: NDArray, keep: BoxTree | None, pad: float) -> NDArray:
+    """Mask of rectangles whose sub-patch box is within ``pad`` of some keep box."""
+    if keep is None:
+        return np.ones(rects.shape[0], bool)
+    pairs = tree_pairs(build_tree(subpatch_boxes(surface, rects)), keep, pad=pad)
+    mask = np.zeros(rects.shape[0], bool)
+    mask[pairs[:, 0]] = True
+    return mask
+
+
+def _refine(surface: NurbsSurface, regions: NDArray, tol: float, max_depth: int,
+            keep: BoxTree | None, pad: float) -> tuple[NDArray, NDArray, NDArray, NDArray, int]:
     """Breadth-first refinement: leaves, their regions, errors and diagonals."""
     rects, region = regions, np.arange(regions.shape[0])
-    out_rects, out_region, out_err, out_diag = [], [], [], []
+    out_rects, out_region = [np.zeros((0, 4))], [np.zeros(0, np.int64)]
+    out_err, out_diag = [np.zeros(0)], [np.zeros(0, np.int64)]
     depth = 0
     while rects.shape[0]:
+        near = _near(surface, rects, keep, pad)
+        rects, region = rects[near], region[near]
+        if rects.shape[0] == 0:
+            break
         err, diag, eu, ev = _chord_errors(surface, rects)
-        done = (err <= tol) | (depth >= max_depth)
+        done = (err <= _MARGIN * tol) | (depth >= max_depth)
         out_rects.append(rects[done])
         out_region.append(region[done])
         out_err.append(err[done])
@@ -325,7 +328,8 @@ def _check_regions(surface: NurbsSurface, regions: ArrayLike | None) -> NDArray:
 
 
 def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = None, *,
-               max_depth: int = 24) -> Tessellation:
+               max_depth: int = 24, keep_boxes: ArrayLike | None = None,
+               keep_pad: float = 0.0) -> Tessellation:
     """Adaptive crack-free triangulation of ``surface`` over parameter regions.
 
     Parameters
@@ -342,6 +346,13 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
     max_depth : int
         Refinement levels at most; leaves still above ``tol`` then are kept
         (their ``leaf_error`` says so).
+    keep_boxes : (b, 2, 3) float, optional
+        Overlap boxes (004 §4.2): at every level, rectangles whose sub-patch
+        control-net box (:func:`.culling.subpatch_boxes`, which encloses the
+        surface there) is farther than ``keep_pad`` from every keep box are
+        dropped, so only the surface near the boxes is triangulated. Needs every
+        region inside one Bézier patch (as the default regions are).
+    keep_pad : float >= 0
 
     Returns
     -------
@@ -361,13 +372,15 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
     if not (np.isfinite(tol) and tol > 0):
         raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
     regions = _check_regions(surface, regions)
-    if regions.shape[0] == 0:
+    keep = None if keep_boxes is None else build_tree(np.reshape(keep_boxes, (-1, 2, 3)))
+    leaves, region, err, diag, depth = _refine(surface, regions, float(tol), int(max_depth),
+                                               keep, float(keep_pad))
+    if leaves.shape[0] == 0:
         empty = TriangleMesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros((0, 2)),
                              np.zeros(0, np.int64))
-        return Tessellation(empty, np.zeros((0, 4)), np.zeros(0, np.int64), np.zeros(0), 0)
-    leaves, region, err, diag, depth = _refine(surface, regions, float(tol), int(max_depth))
+        return Tessellation(empty, leaves, region, err, depth)
     uv, triangles, leaf_of = _triangulate_leaves(leaves, diag)
     xyz = surface.evaluate(uv[:, 0], uv[:, 1])
-    keep = ~collinear_mask(xyz[triangles])
-    mesh = TriangleMesh(xyz, triangles[keep], uv, leaf_of[keep])
+    solid = ~collinear_mask(xyz[triangles])
+    mesh = TriangleMesh(xyz, triangles[solid], uv, leaf_of[solid])
     return Tessellation(mesh, leaves, region, err, depth)

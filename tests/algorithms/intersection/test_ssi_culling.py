@@ -148,3 +148,30 @@ def test_far_apart_surfaces_have_no_overlap():
     # a pad larger than the gap makes them overlap
     near = overlap_patches(sphere_band(), sphere_band(centre=(2.5, 0, 0)), pad=0.6)
     assert near.pairs.shape[0] > 0
+
+
+def test_subpatch_boxes_enclose_the_surface():
+    from surfprep.algorithms.intersection.culling import patch_rectangles, subpatch_boxes
+    surface = sphere_band()
+    rects = patch_rectangles(surface)
+    rng = np.random.default_rng(5)
+    k = rng.integers(0, rects.shape[0], 300)
+    t, w = np.sort(rng.random((300, 2)), axis=1), np.sort(rng.random((300, 2)), axis=1)
+    u0, u1, v0, v1 = rects[k].T
+    sub = np.stack([u0 + (u1 - u0) * t[:, 0], u0 + (u1 - u0) * t[:, 1],
+                    v0 + (v1 - v0) * w[:, 0], v0 + (v1 - v0) * w[:, 1]], axis=1)
+    boxes = subpatch_boxes(surface, sub)
+    g = np.linspace(0, 1, 9)
+    u = sub[:, :1] + (sub[:, 1:2] - sub[:, :1]) * g
+    v = sub[:, 2:3] + (sub[:, 3:4] - sub[:, 2:3]) * g
+    points = surface.evaluate(u[:, :, None], v[:, None, :])
+    assert np.all(points >= boxes[:, None, None, 0] - 1e-14)
+    assert np.all(points <= boxes[:, None, None, 1] + 1e-14)
+    # whole patches: the patch control-net boxes
+    np.testing.assert_allclose(subpatch_boxes(surface, rects), surface_patch_boxes(surface)[0],
+                               atol=1e-15)
+    # small rectangles: tight boxes
+    tiny = np.array([[0.1, 0.1 + 1e-4, 0.5, 0.5 + 1e-4]])
+    assert np.all(np.ptp(subpatch_boxes(surface, tiny)[0], axis=0) < 1e-3)
+    with pytest.raises(InvalidGeometryError, match="one Bézier patch"):
+        subpatch_boxes(surface, [[0.2, 0.3, 0, 1]])

@@ -220,3 +220,24 @@ def test_random_surfaces(seed, amplitude, tol):
     assert max_deviation(surface, tess.mesh, n=4) <= tol
     assert_watertight(tess, patch_rectangles(surface))
     assert_unique_vertices(tess.mesh)
+
+
+def test_keep_boxes_prune_the_refinement():
+    """Only rectangles near the keep box are refined; the part kept is the full one's."""
+    surface = sphere_band()
+    tol = 2e-3
+    box = np.array([[[0.9, -0.2, -0.1], [1.1, 0.2, 0.1]]])
+    full = tessellate(surface, tol)
+    pruned = tessellate(surface, tol, keep_boxes=box, keep_pad=2 * tol)
+    assert 0 < pruned.mesh.n_triangles < full.mesh.n_triangles / 4
+    # every full-mesh triangle that meets the box is in the pruned mesh, bitwise
+    boxes = full.mesh.triangle_boxes()
+    near = np.all((boxes[:, 0] <= box[0, 1]) & (boxes[:, 1] >= box[0, 0]), axis=1)
+    wanted = {tuple(t.ravel()) for t in full.mesh.triangle_points()[near]}
+    got = {tuple(t.ravel()) for t in pruned.mesh.triangle_points()}
+    assert wanted <= got
+    edges, counts = pruned.mesh.edges()
+    assert set(np.unique(counts)) <= {1, 2}
+    assert max_deviation(surface, pruned.mesh) <= tol
+    far = tessellate(surface, tol, keep_boxes=box + 10.0)
+    assert far.mesh.n_triangles == 0 and far.leaves.shape == (0, 4)
