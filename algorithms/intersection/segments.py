@@ -1,0 +1,283 @@
+"""From two operands to the soup of intersection segments (000 §29.4.1 steps 1-4).
+
+:func:`mesh_segments` runs the first half of the SSI pipeline:
+
+1. overlap boxes of the Bézier patch boxes (004 §4.2, :func:`.culling.overlap_boxes`);
+2. adaptive tessellation of only the patches that take part (004 §4.3,
+   :func:`.tessellation.tessellate`), pruned during refinement so the work
+   follows the intersection: a's sub-rectangles must come near a coarse
+   tessellation of b (itself pruned by the overlap boxes), b's near a triangle
+   of a;
+3. box trees over both triangulations and their batched traversal, giving the
+   candidate triangle pairs (000 §29.4.4, :func:`.culling.candidate_pairs`);
+4. triangle-triangle intersection of the candidates (000 §29.4.3,
+   :func:`.triangles.intersect_triangles`), with the (u, v) of every segment end
+   on both surfaces by the barycentric map.
+
+The result, a :class:`SegmentSoup`, is unordered: sorting the segments into
+curves (§29.4.5) and refining them onto the exact surfaces (§29.4.6, 004 §6)
+are later stages.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError, InvalidToleranceError
+from ..surface import NurbsSurface
+from .culling import candidate_pairs, overlap_boxes, surface_patch_boxes
+from .mesh import TriangleMesh
+from .tessellation import tessellate
+from .triangles import TriangleHits, intersect_triangles
+
+__all__ = ["SegmentSoup", "SoupStats", "mesh_segments"]
+
+Operand = NurbsSurface | TriangleMesh
+
+#: tolerance factor of the coarse tessellation of b that guides a's refinement
+_COARSE = 32.0
+
+
+@dataclass(frozen=True)
+class SoupStats:
+    """Work counts of one :func:`mesh_segments` run.
+
+    Attributes
+    ----------
+    patches_a, patches_b : int
+        Bézier patches of each surface (0 for a mesh operand).
+    overlap_pairs : int
+        Overlapping patch-box pairs (004 §4.2; for a mesh side each triangle is a "patch").
+    tessellated_a, tessellated_b : int
+        Patches tessellated (those in some overlap pair).
+    candidate_pairs : int
+        Triangle pairs whose boxes overlap (the tree traversal's output).
+    """
+
+    patches_a: int
+    patches_b: int
+    overlap_pairs: int
+    tessellated_a: int
+    tessellated_b: int
+    candidate_pairs: int
+
+
+@dataclass(frozen=True, eq=False)
+class SegmentSoup:
+    """Unordered intersection segments of two triangulated operands.
+
+    Segment ``i`` is the intersection of triangle ``tri_a[i]`` of ``mesh_a`` with
+    triangle ``tri_b[i]`` of ``mesh_b``. Contract for the later stages:
+
+    Attributes
+    ----------
+    points : (k, 2, 3) float
+        End points of each segment, oriented along ``n_a x n_b`` (the right-hand
+        normals of the two triangles; for tessellated surfaces these follow
+        ``S_u x S_v``), so the segments of one curve run the same way. An end
+        produced by the same mesh edge and the same other triangle is bitwise the
+        same point in every segment that has it (see :meth:`end_keys`).
+    uv_a, uv_b : (k, 2, 2) float or None
+        ``(u, v)`` of each end on surface a (b), interpolated with the
+        barycentric coordinates in the triangle from its vertices' exact
+        parameters (000 §29.4.2's uv connectivity); ``None`` for a side given as a
+        plain mesh without ``uv``.
+    tri_a, tri_b : (k,) int
+        Triangle of each mesh the segment lies in.
+    bary_a, bary_b : (k, 2, 3) float
+        Barycentric coordinates of each end in ``tri_a`` (``tri_b``).
+    end_source : (k, 2) int
+        0: the end is where an edge of ``tri_a`` crosses ``tri_b``; 1: an edge of
+        ``tri_b`` crossing ``tri_a``.
+    end_edge : (k, 2) int
+        Local edge id (0: corners 0-1, 1: 1-2, 2: 2-0) of that triangle.
+    touching_points : (t, 3) float
+        Pairs of triangles that meet in a single point only (tangential contact
+        or a curve through a mesh vertex), minus points that are also segment
+        ends. Hints only: 000 drops them.
+    touching_pairs : (t, 2) int
+        ``(triangle of a, triangle of b)`` of each touching point.
+    touching_uv_a, touching_uv_b : (t, 2) float or None
+    coplanar_pairs : (c, 2) int
+        ``(triangle of a, triangle of b)`` lying in one plane (to rounding) and
+        overlapping there; no segment is made for them.
+    mesh_a, mesh_b : TriangleMesh
+        The triangulations intersected (for a surface: of the patches in overlap
+        boxes only, with ``uv``; for a mesh operand: that mesh).
+    tol : float
+        The tessellation tolerance (model units).
+    stats : SoupStats
+    """
+
+    points: NDArray
+    uv_a: NDArray | None
+    uv_b: NDArray | None
+    tri_a: NDArray
+    tri_b: NDArray
+    bary_a: NDArray
+    bary_b: NDArray
+    end_source: NDArray
+    end_edge: NDArray
+    touching_points: NDArray
+    touching_pairs: NDArray
+    touching_uv_a: NDArray | None
+    touching_uv_b: NDArray | None
+    coplanar_pairs: NDArray
+    mesh_a: TriangleMesh
+    mesh_b: TriangleMesh
+    tol: float
+    stats: SoupStats = field(repr=False)
+
+    @property
+    def n_segments(self) -> int:
+        return self.points.shape[0]
+
+    def end_keys(self) -> NDArray:
+        """Combinatorial identity of every segment end: (k, 2, 4) int.
+
+        ``(side, v0, v1, other)``: the end is where edge ``(v0, v1)`` (``v0 <
+        v1``, vertex ids of mesh a for side 0, of mesh b for side 1) crosses
+        triangle ``other`` of the other mesh. Ends with equal keys are bitwise
+        equal points, so segments can be chained without a distance test
+        (except through mesh vertices, where different edges give one point).
+        """
+        other = np.where(self.end_source == 0, self.tri_b[:, None], self.tri_a[:, None])
+        corners = np.where((self.end_source == 0)[..., None],
+                           self.mesh_a.triangles[self.tri_a][:, None],
+                           self.mesh_b.triangles[self.tri_b][:, None])         # (k, 2, 3)
+        e = self.end_edge
+        v0 = np.take_along_axis(corners, e[..., None], axis=2)[..., 0]
+        v1 = np.take_along_axis(corners, ((e + 1) % 3)[..., None], axis=2)[..., 0]
+        return np.stack([self.end_source, np.minimum(v0, v1), np.maximum(v0, v1), other],
+                        axis=-1)
+
+
+# ----------------------------------------------------------------- driver
+def _operand_boxes(operand: Operand, tol: float) -> tuple[NDArray, NDArray | None, int, float]:
+    """Boxes to cull with, parameter rectangles (surfaces), patch count, padding."""
+    if isinstance(operand, NurbsSurface):
+        if operand.dimension != 3:
+            raise InvalidGeometryError(
+                f"intersection needs surfaces in 3D, got dimension {operand.dimension}")
+        boxes, rects = surface_patch_boxes(operand)
+        return boxes, rects, boxes.shape[0], 2.0 * tol
+    if isinstance(operand, TriangleMesh):
+        return operand.triangle_boxes(), None, 0, 0.0
+    raise InvalidGeometryError(
+        f"an operand must be a NurbsSurface or a TriangleMesh, got {type(operand).__name__}")
+
+
+def _mesh_of(operand: Operand, rects: NDArray | None, patches: NDArray, keep: NDArray,
+             tol: float, pad: float, max_depth: int) -> TriangleMesh:
+    if isinstance(operand, TriangleMesh):
+        return operand
+    return tessellate(operand, tol, rects[patches], max_depth=max_depth, keep_boxes=keep,
+                      keep_pad=pad).mesh
+
+
+def _guide(b: Operand, rects_b: NDArray | None, overlap, tol: float, max_depth: int
+           ) -> tuple[NDArray, float]:
+    """Boxes near operand b to prune a's refinement with, and their padding.
+
+    A mesh gives its triangle boxes; a surface a coarse tessellation (tolerance
+    ``_COARSE tol``, itself pruned by the overlap boxes) whose triangle boxes,
+    widened by twice the coarse tolerance, hold the surface b near the overlap.
+    """
+    if isinstance(b, TriangleMesh):
+        return b.triangle_boxes(), 0.0
+    coarse = _COARSE * tol
+    mesh = _mesh_of(b, rects_b, overlap.patches_b, overlap.boxes, coarse, 2.0 * coarse,
+                    max_depth)
+    return mesh.triangle_boxes(), 2.0 * coarse
+
+
+def _interpolate_uv(mesh: TriangleMesh, tri: NDArray, bary: NDArray) -> NDArray | None:
+    """(u, v) at barycentric coordinates: (..., 2) float, or None without uv."""
+    if mesh.uv is None:
+        return None
+    corners = mesh.uv[mesh.triangles[tri]]                 # (k, 3, 2)
+    if bary.ndim == 3:
+        return np.einsum("kec,kcd->ked", bary, corners)
+    return np.einsum("kc,kcd->kd", bary, corners)
+
+
+def _not_segment_ends(touch: NDArray, ends: NDArray) -> NDArray:
+    """Mask of touching points (t, 3) that are not bitwise segment ends (e, 3)."""
+    if touch.shape[0] == 0 or ends.shape[0] == 0:
+        return np.ones(touch.shape[0], bool)
+    _, inverse = np.unique(np.concatenate([touch, ends]), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    return ~np.isin(inverse[:touch.shape[0]], inverse[touch.shape[0]:])
+
+
+def _soup(hits: TriangleHits, pairs: NDArray, mesh_a: TriangleMesh, mesh_b: TriangleMesh,
+          tol: float, stats: SoupStats) -> SegmentSoup:
+    tri_a, tri_b = pairs[hits.index, 0], pairs[hits.index, 1]
+    keep = _not_segment_ends(hits.touch_points, hits.segments.reshape(-1, 3))
+    touch_pairs = pairs[hits.touch_index[keep]]
+    touch_ba, touch_bb = hits.touch_bary_a[keep], hits.touch_bary_b[keep]
+    return SegmentSoup(
+        points=hits.segments, tri_a=tri_a, tri_b=tri_b,
+        uv_a=_interpolate_uv(mesh_a, tri_a, hits.bary_a),
+        uv_b=_interpolate_uv(mesh_b, tri_b, hits.bary_b),
+        bary_a=hits.bary_a, bary_b=hits.bary_b, end_source=hits.source, end_edge=hits.edge,
+        touching_points=hits.touch_points[keep], touching_pairs=touch_pairs,
+        touching_uv_a=_interpolate_uv(mesh_a, touch_pairs[:, 0], touch_ba),
+        touching_uv_b=_interpolate_uv(mesh_b, touch_pairs[:, 1], touch_bb),
+        coplanar_pairs=pairs[hits.coplanar_index], mesh_a=mesh_a, mesh_b=mesh_b,
+        tol=tol, stats=stats)
+
+
+def mesh_segments(a: Operand, b: Operand, *, tol: float, max_depth: int = 24) -> SegmentSoup:
+    """Intersection segments of two surfaces and/or triangle meshes (000 §29.4.1, steps 1-4).
+
+    Parameters
+    ----------
+    a, b : NurbsSurface (dimension 3) or TriangleMesh
+    tol : float > 0
+        Chord tolerance of the tessellations, model units
+        (:func:`.tessellation.tessellate`); also widens the patch boxes in the
+        overlap test by ``2 tol`` per surface, so no triangle pair is lost.
+        Surface a is refined only where its sub-patch boxes come near a coarse
+        (``32 tol``) tessellation of b, surface b only where they come within
+        ``2 tol`` of a box of a's triangles, so the work follows the intersection.
+    max_depth : int
+        Refinement levels at most.
+
+    Returns
+    -------
+    SegmentSoup
+        Surfaces whose patch boxes do not overlap give an empty soup without
+        any tessellation.
+
+    Raises
+    ------
+    InvalidToleranceError
+        ``tol`` not finite and positive.
+    InvalidGeometryError
+        An operand of another type, or a surface not in 3D.
+    """
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
+    tol = float(tol)
+    boxes_a, rects_a, n_a, pad_a = _operand_boxes(a, tol)
+    boxes_b, rects_b, n_b, pad_b = _operand_boxes(b, tol)
+    # each side's boxes widened by its own pad (2 tol for a surface: its triangles
+    # stray that little from it), so the overlap boxes hold every close triangle pair
+    overlap = overlap_boxes(boxes_a + [[-pad_a], [pad_a]], boxes_b + [[-pad_b], [pad_b]])
+    guide, guide_pad = _guide(b, rects_b, overlap, tol, max_depth)
+    mesh_a = _mesh_of(a, rects_a, overlap.patches_a, guide, tol, pad_a + guide_pad, max_depth)
+    # b is refined only near a's triangles
+    mesh_b = _mesh_of(b, rects_b, overlap.patches_b, mesh_a.triangle_boxes(), tol, pad_b,
+                      max_depth)
+    pairs = candidate_pairs(mesh_a.triangle_boxes(), mesh_b.triangle_boxes())
+    hits = intersect_triangles(mesh_a.triangle_points()[pairs[:, 0]],
+                               mesh_b.triangle_points()[pairs[:, 1]])
+    stats = SoupStats(n_a, n_b, overlap.pairs.shape[0],
+                      overlap.patches_a.size if rects_a is not None else 0,
+                      overlap.patches_b.size if rects_b is not None else 0,
+                      pairs.shape[0])
+    return _soup(hits, pairs, mesh_a, mesh_b, tol, stats)
