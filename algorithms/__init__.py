@@ -14,6 +14,8 @@ from .knots import (Direction, clamp, clamp_surface, insert_knot, insert_knot_ar
                     refine_surface, restrict, restrict_array, restrict_surface, split,
                     split_surface)
 from .measure import arc_length, bounding_box, cumulative_arc_length, normals
+from .projection import (CurveProjectionResult, ProjectionResult, distance_to_curve,
+                         distance_to_surface, project_to_curve, project_to_surface)
 from .surface import NurbsSurface
 
 __all__ = [
@@ -37,4 +39,7 @@ __all__ = [
     # fitting
     "chord_length_parameters", "averaged_knots", "knots_from_breakpoints",
     "approximation_knots", "interpolate_curve", "interpolate_surface", "approximate_curve",
+    # projection
+    "ProjectionResult", "CurveProjectionResult", "project_to_surface", "project_to_curve",
+    "distance_to_surface", "distance_to_curve",
 ]

@@ -1,0 +1,616 @@
+"""Closest points on NURBS surfaces and curves (point inversion), vectorized over points.
+
+For a query point ``P`` the foot point minimizes ``f(u, v) = |S(u, v) - P|^2 / 2``
+over the parameter rectangle. With ``r = S(u, v) - P`` (section 6.1 of [PT]):
+
+.. math:: \\nabla f = \\begin{pmatrix} r \\cdot S_u \\\\ r \\cdot S_v \\end{pmatrix},
+          \\qquad
+          \\nabla^2 f = \\begin{pmatrix} |S_u|^2 + r \\cdot S_{uu} & S_u \\cdot S_v + r \\cdot S_{uv} \\\\
+                                         S_u \\cdot S_v + r \\cdot S_{uv} & |S_v|^2 + r \\cdot S_{vv}
+                        \\end{pmatrix}  \\qquad (6.6, 6.7)
+
+and Newton's step solves ``H delta = -grad f``. The method, for all points at once:
+
+1. **Seeds.** The surface is sampled on a grid a few times denser than its knot
+   spans (``evaluate_grid``); a :class:`scipy.spatial.cKDTree` gives each
+   query's nearest samples. The nearest one (distance ``d0``) is always a
+   seed; up to ``n_seeds - 1`` more are taken among the samples within
+   ``d0 + h`` (``h`` the largest grid cell size: every closer basin has a
+   sample there) that are local minima of the distance on the grid and not
+   grid neighbours of the nearest, so a point over a fold or a narrow neck
+   also starts on the other sheet, while a point over a plain region costs
+   one seed. Every
+   (point, seed) pair is one Newton problem.
+2. **Newton with bounds.** A parameter at a bound whose gradient pushes
+   outward is fixed for that iteration (the problem continues in 1D along the
+   boundary, or stops at a corner); the others take the Newton step of the
+   full Hessian when it is positive definite, else of the Hessian shifted to
+   be positive definite (a descent step that follows negative curvature),
+   projected onto the box. A step that increases the distance is halved (up
+   to 30 times); each accepted step decreases the distance, so a result is
+   never farther than its seed sample.
+3. **Convergence** (eq. 6.8 of [PT], in model units): the point coincides
+   (``|r| <= tol``), or the zero-cosine test holds for the free parameters,
+   written as tangential residuals ``|r . S_u| / |S_u| <= tol`` (the 3D
+   distance from the foot along the tangent), or the 3D step
+   ``|S(x_new) - S(x)|`` is ``<= tol``. The step of the iteration that passes
+   the test is still applied, which squares the error (Newton).
+   Only the unconverged problems are evaluated in each iteration.
+4. The best result over the seeds of each query is returned.
+
+Curves are the same with one parameter (``r . C'`` and ``|C'|^2 + r . C''``).
+
+References
+----------
+.. [PT] L. Piegl, W. Tiller, *The NURBS Book*, 2nd ed., Springer 1997:
+   section 6.1 (point inversion and projection, eqs. 6.3-6.8).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
+
+from ..errors import InvalidGeometryError, InvalidToleranceError
+from .basis import distinct_knots
+from .curve import NurbsCurve
+from .surface import NurbsSurface
+
+__all__ = [
+    "ProjectionResult",
+    "CurveProjectionResult",
+    "project_to_surface",
+    "project_to_curve",
+    "distance_to_surface",
+    "distance_to_curve",
+    "DEFAULT_RELATIVE_TOL",
+]
+
+#: Default ``tol``: this fraction of the control-net bounding-box diagonal.
+DEFAULT_RELATIVE_TOL = 1e-10
+_MAX_HALVINGS = 30
+_SAMPLE_BUDGET = 200_000
+_CANDIDATES = 24
+_MAX_CROSSINGS = 8
+_NUDGE = 1e-13
+_MIN_SAMPLES = 128      # grid intervals per surface direction, at least
+
+
+@dataclass(frozen=True)
+class ProjectionResult:
+    """Closest points on a surface.
+
+    Attributes
+    ----------
+    uv : (..., 2) float
+        Parameters of the foot points, inside the domain.
+    points : (..., 3) float
+        Foot points ``S(uv)``.
+    distance : (...) float
+        ``|P - S(uv)|``.
+    converged : (...) bool
+        The convergence test passed (False: iteration limit or no descent
+        before the test passed; the result is still the best point found).
+    """
+
+    uv: NDArray
+    points: NDArray
+    distance: NDArray
+    converged: NDArray
+
+
+@dataclass(frozen=True)
+class CurveProjectionResult:
+    """Closest points on a curve: ``t (...)``, ``points (..., d)``, ``distance (...)``,
+    ``converged (...)`` as in :class:`ProjectionResult`."""
+
+    t: NDArray
+    points: NDArray
+    distance: NDArray
+    converged: NDArray
+
+
+# ----------------------------------------------------------------- validation
+def _check_points(points: ArrayLike, dimension: int) -> NDArray:
+    p = np.asarray(points, dtype=float)
+    if p.ndim < 1 or p.shape[-1] != dimension:
+        raise InvalidGeometryError(
+            f"points must have shape (..., {dimension}), got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise InvalidGeometryError("points contain NaN or infinite values")
+    return p
+
+
+def _tolerance(tol: float | None, geometry) -> float:
+    box = geometry.bounding_box()
+    diagonal = float(np.linalg.norm(box[1] - box[0]))
+    if tol is None:
+        return DEFAULT_RELATIVE_TOL * max(diagonal, np.finfo(float).tiny)
+    try:
+        tol = float(tol)
+    except (TypeError, ValueError):
+        raise InvalidToleranceError(f"tol must be a positive number, got {tol!r}") from None
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
+    return tol
+
+
+def _check_count(value: int, name: str, minimum: int) -> int:
+    if isinstance(value, bool) or int(value) != value or value < minimum:
+        raise InvalidGeometryError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+# -------------------------------------------------------------------- seeds
+def _span_samples(knots: NDArray, degree: int, counts: NDArray) -> NDArray:
+    """``counts[i]`` equal steps in the i-th non-empty knot span of the domain: (s,) float."""
+    breaks, _ = distinct_knots(knots, degree)
+    span = np.repeat(np.arange(counts.size), counts)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    frac = (np.arange(span.size) - start[span]) / counts[span]
+    inner = breaks[span] + np.diff(breaks)[span] * frac
+    return np.concatenate([inner, breaks[-1:]])
+
+
+def _span_extents(net: NDArray, knots: NDArray, degree: int) -> NDArray:
+    """Length of the control polygon over each non-empty knot span, along axis 0 of
+    ``net (n, ..., d)`` (the longest over the other axes, leg by leg): (S,) float."""
+    n = net.shape[0]
+    legs = np.linalg.norm(np.diff(net, axis=0), axis=-1).reshape(n - 1, -1).max(axis=1)
+    cumulative = np.concatenate([[0.0], np.cumsum(legs)])
+    spans = np.flatnonzero(knots[degree:n] < knots[degree + 1:n + 1]) + degree
+    return cumulative[spans] - cumulative[spans - degree]
+
+
+def _span_counts(extents: NDArray, degree: int, total: int) -> NDArray:
+    """About ``total`` samples shared among the spans in proportion to their extent,
+    at least ``degree + 1`` per span: (S,) int."""
+    weight = extents / extents.sum() if extents.sum() > 0 else np.full(extents.size,
+                                                                       1 / extents.size)
+    return np.maximum(degree + 1, np.ceil(total * weight)).astype(int)
+
+
+def _sample_counts(extents: list[NDArray], degrees: list[int], per_span: int | None,
+                   minimum: int, density: int = 2) -> list[NDArray]:
+    """Samples per span and direction: ``per_span`` everywhere when given, else at least
+    ``max(minimum, density (degree + 1) spans)`` per direction shared by control-polygon
+    extent, reduced until the grid fits :data:`_SAMPLE_BUDGET`."""
+    if per_span is not None:
+        per_span = _check_count(per_span, "samples_per_span", 1)
+        return [np.full(e.size, per_span) for e in extents]
+    totals = [max(minimum, density * (p + 1) * e.size) for e, p in zip(extents, degrees)]
+    while True:
+        counts = [_span_counts(e, p, t) for e, p, t in zip(extents, degrees, totals)]
+        size = np.prod([c.sum() + 1 for c in counts])
+        if size <= _SAMPLE_BUDGET or max(totals) <= 2:
+            return counts
+        i = int(np.argmax(totals))
+        totals[i] = max(2, int(totals[i] * 0.7))
+
+
+def _grid_spacing(grid: NDArray) -> float:
+    """Longest edge or diagonal of a sample grid ``(a, [b,] d)`` cell: every point of
+    the surface lies within this distance of some sample."""
+    if grid.ndim == 2:
+        return float(np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(initial=0.0))
+    steps = [grid[1:, :] - grid[:-1, :], grid[:, 1:] - grid[:, :-1],
+             grid[1:, 1:] - grid[:-1, :-1], grid[1:, :-1] - grid[:-1, 1:]]
+    return max(float(np.linalg.norm(s, axis=-1).max(initial=0.0)) for s in steps)
+
+
+def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
+    """(query, sample) pairs for the Newton starts.
+
+    The nearest sample (distance ``d0``) is always a seed. Any basin whose minimum
+    is closer than ``d0`` holds a sample within ``d0 + h`` (``h`` the longest
+    grid cell edge or diagonal), so up to ``n_seeds - 1`` more seeds are taken
+    among the samples within that radius (of the ``_CANDIDATES`` nearest) that
+    are local minima of the distance on the grid (no grid neighbour closer)
+    and not grid neighbours of the nearest sample, closest first.
+
+    Parameters
+    ----------
+    grid : (a, [b,] d) float
+        Samples on a 1D or 2D parameter grid.
+
+    Returns
+    -------
+    rows : (s,) int, every query at least once
+    sample : (s,) int, flat index into the grid
+    """
+    shape = grid.shape[:-1]
+    samples = grid.reshape(-1, grid.shape[-1])
+    k = min(_CANDIDATES, samples.shape[0])
+    dist, nearest = cKDTree(samples).query(points, k=k, workers=-1)
+    dist, nearest = dist.reshape(points.shape[0], k), nearest.reshape(points.shape[0], k)
+    if n_seeds == 1 or k == 1:
+        return np.arange(points.shape[0]), nearest[:, 0]
+    index = np.stack(np.unravel_index(nearest, shape), axis=-1)          # (m, k, dims)
+    candidate = (np.abs(index - index[:, :1]).max(axis=2) > 1) \
+        & (dist <= dist[:, :1] + _grid_spacing(grid))
+    offsets = np.array(list(itertools.product((-1, 0, 1), repeat=len(shape))))
+    rows, cols = np.nonzero(candidate)
+    for part in np.array_split(np.arange(rows.size), 1 + rows.size // 50_000):
+        r, c = rows[part], cols[part]
+        around = np.clip(index[r, c, None, :] + offsets, 0, np.array(shape) - 1)
+        flat = np.ravel_multi_index(tuple(np.moveaxis(around, -1, 0)), shape)
+        near = np.linalg.norm(samples[flat] - points[r, None, :], axis=-1).min(axis=1)
+        here = np.linalg.norm(samples[nearest[r, c]] - points[r], axis=-1)
+        candidate[r, c] = here <= near
+    candidate[:, 0] = True
+    keep = candidate & (np.cumsum(candidate, axis=1) <= n_seeds)
+    rows, cols = np.nonzero(keep)
+    return rows, nearest[rows, cols]
+
+
+def _best_per_query(rows: NDArray, distance: NDArray) -> NDArray:
+    """Index of the smallest distance among the candidates of each query (rows sorted)."""
+    if rows.size == 0:
+        return rows
+    order = np.lexsort((distance, rows))
+    first = np.r_[True, rows[order][1:] != rows[order][:-1]]
+    return order[first]
+
+
+# ----------------------------------------------------------------- Newton
+def _solve_small(a: NDArray, b: NDArray) -> NDArray:
+    """Solve ``a x = b`` for batches of 1x1 or 2x2 systems; a zero determinant gives 0."""
+    if a.shape[-1] == 1:
+        d = a[:, 0, 0]
+        return np.where(d != 0, b[:, 0] / np.where(d != 0, d, 1.0), 0.0)[:, None]
+    det = a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] * a[:, 1, 0]
+    safe = np.where(det != 0, det, 1.0)
+    x0 = (a[:, 1, 1] * b[:, 0] - a[:, 0, 1] * b[:, 1]) / safe
+    x1 = (a[:, 0, 0] * b[:, 1] - a[:, 1, 0] * b[:, 0]) / safe
+    return np.where((det != 0)[:, None], np.stack([x0, x1], axis=1), 0.0)
+
+
+def _smallest_eigenvalue(a: NDArray) -> NDArray:
+    """Smallest eigenvalue of batches of symmetric 1x1 or 2x2 matrices: (m,) float."""
+    if a.shape[-1] == 1:
+        return a[:, 0, 0]
+    half_trace = 0.5 * (a[:, 0, 0] + a[:, 1, 1])
+    return half_trace - np.hypot(0.5 * (a[:, 0, 0] - a[:, 1, 1]), a[:, 0, 1])
+
+
+def _newton_step(hessian: NDArray, gauss_newton: NDArray, gradient: NDArray,
+                 free: NDArray) -> NDArray:
+    """Step of the free parameters (fixed ones: 0).
+
+    Newton's step when the Hessian restricted to the free parameters is
+    positive definite; otherwise the Hessian shifted by ``2 |lambda_min|``
+    (plus a little of ``trace(J^T J)``), which is positive definite, so the
+    step descends and follows negative curvature out of saddle regions.
+    """
+    k = gradient.shape[1]
+    both = free[:, :, None] & free[:, None, :]
+    matrix = np.where(both, hessian, 0.0) + np.eye(k) * (~free)[:, :, None]
+    scale = np.trace(gauss_newton, axis1=1, axis2=2) + np.finfo(float).tiny
+    lowest = _smallest_eigenvalue(matrix)
+    shift = np.where(lowest > 1e-12 * scale, 0.0, 2 * np.abs(lowest) + 1e-8 * scale)
+    return _solve_small(matrix + shift[:, None, None] * np.eye(k),
+                        -np.where(free, gradient, 0.0))
+
+
+def _line_search(value: Callable, x: NDArray, step: NDArray, targets: NDArray, start: NDArray,
+                 distance: NDArray, lo: NDArray, hi: NDArray):
+    """Step halving: the first ``clip(x + step / 2^j)`` not farther from the target.
+
+    Returns the new parameters, points and distances, and which problems found a step.
+    """
+    x_new, s_new, d_new = x.copy(), start.copy(), distance.copy()
+    accepted = np.zeros(x.shape[0], dtype=bool)
+    slack = 8 * np.finfo(float).eps * (np.abs(targets).max(axis=1) + distance)
+    todo = np.arange(x.shape[0])
+    factor = 1.0
+    for _ in range(_MAX_HALVINGS):
+        candidate = np.clip(x[todo] + factor * step[todo], lo[todo], hi[todo])
+        s = value(candidate)
+        d = np.linalg.norm(s - targets[todo], axis=1)
+        ok = d <= distance[todo] + slack[todo]
+        good = todo[ok]
+        x_new[good], s_new[good], d_new[good], accepted[good] = candidate[ok], s[ok], d[ok], True
+        todo = todo[~ok]
+        if todo.size == 0:
+            break
+        factor *= 0.5
+    return x_new, s_new, d_new, accepted
+
+
+def _minimize(local: Callable, value: Callable, targets: NDArray, x0: NDArray, lo: NDArray,
+              hi: NDArray, tol: float, max_iter: int):
+    """Bounded Newton minimization of ``|F(x) - target|`` for every row (see module docs).
+
+    ``local(x)`` gives ``F (m, d)``, ``J (m, d, k)``, ``H (m, d, k, k)``; ``value(x)`` gives F.
+    ``lo``, ``hi`` (m, k): the box of each problem.
+
+    Returns
+    -------
+    x (m, k), points (m, d), distance (m,), converged (m,) bool
+    """
+    x = x0.copy()
+    points = value(x)
+    distance = np.linalg.norm(points - targets, axis=1)
+    converged = np.zeros(x.shape[0], dtype=bool)
+    active = np.arange(x.shape[0])
+    for _ in range(max_iter):
+        if active.size == 0:
+            break
+        xa, pa, la, ha = x[active], targets[active], lo[active], hi[active]
+        f, jac, hess = local(xa)
+        r = f - pa
+        gradient = np.einsum("md,mdk->mk", r, jac)                   # eq. 6.6
+        gauss_newton = np.einsum("mdk,mdl->mkl", jac, jac)
+        hessian = gauss_newton + np.einsum("md,mdkl->mkl", r, hess)  # eq. 6.7
+        free = ~(((xa <= la) & (gradient > 0)) | ((xa >= ha) & (gradient < 0)))
+        speed = np.linalg.norm(jac, axis=1)
+        tangential = np.where(free & (speed > 0),
+                              np.abs(gradient) / np.where(speed > 0, speed, 1.0), 0.0)
+        passed = (tangential.max(axis=1) <= tol) | (np.linalg.norm(r, axis=1) <= tol)  # eq. 6.8
+        step = _newton_step(hessian, gauss_newton, gradient, free)
+        x_new, f_new, d_new, accepted = _line_search(value, xa, step, pa, f, distance[active],
+                                                     la, ha)
+        small = accepted & (np.linalg.norm(f_new - f, axis=1) <= tol)
+        x[active], points[active], distance[active] = x_new, f_new, d_new
+        converged[active] = passed | small
+        active = active[~(passed | small | ~accepted)]
+    return x, points, distance, converged
+
+
+# ------------------------------------------------------------------- creases
+class _Pieces:
+    """The domain cut along knot lines of multiplicity >= degree (where the first
+    derivatives may jump): per parameter, ``edges`` = domain ends and crease values.
+
+    Newton works inside one piece (its box); a piece's upper bound is moved
+    ``_NUDGE`` of the domain width below the crease, so that evaluation there
+    uses the piece's own polynomial (evaluation at a knot takes the right side).
+    """
+
+    def __init__(self, knot_vectors: list[NDArray], degrees: list[int]):
+        self.edges = []
+        for knots, p in zip(knot_vectors, degrees):
+            values, mult = distinct_knots(knots, p)
+            inner = values[1:-1][mult[1:-1] >= p]
+            self.edges.append(np.concatenate([values[:1], inner, values[-1:]]))
+        self.nudge = np.array([_NUDGE * (e[-1] - e[0]) for e in self.edges])
+
+    def index(self, x: NDArray) -> NDArray:
+        """Piece of each parameter: (m, k) int."""
+        return np.stack([np.clip(np.searchsorted(e, x[:, i], side="right") - 1, 0, e.size - 2)
+                         for i, e in enumerate(self.edges)], axis=1)
+
+    def bounds(self, piece: NDArray) -> tuple[NDArray, NDArray]:
+        lo = np.stack([e[piece[:, i]] for i, e in enumerate(self.edges)], axis=1)
+        hi = np.stack([np.where(piece[:, i] + 2 < e.size, e[piece[:, i] + 1] - self.nudge[i],
+                                e[piece[:, i] + 1]) for i, e in enumerate(self.edges)], axis=1)
+        return lo, hi
+
+    def split_seeds(self, rows: NDArray, x0: NDArray) -> tuple[NDArray, NDArray]:
+        """Seeds on a crease start on both of its sides (a local minimum may hide on
+        either): duplicated rows and start points."""
+        for i, e in enumerate(self.edges):
+            on = np.isin(x0[:, i], e[1:-1])
+            extra = x0[on].copy()
+            extra[:, i] -= self.nudge[i]
+            rows, x0 = np.concatenate([rows, rows[on]]), np.concatenate([x0, extra])
+        return rows, x0
+
+    def crossings(self, local: Callable, x: NDArray, targets: NDArray, piece: NDArray
+                  ) -> tuple[NDArray, NDArray, NDArray]:
+        """Problems stopped on a crease with descent on its other side.
+
+        Returns the mask (m,), their new pieces (m, k) and start points (m, k).
+        """
+        lo, hi = self.bounds(piece)
+        count = np.array([e.size - 1 for e in self.edges])
+        up = (x >= hi) & (piece + 1 < count)
+        down = (x <= lo) & (piece > 0)
+        moved = np.where(up, piece + 1, np.where(down, piece - 1, piece))
+        new_lo, new_hi = self.bounds(moved)
+        start = np.where(up, new_lo, np.where(down, new_hi, x))
+        candidates = np.flatnonzero((up | down).any(axis=1))
+        f, jac, _ = local(start[candidates])
+        gradient = np.einsum("md,mdk->mk", f - targets[candidates], jac)
+        descend = (up[candidates] & (gradient < 0)) | (down[candidates] & (gradient > 0))
+        cross = np.zeros(x.shape[0], dtype=bool)
+        cross[candidates] = descend.any(axis=1)
+        keep = np.zeros_like(up)
+        keep[candidates] = descend
+        return cross, np.where(keep, moved, piece), np.where(keep, start, x)
+
+
+def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, pieces: _Pieces,
+           tol: float, max_iter: int):
+    """:func:`_minimize` piece by piece: a problem that ends on a crease with descent
+    beyond it continues in the neighbouring piece (up to ``_MAX_CROSSINGS`` times)."""
+    piece = pieces.index(x0)
+    x, points, distance, converged = _minimize(local, value, targets, x0, *pieces.bounds(piece),
+                                               tol, max_iter)
+    todo = np.arange(x.shape[0])
+    for _ in range(_MAX_CROSSINGS):
+        cross, moved, start = pieces.crossings(local, x[todo], targets[todo], piece[todo])
+        todo, moved, start = todo[cross], moved[cross], start[cross]
+        if todo.size == 0:
+            break
+        xr, pr, dr, cr = _minimize(local, value, targets[todo], start, *pieces.bounds(moved),
+                                   tol, max_iter)
+        better = dr <= distance[todo]
+        todo = todo[better]
+        x[todo], points[todo], distance[todo] = xr[better], pr[better], dr[better]
+        converged[todo], piece[todo] = cr[better], moved[better]
+    return x, points, distance, converged
+
+
+# ------------------------------------------------------------------ surfaces
+def _surface_local(surface: NurbsSurface) -> tuple[Callable, Callable]:
+    def local(x):
+        d = surface.derivatives(x[:, 0], x[:, 1], 2)
+        jac = np.stack([d[:, 1, 0], d[:, 0, 1]], axis=2)
+        hess = np.stack([np.stack([d[:, 2, 0], d[:, 1, 1]], axis=2),
+                         np.stack([d[:, 1, 1], d[:, 0, 2]], axis=2)], axis=3)
+        return d[:, 0, 0], jac, hess
+
+    def value(x):
+        return surface.evaluate(x[:, 0], x[:, 1])
+
+    return local, value
+
+
+def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float | None = None,
+                       max_iter: int = 30, n_seeds: int = 3,
+                       samples_per_span: int | None = None,
+                       guess: ArrayLike | None = None) -> ProjectionResult:
+    """Closest points of a surface to many points (point inversion, section 6.1 of [PT]).
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+    points : (..., 3) float
+    tol : float, optional
+        Model units: convergence of the 3D step and of the tangential residual
+        (eq. 6.8). Default :data:`DEFAULT_RELATIVE_TOL` times the control-net
+        bounding-box diagonal.
+    max_iter : int
+        Newton iterations per seed.
+    n_seeds : int
+        Seeds per point from the sample grid (nearest sample plus non-adjacent
+        ones); 1 is fastest, more guard against wrong local minima.
+    samples_per_span : int, optional
+        Grid samples per knot span and direction. Default: at least
+        ``max(128, 2 (degree + 1) spans)`` per direction, shared among the spans
+        in proportion to the length of their control polygon (at least
+        ``degree + 1`` each), fewer when the grid would exceed 200 000 samples.
+    guess : (..., 2) float, optional
+        Start parameters instead of the sample grid (a local projection, for
+        marching methods that know where the foot is).
+
+    Returns
+    -------
+    ProjectionResult
+        ``uv (..., 2)``, ``points (..., 3)``, ``distance (...)``, ``converged (...)``.
+    """
+    p = _check_points(points, surface.dimension)
+    shape = p.shape[:-1]
+    targets = p.reshape(-1, surface.dimension)
+    tol = _tolerance(tol, surface)
+    max_iter = _check_count(max_iter, "max_iter", 1)
+    n_seeds = _check_count(n_seeds, "n_seeds", 1)
+    u0, u1, v0, v1 = surface.domain
+    lo, hi = np.array([u0, v0]), np.array([u1, v1])
+    if guess is not None:
+        x0 = np.asarray(guess, dtype=float)
+        if x0.shape != shape + (2,) or not np.all(np.isfinite(x0)):
+            raise InvalidGeometryError(f"guess must be finite of shape {shape + (2,)}, "
+                                       f"got {x0.shape}")
+        rows = np.arange(targets.shape[0])
+        x0 = np.clip(x0.reshape(-1, 2), lo, hi)
+    else:
+        rows, x0 = _surface_seeds(surface, targets, n_seeds, samples_per_span)
+    local, value = _surface_local(surface)
+    pieces = _Pieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
+    rows, x0 = pieces.split_seeds(rows, x0)
+    x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
+    best = _best_per_query(rows, distance)
+    return ProjectionResult(uv=x[best].reshape(shape + (2,)),
+                            points=foot[best].reshape(shape + (surface.dimension,)),
+                            distance=distance[best].reshape(shape),
+                            converged=converged[best].reshape(shape))
+
+
+def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
+                   samples_per_span: int | None) -> tuple[NDArray, NDArray]:
+    net = surface.control_points
+    extents = [_span_extents(net, surface.knots_u, surface.degree_u),
+               _span_extents(np.swapaxes(net, 0, 1), surface.knots_v, surface.degree_v)]
+    per_u, per_v = _sample_counts(extents, [surface.degree_u, surface.degree_v],
+                                  samples_per_span, _MIN_SAMPLES)
+    su = _span_samples(surface.knots_u, surface.degree_u, per_u)
+    sv = _span_samples(surface.knots_v, surface.degree_v, per_v)
+    rows, sample = _pick_seeds(surface.evaluate_grid(su, sv), targets, n_seeds)
+    iu, iv = np.unravel_index(sample, (su.size, sv.size))
+    return rows, np.stack([su[iu], sv[iv]], axis=1)
+
+
+def distance_to_surface(surface: NurbsSurface, points: ArrayLike, *,
+                        tol: float | None = None) -> NDArray:
+    """Distances ``(...)`` from ``points (..., 3)`` to the surface (:func:`project_to_surface`).
+
+    The dense check of later features: sample a result, measure its distance
+    to the surface it must lie on, compare with the tolerance.
+    """
+    return project_to_surface(surface, points, tol=tol).distance
+
+
+# -------------------------------------------------------------------- curves
+def _curve_local(curve: NurbsCurve) -> tuple[Callable, Callable]:
+    def local(x):
+        d = curve.derivatives(x[:, 0], 2)
+        return d[:, 0], d[:, 1, :, None], d[:, 2, :, None, None]
+
+    def value(x):
+        return curve.evaluate(x[:, 0])
+
+    return local, value
+
+
+def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None = None,
+                     max_iter: int = 30, n_seeds: int = 3,
+                     samples_per_span: int | None = None,
+                     guess: ArrayLike | None = None) -> CurveProjectionResult:
+    """Closest points of a curve to many points (eqs. 6.3-6.5 of [PT]).
+
+    Parameters
+    ----------
+    curve : NurbsCurve
+    points : (..., d) float, ``d`` the curve's dimension (2 or 3)
+    tol, max_iter, n_seeds : as in :func:`project_to_surface`
+    samples_per_span : int, optional
+        Default: at least ``max(512, 4 (degree + 1) spans)``, shared as for surfaces.
+    guess : (...) float, optional
+        Start parameters instead of the samples.
+
+    Returns
+    -------
+    CurveProjectionResult
+        ``t (...)``, ``points (..., d)``, ``distance (...)``, ``converged (...)``.
+    """
+    p = _check_points(points, curve.dimension)
+    shape = p.shape[:-1]
+    targets = p.reshape(-1, curve.dimension)
+    tol = _tolerance(tol, curve)
+    max_iter = _check_count(max_iter, "max_iter", 1)
+    n_seeds = _check_count(n_seeds, "n_seeds", 1)
+    lo, hi = (np.array([x]) for x in curve.domain)
+    if guess is not None:
+        x0 = np.asarray(guess, dtype=float)
+        if x0.shape != shape or not np.all(np.isfinite(x0)):
+            raise InvalidGeometryError(f"guess must be finite of shape {shape}, got {x0.shape}")
+        rows, x0 = np.arange(targets.shape[0]), np.clip(x0.reshape(-1, 1), lo, hi)
+    else:
+        extents = _span_extents(curve.control_points, curve.knots, curve.degree)
+        (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
+                                   4 * _MIN_SAMPLES, density=4)
+        st = _span_samples(curve.knots, curve.degree, counts)
+        rows, sample = _pick_seeds(curve.evaluate(st), targets, n_seeds)
+        x0 = st[sample][:, None]
+    local, value = _curve_local(curve)
+    pieces = _Pieces([curve.knots], [curve.degree])
+    rows, x0 = pieces.split_seeds(rows, x0)
+    x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
+    best = _best_per_query(rows, distance)
+    return CurveProjectionResult(t=x[best, 0].reshape(shape),
+                                 points=foot[best].reshape(shape + (curve.dimension,)),
+                                 distance=distance[best].reshape(shape),
+                                 converged=converged[best].reshape(shape))
+
+
+def distance_to_curve(curve: NurbsCurve, points: ArrayLike, *,
+                      tol: float | None = None) -> NDArray:
+    """Distances ``(...)`` from ``points (..., d)`` to the curve (:func:`project_to_curve`)."""
+    return project_to_curve(curve, points, tol=tol).distance

@@ -1,0 +1,326 @@
+"""Closest points on surfaces and curves (surfprep.algorithms.projection)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from nurbs_strategies import curves, random_knots, scale_of, surface_samples, surfaces
+from scipy.spatial import cKDTree
+
+from surfprep.algorithms import NurbsCurve, NurbsSurface
+from surfprep.algorithms.fitting import interpolate_curve
+from surfprep.algorithms.projection import (distance_to_curve, distance_to_surface,
+                                            project_to_curve, project_to_surface)
+from surfprep.errors import InvalidGeometryError, InvalidToleranceError
+
+S2 = np.sqrt(0.5)
+
+
+# ------------------------------------------------------------------ helpers
+def graph_surface(seed: int, degree_u: int, degree_v: int, breaks_u: int, breaks_v: int,
+                  rational: bool) -> NurbsSurface:
+    """A wavy height field over a jittered grid (no folds): the foot of a point close
+    enough along the normal is unique."""
+    rng = np.random.default_rng(seed)
+    ku = random_knots(rng, degree_u, breaks_u, 1)
+    kv = random_knots(rng, degree_v, breaks_v, 1)
+    nu, nv = ku.size - degree_u - 1, kv.size - degree_v - 1
+    x, y = np.meshgrid(np.linspace(0, 10, nu), np.linspace(0, 10, nv), indexing="ij")
+    jitter = rng.uniform(-0.15, 0.15, (nu, nv, 2)) * np.array([10 / nu, 10 / nv])
+    net = np.stack([x + jitter[..., 0], y + jitter[..., 1], rng.uniform(-1.5, 1.5, x.shape)],
+                   axis=2)
+    weights = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
+    return NurbsSurface(net, ku, kv, degree_u, degree_v, weights)
+
+
+def max_curvature(surface: NurbsSurface, count: int = 150) -> float:
+    """Largest |principal curvature| on a dense grid with the knots (first and second
+    fundamental forms)."""
+    d = surface.derivatives_grid(*surface_samples(surface, count), 2)
+    su, sv = d[..., 1, 0, :], d[..., 0, 1, :]
+    n = np.cross(su, sv)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    e, f, g = (su * su).sum(-1), (su * sv).sum(-1), (sv * sv).sum(-1)
+    ll, m, nn = (d[..., 2, 0, :] * n).sum(-1), (d[..., 1, 1, :] * n).sum(-1), \
+        (d[..., 0, 2, :] * n).sum(-1)
+    det = e * g - f * f
+    mean = (e * nn - 2 * f * m + g * ll) / (2 * det)
+    gauss = (ll * nn - m * m) / det
+    return float(np.max(np.abs(mean) + np.sqrt(np.maximum(mean ** 2 - gauss, 0))))
+
+
+def brute_force_surface(surface: NurbsSurface, points: np.ndarray, count: int = 400,
+                        rounds: int = 14) -> tuple[np.ndarray, np.ndarray]:
+    """Best distance on a ``count x count`` grid, and that refined by zooming grids
+    (11 x 11, the window shrinking 4x per round) around the 3 best grid points."""
+    u0, u1, v0, v1 = surface.domain
+    u, v = np.linspace(u0, u1, count), np.linspace(v0, v1, count)
+    grid = surface.evaluate_grid(u, v).reshape(-1, 3)
+    dist, best3 = cKDTree(grid).query(points, k=3)
+    grid_best = dist[:, 0]
+    center = np.stack([u[best3 // count], v[best3 % count]], axis=-1)       # (m, 3, 2)
+    half = np.array([u1 - u0, v1 - v0]) / (count - 1)
+    lo, hi = np.array([u0, v0]), np.array([u1, v1])
+    steps = np.linspace(-1, 1, 11)
+    offsets = np.stack(np.meshgrid(steps, steps, indexing="ij"), axis=-1).reshape(-1, 2)
+    for _ in range(rounds):
+        trial = np.clip(center[:, :, None, :] + offsets * half, lo, hi)    # (m, 3, 121, 2)
+        d = np.linalg.norm(surface.evaluate(trial[..., 0], trial[..., 1])
+                           - points[:, None, None, :], axis=-1)
+        pick = d.argmin(axis=2)
+        center = np.take_along_axis(trial, pick[:, :, None, None], axis=2)[:, :, 0]
+        half = half / 4
+    refined = np.linalg.norm(surface.evaluate(center[..., 0], center[..., 1])
+                             - points[:, None, :], axis=-1).min(axis=1)
+    return grid_best, refined
+
+
+def nurbs_circle_net():
+    square = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1],
+                       [1, -1], [1, 0]], dtype=float)
+    return square, np.array([1, S2, 1, S2, 1, S2, 1, S2, 1]), [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
+
+
+def nurbs_sphere(radius: float, center) -> NurbsSurface:
+    """Exact rational biquadratic sphere: u the longitude, v from the south to the north pole."""
+    ring, w_u, knots_u = nurbs_circle_net()
+    meridian = np.array([[0, -1], [1, -1], [1, 0], [1, 1], [0, 1]], dtype=float)
+    w_v = np.array([1, S2, 1, S2, 1])
+    net = np.empty((9, 5, 3))
+    net[:, :, :2] = ring[:, None, :] * meridian[None, :, 0, None]
+    net[:, :, 2] = meridian[None, :, 1]
+    return NurbsSurface(net * radius + np.asarray(center), knots_u, [0, 0, 0, 1, 1, 2, 2, 2],
+                        2, 2, w_u[:, None] * w_v[None, :])
+
+
+def nurbs_cylinder(radius: float, z0: float, z1: float) -> NurbsSurface:
+    """Exact rational cylinder around the z axis: u the angle, v linear from z0 to z1."""
+    ring, w_u, knots_u = nurbs_circle_net()
+    net = np.empty((9, 2, 3))
+    net[:, :, :2] = radius * ring[:, None, :]
+    net[:, 0, 2], net[:, 1, 2] = z0, z1
+    return NurbsSurface(net, knots_u, [0, 0, 1, 1], 2, 1, np.repeat(w_u[:, None], 2, axis=1))
+
+
+# --------------------------------------------------------- normal offsets
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 5), st.integers(2, 5), st.integers(0, 3),
+       st.integers(0, 3), st.booleans())
+def test_normal_offsets_recover_the_foot(seed, p, q, breaks_u, breaks_v, rational):
+    surface = graph_surface(seed, p, q, breaks_u, breaks_v, rational)
+    rng = np.random.default_rng(seed + 1)
+    u0, u1, v0, v1 = surface.domain
+    width = np.array([u1 - u0, v1 - v0])
+    foot = np.array([u0, v0]) + width * rng.uniform(0.05, 0.95, (200, 2))
+    reach = 1.0 / max_curvature(surface)
+    height = rng.uniform(-0.2, 0.2, 200) * min(reach, 2.0)
+    normal = surface.normals(foot[:, 0], foot[:, 1])
+    points = surface.evaluate(foot[:, 0], foot[:, 1]) + height[:, None] * normal
+    result = project_to_surface(surface, points)
+    assert result.uv.shape == (200, 2) and result.converged.all()
+    assert np.abs(result.uv - foot).max() <= 1e-9 * width.max()
+    scale = scale_of(surface)
+    assert np.abs(result.distance - np.abs(height)).max() <= 1e-12 * scale
+    np.testing.assert_allclose(result.points, surface.evaluate(foot[:, 0], foot[:, 1]),
+                               atol=1e-9 * scale)
+
+
+# ----------------------------------------------------- against brute force
+def beyond_boundary(surface: NurbsSurface, rng: np.random.Generator, count: int) -> np.ndarray:
+    """Points outside the surface's boundary: a boundary point moved outward along
+    the surface tangent and off the surface, up to a fifth of the surface size."""
+    u0, u1, v0, v1 = surface.domain
+    side = rng.integers(0, 4, count)
+    s = rng.uniform(0, 1, count)
+    u = np.where(side == 0, u0, np.where(side == 1, u1, u0 + s * (u1 - u0)))
+    v = np.where(side == 2, v0, np.where(side == 3, v1, v0 + s * (v1 - v0)))
+    d = surface.derivatives(u, v, 1)
+    tangent = np.where((side < 2)[:, None], d[:, 1, 0], d[:, 0, 1])
+    outward = np.where(np.isin(side, [0, 2])[:, None], -tangent, tangent)
+    outward /= np.linalg.norm(outward, axis=1, keepdims=True) + 1e-300
+    size = np.ptp(surface.bounding_box(), axis=0).max()
+    off = rng.normal(size=(count, 3)) * 0.05 * size
+    return d[:, 0, 0] + rng.uniform(0, 0.2 * size, (count, 1)) * outward + off
+
+
+def assert_no_worse_than_brute_force(surface: NurbsSurface, points: np.ndarray) -> None:
+    result = project_to_surface(surface, points)
+    grid_best, refined = brute_force_surface(surface, points)
+    scale = scale_of(surface)
+    assert np.all(result.distance <= grid_best + 1e-12 * scale), \
+        (result.distance - grid_best).max()
+    assert np.all(result.distance <= refined + 1e-10 * scale), (result.distance - refined).max()
+    # the reported foot is where the distance is measured
+    foot = surface.evaluate(result.uv[:, 0], result.uv[:, 1])
+    np.testing.assert_allclose(result.points, foot, atol=1e-12 * scale)
+    np.testing.assert_allclose(result.distance, np.linalg.norm(points - foot, axis=1),
+                               atol=1e-12 * scale)
+
+
+@settings(max_examples=12, deadline=None)
+@given(surfaces(max_degree=4, max_breaks=2), st.integers(0, 2**32 - 1))
+def test_points_beyond_the_boundary_match_brute_force(surface, seed):
+    rng = np.random.default_rng(seed)
+    assert_no_worse_than_brute_force(surface, beyond_boundary(surface, rng, 40))
+
+
+@settings(max_examples=8, deadline=None)
+@given(surfaces(max_degree=4, max_breaks=2), st.integers(0, 2**32 - 1))
+def test_points_anywhere_match_brute_force(surface, seed):
+    box = surface.bounding_box()
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(box[0] - 2, box[1] + 2, (40, 3))
+    assert_no_worse_than_brute_force(surface, points)
+
+
+def test_hairpin_fold_does_not_lock_onto_the_wrong_sheet():
+    # a profile that runs along x, turns and comes back 0.3 below: a narrow fold
+    x = np.r_[np.linspace(0, 10, 11), 10.6, np.linspace(10, 0, 11)]
+    z = np.r_[np.zeros(11), -0.15, np.full(11, -0.3)]
+    profile = interpolate_curve(np.c_[x, z], degree=3)
+    net = np.zeros((profile.n_control, 2, 3))
+    net[:, :, 0] = profile.control_points[:, None, 0]
+    net[:, :, 2] = profile.control_points[:, None, 1]
+    net[:, 1, 1] = 4.0
+    surface = NurbsSurface(net, profile.knots, [0, 0, 1, 1], 3, 1)
+    rng = np.random.default_rng(7)
+    points = np.c_[rng.uniform(-1, 12, 300), rng.uniform(-1, 5, 300), rng.uniform(-1, 0.7, 300)]
+    assert_no_worse_than_brute_force(surface, points)
+    # points between the sheets, nearer the lower one
+    between = np.c_[np.linspace(1, 9, 20), np.full(20, 2.0), np.full(20, -0.2)]
+    result = project_to_surface(surface, between)
+    assert np.all(result.distance < 0.13) and np.all(result.points[:, 2] < -0.25)
+
+
+# ------------------------------------------------------------- exact shapes
+def test_sphere_distances_are_exact():
+    center = np.array([1.0, -2.0, 0.5])
+    radius = 3.0
+    sphere = nurbs_sphere(radius, center)
+    rng = np.random.default_rng(11)
+    direction = rng.normal(size=(2000, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    direction[:3] = [[0, 0, 1], [0, 0, -1], [1, 0, 0]]       # over the poles, on the seam
+    rho = rng.uniform(0.1, 3.0, 2000) * radius
+    points = center + rho[:, None] * direction
+    result = project_to_surface(sphere, points)
+    assert result.converged.all()
+    np.testing.assert_allclose(result.distance, np.abs(rho - radius), rtol=0, atol=1e-12 * radius)
+    np.testing.assert_allclose(np.linalg.norm(result.points - center, axis=1), radius,
+                               atol=1e-12 * radius)
+    np.testing.assert_allclose(distance_to_surface(sphere, points), result.distance)
+
+
+def test_cylinder_distances_are_exact_inside_and_beyond_its_ends():
+    radius, z0, z1 = 2.0, -1.0, 3.0
+    cylinder = nurbs_cylinder(radius, z0, z1)
+    rng = np.random.default_rng(5)
+    angle = rng.uniform(0, 2 * np.pi, 3000)
+    rho = rng.uniform(0.05, 5.0, 3000)
+    z = rng.uniform(-4, 6, 3000)
+    points = np.c_[rho * np.cos(angle), rho * np.sin(angle), z]
+    expected = np.hypot(rho - radius, z - np.clip(z, z0, z1))
+    result = project_to_surface(cylinder, points.reshape(30, 100, 3))
+    assert result.distance.shape == (30, 100) and result.uv.shape == (30, 100, 2)
+    np.testing.assert_allclose(result.distance.reshape(-1), expected, rtol=0, atol=1e-12 * radius)
+    beyond = (z < z0) | (z > z1)
+    np.testing.assert_allclose(result.uv.reshape(-1, 2)[beyond, 1],
+                               np.where(z[beyond] < z0, 0.0, 1.0))
+
+
+# ------------------------------------------------------------------- curves
+def brute_force_curve(curve: NurbsCurve, points: np.ndarray, rounds: int = 14) -> np.ndarray:
+    a, b = curve.domain
+    t = np.linspace(a, b, 20001)
+    samples = curve.evaluate(t)
+    dist = np.linalg.norm(samples[None] - points[:, None], axis=2)
+    center = t[np.argsort(dist, axis=1)[:, :3]]                            # (m, 3)
+    half = (b - a) / 20000
+    for _ in range(rounds):
+        trial = np.clip(center[..., None] + np.linspace(-1, 1, 21) * half, a, b)
+        d = np.linalg.norm(curve.evaluate(trial) - points[:, None, None], axis=-1)
+        center = np.take_along_axis(trial, d.argmin(axis=2)[..., None], axis=2)[..., 0]
+        half /= 8
+    return np.linalg.norm(curve.evaluate(center) - points[:, None], axis=-1).min(axis=1)
+
+
+@settings(max_examples=30, deadline=None)
+@given(curves(max_degree=6), st.integers(0, 2**32 - 1))
+def test_curve_projection_matches_brute_force(curve, seed):
+    box = curve.bounding_box()
+    points = np.random.default_rng(seed).uniform(box[0] - 3, box[1] + 3, (50, curve.dimension))
+    result = project_to_curve(curve, points)
+    scale = scale_of(curve)
+    assert result.t.shape == (50,) and result.points.shape == (50, curve.dimension)
+    assert np.all(result.distance <= brute_force_curve(curve, points) + 1e-10 * scale)
+    np.testing.assert_allclose(result.points, curve.evaluate(result.t), atol=1e-12 * scale)
+    # interior feet are stationary: the offset is normal to the tangent
+    a, b = curve.domain
+    knots = curve.knots[(curve.knots > a) & (curve.knots < b)]
+    at_knot = np.abs(result.t[:, None] - knots).min(axis=1, initial=np.inf) <= 1e-9 * (b - a)
+    inside = (result.t > a) & (result.t < b) & result.converged & ~at_knot
+    tangent = curve.derivatives(result.t[inside], 1)[:, 1]
+    offset = points[inside] - result.points[inside]
+    cosine = np.abs((tangent * offset).sum(1)) / np.linalg.norm(tangent, axis=1)
+    assert np.all(cosine <= 1e-8 * scale)
+
+
+def test_curve_normal_offsets_and_ends():
+    angle = np.linspace(0, np.pi, 30)
+    curve = interpolate_curve(np.c_[np.cos(angle), np.sin(angle)], degree=3)
+    t = np.linspace(0.05, 0.95, 25)
+    d = curve.derivatives(t, 1)
+    normal = np.c_[-d[:, 1, 1], d[:, 1, 0]] / np.linalg.norm(d[:, 1], axis=1, keepdims=True)
+    points = d[:, 0] + 0.1 * normal
+    result = project_to_curve(curve, points)
+    np.testing.assert_allclose(result.t, t, atol=1e-10)
+    np.testing.assert_allclose(result.distance, 0.1, atol=1e-12)
+    ends = project_to_curve(curve, [[2.0, -1.0], [-2.0, -1.0]])
+    np.testing.assert_array_equal(ends.t, [0.0, 1.0])
+    np.testing.assert_allclose(distance_to_curve(curve, [[2.0, -1.0]]), [np.hypot(1, 1)],
+                               atol=1e-12)
+
+
+# ------------------------------------------------------- guess, performance
+def test_many_points_on_a_bicubic_surface():
+    rng = np.random.default_rng(2)
+    x, y = np.meshgrid(np.linspace(0, 10, 20), np.linspace(0, 10, 20), indexing="ij")
+    net = np.stack([x, y, rng.uniform(-1, 1, x.shape)], axis=2)
+    knots = np.r_[[0] * 4, np.linspace(0, 1, 18)[1:-1], [1] * 4]
+    surface = NurbsSurface(net, knots, knots, 3, 3)
+    points = rng.uniform([-1, -1, -3], [11, 11, 3], (10_000, 3))
+    result = project_to_surface(surface, points)
+    assert result.converged.all()
+    # hardly ever farther than the nearest of an independent 100 x 100 sample grid
+    # (a point far from a wavy surface can still miss a distant, equally deep basin)
+    grid = surface.evaluate_grid(np.linspace(0, 1, 100), np.linspace(0, 1, 100)).reshape(-1, 3)
+    nearest, _ = cKDTree(grid).query(points)
+    worse = result.distance > nearest + 1e-12
+    assert worse.mean() <= 1e-3 and np.all(result.distance <= nearest * (1 + 1e-3))
+    # a local projection from the answer stays there
+    again = project_to_surface(surface, points[:100], guess=result.uv[:100])
+    np.testing.assert_allclose(again.uv, result.uv[:100], atol=1e-12)
+
+
+# -------------------------------------------------------------------- errors
+@pytest.mark.parametrize("call, error, message", [
+    (lambda s, c: project_to_surface(s, np.zeros((4, 2))), InvalidGeometryError, r"\(\.\.\., 3\)"),
+    (lambda s, c: project_to_surface(s, [[0, np.nan, 0]]), InvalidGeometryError, "NaN"),
+    (lambda s, c: project_to_surface(s, np.zeros(3), tol=0), InvalidToleranceError, "> 0"),
+    (lambda s, c: project_to_surface(s, np.zeros(3), tol=np.inf), InvalidToleranceError, "finite"),
+    (lambda s, c: project_to_surface(s, np.zeros(3), tol="x"), InvalidToleranceError, "number"),
+    (lambda s, c: project_to_surface(s, np.zeros(3), n_seeds=0), InvalidGeometryError, "n_seeds"),
+    (lambda s, c: project_to_surface(s, np.zeros(3), max_iter=1.5), InvalidGeometryError,
+     "max_iter"),
+    (lambda s, c: project_to_surface(s, np.zeros((2, 3)), guess=np.zeros(2)),
+     InvalidGeometryError, "guess"),
+    (lambda s, c: project_to_curve(c, np.zeros((4, 3))), InvalidGeometryError, r"\(\.\.\., 2\)"),
+    (lambda s, c: project_to_curve(c, np.zeros(2), tol=-1), InvalidToleranceError, "> 0"),
+])
+def test_bad_input_is_refused(call, error, message):
+    sphere = nurbs_sphere(1.0, [0, 0, 0])
+    curve = interpolate_curve([[0, 0], [1, 0], [1, 1], [2, 1]], degree=2)
+    with pytest.raises(error, match=message):
+        call(sphere, curve)
