@@ -55,9 +55,10 @@ def _frozen(a: ArrayLike, dtype) -> NDArray:
 
 def _as_index_array(a: ArrayLike, name: str) -> NDArray:
     arr = np.asarray(a)
-    if arr.size and not np.issubdtype(arr.dtype, np.integer):
-        if not np.all(np.isfinite(arr)) or np.any(arr != np.round(arr)):
-            raise InvalidGeometryError(f"{name} must hold integer indices")
+    fractional = arr.size and not np.issubdtype(arr.dtype, np.integer) and (
+        not np.all(np.isfinite(arr)) or np.any(arr != np.round(arr)))
+    if fractional:
+        raise InvalidGeometryError(f"{name} must hold integer indices")
     return _frozen(arr, np.int64)
 
 

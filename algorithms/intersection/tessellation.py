@@ -34,6 +34,15 @@ triangulated as a fan from its centre through all its boundary vertices
 gets two triangles. Every interior edge is then shared by exactly two
 triangles and no balance condition is needed.
 
+Pruning
+-------
+With ``keep_boxes`` (overlap boxes, or the triangle boxes of the other
+operand) every level first drops the rectangles whose sub-patch control-net
+box (which encloses the surface there) is farther than ``keep_pad`` from all
+keep boxes (004 §4.2-4.3: only the parts of the patches in overlap boxes are
+tessellated). The leaves kept are leaves of the unpruned tessellation; only
+the fans next to dropped rectangles lose their hanging vertices.
+
 Vertices are identified by their exact ``(u, v)``: every split value is the
 floating-point midpoint of its parent interval, computed the same way in every
 rectangle that has it on its boundary, so equal parameters are bitwise equal.

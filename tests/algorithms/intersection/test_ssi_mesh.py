@@ -68,7 +68,7 @@ def test_from_soup_merges_equal_corners():
     mesh = TriangleMesh.from_arrays(soup)
     assert mesh.n_vertices == 4 and mesh.n_triangles == 2
     np.testing.assert_array_equal(mesh.triangle_points(), soup)
-    edges, counts = mesh.edges()
+    _, counts = mesh.edges()
     assert sorted(counts.tolist()) == [1, 1, 1, 1, 2]
     assert mesh.uv is None
 

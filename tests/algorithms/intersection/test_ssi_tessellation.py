@@ -236,7 +236,7 @@ def test_keep_boxes_prune_the_refinement():
     wanted = {tuple(t.ravel()) for t in full.mesh.triangle_points()[near]}
     got = {tuple(t.ravel()) for t in pruned.mesh.triangle_points()}
     assert wanted <= got
-    edges, counts = pruned.mesh.edges()
+    _, counts = pruned.mesh.edges()
     assert set(np.unique(counts)) <= {1, 2}
     assert max_deviation(surface, pruned.mesh) <= tol
     far = tessellate(surface, tol, keep_boxes=box + 10.0)
