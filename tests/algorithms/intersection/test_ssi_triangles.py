@@ -230,3 +230,83 @@ def test_random_pairs_match_reference(seed, scale):
         assert i in got
         np.testing.assert_allclose(got[i], ref, atol=1e-9 * scale)
     assert hits.touch_points.shape[0] == 0 and hits.coplanar_index.size == 0
+
+
+def lattice_mesh(rng, n, flip_share=0.3):
+    """Triangles of an n x n unit grid in z = 0, random diagonals and orientations."""
+    tris = []
+    for i in range(n):
+        for j in range(n):
+            p00, p10, p11, p01 = [i, j, 0], [i + 1, j, 0], [i + 1, j + 1, 0], [i, j + 1, 0]
+            if rng.random() < 0.5:
+                tris += [[p00, p10, p11], [p00, p11, p01]]
+            else:
+                tris += [[p00, p10, p01], [p10, p11, p01]]
+    tris = np.array(tris, float)
+    flip = rng.random(len(tris)) < flip_share
+    tris[flip] = tris[flip][:, ::-1]
+    return tris
+
+
+def wall_mesh(rng, origin, direction, z_rows, flip_share=0.3):
+    """Vertical strip over the line origin + t direction, t in [-20, 20], rows at z_rows."""
+    ts = np.arange(-20, 21, 2.0)
+    tris = []
+    for t0, t1 in zip(ts[:-1], ts[1:]):
+        for z0, z1 in zip(z_rows[:-1], z_rows[1:]):
+            q = [np.r_[origin + t * direction, z] for t, z in ((t0, z0), (t1, z0), (t1, z1),
+                                                                (t0, z1))]
+            if rng.random() < 0.5:
+                tris += [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
+            else:
+                tris += [[q[0], q[1], q[3]], [q[1], q[2], q[3]]]
+    tris = np.array(tris, float)
+    flip = rng.random(len(tris)) < flip_share
+    tris[flip] = tris[flip][:, ::-1]
+    return tris
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1),
+       direction=st.sampled_from([(1, 0), (0, 1), (1, 1), (1, -1), (2, 1)]),
+       offset=st.sampled_from([(2, 0), (1, 1), (2, 2), (0.5, 1), (0, 0)]),
+       z_rows=st.sampled_from([(-1.0, 0.0, 1.0), (-1.0, 1.0), (-0.5, 0.0, 0.25, 1.0)]))
+def test_lattice_degeneracies_cover_the_line_once(seed, direction, offset, z_rows):
+    """Meshes whose vertices and edges lie exactly in the other plane, in every
+    orientation: the segments cover the exact intersection once, no gap, no overlap.
+
+    Along the boundary of a (the line y = 0 or x = 0) the contact is degenerate:
+    the perturbation decides all or nothing, and nothing leaves touching points."""
+    rng = np.random.default_rng(seed)
+    n = 4
+    a = lattice_mesh(rng, n)
+    d = np.array(direction, float)
+    b = wall_mesh(rng, np.array(offset, float), d, np.array(z_rows))
+    hits = all_pairs(a, b)
+    # the exact intersection: the line clipped to the square [0, n]^2, parameter along d
+    t = (hits.segments[..., :2] - offset) @ d / (d @ d)
+    lo, hi = -np.inf, np.inf
+    for k in range(2):
+        if d[k] != 0:
+            ends = sorted([(0 - offset[k]) / d[k], (n - offset[k]) / d[k]])
+            lo, hi = max(lo, ends[0]), min(hi, ends[1])
+        elif not 0 <= offset[k] <= n:
+            lo, hi = 1, 0
+    expected = max(hi - lo, 0.0)
+    assert np.all(np.abs(hits.segments[..., 2]) == 0)
+    t = np.sort(t, axis=1)
+    total = np.sum(t[:, 1] - t[:, 0])
+    union, reach = 0.0, -np.inf
+    for s0, s1 in t[np.argsort(t[:, 0])]:
+        union += max(0.0, s1 - max(s0, reach))
+        reach = max(reach, s1)
+    on_boundary = any(d[1 - k] == 0 and offset[1 - k] in (0, n) for k in range(2))
+    if expected == 0:
+        assert hits.segments.shape[0] == 0
+    elif on_boundary:
+        assert union == total and union in (0.0, pytest.approx(expected, abs=1e-12))
+        if union == 0:
+            assert hits.touch_points.shape[0] > 0
+    else:
+        assert union == pytest.approx(expected, abs=1e-12)
+        assert total == pytest.approx(expected, abs=1e-12)
