@@ -135,7 +135,7 @@ def _sort_segments(order: NDArray, centroid: NDArray, starts: NDArray, counts: N
     extent = np.maximum.reduceat(c, first, axis=0) - np.minimum.reduceat(c, first, axis=0)
     axis = np.argmax(extent, axis=1)
     key = c[np.arange(seg.size), axis[seg]]
-    perm = np.lexsort((order[pos], key, seg))                      # stable, deterministic
+    perm = np.lexsort((key, seg))                                   # stable: deterministic
     out = order.copy()
     out[pos] = order[pos][perm]
     return out

@@ -186,3 +186,14 @@ def test_pruned_refinement_finds_the_same_segments():
     # both spheres: the ends lie on both within the tolerance
     for surface, uv in ((a, soup.uv_a), (b, soup.uv_b)):
         assert np.abs(surface.evaluate(uv[..., 0], uv[..., 1]) - soup.points).max() <= 2e-3
+
+
+def test_candidate_pairs_of_the_soup_are_the_brute_force_ones():
+    from surfprep.algorithms.intersection.culling import candidate_pairs
+    soup = mesh_segments(sphere_band(), sphere_band(centre=(1.2, 0.3, 0.1)), tol=2e-3)
+    ba, bb = soup.mesh_a.triangle_boxes(), soup.mesh_b.triangle_boxes()
+    hit = np.all((ba[:, None, 0] <= bb[None, :, 1]) & (bb[None, :, 0] <= ba[:, None, 1]), axis=-1)
+    np.testing.assert_array_equal(candidate_pairs(ba, bb), np.argwhere(hit))
+    assert soup.stats.candidate_pairs == int(hit.sum())
+    # every segment's pair is a candidate
+    assert np.all(hit[soup.tri_a, soup.tri_b])
