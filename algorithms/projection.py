@@ -78,7 +78,7 @@ _SAMPLE_BUDGET = 200_000
 _CANDIDATES = 24
 _MAX_CROSSINGS = 8
 _NUDGE = 1e-13
-_MIN_SAMPLES = 128      # grid intervals per surface direction, at least
+_MIN_SAMPLES = 256      # grid intervals per surface direction, at least
 
 
 @dataclass(frozen=True)
@@ -203,20 +203,24 @@ def _grid_spacing(grid: NDArray) -> float:
     return max(float(np.linalg.norm(s, axis=-1).max(initial=0.0)) for s in steps)
 
 
-def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
+def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int, pieces: list[NDArray]
+                ) -> tuple[NDArray, NDArray]:
     """(query, sample) pairs for the Newton starts.
 
     The nearest sample (distance ``d0``) is always a seed. Any basin whose minimum
     is closer than ``d0`` holds a sample within ``d0 + h`` (``h`` the longest
     grid cell edge or diagonal), so up to ``n_seeds - 1`` more seeds are taken
     among the samples within that radius (of the ``_CANDIDATES`` nearest) that
-    are local minima of the distance on the grid (no grid neighbour closer)
-    and not grid neighbours of the nearest sample, closest first.
+    are local minima of the distance on the grid (no grid neighbour in the
+    same crease-free piece closer) and not grid neighbours of the nearest
+    sample, closest first.
 
     Parameters
     ----------
     grid : (a, [b,] d) float
         Samples on a 1D or 2D parameter grid.
+    pieces : list of (a,) and (b,) int
+        Crease-free piece of the samples along each axis.
 
     Returns
     -------
@@ -239,7 +243,10 @@ def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int) -> tuple[NDArray, 
         r, c = rows[part], cols[part]
         around = np.clip(index[r, c, None, :] + offsets, 0, np.array(shape) - 1)
         flat = np.ravel_multi_index(tuple(np.moveaxis(around, -1, 0)), shape)
-        near = np.linalg.norm(samples[flat] - points[r, None, :], axis=-1).min(axis=1)
+        near = np.linalg.norm(samples[flat] - points[r, None, :], axis=-1)
+        for i, piece in enumerate(pieces):     # neighbours across a crease do not count
+            near[piece[around[..., i]] != piece[index[r, c, i]][:, None]] = np.inf
+        near = near.min(axis=1)
         here = np.linalg.norm(samples[nearest[r, c]] - points[r], axis=-1)
         candidate[r, c] = here <= near
     candidate[:, 0] = True
@@ -391,6 +398,11 @@ class _Pieces:
                                 e[piece[:, i] + 1]) for i, e in enumerate(self.edges)], axis=1)
         return lo, hi
 
+    def axis_index(self, axis: int, values: NDArray) -> NDArray:
+        """Piece of parameter values along one axis: (s,) int."""
+        e = self.edges[axis]
+        return np.clip(np.searchsorted(e, values, side="right") - 1, 0, e.size - 2)
+
     def split_seeds(self, rows: NDArray, x0: NDArray) -> tuple[NDArray, NDArray]:
         """Seeds on a crease start on both of its sides (a local minimum may hide on
         either): duplicated rows and start points."""
@@ -483,7 +495,7 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
         ones); 1 is fastest, more guard against wrong local minima.
     samples_per_span : int, optional
         Grid samples per knot span and direction. Default: at least
-        ``max(128, 2 (degree + 1) spans)`` per direction, shared among the spans
+        ``max(256, 2 (degree + 1) spans)`` per direction, shared among the spans
         in proportion to the length of their control polygon (at least
         ``degree + 1`` each), fewer when the grid would exceed 200 000 samples.
     guess : (..., 2) float, optional
@@ -503,6 +515,7 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
     n_seeds = _check_count(n_seeds, "n_seeds", 1)
     u0, u1, v0, v1 = surface.domain
     lo, hi = np.array([u0, v0]), np.array([u1, v1])
+    pieces = _Pieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
     if guess is not None:
         x0 = np.asarray(guess, dtype=float)
         if x0.shape != shape + (2,) or not np.all(np.isfinite(x0)):
@@ -511,9 +524,8 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
         rows = np.arange(targets.shape[0])
         x0 = np.clip(x0.reshape(-1, 2), lo, hi)
     else:
-        rows, x0 = _surface_seeds(surface, targets, n_seeds, samples_per_span)
+        rows, x0 = _surface_seeds(surface, targets, n_seeds, samples_per_span, pieces)
     local, value = _surface_local(surface)
-    pieces = _Pieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
     rows, x0 = pieces.split_seeds(rows, x0)
     x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
     best = _best_per_query(rows, distance)
@@ -524,7 +536,7 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
 
 
 def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
-                   samples_per_span: int | None) -> tuple[NDArray, NDArray]:
+                   samples_per_span: int | None, pieces: _Pieces) -> tuple[NDArray, NDArray]:
     net = surface.control_points
     extents = [_span_extents(net, surface.knots_u, surface.degree_u),
                _span_extents(np.swapaxes(net, 0, 1), surface.knots_v, surface.degree_v)]
@@ -532,7 +544,8 @@ def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
                                   samples_per_span, _MIN_SAMPLES)
     su = _span_samples(surface.knots_u, surface.degree_u, per_u)
     sv = _span_samples(surface.knots_v, surface.degree_v, per_v)
-    rows, sample = _pick_seeds(surface.evaluate_grid(su, sv), targets, n_seeds)
+    sample_pieces = [pieces.axis_index(0, su), pieces.axis_index(1, sv)]
+    rows, sample = _pick_seeds(surface.evaluate_grid(su, sv), targets, n_seeds, sample_pieces)
     iu, iv = np.unravel_index(sample, (su.size, sv.size))
     return rows, np.stack([su[iu], sv[iv]], axis=1)
 
@@ -571,7 +584,7 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
     points : (..., d) float, ``d`` the curve's dimension (2 or 3)
     tol, max_iter, n_seeds : as in :func:`project_to_surface`
     samples_per_span : int, optional
-        Default: at least ``max(512, 4 (degree + 1) spans)``, shared as for surfaces.
+        Default: at least ``max(1024, 4 (degree + 1) spans)``, shared as for surfaces.
     guess : (...) float, optional
         Start parameters instead of the samples.
 
@@ -587,6 +600,7 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
     max_iter = _check_count(max_iter, "max_iter", 1)
     n_seeds = _check_count(n_seeds, "n_seeds", 1)
     lo, hi = (np.array([x]) for x in curve.domain)
+    pieces = _Pieces([curve.knots], [curve.degree])
     if guess is not None:
         x0 = np.asarray(guess, dtype=float)
         if x0.shape != shape or not np.all(np.isfinite(x0)):
@@ -597,10 +611,10 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
         (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
                                    4 * _MIN_SAMPLES, density=4)
         st = _span_samples(curve.knots, curve.degree, counts)
-        rows, sample = _pick_seeds(curve.evaluate(st), targets, n_seeds)
+        rows, sample = _pick_seeds(curve.evaluate(st), targets, n_seeds,
+                                   [pieces.axis_index(0, st)])
         x0 = st[sample][:, None]
     local, value = _curve_local(curve)
-    pieces = _Pieces([curve.knots], [curve.degree])
     rows, x0 = pieces.split_seeds(rows, x0)
     x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
     best = _best_per_query(rows, distance)
