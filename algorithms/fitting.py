@@ -493,7 +493,8 @@ def approximate_curve(points: ArrayLike, n_control: int, *, degree: int = 3,
     The end control points are the end points; the interior ones minimize
     ``sum_k |Q_k - C(ubar_k)|^2`` (eq. 9.63) through the normal equations
     ``(N^T N) P = R`` (eq. 9.67), a symmetric positive definite band system
-    solved with :func:`scipy.linalg.solveh_banded`.
+    solved with :func:`scipy.linalg.solveh_banded` (when its Cholesky factorization
+    fails from ill-conditioning, the dense least-squares problem is solved instead).
 
     Parameters
     ----------
@@ -504,7 +505,9 @@ def approximate_curve(points: ArrayLike, n_control: int, *, degree: int = 3,
     parameters : (m,) float, optional
         Non-decreasing; default chord length on [0, 1] (repeated points allowed).
     knots : (n_control + degree + 1,) float, optional
-        Default :func:`approximation_knots` (eqs. 9.68-9.69).
+        Default :func:`approximation_knots` (eqs. 9.68-9.69), or with
+        ``n_control == m`` (interpolation) :func:`averaged_knots` (eq. 9.8),
+        for which eq. 9.68 can leave a span empty.
 
     Returns
     -------
@@ -520,7 +523,10 @@ def approximate_curve(points: ArrayLike, n_control: int, *, degree: int = 3,
     n_control = int(n_control)
     p = _check_degree(degree, m, n_control)
     t = chord_length_parameters(q) if parameters is None else _check_parameters(parameters, m)
-    if knots is None:
+    if knots is None and n_control == m:        # as many poles as points: interpolation
+        _require_distinct(t)
+        knots = averaged_knots(t, p)
+    elif knots is None:
         knots = approximation_knots(t, n_control, p)
     else:
         knots = validate_knots(knots, p, n_control, "knots")
@@ -557,7 +563,17 @@ def _least_squares_interior(knots: NDArray, p: int, t: NDArray, q: NDArray,
         return rhs / ab[-1, 0]
     try:
         return scipy.linalg.solveh_banded(ab, rhs, check_finite=False)
-    except np.linalg.LinAlgError as exc:
+    except np.linalg.LinAlgError:
+        pass
+    # the normal equations square the condition number; near interpolation
+    # (n_control close to m) Cholesky can fail: solve the least-squares problem
+    # itself (QR/SVD), which only needs full column rank
+    dense = np.zeros((t.size, size))
+    rows = np.broadcast_to(np.arange(t.size)[:, None], idx.shape)
+    np.add.at(dense, (rows[unknown], idx[unknown]), vals[unknown])
+    solution, _, rank, _ = np.linalg.lstsq(dense, residual, rcond=None)
+    if rank < size:
         raise DegenerateGeometryError(
             "singular least-squares system: some knot span holds no parameter "
-            "(Schoenberg-Whitney)") from exc
+            "(Schoenberg-Whitney)")
+    return solution

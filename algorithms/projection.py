@@ -36,7 +36,15 @@ and Newton's step solves ``H delta = -grad f``. The method, for all points at on
    ``|S(x_new) - S(x)|`` is ``<= tol``. The step of the iteration that passes
    the test is still applied, which squares the error (Newton).
    Only the unconverged problems are evaluated in each iteration.
-4. The best result over the seeds of each query is returned.
+4. **Creases.** Knot lines of multiplicity >= degree may carry a jump of the
+   first derivatives, where Newton would stall. The domain is cut there into
+   pieces and each problem runs inside one piece (its box). A seed on a
+   crease starts on both sides; a problem that stops on a crease with
+   descent on the other side continues in the neighbouring piece; grid
+   neighbours across a crease do not count in the local-minimum test of
+   the seeds. A foot exactly on a crease is reported ``1e-13`` of the
+   parameter range before it when reached from below.
+5. The best result over the seeds of each query is returned.
 
 Curves are the same with one parameter (``r . C'`` and ``|C'|^2 + r . C''``).
 

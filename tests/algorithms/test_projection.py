@@ -159,6 +159,23 @@ def assert_no_worse_than_brute_force(surface: NurbsSurface, points: np.ndarray) 
                                atol=1e-12 * scale)
 
 
+@settings(max_examples=10, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 4), st.integers(1, 4), st.booleans())
+def test_points_beyond_a_plane_edge_project_onto_the_edge(seed, p, q, rational):
+    # a flat patch (z = 0) with a wavy boundary; points with x left of the whole
+    # patch, anywhere in z, have their foot on the edge u = u0
+    surface = graph_surface(seed, p, q, 2, 2, rational)
+    flat = np.array(surface.control_points)
+    flat[..., 2] = 0
+    surface = NurbsSurface(flat, surface.knots_u, surface.knots_v, p, q, surface.weights)
+    rng = np.random.default_rng(seed)
+    points = np.c_[rng.uniform(-6, -1, 60), rng.uniform(1, 9, 60), rng.uniform(-3, 3, 60)]
+    result = project_to_surface(surface, points)
+    assert np.all(result.uv[:, 0] == surface.domain[0])
+    assert np.all(result.converged)
+    assert_no_worse_than_brute_force(surface, points)
+
+
 @settings(max_examples=12, deadline=None)
 @given(surfaces(max_degree=4, max_breaks=2), st.integers(0, 2**32 - 1))
 def test_points_beyond_the_boundary_match_brute_force(surface, seed):
