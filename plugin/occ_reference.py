@@ -176,3 +176,171 @@ def project_point_on_surface(surface: NurbsSurface | Geom_Surface,
         uv[i] = projector.LowerDistanceParameters()
         distance[i] = projector.LowerDistance()
     return uv.reshape(points.shape[:-1] + (2,)), distance.reshape(points.shape[:-1])
+
+
+# ====================================================== surface-surface intersection
+# OpenCascade's answer to SSI (issue 3), returned as :class:`OccCurve` objects that
+# carry ``points``, ``closed`` and ``length`` like surfprep's IntersectionCurve, so
+# the same checks apply to both.
+from dataclasses import dataclass as _dataclass  # noqa: E402
+
+from OCP.BRep import BRep_Tool  # noqa: E402
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Section  # noqa: E402
+from OCP.GeomAPI import GeomAPI_IntSS  # noqa: E402
+from OCP.TopAbs import TopAbs_EDGE  # noqa: E402
+from OCP.TopExp import TopExp_Explorer  # noqa: E402
+from OCP.TopoDS import TopoDS, TopoDS_Face  # noqa: E402
+
+__all__ += ["OccCurve", "intersect_surfaces_occ", "section_faces_occ", "sample_occ_curve"]
+
+#: samples per OpenCascade curve (uniform in its parameter)
+OCC_CURVE_SAMPLES = 801
+
+
+@_dataclass(frozen=True)
+class OccCurve:
+    """One intersection curve found by OpenCascade.
+
+    Attributes
+    ----------
+    points : (n, 3) float
+        Samples, uniform in the curve's parameter (a closed curve does not repeat
+        its first sample).
+    closed : bool
+        The curve's ends meet (within ``1e-7`` times its length, or the curve says so).
+    length : float
+        Length of the polyline of the samples (closing chord included when closed).
+    curves : tuple of Geom_Curve
+        The OpenCascade curve(s) sampled (several edges of a section joined end to end).
+    """
+
+    points: NDArray
+    closed: bool
+    length: float
+    curves: tuple
+
+
+def sample_occ_curve(curve: Geom_Curve, first: float | None = None, last: float | None = None,
+                     samples: int = OCC_CURVE_SAMPLES) -> NDArray:
+    """``(samples, 3)`` points of ``curve`` uniform in its parameter over ``[first, last]``
+    (default: its own bounds), by ``Geom_Curve.D0`` per point."""
+    t0 = curve.FirstParameter() if first is None else first
+    t1 = curve.LastParameter() if last is None else last
+    if not (np.isfinite(t0) and np.isfinite(t1)) or abs(t0) > 1e90 or abs(t1) > 1e90:
+        raise OpenCascadeError(f"cannot sample an infinite {curve.DynamicType().Name()}")
+    return evaluate_curve(curve, np.linspace(t0, t1, samples))[:, 0]
+
+
+def _occ_curve(points: NDArray, curves: tuple, closed_flag: bool = False) -> OccCurve:
+    chord = np.linalg.norm(np.diff(points, axis=0), axis=1).sum()
+    gap = float(np.linalg.norm(points[-1] - points[0]))
+    closed = closed_flag or (points.shape[0] > 2 and gap <= 1e-7 * max(chord, 1e-300))
+    if closed and gap <= 1e-7 * max(chord, 1e-300):
+        points = points[:-1]
+    length = chord if not closed else chord + (0.0 if gap <= 1e-7 * chord else gap)
+    points = np.ascontiguousarray(points)
+    points.setflags(write=False)
+    return OccCurve(points, bool(closed), float(length), curves)
+
+
+def intersect_surfaces_occ(surface_a: NurbsSurface | Geom_Surface,
+                           surface_b: NurbsSurface | Geom_Surface, tol: float,
+                           samples: int = OCC_CURVE_SAMPLES) -> list[OccCurve]:
+    """Intersection curves by ``GeomAPI_IntSS(S1, S2, tol)``, one per ``Line(i)``.
+
+    Raises
+    ------
+    OpenCascadeError
+        ``IsDone()`` false, or OpenCascade throws.
+    """
+    sa, sb = _occ_surface(surface_a), _occ_surface(surface_b)
+    try:
+        algo = GeomAPI_IntSS(sa, sb, float(tol))
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"GeomAPI_IntSS failed: {exc}") from exc
+    if not algo.IsDone():
+        raise OpenCascadeError("GeomAPI_IntSS did not finish (IsDone() is false)")
+    out = []
+    for i in range(1, algo.NbLines() + 1):
+        line = algo.Line(i)
+        pts = sample_occ_curve(line, samples=samples)
+        out.append(_occ_curve(pts, (line,), bool(line.IsClosed())))
+    return out
+
+
+def _join_polylines(polylines: list[NDArray], curves: list, tol: float) -> list[OccCurve]:
+    """Join polylines end to end where their ends meet within ``tol`` (greedy)."""
+    pieces = [(p, [c]) for p, c in zip(polylines, curves)]
+    joined: list[tuple[NDArray, list]] = []
+    while pieces:
+        cur, cs = pieces.pop(0)
+        grown = True
+        while grown:
+            grown = False
+            for k, (p, c) in enumerate(pieces):
+                if np.linalg.norm(cur[-1] - p[0]) <= tol:
+                    cur = np.vstack([cur, p[1:]])
+                elif np.linalg.norm(cur[-1] - p[-1]) <= tol:
+                    cur = np.vstack([cur, p[::-1][1:]])
+                elif np.linalg.norm(cur[0] - p[-1]) <= tol:
+                    cur = np.vstack([p, cur[1:]])
+                elif np.linalg.norm(cur[0] - p[0]) <= tol:
+                    cur = np.vstack([p[::-1], cur[1:]])
+                else:
+                    continue
+                cs = cs + c
+                pieces.pop(k)
+                grown = True
+                break
+        joined.append((cur, cs))
+    out = []
+    for pts, cs in joined:
+        closed = pts.shape[0] > 2 and np.linalg.norm(pts[-1] - pts[0]) <= tol
+        out.append(_occ_curve(pts[:-1] if closed else pts, tuple(cs), bool(closed)))
+    return out
+
+
+def section_faces_occ(face_a: TopoDS_Face, face_b: TopoDS_Face, tol: float = 1e-7,
+                      samples: int = OCC_CURVE_SAMPLES) -> list[OccCurve]:
+    """Section of two trimmed faces by ``BRepAlgoAPI_Section`` (approximated curves).
+
+    The section's edges are sampled over their ranges and joined end to end
+    where they meet within ``tol`` (or the larger vertex tolerance), so one
+    :class:`OccCurve` is one branch.
+
+    Raises
+    ------
+    OpenCascadeError
+        ``IsDone()`` false or OpenCascade throws.
+    """
+    try:
+        section = BRepAlgoAPI_Section(face_a, face_b, False)
+        section.Approximation(True)
+        section.ComputePCurveOn1(True)
+        section.ComputePCurveOn2(True)
+        section.Build()
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"BRepAlgoAPI_Section failed: {exc}") from exc
+    if not section.IsDone():
+        raise OpenCascadeError("BRepAlgoAPI_Section did not finish (IsDone() is false)")
+    shape = section.Shape()
+    polylines, curves = [], []
+    join = float(tol)
+    explorer = TopExp_Explorer(shape, TopAbs_EDGE)
+    while explorer.More():
+        edge = TopoDS.Edge_s(explorer.Current())
+        explorer.Next()
+        if BRep_Tool.Degenerated_s(edge):
+            continue
+        curve, t0, t1 = BRep_Tool.Curve_s(edge, 0.0, 0.0)
+        if curve is None:
+            continue
+        pts = sample_occ_curve(curve, t0, t1, samples)
+        location = edge.Location()
+        if not location.IsIdentity():
+            trsf = location.Transformation()
+            pts = np.array([gp_Pnt(*p).Transformed(trsf).Coord() for p in pts.tolist()])
+        polylines.append(pts)
+        curves.append(curve)
+        join = max(join, BRep_Tool.Tolerance_s(edge))
+    return _join_polylines(polylines, curves, join)

@@ -1,2 +1,47 @@
 """Surface-surface intersection (000 §29.4, 004 §4-6): triangulation, culling,
-triangle intersection, curve topology and refinement onto the exact surfaces."""
+triangle intersection, curve topology and refinement onto the exact surfaces.
+
+The entry point is :func:`intersect_surfaces` (:mod:`.pipeline`); the stages are
+public too, module by module:
+
+* :mod:`.mesh`: :class:`TriangleMesh`;
+* :mod:`.tessellation`: adaptive tessellation of a surface's parameter regions;
+* :mod:`.culling`: Bézier patch boxes, overlap boxes, box trees;
+* :mod:`.triangles`: vectorized triangle-triangle intersection;
+* :mod:`.segments`: :func:`mesh_segments`, steps 1-4 to a :class:`SegmentSoup`;
+* :mod:`.topology`: Point / PointUse / Segment topology, traced chains;
+* :mod:`.refine`: auxiliary-plane refinement (eqs. 29.18-29.26);
+* :mod:`.result`: :class:`IntersectionCurve` and its interpolants;
+* :mod:`.compare`: distances between two answers (Hausdorff, per-branch).
+"""
+
+from .compare import (CurveSetDistance, connected_branches, curve_set_distance, hausdorff,
+                      polyline_distance)
+from .culling import (BoxTree, PatchOverlap, build_tree, candidate_pairs, overlap_boxes,
+                      overlap_patches, patch_rectangles, subpatch_boxes, surface_patch_boxes,
+                      tree_pairs)
+from .mesh import TriangleMesh, collinear_mask
+from .pipeline import closed_in_space, default_mesh_tolerance, intersect_surfaces, operand_size
+from .refine import (RefinedCurve, RefinedPoints, project_points, refine_curves, refine_points,
+                     segment_distance)
+from .result import CurveDeviation, IntersectionCurve, interpolate_samples, intersection_curves
+from .segments import SegmentSoup, SoupStats, mesh_segments
+from .tessellation import Tessellation, tessellate
+from .topology import Chain, EndKind, SegmentTopology, build_topology, topology_from_soup
+from .triangles import TriangleHits, intersect_triangles
+
+__all__ = [
+    "intersect_surfaces", "closed_in_space", "default_mesh_tolerance", "operand_size",
+    "IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
+    "EndKind", "Chain", "SegmentTopology", "build_topology", "topology_from_soup",
+    "RefinedPoints", "RefinedCurve", "refine_points", "refine_curves", "project_points",
+    "segment_distance",
+    "SegmentSoup", "SoupStats", "mesh_segments",
+    "TriangleHits", "intersect_triangles",
+    "TriangleMesh", "collinear_mask",
+    "Tessellation", "tessellate",
+    "BoxTree", "PatchOverlap", "build_tree", "tree_pairs", "candidate_pairs", "overlap_boxes",
+    "overlap_patches", "surface_patch_boxes", "patch_rectangles", "subpatch_boxes",
+    "hausdorff", "polyline_distance", "curve_set_distance", "CurveSetDistance",
+    "connected_branches",
+]

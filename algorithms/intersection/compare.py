@@ -1,0 +1,140 @@
+"""Distances between two answers to the same intersection problem (ours, OpenCascade's, exact).
+
+All functions take sampled curves (anything with ``points (n, 3)`` and
+``closed``, or plain ``(n, 3)`` arrays) and measure with k-d trees
+(``scipy.spatial.cKDTree``), vectorized over the samples:
+
+* :func:`hausdorff`: the symmetric Hausdorff distance of two point sets;
+* :func:`polyline_distance`: each point's distance to a set of polylines
+  (segments, not just vertices, so sparse sampling is not punished);
+* :func:`curve_set_distance`: symmetric Hausdorff distance between two sets
+  of curves measured to the polylines, and the one-sided distance of every
+  curve of each set to the other set (a branch missed by one side shows as a
+  large one-sided distance of that branch).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
+
+from ...errors import InvalidGeometryError
+
+__all__ = ["hausdorff", "polyline_distance", "curve_set_distance", "CurveSetDistance",
+           "connected_branches"]
+
+
+def _points(x: ArrayLike) -> NDArray:
+    p = np.asarray(getattr(x, "points", x), dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise InvalidGeometryError(f"points must have shape (n, 3), got {p.shape}")
+    return p
+
+
+def hausdorff(points_a: ArrayLike, points_b: ArrayLike) -> float:
+    """Symmetric Hausdorff distance of two point sets ``(n, 3)``, ``(m, 3)``.
+
+    ``max(max_a min_b |a - b|, max_b min_a |a - b|)``; ``inf`` when exactly one
+    set is empty, 0 when both are.
+    """
+    a, b = _points(np.reshape(points_a, (-1, 3))), _points(np.reshape(points_b, (-1, 3)))
+    if a.shape[0] == 0 or b.shape[0] == 0:
+        return 0.0 if a.shape[0] == b.shape[0] else float("inf")
+    d_ab = cKDTree(b).query(a)[0]
+    d_ba = cKDTree(a).query(b)[0]
+    return float(max(d_ab.max(), d_ba.max()))
+
+
+def _segments(curves: Sequence) -> tuple[NDArray, NDArray]:
+    """Start points and vectors ``(s, 3)`` of all segments of all curves (closing chords too)."""
+    starts, vectors = [], []
+    for c in curves:
+        p = _points(c)
+        closed = bool(getattr(c, "closed", False))
+        q = np.vstack([p, p[:1]]) if closed else p
+        if q.shape[0] == 1:
+            q = np.vstack([q, q])
+        starts.append(q[:-1])
+        vectors.append(np.diff(q, axis=0))
+    return np.concatenate(starts), np.concatenate(vectors)
+
+
+def polyline_distance(points: ArrayLike, curves: Sequence, k: int = 8) -> NDArray:
+    """Distance ``(n,)`` of each point ``(n, 3)`` to the nearest segment of the polylines.
+
+    The ``k`` segments whose midpoints are nearest are tested exactly (segments
+    of sampled curves are short and even, so the nearest one is among them).
+    """
+    x = _points(np.reshape(points, (-1, 3)))
+    if len(curves) == 0:
+        return np.full(x.shape[0], np.inf)
+    start, vec = _segments(curves)
+    k = min(k, start.shape[0])
+    _, idx = cKDTree(start + 0.5 * vec).query(x, k=k)
+    idx = idx.reshape(x.shape[0], k)
+    a, d = start[idx], vec[idx]                                 # (n, k, 3)
+    dd = np.einsum("nkc,nkc->nk", d, d)
+    t = np.where(dd > 0, np.einsum("nkc,nkc->nk", x[:, None] - a, d) / np.where(dd > 0, dd, 1),
+                 0.0)
+    t = np.clip(t, 0.0, 1.0)
+    dist = np.linalg.norm(a + t[..., None] * d - x[:, None], axis=-1)
+    return dist.min(axis=1)
+
+
+@dataclass(frozen=True)
+class CurveSetDistance:
+    """Result of :func:`curve_set_distance`.
+
+    Attributes
+    ----------
+    hausdorff : float
+        Symmetric Hausdorff distance between the two sets (points to polylines).
+    a_to_b, b_to_a : (n_a,), (n_b,) float
+        Largest distance of each curve of one set to the other set's polylines.
+    """
+
+    hausdorff: float
+    a_to_b: NDArray
+    b_to_a: NDArray
+
+    def unmatched_a(self, tol: float) -> NDArray:
+        """Indices of curves of a farther than ``tol`` from b (b missed them)."""
+        return np.flatnonzero(self.a_to_b > tol)
+
+    def unmatched_b(self, tol: float) -> NDArray:
+        return np.flatnonzero(self.b_to_a > tol)
+
+
+def curve_set_distance(curves_a: Sequence, curves_b: Sequence) -> CurveSetDistance:
+    """Distances between two sets of sampled curves (see module docstring)."""
+    a_to_b = np.array([polyline_distance(_points(c), curves_b).max() for c in curves_a])
+    b_to_a = np.array([polyline_distance(_points(c), curves_a).max() for c in curves_b])
+    both = np.concatenate([a_to_b, b_to_a])
+    h = float(both.max()) if both.size else 0.0
+    return CurveSetDistance(h, a_to_b, b_to_a)
+
+
+def connected_branches(curves: Sequence, tol: float) -> int:
+    """Number of connected pieces of a set of curves in space.
+
+    Curves whose end points meet within ``tol`` (a loop cut at a seam, arcs
+    meeting at a bifurcation) count as one; a closed curve is its own piece
+    unless an open curve ends on one of its ends. Union-find over the curve
+    ends with a k-d tree, so the count does not depend on how an answer
+    splits its curves.
+    """
+    n = len(curves)
+    if n == 0:
+        return 0
+    ends = np.stack([np.stack([_points(c)[0], _points(c)[-1]]) for c in curves]).reshape(-1, 3)
+    owner = np.repeat(np.arange(n), 2)
+    pairs = cKDTree(ends).query_pairs(tol, output_type="ndarray")
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    graph = coo_matrix((np.ones(len(pairs)), (owner[pairs[:, 0]], owner[pairs[:, 1]])),
+                       shape=(n, n))
+    return int(connected_components(graph, directed=False)[0])
