@@ -2,19 +2,35 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import (assert_same_curve, assert_same_surface, curve_samples, curves,
-                              make_surface, scale_of, surface_samples)
+from nurbs_strategies import (
+    assert_same_curve,
+    assert_same_surface,
+    curve_samples,
+    curves,
+    make_surface,
+    scale_of,
+    surface_samples,
+)
 from scipy.interpolate import make_interp_spline
 
 from surfprep.algorithms import NurbsCurve
 from surfprep.algorithms.basis import greville_abscissae
-from surfprep.algorithms.fitting import (approximate_curve, approximation_knots, averaged_knots,
-                                         chord_length_parameters, interpolate_curve,
-                                         interpolate_surface, knots_from_breakpoints)
+from surfprep.algorithms.fitting import (
+    approximate_curve,
+    approximation_knots,
+    averaged_knots,
+    chord_length_parameters,
+    interpolate_curve,
+    interpolate_surface,
+    knots_from_breakpoints,
+)
+
 from surfprep.errors import DegenerateGeometryError, InvalidGeometryError
 
 
@@ -209,7 +225,7 @@ def test_approximation_error_decreases_with_more_control_points():
         assert curve.n_control == n_control
         np.testing.assert_array_equal(curve.control_points[[0, -1]], points[[0, -1]])
         errors.append(np.linalg.norm(curve.evaluate(params) - points, axis=1).max())
-    assert all(b < a for a, b in zip(errors, errors[1:])), errors
+    assert all(b < a for a, b in itertools.pairwise(errors)), errors
     assert errors[-1] < 1e-5
 
 

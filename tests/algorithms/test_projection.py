@@ -11,8 +11,12 @@ from scipy.spatial import cKDTree
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.algorithms.fitting import interpolate_curve
-from surfprep.algorithms.projection import (distance_to_curve, distance_to_surface,
-                                            project_to_curve, project_to_surface)
+from surfprep.algorithms.projection import (
+    distance_to_curve,
+    distance_to_surface,
+    project_to_curve,
+    project_to_surface,
+)
 from surfprep.errors import InvalidGeometryError, InvalidToleranceError
 
 S2 = np.sqrt(0.5)
