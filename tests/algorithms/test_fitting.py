@@ -30,7 +30,6 @@ from surfprep.algorithms.fitting import (
     interpolate_surface,
     knots_from_breakpoints,
 )
-
 from surfprep.errors import DegenerateGeometryError, InvalidGeometryError
 
 
