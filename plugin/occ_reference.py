@@ -185,6 +185,7 @@ def project_point_on_surface(surface: NurbsSurface | Geom_Surface,
 from dataclasses import dataclass as _dataclass  # noqa: E402
 
 from OCP.BRep import BRep_Tool  # noqa: E402
+from OCP.BRepAdaptor import BRepAdaptor_Curve  # noqa: E402
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section  # noqa: E402
 from OCP.GeomAPI import GeomAPI_IntSS  # noqa: E402
 from OCP.TopAbs import TopAbs_EDGE  # noqa: E402
@@ -332,15 +333,10 @@ def section_faces_occ(face_a: TopoDS_Face, face_b: TopoDS_Face, tol: float = 1e-
         explorer.Next()
         if BRep_Tool.Degenerated_s(edge):
             continue
-        curve, t0, t1 = BRep_Tool.Curve_s(edge, 0.0, 0.0)
-        if curve is None:
-            continue
-        pts = sample_occ_curve(curve, t0, t1, samples)
-        location = edge.Location()
-        if not location.IsIdentity():
-            trsf = location.Transformation()
-            pts = np.array([gp_Pnt(*p).Transformed(trsf).Coord() for p in pts.tolist()])
+        adaptor = BRepAdaptor_Curve(edge)          # the edge's curve, location applied
+        t = np.linspace(adaptor.FirstParameter(), adaptor.LastParameter(), samples)
+        pts = np.array([adaptor.Value(x).Coord() for x in t.tolist()])
         polylines.append(pts)
-        curves.append(curve)
+        curves.append(BRep_Tool.Curve_s(edge, 0.0, 0.0))
         join = max(join, BRep_Tool.Tolerance_s(edge))
     return _join_polylines(polylines, curves, join)

@@ -36,6 +36,7 @@ _PLUGIN_EXPORTS = {
     "TrimEdge": "surfprep.plugin.topology",
     "make_face": "surfprep.plugin.topology",
     "make_edge": "surfprep.plugin.topology",
+    "intersect": "surfprep.plugin.intersect",
 }
 
 __all__ = [

@@ -12,7 +12,10 @@
      surface (see below);
 5-6. :func:`.result.intersection_curves`: auxiliary-plane refinement (eqs.
      29.18-29.26) to ``tol``, chord-midpoint insertion, redundant points dropped,
-     interpolants checked between the samples.
+     interpolants checked between the samples; then every end the topology
+     found on a domain side is solved again on that side (Newton with the side
+     parameter held), because the anchored refinement lets it slide inward by
+     up to about ``mesh_tol`` (:func:`_close_boundary_gaps`).
 
 Seams. A closed surface converted to a B-spline (a sphere, a cylinder, a
 torus) has two parameter lines that are one curve in space. The soup's ends on
@@ -261,6 +264,127 @@ def closed_in_space(curve: IntersectionCurve, tol: float) -> bool:
     return bool(np.linalg.norm(curve.points[0] - curve.points[-1]) <= tol)
 
 
+# ------------------------------------------------------------------ boundary ends
+def _side_constraint(uv: NDArray, domain, rel: float = 1e-9) -> tuple[int, float] | None:
+    """``(coordinate, value)`` of the domain side ``uv (2,)`` lies on, or None."""
+    sides = ((0, domain[0]), (0, domain[1]), (1, domain[2]), (1, domain[3]))
+    extent = (domain[1] - domain[0], domain[3] - domain[2])
+    for coord, value in sides:
+        if abs(uv[coord] - value) <= rel * extent[coord]:
+            return coord, value
+    return None
+
+
+def _solve_on_side(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: NDArray,
+                   uv_b: NDArray, side: NDArray, coord: NDArray, value: NDArray, tol: float,
+                   iterations: int = 30) -> tuple[NDArray, NDArray, NDArray]:
+    """Newton on ``S_a(uv_a) = S_b(uv_b)`` with one parameter held on a domain side.
+
+    Batched over ``k`` ends: ``side (k,)`` 0 holds a coordinate of ``uv_a``, 1 of
+    ``uv_b``; ``coord (k,)`` which one; ``value (k,)`` its value. Three equations,
+    three free parameters: the other parameter of the held surface and both of
+    the other. Returns ``uv_a, uv_b (k, 2)`` and ``converged (k,) bool``
+    (``|S_a - S_b| <= tol``).
+    """
+    ua, ub = uv_a.copy(), uv_b.copy()
+    rows = np.arange(ua.shape[0])
+    held = np.where(side == 0, 0, 1)
+    for target, s in ((ua, 0), (ub, 1)):
+        m = held == s
+        target[rows[m], coord[m]] = value[m]
+    lo_a, hi_a = np.array(surface_a.domain[0::2]), np.array(surface_a.domain[1::2])
+    lo_b, hi_b = np.array(surface_b.domain[0::2]), np.array(surface_b.domain[1::2])
+    converged = np.zeros(rows.size, dtype=bool)
+    for _ in range(iterations):
+        da = surface_a.derivatives(ua[:, 0], ua[:, 1], 1)
+        db = surface_b.derivatives(ub[:, 0], ub[:, 1], 1)
+        gap = da[:, 0, 0] - db[:, 0, 0]                                   # (k, 3)
+        converged = np.linalg.norm(gap, axis=1) <= tol
+        if converged.all():
+            break
+        jac_a = np.stack([da[:, 1, 0], da[:, 0, 1]], axis=2)              # (k, 3, 2)
+        jac_b = -np.stack([db[:, 1, 0], db[:, 0, 1]], axis=2)
+        free_a = np.where((held == 0)[:, None], (1 - coord)[:, None] == np.arange(2), True)
+        free_b = np.where((held == 1)[:, None], (1 - coord)[:, None] == np.arange(2), True)
+        # three columns: the free ones of a's and b's (4 minus the held one)
+        cols = np.concatenate([jac_a, jac_b], axis=2)                     # (k, 3, 4)
+        free = np.concatenate([free_a, free_b], axis=1)                   # (k, 4)
+        order = np.argsort(~free, axis=1, kind="stable")[:, :3]
+        jac = np.take_along_axis(cols, order[:, None, :], axis=2)         # (k, 3, 3)
+        ok = np.abs(np.linalg.det(jac)) > 1e-300
+        step = np.zeros((rows.size, 3))
+        if ok.any():
+            step[ok] = np.linalg.solve(jac[ok], -gap[ok][..., None])[..., 0]
+        full = np.zeros((rows.size, 4))
+        np.put_along_axis(full, order, step, axis=1)
+        ua = np.clip(ua + full[:, :2], lo_a, hi_a)
+        ub = np.clip(ub + full[:, 2:], lo_b, hi_b)
+    return ua, ub, converged
+
+
+def _close_boundary_gaps(curves: list[IntersectionCurve], ends_uv: list, surface_a, surface_b,
+                         tol: float, reach: float) -> list[IntersectionCurve]:
+    """Put every BOUNDARY end back on the domain side its traced end was on.
+
+    The auxiliary-plane refinement anchors ``F_n`` at the midpoint of the two
+    start images; at an end on a domain side that midpoint is off the side by
+    the mesh error, so the refined end slides along the curve, inside the
+    domain, by up to about ``mesh_tol``: a gap in coverage. Each such end is
+    solved again with its side parameter held (:func:`_solve_on_side`) and
+    added as a new end sample (replacing the old one when closer than ``tol``).
+    ``ends_uv[i]`` holds the traced ``(uv_a, uv_b)`` of curve ``i``'s two ends.
+    """
+    jobs = []            # (curve, end (0 start / -1 end), side, coord, value, uv_a, uv_b)
+    for i, (curve, ends) in enumerate(zip(curves, ends_uv)):
+        if curve.closed or curve.uv_a is None or curve.uv_b is None:
+            continue
+        for end, kind in ((0, curve.start_kind), (-1, curve.end_kind)):
+            if kind is not EndKind.BOUNDARY:
+                continue
+            traced_a, traced_b = ends[0 if end == 0 else 1]
+            for side, (traced, surface) in enumerate(((traced_a, surface_a),
+                                                       (traced_b, surface_b))):
+                held = _side_constraint(traced, surface.domain)
+                if held is not None:
+                    jobs.append((i, end, side, held[0], held[1]))
+                    break
+    if not jobs:
+        return curves
+    idx = np.array([j[0] for j in jobs])
+    end = np.array([j[1] for j in jobs])
+    uv_a = np.stack([curves[i].uv_a[e] for i, e in zip(idx, end)])
+    uv_b = np.stack([curves[i].uv_b[e] for i, e in zip(idx, end)])
+    ua, ub, ok = _solve_on_side(surface_a, surface_b, uv_a, uv_b, np.array([j[2] for j in jobs]),
+                                np.array([j[3] for j in jobs]), np.array([j[4] for j in jobs]),
+                                tol / 16)
+    pa, pb = surface_a.evaluate(ua[:, 0], ua[:, 1]), surface_b.evaluate(ub[:, 0], ub[:, 1])
+    new_points = 0.5 * (pa + pb)
+    out = list(curves)
+    for k in np.flatnonzero(ok):
+        i, e = int(idx[k]), int(end[k])
+        c = out[i]
+        moved = float(np.linalg.norm(new_points[k] - c.points[e]))
+        if moved > reach:
+            continue            # not the same end: leave it
+        pts, a, b, sing = c.points.copy(), c.uv_a.copy(), c.uv_b.copy(), c.singular.copy()
+        if moved <= tol / 16:
+            pts[e], a[e], b[e] = new_points[k], ua[k], ub[k]
+        elif e == 0:
+            pts, a, b = (np.vstack([new_points[k], pts]), np.vstack([ua[k], a]),
+                         np.vstack([ub[k], b]))
+            sing = np.concatenate([[False], sing])
+        else:
+            pts, a, b = (np.vstack([pts, new_points[k]]), np.vstack([a, ua[k]]),
+                         np.vstack([b, ub[k]]))
+            sing = np.concatenate([sing, [False]])
+        try:
+            out[i] = IntersectionCurve.from_samples(pts, a, b, False, c.start_kind, c.end_kind,
+                                                    singular=sing)
+        except InvalidGeometryError:
+            continue
+    return out
+
+
 # ------------------------------------------------------------------ driver
 def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
                        mesh_tol: float | None = None, max_depth: int = 24
@@ -321,4 +445,11 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     surface_a = a if isinstance(a, NurbsSurface) else None
     surface_b = b if isinstance(b, NurbsSurface) else None
     topology = _cut_at_seams(topology, surface_a, surface_b, _JOIN_FACTOR * mesh_tol)
-    return intersection_curves(topology, surface_a, surface_b, tol=tol)
+    curves = intersection_curves(topology, surface_a, surface_b, tol=tol)
+    if surface_a is None or surface_b is None:
+        return curves
+    kept = [c for c in topology.chains if len(c) >= 2 + c.closed]     # as intersection_curves
+    ends = [((topology.uv_a[c.point_ids[0]], topology.uv_b[c.point_ids[0]]),
+             (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in kept]
+    return _close_boundary_gaps(curves, ends, surface_a, surface_b, tol,
+                                reach=_JOIN_FACTOR * mesh_tol)

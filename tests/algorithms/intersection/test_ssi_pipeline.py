@@ -157,6 +157,22 @@ def test_plane_sphere_circle_off_the_seam_is_closed():
     check_against_occ(curves, a, b, expect_branches=1)
 
 
+def test_curve_ends_on_the_domain_sides():
+    """A unit square at z = 0.3 cuts a quarter of the circle; its ends lie on the
+    square's sides x = 0 and y = 0 (not a mesh error inside), so it covers the arc."""
+    cp = np.array([[[0, 0, 0.3], [0, 1, 0.3]], [[1, 0, 0.3], [1, 1, 0.3]]], float)
+    a, b = NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1), sphere(1.0)
+    curves = intersect_surfaces(a, b, tol=TOL)
+    check_on_surfaces(curves, a, b)
+    (c,) = curves
+    assert c.start_kind is EndKind.BOUNDARY and c.end_kind is EndKind.BOUNDARY
+    ends = c.points[[0, -1]]
+    assert np.sort(np.abs(ends[:, :2]).min(axis=1)).max() <= TOL     # x = 0 or y = 0
+    r = np.sqrt(0.91)
+    assert c.length == pytest.approx(np.pi / 2 * r, rel=1e-6)
+    check_against_occ(curves, a, b, expect_branches=1)
+
+
 # ---------------------------------------------------------------- cylinder x cylinder
 def exact_cylinders(r_small: float, n: int = 20001) -> np.ndarray:
     """Both loops of x^2 + y^2 = 1, y^2 + z^2 = r^2: (2, n, 3) samples."""

@@ -1,0 +1,516 @@
+"""Intersection curves of faces: :func:`intersect` on anything that holds faces.
+
+For every pair of faces (across ``a`` and ``b``, or within ``a`` when ``b`` is
+None) whose boxes overlap, the two *surfaces* are intersected by
+:func:`surfprep.algorithms.intersection.intersect_surfaces`, then every curve
+is clipped to both faces' trimmed domains:
+
+* **Classification**: each face's trimming loops are sampled densely in
+  ``(u, v)`` (every edge's pcurve at ``EDGE_SAMPLES`` points, more for edges
+  that are long in the parameter plane) into one set of polygon segments; a
+  (u, v) point is inside when a ray in +u crosses them an odd number of times
+  (even-odd rule: outer loop and holes at once), vectorized over points x
+  segments. A face without loops is its whole parameter rectangle.
+* **Splitting**: a curve is cut into the runs of samples inside both faces.
+  Where a run leaves a face, the crossing is located on the interpolants
+  (``curve3d``, ``pcurve_a``, ``pcurve_b`` share one parameter) by 30
+  bisection steps batched over all crossings, and becomes the run's end
+  (:attr:`EndKind.BOUNDARY`). The pieces are new :class:`IntersectionCurve`
+  objects (refined samples inside, interpolated crossing points at the ends).
+* **Shared edges** (faces of one shape): adjacent faces meet along their common
+  edge, which is an intersection of their surfaces but not one of the faces.
+  A piece is dropped when all its samples lie within ``max(10 tol, 2 x edge
+  tolerance)`` of the trimming loops of *both* faces: it runs along a common
+  boundary.
+
+Each result is a :class:`FaceIntersection` (the piece, the two faces' indices
+and names); :meth:`FaceIntersection.to_edges` builds a ``TopoDS_Edge`` with the
+3D curve and a pcurve on each face (:func:`surfprep.plugin.edges.make_edge`,
+checked by BRepCheck).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from OCP.Geom import Geom_Surface
+from OCP.TopoDS import TopoDS_Face
+
+from ..algorithms import NurbsSurface
+from ..algorithms.intersection import (EndKind, IntersectionCurve, closed_in_space,
+                                       intersect_surfaces, polyline_distance)
+from ..errors import InvalidGeometryError, InvalidToleranceError, OpenCascadeError
+from .convert import to_nurbs
+from .edges import make_edge
+from .faces import TrimmedFace, make_face, needs_nurbs_convert, trimmed_face_to_occ
+from .io import CadModel
+
+__all__ = ["intersect", "FaceIntersection", "FaceOperand", "face_operands",
+           "inside_face", "clip_curve", "DEFAULT_TOL_FACTOR", "MIN_TOL_FACTOR"]
+
+#: default ``tol``: this times the diagonal of the box of all faces
+DEFAULT_TOL_FACTOR = 1e-6
+#: smallest accepted ``tol``: this times that diagonal
+MIN_TOL_FACTOR = 1e-9
+#: samples per trimming edge for the point-in-face test
+EDGE_SAMPLES = 64
+_BISECTIONS = 30
+#: a (u, v) this close to a trimming loop (relative to the domain diagonal) is inside
+ON_BOUNDARY = 1e-9
+#: (u, v) this close to a loop (relative to the domain diagonal) are measured in space
+NEAR_BOUNDARY = 1e-2
+#: the clipping classifies the interpolants at this many points per span
+CLASSIFY_PER_SPAN = 8
+
+
+# ------------------------------------------------------------------ operands
+@dataclass(frozen=True, eq=False)
+class FaceOperand:
+    """One face taking part: its NURBS form and, when known, its OpenCascade face.
+
+    Attributes
+    ----------
+    index : int
+        Position among the faces of its operand (``a`` or ``b``).
+    trimmed : TrimmedFace
+    occ_face : TopoDS_Face or None
+        The face as given, when its surface is exactly ``trimmed.surface`` (same
+        parameters); None when it must be rebuilt (:meth:`face_for_edges`).
+    """
+
+    index: int
+    trimmed: TrimmedFace
+    occ_face: TopoDS_Face | None = None
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def surface(self) -> NurbsSurface:
+        return self.trimmed.surface
+
+    @property
+    def name(self) -> str | None:
+        return self.trimmed.name
+
+    def face_for_edges(self) -> TopoDS_Face:
+        """A face whose surface has ``surface``'s parameters, to hang pcurves on:
+        the given face, else the trimmed face rebuilt (natural bounds if that fails)."""
+        if self.occ_face is not None:
+            return self.occ_face
+        if "face" not in self._cache:
+            try:
+                face = trimmed_face_to_occ(self.trimmed) if self.trimmed.loops else \
+                    make_face(self.surface)
+            except OpenCascadeError:
+                face = make_face(self.surface)
+            self._cache["face"] = face
+        return self._cache["face"]
+
+    def boundary_segments(self) -> NDArray:
+        """``(m, 2, 2)`` segments of the sampled trimming loops in ``(u, v)`` (cached)."""
+        if "segments" not in self._cache:
+            self._cache["segments"] = _loop_segments(self.trimmed)
+        return self._cache["segments"]
+
+    def boundary_polylines(self) -> list[NDArray]:
+        """Samples ``(k, 3)`` in space of every trimming edge, one polyline each (cached)."""
+        if "polylines" not in self._cache:
+            lines = []
+            for edge in self.trimmed.edges:
+                uv = edge.pcurve.evaluate(np.linspace(edge.t0, edge.t1, 2 * EDGE_SAMPLES))
+                lines.append(self.surface.evaluate(uv[:, 0], uv[:, 1]))
+            self._cache["polylines"] = lines
+        return self._cache["polylines"]
+
+    def edge_tolerance(self) -> float:
+        return max((e.tolerance for e in self.trimmed.edges), default=0.0)
+
+
+def _as_faces(x: Any) -> list[tuple[TrimmedFace, TopoDS_Face | None]]:
+    if isinstance(x, NurbsSurface):
+        return [(TrimmedFace(x), None)]
+    if isinstance(x, TrimmedFace):
+        return [(x, None)]
+    if isinstance(x, Geom_Surface):
+        return [(TrimmedFace(to_nurbs(x)), None)]
+    if isinstance(x, CadModel):
+        faces = to_nurbs(x)
+        return [(t, f if not needs_nurbs_convert(f) else None) for t, f in zip(faces, x.faces)]
+    if isinstance(x, TopoDS_Face):
+        return [(to_nurbs(x), None if needs_nurbs_convert(x) else x)]
+    if isinstance(x, (list, tuple)) and not isinstance(x, CadModel):
+        return [item for y in x for item in _as_faces(y)]
+    wrapped = getattr(x, "wrapped", None)
+    if isinstance(wrapped, TopoDS_Face):
+        return _as_faces(wrapped)
+    from .convert import _unwrap, faces_of
+    shape = _unwrap(x)
+    if isinstance(shape, list):
+        return [item for y in shape for item in _as_faces(y)]
+    if isinstance(shape, (TopoDS_Face, Geom_Surface)):
+        return _as_faces(shape)
+    from OCP.TopoDS import TopoDS_Shape
+    if isinstance(shape, TopoDS_Shape):
+        return [item for f in faces_of(shape) for item in _as_faces(f)]
+    converted = to_nurbs(x)          # raises ConversionError for what it cannot take
+    return _as_faces(converted)
+
+
+def face_operands(x: Any) -> list[FaceOperand]:
+    """The faces of anything :func:`intersect` accepts, numbered in order."""
+    return [FaceOperand(i, t, f) for i, (t, f) in enumerate(_as_faces(x))]
+
+
+# ------------------------------------------------------------------ classification
+def _loop_segments(face: TrimmedFace) -> NDArray:
+    """Polygon segments ``(m, 2, 2)`` of all trimming loops (pcurves sampled densely)."""
+    segments = []
+    for edge in face.edges:
+        t = np.linspace(edge.t0, edge.t1, EDGE_SAMPLES)
+        uv = edge.pcurve.evaluate(t)
+        # edges long in the parameter plane get more samples
+        extent = np.linalg.norm(np.diff(uv, axis=0), axis=1).sum()
+        u0, u1, v0, v1 = face.surface.domain
+        rel = extent / max(np.hypot(u1 - u0, v1 - v0), 1e-300)
+        if rel > 0.25:
+            t = np.linspace(edge.t0, edge.t1, int(EDGE_SAMPLES * min(16, 4 * rel)))
+            uv = edge.pcurve.evaluate(t)
+        segments.append(np.stack([uv[:-1], uv[1:]], axis=1))
+    return np.concatenate(segments) if segments else np.zeros((0, 2, 2))
+
+
+def _is_rectangle(seg: NDArray, domain, eps: float) -> bool:
+    """True when every loop segment lies on a side of the parameter rectangle."""
+    u0, u1, v0, v1 = domain
+    on = lambda x, lo, hi: (np.abs(x - lo) <= eps) | (np.abs(x - hi) <= eps)   # noqa: E731
+    pts = seg.reshape(-1, 2)
+    same_u = on(seg[:, 0, 0], u0, u1) & (np.abs(seg[:, 0, 0] - seg[:, 1, 0]) <= eps)
+    same_v = on(seg[:, 0, 1], v0, v1) & (np.abs(seg[:, 0, 1] - seg[:, 1, 1]) <= eps)
+    return bool(np.all(same_u | same_v) and pts.size)
+
+
+def _crossings(uv: NDArray, seg: NDArray, bins: int) -> NDArray:
+    """Crossings ``(n,) int`` of a ray in +u from each point with the segments, only
+    testing the segments whose v-range holds the point (bucketed by v)."""
+    a, b = seg[:, 0], seg[:, 1]
+    vlo, vhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+    lo, hi = vlo.min(), vhi.max()
+    width = (hi - lo) / bins if hi > lo else 1.0
+    first = np.clip(((vlo - lo) / width).astype(np.int64), 0, bins - 1)
+    last = np.clip(((vhi - lo) / width).astype(np.int64), 0, bins - 1)
+    count = last - first + 1
+    seg_of = np.repeat(np.arange(seg.shape[0]), count)
+    bin_of = np.repeat(first, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count,
+                                                                           count))
+    order = np.argsort(bin_of, kind="stable")
+    seg_sorted = seg_of[order]
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(bin_of, minlength=bins))])
+    pbin = np.clip(((uv[:, 1] - lo) / width).astype(np.int64), 0, bins - 1)
+    inside_range = (uv[:, 1] >= lo) & (uv[:, 1] <= hi)
+    per_point = np.where(inside_range, indptr[pbin + 1] - indptr[pbin], 0)
+    point_of = np.repeat(np.arange(uv.shape[0]), per_point)
+    offs = np.arange(per_point.sum()) - np.repeat(np.cumsum(per_point) - per_point, per_point)
+    cand = seg_sorted[indptr[pbin[point_of]] + offs]
+    pa, pb, p = a[cand], b[cand], uv[point_of]
+    straddle = (pa[:, 1] > p[:, 1]) != (pb[:, 1] > p[:, 1])
+    dv = np.where(pb[:, 1] != pa[:, 1], pb[:, 1] - pa[:, 1], 1.0)
+    u_cross = pa[:, 0] + (p[:, 1] - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dv
+    hit = straddle & (u_cross > p[:, 0])
+    return np.bincount(point_of[hit], minlength=uv.shape[0])
+
+
+def _segment_distance_uv(uv: NDArray, seg: NDArray, k: int = 8) -> NDArray:
+    """Distance ``(n,)`` from each point to the nearest of the segments (k-d tree on midpoints)."""
+    from scipy.spatial import cKDTree
+    a, d = seg[:, 0], seg[:, 1] - seg[:, 0]
+    k = min(k, seg.shape[0])
+    _, idx = cKDTree(a + 0.5 * d).query(uv, k=k)
+    idx = idx.reshape(uv.shape[0], k)
+    pa, pd = a[idx], d[idx]
+    dd = np.einsum("nkc,nkc->nk", pd, pd)
+    t = np.clip(np.einsum("nkc,nkc->nk", uv[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0), 0, 1)
+    return np.linalg.norm(pa + t[..., None] * pd - uv[:, None], axis=-1).min(axis=1)
+
+
+def inside_face(operand: FaceOperand, uv: NDArray, tol: float = 0.0) -> NDArray:
+    """``(n,) bool``: which ``uv (n, 2)`` lie inside the face.
+
+    Even-odd rule on the sampled loops (rays in +u, segments bucketed by their
+    v-range so each point meets only its neighbours); points within
+    ``ON_BOUNDARY`` times the domain diagonal of a loop count as inside, and so
+    do points whose image lies within ``tol`` plus twice the face's largest edge
+    tolerance of a trimming edge in space (a curve running along a shared edge
+    of two faces is on both). A face without loops, or whose loops run along
+    its parameter rectangle, is the rectangle.
+    """
+    uv = np.asarray(uv, dtype=float).reshape(-1, 2)
+    u0, u1, v0, v1 = operand.surface.domain
+    eps = ON_BOUNDARY * np.hypot(u1 - u0, v1 - v0)
+    in_box = ((uv[:, 0] >= u0 - eps) & (uv[:, 0] <= u1 + eps) & (uv[:, 1] >= v0 - eps)
+              & (uv[:, 1] <= v1 + eps))
+    seg = operand.boundary_segments()
+    if seg.shape[0] == 0 or operand._cache.setdefault(
+            "rectangle", _is_rectangle(seg, operand.surface.domain, 1e3 * eps)):
+        return in_box
+    bins = int(max(1, min(4096, 2 * np.sqrt(seg.shape[0]))))
+    odd = _crossings(uv, seg, bins) % 2 == 1
+    near = _segment_distance_uv(uv, seg)
+    inside = in_box & (odd | (near <= eps))
+    if tol > 0:
+        # close to a loop in (u, v): measure in space against the trimming edges
+        cand = np.flatnonzero(in_box & ~inside & (near <= NEAR_BOUNDARY * np.hypot(u1 - u0,
+                                                                                  v1 - v0)))
+        if cand.size:
+            p = operand.surface.evaluate(uv[cand, 0], uv[cand, 1])
+            limit = tol + 2.0 * operand.edge_tolerance()
+            inside[cand] = polyline_distance(p, operand.boundary_polylines()) <= limit
+    return inside
+
+
+def _inside_both(fa: FaceOperand, fb: FaceOperand, curve: IntersectionCurve, t: NDArray,
+                 tol: float) -> NDArray:
+    uva, uvb = curve.pcurve_a.evaluate(t), curve.pcurve_b.evaluate(t)
+    return inside_face(fa, uva, tol) & inside_face(fb, uvb, tol)
+
+
+def clip_curve(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: float = 0.0
+               ) -> list[IntersectionCurve]:
+    """The pieces of ``curve`` inside both faces (module docstring: splitting).
+
+    The interpolants are classified at ``CLASSIFY_PER_SPAN`` points per span (a
+    curve with few samples can still leave a face between them); pieces keep
+    the refined samples inside and get interpolated crossing points as ends.
+    """
+    n = curve.points.shape[0]
+    period = curve.parameters[-1]
+    t = curve.parameters[:n]
+    spans = np.diff(curve.parameters)                                  # (n or n-1,)
+    k = np.arange(CLASSIFY_PER_SPAN) / CLASSIFY_PER_SPAN
+    dense = (curve.parameters[:-1, None] + k[None, :] * spans[:, None]).ravel()
+    is_sample = np.tile(k == 0, spans.size)
+    if not curve.closed:
+        dense, is_sample = np.append(dense, t[-1]), np.append(is_sample, True)
+    flags = _inside_both(fa, fb, curve, dense, tol)
+    sample_index = np.cumsum(is_sample) - 1
+    if flags.all():
+        return [curve]
+    if not flags.any():
+        return []
+    if curve.closed:                     # start at an outside point, go once around
+        first_out = int(np.flatnonzero(~flags)[0])
+        order = np.append(np.roll(np.arange(dense.size), -first_out), first_out)
+        tt = dense[order].copy()
+        tt[1:][tt[1:] <= tt[0]] += period
+        tt[-1] = tt[0] + period
+        flags, is_sample, sample_index = flags[order], is_sample[order], sample_index[order]
+    else:
+        tt = dense
+    change = np.flatnonzero(flags[1:] != flags[:-1])       # crossing between k and k + 1
+    lo, hi = tt[change].copy(), tt[change + 1].copy()
+    lo_in = flags[change]
+    for _ in range(_BISECTIONS):                           # all crossings at once
+        mid = 0.5 * (lo + hi)
+        ok = _inside_both(fa, fb, curve, np.mod(mid, period) if curve.closed else mid, tol)
+        same = ok == lo_in
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+    cross_t = np.where(lo_in, lo, hi)                      # the inside end of each bracket
+    crossing = {int(c): i for i, c in enumerate(change)}
+    pieces = []
+    for run in np.split(np.arange(flags.size), change + 1):
+        if not flags[run[0]]:
+            continue
+        params, samples = [], []
+        if (run[0] - 1) in crossing:
+            params.append(cross_t[crossing[run[0] - 1]])
+            samples.append(-1)
+        inner = run[is_sample[run]]
+        params.extend(tt[inner])
+        samples.extend(sample_index[inner])
+        if int(run[-1]) in crossing:
+            params.append(cross_t[crossing[int(run[-1])]])
+            samples.append(-1)
+        params, samples = np.array(params), np.array(samples)
+        if params.size < 2:
+            continue
+        targ = np.mod(params, period) if curve.closed else params
+        pts = curve.curve3d.evaluate(targ)
+        uva, uvb = curve.pcurve_a.evaluate(targ), curve.pcurve_b.evaluate(targ)
+        exact = samples >= 0
+        pts[exact] = curve.points[samples[exact]]          # samples keep their refined values
+        uva[exact], uvb[exact] = curve.uv_a[samples[exact]], curve.uv_b[samples[exact]]
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1)
+                               > 1e-12 * max(period, 1e-300)])
+        pts, uva, uvb, exact, samples = pts[keep], uva[keep], uvb[keep], exact[keep], samples[keep]
+        if pts.shape[0] < 2:
+            continue
+        start = curve.start_kind if exact[0] and not curve.closed else EndKind.BOUNDARY
+        end = curve.end_kind if exact[-1] and not curve.closed else EndKind.BOUNDARY
+        sing = np.zeros(pts.shape[0], dtype=bool)
+        sing[exact] = curve.singular[samples[exact]]
+        pieces.append(IntersectionCurve.from_samples(pts, uva, uvb, False, start, end,
+                                                     singular=sing))
+    return pieces
+
+
+# ------------------------------------------------------------------ result
+@dataclass(frozen=True, eq=False)
+class FaceIntersection:
+    """One intersection curve of two faces, clipped to both.
+
+    Attributes
+    ----------
+    curve : IntersectionCurve
+        Samples, (u, v) on each face's surface, interpolants.
+    face_a, face_b : FaceOperand
+        The faces (``face_b`` from ``b``, or from ``a`` when ``b`` was None).
+    tol : float
+        The tolerance the curve was computed to (model units).
+    """
+
+    curve: IntersectionCurve
+    face_a: FaceOperand
+    face_b: FaceOperand
+    tol: float
+
+    @property
+    def points(self) -> NDArray:
+        return self.curve.points
+
+    @property
+    def closed(self) -> bool:
+        """Closed in space (a loop cut at a seam included)."""
+        return closed_in_space(self.curve, self.tol)
+
+    @property
+    def length(self) -> float:
+        return self.curve.length
+
+    @property
+    def faces(self) -> tuple[int, int]:
+        """Indices of the two faces in their operands."""
+        return self.face_a.index, self.face_b.index
+
+    def max_deviation(self):
+        """:meth:`IntersectionCurve.max_deviation` from both faces' surfaces."""
+        return self.curve.max_deviation(self.face_a.surface, self.face_b.surface)
+
+    def to_edges(self, tol: float | None = None) -> list:
+        """``[TopoDS_Edge]``: the 3D curve with a pcurve on each face, checked by BRepCheck.
+
+        ``tol`` (edge tolerance) defaults to the larger of the curve's tolerance
+        and its measured deviation from the surfaces.
+        """
+        c = self.curve
+        if c.curve3d is None or c.pcurve_a is None or c.pcurve_b is None:
+            raise InvalidGeometryError("the curve has no interpolants to build an edge from")
+        if tol is None:
+            tol = max(self.tol, 1.01 * self.max_deviation().max)
+        fa, fb = self.face_a.face_for_edges(), self.face_b.face_for_edges()
+        pcurves = [(c.pcurve_a, fa)]
+        if not fb.IsSame(fa):
+            pcurves.append((c.pcurve_b, fb))
+        return [make_edge(c.curve3d, pcurves, tol)]
+
+
+# ------------------------------------------------------------------ driver
+def _boxes(faces: Sequence[FaceOperand]) -> NDArray:
+    return np.stack([np.asarray(f.surface.bounding_box(), dtype=float) for f in faces]) \
+        if faces else np.zeros((0, 2, 3))
+
+
+def _size(boxes: NDArray) -> float:
+    return float(np.linalg.norm(boxes[:, 1].max(axis=0) - boxes[:, 0].min(axis=0)))
+
+
+def _on_common_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: float
+                        ) -> bool:
+    """True when all samples lie near the trimming edges of both faces (a shared edge)."""
+    near = max(10 * tol, 2 * max(fa.edge_tolerance(), fb.edge_tolerance()))
+    for face in (fa, fb):
+        lines = face.boundary_polylines()
+        if not lines:
+            return False
+        sag = 0.01 * max(float(np.linalg.norm(np.diff(p, axis=0), axis=1).max()) for p in lines)
+        if polyline_distance(curve.points, lines).max() > near + sag:
+            return False
+    return True
+
+
+def intersect(a: Any, b: Any = None, *, tol: float | None = None,
+              mesh_tol: float | None = None,
+              progress: Callable[[int, int], None] | None = None) -> list[FaceIntersection]:
+    """Intersection curves of the faces of ``a`` with those of ``b`` (or among ``a``'s).
+
+    Parameters
+    ----------
+    a, b
+        Faces, shapes, :class:`CadModel`, ``Geom_Surface`` (finite),
+        :class:`NurbsSurface`, :class:`TrimmedFace`, cadquery / build123d
+        objects, or lists of these. With ``b`` None, every pair of distinct
+        faces of ``a`` is intersected and common edges of adjacent faces are
+        not reported (module docstring).
+    tol : float, optional
+        Model units; default ``DEFAULT_TOL_FACTOR`` (1e-6) times the diagonal
+        of the box of all faces. Must not be below ``MIN_TOL_FACTOR`` (1e-9)
+        times that diagonal.
+    mesh_tol : float, optional
+        Tessellation tolerance per pair (default: 1e-3 times the pair's size).
+    progress : callable(done, total), optional
+        Called after each face pair whose boxes overlap.
+
+    Returns
+    -------
+    list of FaceIntersection
+        Pieces clipped to both faces, in face-pair order. A pair whose
+        intersection fails raises no error: it is skipped with a warning.
+
+    Raises
+    ------
+    InvalidToleranceError
+        ``tol`` not finite and positive, or below ``MIN_TOL_FACTOR`` times the size.
+    ConversionError
+        An operand without faces or of an unsupported type.
+    """
+    faces_a = face_operands(a)
+    faces_b = faces_a if b is None else face_operands(b)
+    boxes_a, boxes_b = _boxes(faces_a), _boxes(faces_b)
+    size = _size(np.concatenate([boxes_a, boxes_b]))
+    if tol is None:
+        tol = DEFAULT_TOL_FACTOR * size
+    try:
+        tol = float(tol)
+    except (TypeError, ValueError):
+        raise InvalidToleranceError(f"tol must be a number, got {tol!r}") from None
+    if not np.isfinite(tol) or tol <= 0:
+        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
+    if tol < MIN_TOL_FACTOR * size:
+        raise InvalidToleranceError(
+            f"tol={tol:g} is below {MIN_TOL_FACTOR:g} x the model size {size:g}; "
+            "the refinement cannot reach it reliably")
+    pad = tol
+    overlap = np.all((boxes_a[:, None, 0] <= boxes_b[None, :, 1] + pad)
+                     & (boxes_b[None, :, 0] <= boxes_a[:, None, 1] + pad), axis=-1)
+    if b is None:
+        overlap &= np.triu(np.ones_like(overlap), k=1).astype(bool)
+    pairs = np.argwhere(overlap)
+    out: list[FaceIntersection] = []
+    for done, (i, j) in enumerate(pairs, start=1):
+        fa, fb = faces_a[i], faces_b[j]
+        try:
+            curves = intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol)
+        except (InvalidGeometryError, InvalidToleranceError) as exc:
+            warnings.warn(f"faces {i} and {j}: intersection skipped: {exc}", stacklevel=2)
+            curves = []
+        for curve in curves:
+            for piece in clip_curve(curve, fa, fb, tol):
+                if b is None and _on_common_boundary(piece, fa, fb, tol):
+                    continue
+                out.append(FaceIntersection(piece, fa, fb, tol))
+        if progress is not None:
+            progress(done, len(pairs))
+    return out
