@@ -1,0 +1,183 @@
+"""Surface-surface intersection: surfprep against OpenCascade on the same pairs, one run.
+
+Per case it runs
+
+* surfprep: ``intersect_surfaces(a, b, tol)`` on the untrimmed surfaces (and, for
+  real-file faces, ``surfprep.intersect(face_a, face_b)`` on the trimmed faces);
+* OpenCascade: ``GeomAPI_IntSS(a, b, tol)`` (and ``BRepAlgoAPI_Section`` on the faces),
+
+and prints the times, their ratio (ours / OCC), the branch counts (curves whose
+ends meet count as one branch), the largest distance of each answer from both
+surfaces, and the Hausdorff distance between the two answers. Distances are
+measured densely with ``surfprep.algorithms.projection.distance_to_surface``:
+for ours at the samples and at three interpolant points per span, for
+OpenCascade at 4001 points per curve, uniform in its parameter.
+
+Run:  python benchmarks/intersect.py        (prints a markdown table)
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+from OCP.Geom import (Geom_CylindricalSurface, Geom_Plane, Geom_SphericalSurface,
+                      Geom_ToroidalSurface)
+from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+
+import surfprep
+from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms.intersection import (connected_branches, curve_set_distance,
+                                              intersect_surfaces)
+from surfprep.algorithms.projection import distance_to_surface
+from surfprep.plugin.geom import surface_from_occ
+from surfprep.plugin.intersect import intersect
+from surfprep.plugin.occ_reference import intersect_surfaces_occ, section_faces_occ
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data"
+TAU = 2 * np.pi
+OCC_SAMPLES = 4001
+
+
+def axes(origin=(0, 0, 0), normal=(0, 0, 1), xdir=None):
+    if xdir is None:
+        return gp_Ax3(gp_Pnt(*origin), gp_Dir(*normal))
+    return gp_Ax3(gp_Pnt(*origin), gp_Dir(*normal), gp_Dir(*xdir))
+
+
+def sphere(r, **kw):
+    return surface_from_occ(Geom_SphericalSurface(axes(**kw), r), (0, TAU, -np.pi / 2, np.pi / 2))
+
+
+def cylinder(r, h, **kw):
+    return surface_from_occ(Geom_CylindricalSurface(axes(**kw), r), (0, TAU, -h, h))
+
+
+def torus(big, small, **kw):
+    return surface_from_occ(Geom_ToroidalSurface(axes(**kw), big, small), (0, TAU, 0, TAU))
+
+
+def plane(s, **kw):
+    return surface_from_occ(Geom_Plane(axes(**kw)), (-s, s, -s, s))
+
+
+def bumpy(n=20):
+    def knots(m, p=3):
+        return np.concatenate([[0.0] * p, np.linspace(0, 1, m - p + 1), [1.0] * p])
+    x = np.linspace(0, 1, n)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    bumps = [(0.25, 0.25, 0.08, 0.5), (0.72, 0.3, 0.06, 0.45), (0.4, 0.7, 0.12, 0.6),
+             (0.8, 0.78, 0.05, 0.4)]
+    Z = sum(h * np.exp(-((X - cx) ** 2 + (Y - cy) ** 2) / (2 * s * s)) for cx, cy, s, h in bumps)
+    return NurbsSurface(np.stack([X, Y, Z], -1), knots(n), knots(n), 3, 3)
+
+
+def flat(z):
+    cp = np.array([[[-0.1, -0.1, z], [-0.1, 1.1, z]], [[1.1, -0.1, z], [1.1, 1.1, z]]])
+    return NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+
+def analytic_cases():
+    return [
+        ("plane x sphere", plane(2, origin=(0, 0, 0.3)), sphere(1.0), 1e-7),
+        ("cylinder x cylinder, r 1 / 0.5", cylinder(1.0, 1.5), cylinder(0.5, 2.0, normal=(1, 0, 0)),
+         1e-7),
+        ("cylinder x cylinder, equal r", cylinder(1.0, 1.5), cylinder(1.0, 2.0, normal=(1, 0, 0)),
+         1e-7),
+        ("sphere x cylinder (Viviani)", sphere(2.0, normal=(0, 1, 0), xdir=(-1, 0, 0)),
+         cylinder(1.0, 2.5, origin=(1, 0, 0)), 1e-7),
+        ("torus x plane through axis", torus(2.0, 0.5, xdir=(1, 1, 0)), plane(3, normal=(0, 1, 0)),
+         1e-7),
+        ("bumpy 20^2 x plane (4 loops)", bumpy(), flat(0.2), 1e-7),
+        ("bumpy 40^2 x plane", bumpy(40), flat(0.2), 1e-7),
+    ]
+
+
+#: face pairs of real files sharing a sharp edge (indices in file order)
+REAL_PAIRS = [("occt_k1_catia_debis.stp", 9, 11), ("occt_k1_catia_debis.stp", 45, 47),
+              ("occt_k1_catia_debis.stp", 3, 6), ("occt_k1_catia_debis.stp", 48, 49)]
+
+
+def densely(curves) -> np.ndarray:
+    out = [np.zeros((0, 3))]
+    for c in curves:
+        out.append(c.points)
+        if getattr(c, "curve3d", None) is not None:
+            out.append(c.curve3d.evaluate(c.span_parameters(3).ravel()))
+    return np.concatenate(out)
+
+
+def deviation(points: np.ndarray, a: NurbsSurface, b: NurbsSurface) -> float:
+    if points.shape[0] == 0:
+        return float("nan")
+    return float(max(distance_to_surface(a, points).max(), distance_to_surface(b, points).max()))
+
+
+def timed(fn, *args, **kw):
+    start = time.perf_counter()
+    out = fn(*args, **kw)
+    return out, time.perf_counter() - start
+
+
+def row(name, a, b, tol, ours, t_ours, occ, t_occ, method) -> dict:
+    join = 1e3 * tol
+    dist = curve_set_distance(ours, occ) if ours and occ else None
+    return {
+        "case": name, "method": method, "tol": tol,
+        "t_ours": t_ours, "t_occ": t_occ, "ratio": t_ours / t_occ if t_occ > 0 else float("inf"),
+        "branches": f"{connected_branches(ours, join)} / {connected_branches(occ, join)}",
+        "curves": f"{len(ours)} / {len(occ)}",
+        "dev_ours": deviation(densely(ours), a, b),
+        "dev_occ": deviation(densely(occ), a, b),
+        "hausdorff": float("nan") if dist is None else dist.hausdorff,
+    }
+
+
+def run() -> list[dict]:
+    rows = []
+    for name, a, b, tol in analytic_cases():
+        intersect_surfaces(a, b, tol=tol)                      # warm-up (imports, caches)
+        ours, t_ours = timed(intersect_surfaces, a, b, tol=tol)
+        occ, t_occ = timed(intersect_surfaces_occ, a, b, tol, samples=OCC_SAMPLES)
+        rows.append(row(name, a, b, tol, ours, t_ours, occ, t_occ, "IntSS"))
+    models = {}
+    for file, ia, ib in REAL_PAIRS:
+        path = DATA / file
+        if not path.exists():
+            continue
+        if file not in models:
+            models[file] = surfprep.read(path)
+        model = models[file]
+        fa, fb = model.faces[ia], model.faces[ib]
+        ta, tb = surfprep.to_nurbs(fa), surfprep.to_nurbs(fb)
+        a, b = ta.surface, tb.surface
+        tol = 1e-6 * model.size
+        ours, t_ours = timed(intersect_surfaces, a, b, tol=tol)
+        occ, t_occ = timed(intersect_surfaces_occ, a, b, tol, samples=OCC_SAMPLES)
+        rows.append(row(f"{file} faces {ia}x{ib}", a, b, tol, ours, t_ours, occ, t_occ, "IntSS"))
+        pieces, t_ours = timed(intersect, fa, fb, tol=tol)
+        occ, t_occ = timed(section_faces_occ, fa, fb, tol, samples=OCC_SAMPLES)
+        rows.append(row(f"{file} faces {ia}x{ib} (trimmed)", a, b, tol,
+                        [p.curve for p in pieces], t_ours, occ, t_occ, "Section"))
+    return rows
+
+
+def markdown(rows: list[dict]) -> str:
+    head = ("| case | OCC method | tol | ours s | OCC s | ours/OCC | branches ours / OCC "
+            "| curves ours / OCC | max dev ours | max dev OCC | Hausdorff |")
+    lines = [head, "|" + "---|" * 11]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['method']} | {r['tol']:.1e} | {r['t_ours']:.3f} | "
+                     f"{r['t_occ']:.3f} | {r['ratio']:.1f} | {r['branches']} | {r['curves']} | "
+                     f"{r['dev_ours']:.1e} | {r['dev_occ']:.1e} | {r['hausdorff']:.1e} |")
+    ratios = np.array([r["ratio"] for r in rows])
+    lines.append("")
+    lines.append(f"median time ratio ours/OCC: {np.median(ratios):.1f} "
+                 f"(min {ratios.min():.1f}, max {ratios.max():.1f})")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(markdown(run()))
