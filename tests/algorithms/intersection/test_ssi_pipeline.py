@@ -414,3 +414,62 @@ def test_hausdorff_is_symmetric_and_exact():
     assert hausdorff(x, y) == hausdorff(y, x) == pytest.approx(2.0)
     assert hausdorff(x, x) == 0.0
     assert hausdorff(x, np.zeros((0, 3))) == float("inf")
+
+
+# ---------------------------------------------------------------- slow: every sharp edge
+def sharp_edge_pairs(model, faces, min_angle=20.0):
+    """(face i, face j, edge samples, edge tolerance) of every edge shared by two
+    different faces whose normals differ by more than min_angle degrees along it."""
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopoDS import TopoDS
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+    from surfprep.algorithms.projection import project_to_surface
+    from surfprep.plugin.edges import edge_to_nurbs
+    ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(model.shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
+    def face_index(f):
+        return next(i for i, g in enumerate(model.faces) if g.IsSame(f))
+
+    out = []
+    for k in range(1, ancestors.Extent() + 1):
+        edge = TopoDS.Edge_s(ancestors.FindKey(k))
+        owners = list(ancestors.FindFromIndex(k))
+        if len(owners) != 2 or BRep_Tool.Degenerated_s(edge) or owners[0].IsSame(owners[1]):
+            continue
+        i, j = face_index(owners[0]), face_index(owners[1])
+        curve = edge_to_nurbs(edge)
+        samples = curve.evaluate(np.linspace(*curve.domain, 101))
+        a, b = faces[i].surface, faces[j].surface
+        pa, pb = project_to_surface(a, samples[::10]), project_to_surface(b, samples[::10])
+        na = a.normals(pa.uv[:, 0], pa.uv[:, 1])
+        nb = b.normals(pb.uv[:, 0], pb.uv[:, 1])
+        angle = np.degrees(np.arccos(np.clip(np.abs((na * nb).sum(axis=1)), 0, 1))).min()
+        if angle > min_angle:
+            out.append((i, j, samples, BRep_Tool.Tolerance_s(edge)))
+    return out
+
+
+@pytest.mark.slow
+def test_every_sharp_edge_of_a_real_file(debis):
+    """All sharp edges of occt_k1_catia_debis.stp: intersect the two surfaces, the
+    stored edge must lie on our curves (within twice its tolerance plus tol), our
+    curves within tol of both surfaces, and IntSS must find no branch we miss."""
+    model, faces = debis
+    tol = 1e-6 * model.size
+    pairs = sharp_edge_pairs(model, faces)
+    assert len(pairs) > 20
+    misses = []
+    for i, j, samples, edge_tol in pairs:
+        a, b = faces[i].surface, faces[j].surface
+        curves = intersect_surfaces(a, b, tol=tol)
+        check_on_surfaces(curves, a, b, tol)
+        if polyline_distance(samples, curves).max() > 2 * edge_tol + tol:
+            misses.append((i, j))
+            continue
+        occ = intersect_surfaces_occ(a, b, tol, samples=4001)
+        distance = curve_set_distance(curves, occ)
+        assert distance.unmatched_b(10 * tol).size == 0, (i, j, distance.b_to_a)
+    assert not misses, misses
