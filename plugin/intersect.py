@@ -14,8 +14,10 @@ is clipped to both faces' trimmed domains:
 * **Splitting**: a curve is cut into the runs of samples inside both faces.
   Where a run leaves a face, the crossing is located on the interpolants
   (``curve3d``, ``pcurve_a``, ``pcurve_b`` share one parameter) by 30
-  bisection steps batched over all crossings, and becomes the run's end
-  (:attr:`EndKind.BOUNDARY`). The pieces are new :class:`IntersectionCurve`
+  bisection steps batched over all crossings against the loop polygons, then
+  moved onto the exact trimming pcurve by Newton on ``pcurve(t) =
+  edge.pcurve(s)`` (kept on the polygon where that fails or the crossing is
+  near-tangential), and becomes the run's end (:attr:`EndKind.BOUNDARY`). The pieces are new :class:`IntersectionCurve`
   objects (refined samples inside, interpolated crossing points at the ends).
 * **Shared edges** (faces of one shape): adjacent faces meet along their common
   edge, which is an intersection of their surfaces but not one of the faces.
@@ -113,8 +115,14 @@ class FaceOperand:
     def boundary_segments(self) -> NDArray:
         """``(m, 2, 2)`` segments of the sampled trimming loops in ``(u, v)`` (cached)."""
         if "segments" not in self._cache:
-            self._cache["segments"] = _loop_segments(self.trimmed)
+            (self._cache["segments"], self._cache["segment_edges"],
+             self._cache["segment_params"]) = _loop_segments(self.trimmed)
         return self._cache["segments"]
+
+    def segment_edges(self) -> tuple[NDArray, NDArray]:
+        """Edge index ``(m,)`` and pcurve parameters ``(m, 2)`` of each boundary segment."""
+        self.boundary_segments()
+        return self._cache["segment_edges"], self._cache["segment_params"]
 
     def boundary_polylines(self) -> list[NDArray]:
         """Samples ``(k, 3)`` in space of every trimming edge, one polyline each (cached)."""
@@ -166,21 +174,30 @@ def face_operands(x: Any) -> list[FaceOperand]:
 
 
 # ------------------------------------------------------------------ classification
-def _loop_segments(face: TrimmedFace) -> NDArray:
-    """Polygon segments ``(m, 2, 2)`` of all trimming loops (pcurves sampled densely)."""
-    segments = []
-    for edge in face.edges:
+def _loop_segments(face: TrimmedFace) -> tuple[NDArray, NDArray, NDArray]:
+    """Polygon segments of all trimming loops (pcurves sampled densely).
+
+    Returns ``segments (m, 2, 2)`` in ``(u, v)``, the edge (index into
+    ``face.edges``) of each ``(m,) int`` and its pcurve parameters at both ends
+    ``(m, 2) float``.
+    """
+    segments, owners, params = [], [], []
+    u0, u1, v0, v1 = face.surface.domain
+    diagonal = max(np.hypot(u1 - u0, v1 - v0), 1e-300)
+    for k, edge in enumerate(face.edges):
         t = np.linspace(edge.t0, edge.t1, EDGE_SAMPLES)
         uv = edge.pcurve.evaluate(t)
         # edges long in the parameter plane get more samples
-        extent = np.linalg.norm(np.diff(uv, axis=0), axis=1).sum()
-        u0, u1, v0, v1 = face.surface.domain
-        rel = extent / max(np.hypot(u1 - u0, v1 - v0), 1e-300)
+        rel = np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() / diagonal
         if rel > 0.25:
             t = np.linspace(edge.t0, edge.t1, int(EDGE_SAMPLES * min(16, 4 * rel)))
             uv = edge.pcurve.evaluate(t)
         segments.append(np.stack([uv[:-1], uv[1:]], axis=1))
-    return np.concatenate(segments) if segments else np.zeros((0, 2, 2))
+        owners.append(np.full(t.size - 1, k))
+        params.append(np.stack([t[:-1], t[1:]], axis=1))
+    if not segments:
+        return np.zeros((0, 2, 2)), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
+    return np.concatenate(segments), np.concatenate(owners), np.concatenate(params)
 
 
 def _is_rectangle(seg: NDArray, domain, eps: float) -> bool:
@@ -277,6 +294,48 @@ def _inside_both(fa: FaceOperand, fb: FaceOperand, curve: IntersectionCurve, t: 
     return inside_face(fa, uva, tol) & inside_face(fb, uvb, tol)
 
 
+def _refine_crossing(curve_pcurve, face: FaceOperand, t0: float, bracket: float
+                     ) -> float | None:
+    """Parameter where ``curve_pcurve`` crosses the face's exact trimming pcurve near ``t0``.
+
+    Newton on ``pcurve(t) = edge.pcurve(s)`` (2 equations, 2 unknowns) from the
+    polygon crossing: the nearest boundary segment gives the edge and the start
+    ``s``. Returns None (keep the polygon crossing) when it does not converge,
+    the crossing is near-tangential, or ``t`` leaves ``t0 +- bracket``.
+    """
+    seg = face.boundary_segments()
+    owners, params = face.segment_edges()
+    if seg.shape[0] == 0:
+        return None
+    uv = curve_pcurve.evaluate(np.array([t0]))[0]
+    a, d = seg[:, 0], seg[:, 1] - seg[:, 0]
+    dd = np.einsum("mc,mc->m", d, d)
+    w = np.clip(np.einsum("mc,mc->m", uv - a, d) / np.where(dd > 0, dd, 1.0), 0, 1)
+    nearest = int(np.argmin(np.linalg.norm(a + w[:, None] * d - uv, axis=1)))
+    edge = face.trimmed.edges[int(owners[nearest])]
+    s = params[nearest, 0] + w[nearest] * (params[nearest, 1] - params[nearest, 0])
+    t = t0
+    u0, u1, v0, v1 = face.surface.domain
+    scale = np.hypot(u1 - u0, v1 - v0)
+    for _ in range(12):
+        c = curve_pcurve.derivatives(np.array([t]), 1)[0]
+        e = edge.pcurve.derivatives(np.array([s]), 1)[0]
+        residual = c[0] - e[0]
+        if np.linalg.norm(residual) <= 1e-13 * scale:
+            break
+        jac = np.stack([c[1], -e[1]], axis=1)
+        sine = abs(np.linalg.det(jac)) / max(np.linalg.norm(c[1]) * np.linalg.norm(e[1]), 1e-300)
+        if sine < 0.05:                                   # near-tangential: leave it
+            return None
+        step = np.linalg.solve(jac, -residual)
+        t, s = t + step[0], float(np.clip(s + step[1], edge.t0, edge.t1))
+        if abs(t - t0) > bracket:
+            return None
+    else:
+        return None
+    return float(t)
+
+
 def clip_curve(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: float = 0.0
                ) -> list[IntersectionCurve]:
     """The pieces of ``curve`` inside both faces (module docstring: splitting).
@@ -319,6 +378,22 @@ def clip_curve(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: 
         lo = np.where(same, mid, lo)
         hi = np.where(same, hi, mid)
     cross_t = np.where(lo_in, lo, hi)                      # the inside end of each bracket
+    # onto the exact trimming pcurve of the face the curve leaves (per crossing, few)
+    # Newton may move a crossing by the polygon's error along the curve: allow a few
+    # classification steps and a hundredth of the curve
+    step = float(np.max(np.diff(tt))) + 0.01 * period if tt.size > 1 else period
+    for k_cross, (t_lo, t_hi) in enumerate(zip(tt[change], tt[change + 1])):
+        ends = np.array([t_lo, t_hi])
+        ends = np.mod(ends, period) if curve.closed else ends
+        flips = [bool(np.ptp(inside_face(face, pcurve.evaluate(ends), tol).astype(int)))
+                 for face, pcurve in ((fa, curve.pcurve_a), (fb, curve.pcurve_b))]
+        if flips[0] == flips[1]:
+            continue                                        # both or neither: keep it
+        face, pcurve = (fa, curve.pcurve_a) if flips[0] else (fb, curve.pcurve_b)
+        t0 = float(np.mod(cross_t[k_cross], period)) if curve.closed else float(cross_t[k_cross])
+        exact = _refine_crossing(pcurve, face, t0, step)
+        if exact is not None:
+            cross_t[k_cross] += exact - t0
     crossing = {int(c): i for i, c in enumerate(change)}
     pieces = []
     for run in np.split(np.arange(flags.size), change + 1):

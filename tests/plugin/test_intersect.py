@@ -70,15 +70,12 @@ def test_hole_in_a_face_splits_the_curve():
     check_result(result)
     assert len(result) == 1 and not result[0].closed
     p = result[0].points
-    # the crossings are located on the loops sampled at 64 points per edge: the
-    # hole's polygon lies up to 0.2 (1 - cos(pi / 63)) = 2.5e-4 inside its circle, and
-    # the curve crosses the polygon's chord at a slant (a known limitation: the
-    # crossings are not refined onto the exact pcurves yet)
-    sag = 2 * 0.2 * (1 - np.cos(np.pi / 63))
+    # the crossings are moved from the sampled loop polygon (up to 2.5e-4 inside the
+    # hole's circle) onto the exact pcurve: the ends lie on the hole's rim
     # (the hole is at x = 0.95 or -0.95 depending on the workplane's orientation: the
     # circle passes 0.0039 from the other centre, so the hole is the farther one)
     hole = max(np.hypot(p[:, 0] - x, p[:, 1]).min() for x in (0.95, -0.95))
-    assert 0.2 - sag - 1e-7 <= hole <= 0.2 + 1e-7
+    assert hole == pytest.approx(0.2, abs=1e-7)
     assert result[0].length < 2 * np.pi * np.sqrt(0.91) - 0.3
 
 
