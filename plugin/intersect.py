@@ -21,9 +21,11 @@ is clipped to both faces' trimmed domains:
   objects (refined samples inside, interpolated crossing points at the ends).
 * **Shared edges** (faces of one shape): adjacent faces meet along their common
   edge, which is an intersection of their surfaces but not one of the faces.
-  A piece is dropped when all its samples lie within ``max(10 tol, 2 x edge
-  tolerance)`` of the trimming loops of *both* faces: it runs along a common
-  boundary.
+  With ``b`` None a piece is dropped when all its samples lie within
+  ``max(10 tol, 2 x edge tolerance)`` of the trimming loops of *either* face:
+  faces of one valid shape meet only along edges, so it is a common edge or
+  a remnant of one. Across ``a`` and ``b`` nothing is dropped (a face of ``b``
+  touching an edge of ``a`` is an answer there).
 
 Each result is a :class:`FaceIntersection` (the piece, the two faces' indices
 and names); :meth:`FaceIntersection.to_edges` builds a ``TopoDS_Edge`` with the
@@ -502,18 +504,24 @@ def _size(boxes: NDArray) -> float:
     return float(np.linalg.norm(boxes[:, 1].max(axis=0) - boxes[:, 0].min(axis=0)))
 
 
-def _on_common_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: float
-                        ) -> bool:
-    """True when all samples lie near the trimming edges of both faces (a shared edge)."""
+def _along_a_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: float
+                      ) -> bool:
+    """True when all samples lie near the trimming edges of either face.
+
+    Faces of one valid shape meet only along their edges, so such a piece is a
+    common edge, or a remnant of one (where the surfaces' intersection leaves a
+    shared edge near a vertex, or runs within the edge tolerance of a loop that
+    the classification counts as inside).
+    """
     near = max(10 * tol, 2 * max(fa.edge_tolerance(), fb.edge_tolerance()))
     for face in (fa, fb):
         lines = face.boundary_polylines()
         if not lines:
-            return False
+            continue
         sag = 0.01 * max(float(np.linalg.norm(np.diff(p, axis=0), axis=1).max()) for p in lines)
-        if polyline_distance(curve.points, lines).max() > near + sag:
-            return False
-    return True
+        if polyline_distance(curve.points, lines).max() <= near + sag:
+            return True
+    return False
 
 
 def intersect(a: Any, b: Any = None, *, tol: float | None = None,
@@ -583,7 +591,7 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
             curves = []
         for curve in curves:
             for piece in clip_curve(curve, fa, fb, tol):
-                if b is None and _on_common_boundary(piece, fa, fb, tol):
+                if b is None and _along_a_boundary(piece, fa, fb, tol):
                     continue
                 out.append(FaceIntersection(piece, fa, fb, tol))
         if progress is not None:
