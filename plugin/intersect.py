@@ -46,8 +46,8 @@ from OCP.Geom import Geom_Surface
 from OCP.TopoDS import TopoDS_Face
 
 from ..algorithms import NurbsSurface
-from ..algorithms.intersection import (EndKind, IntersectionCurve, closed_in_space,
-                                       intersect_surfaces, polyline_distance)
+from ..algorithms.intersection import (EndKind, IntersectionCurve, StrayCurves,
+                                       closed_in_space, intersect_surfaces, polyline_distance)
 from ..errors import InvalidGeometryError, InvalidToleranceError, OpenCascadeError
 from .convert import to_nurbs
 from .edges import make_edge
@@ -549,7 +549,9 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
     Returns
     -------
     list of FaceIntersection
-        Pieces clipped to both faces, in face-pair order. A pair whose
+        Pieces clipped to both faces, in face-pair order. Curves that break
+        ``tol`` (near-tangential or overlapping surfaces, where the refinement
+        does not converge) are left out (``StrayCurves.DROP``); a pair whose
         intersection fails raises no error: it is skipped with a warning.
 
     Raises
@@ -585,7 +587,8 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
     for done, (i, j) in enumerate(pairs, start=1):
         fa, fb = faces_a[i], faces_b[j]
         try:
-            curves = intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol)
+            curves = intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
+                                        stray=StrayCurves.DROP)
         except (InvalidGeometryError, InvalidToleranceError) as exc:
             warnings.warn(f"faces {i} and {j}: intersection skipped: {exc}", stacklevel=2)
             curves = []

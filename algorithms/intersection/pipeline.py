@@ -33,6 +33,7 @@ whose two ends coincide in space (``start_kind == end_kind == BOUNDARY``);
 
 from __future__ import annotations
 
+import enum
 from dataclasses import replace
 
 import numpy as np
@@ -45,7 +46,7 @@ from .result import IntersectionCurve, intersection_curves
 from .segments import mesh_segments
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
-__all__ = ["intersect_surfaces", "operand_size", "default_mesh_tolerance", "closed_in_space",
+__all__ = ["intersect_surfaces", "StrayCurves", "operand_size", "default_mesh_tolerance", "closed_in_space",
            "MESH_TOL_FACTOR", "MIN_TOL_FACTOR", "MAX_TOL_FACTOR", "MAX_MESH_TOL_FACTOR"]
 
 Operand = NurbsSurface | TriangleMesh
@@ -386,9 +387,18 @@ def _close_boundary_gaps(curves: list[IntersectionCurve], ends_uv: list, surface
 
 
 # ------------------------------------------------------------------ driver
+class StrayCurves(enum.Enum):
+    """What :func:`intersect_surfaces` does with curves that break ``tol``."""
+
+    #: raise InvalidGeometryError (the default: no silent loss)
+    RAISE = "raise"
+    #: leave them out and return the others
+    DROP = "drop"
+
+
 def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
-                       mesh_tol: float | None = None, max_depth: int = 24
-                       ) -> list[IntersectionCurve]:
+                       mesh_tol: float | None = None, max_depth: int = 24,
+                       stray: StrayCurves = StrayCurves.RAISE) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces and/or triangle meshes (000 §29.4, steps 1-6).
 
     Parameters
@@ -407,6 +417,10 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         them (the work grows about as ``1 / mesh_tol`` along the curves).
     max_depth : int
         Tessellation refinement levels at most.
+    stray : StrayCurves
+        A NURBS x NURBS curve whose interpolants stray from the surfaces by more
+        than ``tol`` (near-tangential or overlapping surfaces, where the
+        refinement does not converge) raises (``RAISE``) or is left out (``DROP``).
 
     Returns
     -------
@@ -424,7 +438,10 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         ``MAX_TOL_FACTOR`` times their diagonal, ``mesh_tol`` above
         ``MAX_MESH_TOL_FACTOR`` times the diagonal or below ``tol``.
     InvalidGeometryError
-        An operand of another type, or a surface not in 3D.
+        An operand of another type, a surface not in 3D, or a NURBS x NURBS
+        result that breaks the tolerance contract (some curve's interpolants
+        stray from the surfaces by more than ``tol``: near-tangential or
+        overlapping surfaces, where the refinement does not converge).
     """
     size, magnitude = operand_size(a, b)
     scale = max(size, magnitude, np.finfo(float).tiny)
@@ -451,5 +468,14 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     kept = [c for c in topology.chains if len(c) >= 2 + c.closed]     # as intersection_curves
     ends = [((topology.uv_a[c.point_ids[0]], topology.uv_b[c.point_ids[0]]),
              (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in kept]
-    return _close_boundary_gaps(curves, ends, surface_a, surface_b, tol,
-                                reach=_JOIN_FACTOR * mesh_tol)
+    curves = _close_boundary_gaps(curves, ends, surface_a, surface_b, tol,
+                                  reach=_JOIN_FACTOR * mesh_tol)
+    worst = np.array([c.max_deviation(surface_a, surface_b).max for c in curves])
+    if stray is StrayCurves.DROP:
+        return [c for c, w in zip(curves, worst) if w <= tol]
+    if np.any(worst > tol):
+        raise InvalidGeometryError(
+            f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves stray from "
+            f"the surfaces by up to {worst.max():.3g} > tol={tol:g}: the surfaces are "
+            "near-tangential or overlap there")
+    return curves

@@ -26,7 +26,7 @@ from OCP.Geom import (Geom_CylindricalSurface, Geom_Plane, Geom_SphericalSurface
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt  # noqa: E402
 
 from surfprep.algorithms import NurbsSurface  # noqa: E402
-from surfprep.algorithms.intersection import (EndKind, closed_in_space,  # noqa: E402
+from surfprep.algorithms.intersection import (EndKind, StrayCurves, closed_in_space,  # noqa: E402
                                               connected_branches, curve_set_distance,
                                               hausdorff, intersect_surfaces, polyline_distance)
 from surfprep.errors import InvalidGeometryError, InvalidToleranceError  # noqa: E402
@@ -473,3 +473,17 @@ def test_every_sharp_edge_of_a_real_file(debis):
         distance = curve_set_distance(curves, occ)
         assert distance.unmatched_b(10 * tol).size == 0, (i, j, distance.b_to_a)
     assert not misses, misses
+
+
+@pytest.mark.slow
+def test_stray_curves_of_near_tangential_surfaces_raise_or_are_dropped(debis):
+    """Faces 41 and 53 of the debis file meet tangentially: some refined curves do
+    not reach tol. By default that raises; with DROP only curves within tol remain."""
+    model, faces = debis
+    a, b = faces[41].surface, faces[53].surface
+    tol = 1e-6 * model.size
+    with pytest.raises(InvalidGeometryError, match="stray"):
+        intersect_surfaces(a, b, tol=tol)
+    kept = intersect_surfaces(a, b, tol=tol, stray=StrayCurves.DROP)
+    for c in kept:
+        assert c.max_deviation(a, b).max <= tol
