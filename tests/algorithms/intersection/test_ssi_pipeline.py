@@ -317,7 +317,8 @@ def test_small_loop_needs_a_finer_mesh_tolerance():
     distance = curve_set_distance(fine, occ)
     assert distance.unmatched_b(1e-5).size == 0
     missed_by_occ = {int(i) for i in distance.unmatched_a(1e-5)}
-    assert missed_by_occ <= {i for i, c in enumerate(fine) if c is small[0]}
+    assert missed_by_occ == {i for i, c in enumerate(fine) if c is small[0]}   # pinned
+    assert len(occ) == len(fine) - 1
 
 
 # ---------------------------------------------------------------- real file
