@@ -34,6 +34,7 @@ whose two ends coincide in space (``start_kind == end_kind == BOUNDARY``);
 from __future__ import annotations
 
 import enum
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -387,6 +388,10 @@ def _close_boundary_gaps(curves: list[IntersectionCurve], ends_uv: list, surface
 
 
 # ------------------------------------------------------------------ driver
+class StrayCurveWarning(UserWarning):
+    """Curves were left out because they stray from the surfaces by more than tol."""
+
+
 class StrayCurves(enum.Enum):
     """What :func:`intersect_surfaces` does with curves that break ``tol``."""
 
@@ -472,6 +477,11 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
                                   reach=_JOIN_FACTOR * mesh_tol)
     worst = np.array([c.max_deviation(surface_a, surface_b).max for c in curves])
     if stray is StrayCurves.DROP:
+        if np.any(worst > tol):
+            warnings.warn(
+                f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves left out: "
+                f"they stray from the surfaces by up to {worst.max():.3g} > tol={tol:g} "
+                "(near-tangential or overlapping surfaces)", StrayCurveWarning, stacklevel=2)
         return [c for c, w in zip(curves, worst) if w <= tol]
     if np.any(worst > tol):
         raise InvalidGeometryError(
