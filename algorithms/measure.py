@@ -19,9 +19,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import DegenerateGeometryError, InvalidGeometryError, InvalidToleranceError
+from ..errors import (
+    DegenerateGeometryError,
+    InvalidGeometryError,
+)
 from .curve import NurbsCurve
 from .surface import NurbsSurface
+from .tolerance import check_tolerance
 
 __all__ = ["bounding_box", "normals", "arc_length", "cumulative_arc_length"]
 
@@ -134,16 +138,6 @@ def normals(surface: NurbsSurface, u: ArrayLike, v: ArrayLike) -> NDArray:
 
 
 # ----------------------------------------------------------------- arc length
-def _check_tolerance(tol: float) -> float:
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"tol must be a positive number, got {tol!r}") from None
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
-    return tol
-
-
 def _speed_quadrature(curve: NurbsCurve, a: NDArray, b: NDArray,
                       nodes: NDArray, weights: NDArray) -> NDArray:
     """Gauss–Legendre estimate of the integral of ``|C'|`` over each ``[a_i, b_i]``."""
@@ -217,7 +211,7 @@ def cumulative_arc_length(curve: NurbsCurve, t: ArrayLike, tol: float = 1e-12) -
     -------
     (...) float, non-decreasing in ``t``.
     """
-    tol = _check_tolerance(tol)
+    tol = check_tolerance(tol)
     t = np.asarray(t, dtype=float)
     _check_parameters(curve, t.reshape(-1), "t")
     points, a, b = _pieces(curve, t.reshape(-1))
@@ -241,7 +235,7 @@ def arc_length(curve: NurbsCurve, t0: float | None = None, t1: float | None = No
     InvalidToleranceError
         ``tol`` not a finite positive number.
     """
-    tol = _check_tolerance(tol)
+    tol = check_tolerance(tol)
     lo, hi = curve.domain
     t0 = lo if t0 is None else float(t0)
     t1 = hi if t1 is None else float(t1)

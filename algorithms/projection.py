@@ -64,10 +64,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from ..errors import InvalidGeometryError, InvalidToleranceError
+from ..errors import InvalidGeometryError
 from .basis import distinct_knots
 from .curve import NurbsCurve
 from .surface import NurbsSurface
+from .tolerance import check_tolerance
 
 __all__ = [
     "ProjectionResult",
@@ -139,13 +140,7 @@ def _tolerance(tol: float | None, geometry) -> float:
     diagonal = float(np.linalg.norm(box[1] - box[0]))
     if tol is None:
         return DEFAULT_RELATIVE_TOL * max(diagonal, np.finfo(float).tiny)
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"tol must be a positive number, got {tol!r}") from None
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
-    return tol
+    return check_tolerance(tol)
 
 
 def _check_count(value: int, name: str, minimum: int) -> int:

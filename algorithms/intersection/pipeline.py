@@ -40,8 +40,9 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
 from .mesh import TriangleMesh
 from .result import IntersectionCurve, intersection_curves
 from .segments import mesh_segments
@@ -94,24 +95,6 @@ def operand_size(a: Operand, b: Operand) -> tuple[float, float]:
 def default_mesh_tolerance(a: Operand, b: Operand) -> float:
     """``MESH_TOL_FACTOR`` times the operands' diagonal (model units)."""
     return MESH_TOL_FACTOR * operand_size(a, b)[0]
-
-
-def _check_tolerance(value, name: str, low: float, high: float) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise InvalidToleranceError(f"{name} must be finite and > 0, got {value!r}")
-    if value < low:
-        raise InvalidToleranceError(
-            f"{name}={value:g} is below what double precision resolves on operands of "
-            f"this size (>= {low:.3g} model units)")
-    if value > high:
-        raise InvalidToleranceError(
-            f"{name}={value:g} is absurdly large for operands of this size (<= {high:.3g} "
-            "model units)")
-    return value
 
 
 # ------------------------------------------------------------------ seams
@@ -450,12 +433,12 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     """
     size, magnitude = operand_size(a, b)
     scale = max(size, magnitude, np.finfo(float).tiny)
-    tol = _check_tolerance(tol, "tol", MIN_TOL_FACTOR * scale, max(MAX_TOL_FACTOR * size,
-                                                                    MIN_TOL_FACTOR * scale))
+    tol = check_tolerance(tol, "tol", low=MIN_TOL_FACTOR * scale,
+                          high=max(MAX_TOL_FACTOR * size, MIN_TOL_FACTOR * scale))
     if mesh_tol is None:
         mesh_tol = max(MESH_TOL_FACTOR * size, tol)
-    mesh_tol = _check_tolerance(mesh_tol, "mesh_tol", tol,
-                                max(MAX_MESH_TOL_FACTOR * size, tol))
+    mesh_tol = check_tolerance(mesh_tol, "mesh_tol", low=tol,
+                               high=max(MAX_MESH_TOL_FACTOR * size, tol))
     soup = mesh_segments(a, b, tol=mesh_tol, max_depth=max_depth)
     if soup.n_segments == 0:
         return []

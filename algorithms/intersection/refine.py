@@ -52,9 +52,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import InvalidGeometryError
 from ..measure import normals
 from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
 
 __all__ = ["RefinedPoints", "RefinedCurve", "refine_points", "refine_curves",
            "project_points", "segment_distance"]
@@ -119,16 +120,6 @@ class RefinedCurve:
 
 
 # ------------------------------------------------------------------ helpers
-def _check_tol(tol: float, name: str = "tol") -> float:
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"{name} must be a number, got {tol!r}") from None
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidToleranceError(f"{name} must be finite and > 0, got {tol!r}")
-    return tol
-
-
 def _check_uv(uv: ArrayLike, name: str, n: int | None = None) -> NDArray:
     out = np.array(uv, dtype=float, copy=True)
     if out.ndim != 2 or out.shape[1] != 2 or (n is not None and out.shape[0] != n):
@@ -219,7 +210,7 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
     """
     _check_surface(surface_a, "surface_a")
     _check_surface(surface_b, "surface_b")
-    tol = _check_tol(tol)
+    tol = check_tolerance(tol)
     ua = _clamp(_check_uv(uv_a, "uv_a"), surface_a)
     ub = _clamp(_check_uv(uv_b, "uv_b", ua.shape[0]), surface_b)
     n = ua.shape[0]
@@ -293,7 +284,7 @@ def project_points(surface: NurbsSurface, points: ArrayLike, uv: ArrayLike, *,
     converged : (n,) bool
     """
     _check_surface(surface, "surface")
-    tol = _check_tol(tol)
+    tol = check_tolerance(tol)
     x = np.asarray(points, dtype=float)
     uv = _clamp(_check_uv(uv, "uv"), surface)
     if x.shape != (uv.shape[0], 3):
@@ -471,7 +462,7 @@ def refine_curves(surface_a: NurbsSurface, surface_b: NurbsSurface,
     """
     _check_surface(surface_a, "surface_a")
     _check_surface(surface_b, "surface_b")
-    tol = _check_tol(tol)
+    tol = check_tolerance(tol)
     if not (len(uv_a) == len(uv_b) == len(closed)):
         raise InvalidGeometryError(
             f"uv_a, uv_b and closed need one entry per curve, got "

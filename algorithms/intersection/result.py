@@ -21,10 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
 from ..fitting import interpolate_curve
 from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
 from .refine import project_points, refine_curves, refine_points
 from .topology import EndKind, SegmentTopology
 
@@ -207,16 +208,6 @@ class IntersectionCurve:
 
 
 # ------------------------------------------------------------------ pipeline
-def _check_tol(tol: float) -> float:
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"tol must be a number, got {tol!r}") from None
-    if not (np.isfinite(tol) and tol > 0):
-        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
-    return tol
-
-
 def _split_failing(curve: IntersectionCurve, surface_a, surface_b, tol: float
                    ) -> IntersectionCurve | None:
     """Insert refined midpoints in the spans whose interpolants stray by more than tol;
@@ -263,7 +254,7 @@ def intersection_curves(topology: SegmentTopology, surface_a: NurbsSurface | Non
     -------
     list of IntersectionCurve, in the order of ``topology.chains``
     """
-    tol = _check_tol(tol)
+    tol = check_tolerance(tol)
     chains = [c for c in topology.chains if len(c) >= 2 + c.closed]
     if surface_a is not None and surface_b is not None:
         if topology.uv_a is None or topology.uv_b is None:

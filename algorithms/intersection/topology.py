@@ -33,7 +33,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import InvalidGeometryError
+from ..tolerance import check_tolerance
 
 __all__ = ["EndKind", "Chain", "SegmentTopology", "build_topology", "topology_from_soup"]
 
@@ -113,16 +114,6 @@ class SegmentTopology:
 
 
 # ------------------------------------------------------------------ validation
-def _check_tol(value: float, name: str, allow_zero: bool = False) -> float:
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(value) or value < 0 or (value == 0 and not allow_zero):
-        raise InvalidToleranceError(f"{name} must be finite and > 0, got {value!r}")
-    return value
-
-
 def _check_ends(array: ArrayLike | None, k: int, dim: int, name: str) -> NDArray | None:
     if array is None:
         return None
@@ -310,9 +301,9 @@ def build_topology(points: ArrayLike, uv_a: ArrayLike | None = None,
     InvalidToleranceError
         A tolerance that is not finite and positive.
     """
-    tol = _check_tol(tol, "tol")
-    join_tol = tol if join_tol is None else _check_tol(join_tol, "join_tol")
-    uv_tol = _check_tol(uv_tol, "uv_tol", allow_zero=True)
+    tol = check_tolerance(tol, "tol")
+    join_tol = tol if join_tol is None else check_tolerance(join_tol, "join_tol")
+    uv_tol = check_tolerance(uv_tol, "uv_tol", allow_zero=True)
     ends = np.asarray(points, dtype=float)
     if ends.ndim != 3 or ends.shape[1:] != (2, 3):
         raise InvalidGeometryError(f"points must have shape (k, 2, 3), got {ends.shape}")
