@@ -25,7 +25,8 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Vertex
 
 from ..algorithms import NurbsCurve, NurbsSurface
-from ..errors import ConversionError, InvalidGeometryError, InvalidToleranceError, OpenCascadeError
+from ..algorithms.tolerance import check_tolerance
+from ..errors import ConversionError, InvalidGeometryError, OpenCascadeError
 from .geom import curve2d_to_occ, curve_from_occ, curve_to_occ
 
 __all__ = ["TrimEdge", "edge_to_nurbs", "make_edge", "check_valid", "DEFAULT_TOLERANCE"]
@@ -202,13 +203,6 @@ def check_valid(shape, what: str = "shape") -> None:
     """Raise :class:`OpenCascadeError` unless ``BRepCheck_Analyzer`` finds ``shape`` valid."""
     if not BRepCheck_Analyzer(shape).IsValid():
         raise OpenCascadeError(f"the {what} built is not valid (BRepCheck_Analyzer)")
-
-
-def check_tolerance(tol: float) -> float:
-    tol = float(tol)
-    if not np.isfinite(tol) or tol <= 0:
-        raise InvalidToleranceError(f"tolerance must be a finite number > 0, got {tol}")
-    return tol
 
 
 def make_edge(curve3d: NurbsCurve,
