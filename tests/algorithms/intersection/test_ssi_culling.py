@@ -13,7 +13,8 @@ from surfprep.algorithms.intersection.culling import (build_tree, candidate_pair
                                                       tree_pairs)
 from surfprep.errors import InvalidGeometryError
 
-R2 = np.sqrt(0.5)
+from ssi_surfaces import sphere_band  # helper beside the tests (pytest prepend import mode)
+
 
 
 def brute_force_pairs(a, b, pad=0.0):
@@ -33,20 +34,6 @@ def random_boxes(rng, m, size, grid=False):
     if grid:
         half = np.round(half * 8) / 8
     return np.stack([centre - half, centre + half], axis=1)
-
-
-def sphere_band(r=1.0, centre=(0, 0, 0)):
-    circ = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1],
-                     [1, 0]], float)
-    wc = np.array([1, R2, 1, R2, 1, R2, 1, R2, 1])
-    mer = np.array([[R2, -R2], [2 * R2, 0.0], [R2, R2]])
-    cp = np.empty((9, 3, 3))
-    cp[..., 0] = circ[:, None, 0] * mer[None, :, 0]
-    cp[..., 1] = circ[:, None, 1] * mer[None, :, 0]
-    cp[..., 2] = mer[None, :, 1]
-    ku = [0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1]
-    return NurbsSurface(cp * r + np.asarray(centre, float), ku, [0, 0, 0, 1, 1, 1], 2, 2,
-                        wc[:, None] * np.array([1, R2, 1])[None, :])
 
 
 def plane(x, y, z):

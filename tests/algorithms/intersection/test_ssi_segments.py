@@ -10,7 +10,8 @@ from surfprep.algorithms.intersection.mesh import TriangleMesh
 from surfprep.algorithms.intersection.segments import SegmentSoup, mesh_segments
 from surfprep.errors import InvalidGeometryError, InvalidToleranceError
 
-R2 = np.sqrt(0.5)
+from ssi_surfaces import sphere_band  # helper beside the tests (pytest prepend import mode)
+
 
 
 def plane(x, y, z=0.0, tilt=(0.0, 0.0)):
@@ -24,20 +25,6 @@ def vertical_plane(x, y, z):
     cp = np.array([[[x[0], y[0], z[0]], [x[1], y[0], z[1]]],
                    [[x[0], y[1], z[0]], [x[1], y[1], z[1]]]], float)
     return NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
-
-
-def sphere_band(r=1.0, centre=(0, 0, 0)):
-    circ = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1],
-                     [1, 0]], float)
-    wc = np.array([1, R2, 1, R2, 1, R2, 1, R2, 1])
-    mer = np.array([[R2, -R2], [2 * R2, 0.0], [R2, R2]])
-    cp = np.empty((9, 3, 3))
-    cp[..., 0] = circ[:, None, 0] * mer[None, :, 0]
-    cp[..., 1] = circ[:, None, 1] * mer[None, :, 0]
-    cp[..., 2] = mer[None, :, 1]
-    ku = [0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1]
-    return NurbsSurface(cp * r + np.asarray(centre, float), ku, [0, 0, 0, 1, 1, 1], 2, 2,
-                        wc[:, None] * np.array([1, R2, 1])[None, :])
 
 
 def chain_length(soup: SegmentSoup) -> float:

@@ -12,6 +12,8 @@ from surfprep.algorithms.intersection.tessellation import (Tessellation, patch_r
                                                            tessellate)
 from surfprep.errors import InvalidGeometryError, InvalidToleranceError
 
+from ssi_surfaces import sphere_band  # helper beside the tests (pytest prepend import mode)
+
 R2 = np.sqrt(0.5)
 
 
@@ -41,21 +43,6 @@ def half_flat():
     cp = np.stack([*np.meshgrid(gu, gv, indexing="ij"), np.zeros((8, 4))], axis=-1)
     cp[6:, :, 2] = [[0.3, -0.2, 0.4, 0.1], [-0.3, 0.5, 0.0, 0.2]]
     return NurbsSurface(cp, ku, [0] * 4 + [1] * 4, 3, 3)
-
-
-def sphere_band(r=1.0):
-    """Rational biquadratic sphere zone between latitudes -45 and 45 degrees, 4 x 1 patches."""
-    circ = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1],
-                     [1, 0]], float)
-    wc = np.array([1, R2, 1, R2, 1, R2, 1, R2, 1])
-    mer = np.array([[R2, -R2], [2 * R2, 0.0], [R2, R2]])
-    cp = np.empty((9, 3, 3))
-    cp[..., 0] = circ[:, None, 0] * mer[None, :, 0]
-    cp[..., 1] = circ[:, None, 1] * mer[None, :, 0]
-    cp[..., 2] = mer[None, :, 1]
-    ku = [0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1]
-    return NurbsSurface(cp * r, ku, [0, 0, 0, 1, 1, 1], 2, 2,
-                        wc[:, None] * np.array([1, R2, 1])[None, :])
 
 
 def random_bspline(seed: int, amplitude: float):
