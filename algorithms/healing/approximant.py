@@ -1,0 +1,261 @@
+"""One local approximant of the original geometry over four boundary curves
+(Hamann & Jean 1996, paper 001 §§3-7; handbook 000 §29.3; Soni & Hamann 1993, paper 003).
+
+:func:`local_approximant` runs, at a resolution ``(M, N)``:
+
+1. the discrete Coons patch of the boundary (eq. 4, :mod:`.coons`);
+2. normals by central differences and the upper/lower offsets (eqs. 6-8,
+   :mod:`.offsets`);
+3. clipping of the sources against the offsets' box (:mod:`.clipping`);
+4. projection of every segment ``a b`` onto the clipped triangles, the hit
+   closest to the Coons point, mapped onto the exact surface (eqs. 9-11) and
+   polished by Newton (:mod:`.segments`);
+5. artificial projections where a segment hits nothing (Hardy's reciprocal
+   multiquadric, localized or global, eqs. 12-15, :mod:`.multiquadric`);
+6. the bicubic interpolant (C1 of eqs. 16-18 or C2 of 003, :mod:`.interpolant`);
+7. the error at the points of eq. (19), cells over holes skipped (:mod:`.error`).
+
+If the error exceeds ``tol`` the resolution grows and everything is redone from
+the boundary, up to ``max_resolution``; the result then says
+``converged=False`` (or, with ``strict=True``, an error is raised).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError, InvalidToleranceError
+from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
+from .boundary import Boundary, BoundaryCurve, as_boundary
+from .clipping import Source, as_sources, clip_sources
+from .coons import discrete_coons
+from .error import ErrorSample, measure_error
+from .interpolant import Interpolant, interpolate_grid
+from .multiquadric import HardyMode, fill_positions
+from .offsets import offsets
+from .segments import project_grid
+
+__all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_approximant"]
+
+#: default ``tol``: this fraction of the boundary's bounding-box diagonal
+DEFAULT_RELATIVE_TOL = 1e-3
+#: default chord tolerance of the triangulation of surfaces: this fraction of ``d``
+MESH_FRACTION = 0.02
+_NEWTON_FRACTION = 1e-9      # residual of the Newton polish, fraction of the size
+_INVERSION_FRACTION = 1e-10  # convergence of point inversion, fraction of the size
+
+
+@dataclass(frozen=True)
+class ResolutionStep:
+    """One pass of the resolution loop: ``resolution (M, N)``, ``max_error``,
+    ``rms_error``, ``artificial_share``."""
+
+    resolution: tuple[int, int]
+    max_error: float
+    rms_error: float
+    artificial_share: float
+
+
+@dataclass(frozen=True, eq=False)
+class LocalApproximant:
+    """A bicubic B-spline approximant and how well it follows the originals.
+
+    Attributes
+    ----------
+    surface : NurbsSurface
+        Bicubic, non-rational, domain ``[0, 1]^2``; ``u`` runs along the bottom
+        boundary curve, ``v`` along the left one (:mod:`.boundary`).
+    resolution : (int, int)
+        ``(M, N)``: the grid of ``(M + 1) x (N + 1)`` interpolated points.
+    max_error, rms_error : float
+        Error of §7 at the points of eq. (19) not over holes (model units;
+        NaN when nothing could be measured).
+    artificial_share : float
+        Fraction of the grid points from Hardy's method (over holes or gaps).
+    converged : bool
+        ``max_error <= tol``.
+    tol : float
+    interpolant : Interpolant
+    offset : float
+        ``d`` used (eq. 8 or given).
+    grid : (M + 1, N + 1, 3) float
+        The interpolated points ``y`` and ``z``.
+    artificial : (M + 1, N + 1) bool
+        True at the artificial projections ``z``.
+    source : (M + 1, N + 1) int
+        Index of the source each projection lies on, -1 at artificial points.
+    error : ErrorSample
+        The measured points and their distances (a deviation map).
+    history : tuple of ResolutionStep
+        Every resolution tried, in order.
+    boundary : Boundary
+    """
+
+    surface: NurbsSurface
+    resolution: tuple[int, int]
+    max_error: float
+    rms_error: float
+    artificial_share: float
+    converged: bool
+    tol: float
+    interpolant: Interpolant
+    offset: float
+    grid: NDArray
+    artificial: NDArray
+    source: NDArray
+    error: ErrorSample
+    history: tuple
+    boundary: Boundary
+
+
+def _check_resolution(value, name: str, minimum: int) -> tuple[int, int]:
+    try:
+        m, n = (int(x) for x in value)
+    except (TypeError, ValueError):
+        raise InvalidGeometryError(f"{name} must be two integers (M, N), got {value!r}") from None
+    if m < minimum or n < minimum or (m, n) != tuple(value):
+        raise InvalidGeometryError(f"{name} must be integers >= {minimum}, got {value!r}")
+    return m, n
+
+
+def _next_resolution(current: tuple[int, int], limit: tuple[int, int], growth: float
+                     ) -> tuple[int, int]:
+    return tuple(min(lim, max(c + 2, math.ceil(c * growth)))
+                 for c, lim in zip(current, limit, strict=True))
+
+
+@dataclass(frozen=True, eq=False)
+class _Pass:
+    surface: NurbsSurface
+    grid: NDArray
+    found: NDArray
+    source: NDArray
+    error: ErrorSample
+    offset: float
+
+
+def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
+              interpolant: Interpolant, hardy: HardyMode, neighbours: int,
+              mesh_tol: float | None, size: float) -> _Pass:
+    coons = discrete_coons(boundary, m, n)
+    off = offsets(coons, offset)
+    clipped = clip_sources(sources, off.box,
+                           mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    a, b = off.upper.reshape(-1, 3), off.lower.reshape(-1, 3)
+    y, t, found, src = project_grid(a, b, clipped, tol=_NEWTON_FRACTION * size)
+    shape = (m + 1, n + 1)
+    found, t = found.reshape(shape), t.reshape(shape)
+    t_all = fill_positions(coons.u, coons.v, t, found, mode=hardy, neighbours=neighbours)
+    z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
+    grid = np.where(found[..., None], y.reshape(shape + (3,)), z)
+    surface = interpolate_grid(grid, interpolant)
+    near = tuple(s for s, k in zip(sources, clipped.kept, strict=True) if k)
+    error = measure_error(surface, found, near, tol=_INVERSION_FRACTION * size)
+    return _Pass(surface, grid, found, src.reshape(shape), error, off.distance)
+
+
+def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
+                      sources: Sequence[Source] | Source, *, tol: float | None = None,
+                      resolution: tuple[int, int] = (8, 8),
+                      max_resolution: tuple[int, int] = (64, 64),
+                      interpolant: Interpolant = Interpolant.C1_BICUBIC,
+                      offset: float | None = None, neighbours: int = 8,
+                      hardy: HardyMode = HardyMode.LOCAL, growth: float = 1.5,
+                      gap_tol: float | None = None, mesh_tol: float | None = None,
+                      strict: bool = False) -> LocalApproximant:
+    """A bicubic B-spline surface over four boundary curves that follows the sources.
+
+    Parameters
+    ----------
+    boundary : Boundary or four NurbsCurve / (n, 3) float
+        Bottom, right, top, left, meeting end to end (:mod:`.boundary`;
+        :func:`.corners_boundary` for four picked points).
+    sources : NurbsSurface, TriangleMesh, SurfaceSource or a sequence of them
+        The original geometry.
+    tol : float, optional
+        Largest accepted error (§7), model units. Default
+        :data:`DEFAULT_RELATIVE_TOL` times the boundary's bounding-box diagonal.
+    resolution : (int, int)
+        First ``(M, N)`` tried (at least 2, 3 for the C2 interpolant).
+    max_resolution : (int, int)
+        Largest ``(M, N)``; equal to ``resolution`` for one fixed resolution
+        (compatible approximants of a network).
+    interpolant : Interpolant
+        C1 with triple knots (001, default) or C2 (003).
+    offset : float, optional
+        ``d`` of eq. (7), model units; default eq. (8).
+    neighbours : int
+        ``K`` of the localized Hardy method (5-10).
+    hardy : HardyMode
+        Localized (default) or global Hardy interpolation.
+    growth : float > 1
+        Resolution factor between passes (at least +2 each).
+    gap_tol : float, optional
+        Largest gap between consecutive boundary curves (:func:`.as_boundary`).
+    mesh_tol : float, optional
+        Chord tolerance of the triangulation of the surfaces; default ``d / 50``.
+    strict : bool
+        Raise :class:`InvalidToleranceError` instead of returning an
+        unconverged approximant.
+
+    Returns
+    -------
+    LocalApproximant
+        The first pass within ``tol``, else the pass of smallest error.
+
+    Raises
+    ------
+    InvalidGeometryError
+        Bad boundary (not meeting end to end, NaN...), no sources, bad resolution.
+    DegenerateGeometryError
+        The boundary lies over no source, or has zero area.
+    InvalidToleranceError
+        ``tol`` not positive, below double precision for the model or larger
+        than it; with ``strict``, ``tol`` not reached at ``max_resolution``.
+    """
+    bnd = as_boundary(boundary, gap_tol=gap_tol)
+    srcs = as_sources(sources)
+    size = bnd.size
+    tol = DEFAULT_RELATIVE_TOL * size if tol is None else check_tolerance(
+        tol, "tol", low=1e-12 * size, high=size)
+    minimum = 3 if interpolant is Interpolant.C2_BICUBIC else 2
+    current = _check_resolution(resolution, "resolution", minimum)
+    limit = _check_resolution(max_resolution, "max_resolution", minimum)
+    if limit[0] < current[0] or limit[1] < current[1]:
+        raise InvalidGeometryError(
+            f"max_resolution {limit} must be at least resolution {current}")
+    if not (np.isfinite(growth) and growth > 1):
+        raise InvalidGeometryError(f"growth must be > 1, got {growth!r}")
+    if offset is not None:
+        offset = check_tolerance(offset, "offset", low=1e-12 * size)
+    history, passes = [], []
+    while True:
+        p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
+                      hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol, size=size)
+        share = float(1.0 - p.found.mean())
+        history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
+        passes.append(p)
+        if p.error.max_error <= tol or current == limit:
+            break
+        current = _next_resolution(current, limit, growth)
+    errors = np.array([s.max_error for s in history])
+    converged = bool(errors[-1] <= tol)
+    best = len(passes) - 1 if converged or np.all(np.isnan(errors)) else int(np.nanargmin(errors))
+    p, step = passes[best], history[best]
+    if strict and not converged:
+        raise InvalidToleranceError(
+            f"tol={tol:.3g} not reached up to resolution {limit}: smallest error "
+            f"{np.nanmin(errors) if not np.all(np.isnan(errors)) else float('nan'):.3g} "
+            f"at {step.resolution}")
+    return LocalApproximant(
+        surface=p.surface, resolution=step.resolution, max_error=step.max_error,
+        rms_error=step.rms_error, artificial_share=step.artificial_share, converged=converged,
+        tol=float(tol), interpolant=interpolant, offset=p.offset, grid=p.grid,
+        artificial=~p.found, source=p.source, error=p.error, history=tuple(history),
+        boundary=bnd)

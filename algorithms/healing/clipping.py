@@ -1,0 +1,178 @@
+"""Original geometry taking part in a local approximant: selection, triangulation, clipping
+(001 §4, 000 §29.3.3, 003 "block").
+
+A source is a :class:`NurbsSurface`, a :class:`TriangleMesh` (a discretized
+geometry with no parametric form, e.g. STL data), or a :class:`SurfaceSource`
+pairing both: a surface and a triangulation of the part of it that exists
+(a trimmed face), whose vertices carry their ``(u, v)``.
+
+Clipping, against the box of the upper and lower offsets:
+
+1. a surface whose control-net box misses the box is dropped (a B-spline
+   surface lies in the convex hull of its control points); a mesh whose
+   vertex box misses it likewise;
+2. the other surfaces are triangulated near the box only
+   (:func:`..intersection.tessellation.tessellate` with the box as keep box, so
+   Bézier patches whose control nets miss it are never refined);
+3. triangles whose box misses the box are dropped ("all vertices left of ...
+   the bounding box").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError
+from ..intersection.mesh import TriangleMesh
+from ..intersection.tessellation import tessellate
+from ..surface import NurbsSurface
+
+__all__ = ["ClippedTriangles", "Source", "SurfaceSource", "as_sources", "clip_sources"]
+
+
+@dataclass(frozen=True, eq=False)
+class SurfaceSource:
+    """An original surface, its triangulation, or both.
+
+    Attributes
+    ----------
+    surface : NurbsSurface or None
+        Exact geometry: hits are mapped onto it (eqs. 9-10) and distances are
+        measured to it.
+    mesh : TriangleMesh or None
+        The triangulation to project onto. With a surface it must carry
+        ``uv`` (the parameters of its vertices on ``surface``) and stands for
+        the part of the surface that exists (trimmed faces, holes); without
+        a mesh the whole surface is triangulated.
+    name : str
+        Free label, reported back (e.g. the face's name).
+    """
+
+    surface: NurbsSurface | None = None
+    mesh: TriangleMesh | None = None
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if self.surface is None and self.mesh is None:
+            raise InvalidGeometryError("a SurfaceSource needs a surface, a mesh or both")
+        if self.surface is not None and (not isinstance(self.surface, NurbsSurface)
+                                         or self.surface.dimension != 3):
+            raise InvalidGeometryError("SurfaceSource.surface must be a 3D NurbsSurface")
+        if self.mesh is not None and not isinstance(self.mesh, TriangleMesh):
+            raise InvalidGeometryError("SurfaceSource.mesh must be a TriangleMesh")
+        if self.surface is not None and self.mesh is not None and self.mesh.uv is None:
+            raise InvalidGeometryError(
+                "a SurfaceSource with both surface and mesh needs the mesh's (u, v)")
+
+    def box(self) -> NDArray:
+        """(2, 3) float: control-net box of the surface, else the mesh's box."""
+        if self.mesh is not None:
+            return self.mesh.bounding_box()
+        return self.surface.bounding_box()
+
+
+Source = NurbsSurface | TriangleMesh | SurfaceSource
+
+
+def as_sources(sources: Sequence[Source] | Source) -> tuple[SurfaceSource, ...]:
+    """Normalize a source or a sequence of sources to :class:`SurfaceSource`.
+
+    Raises
+    ------
+    InvalidGeometryError
+        No source, or an object of another type.
+    """
+    if isinstance(sources, (NurbsSurface, TriangleMesh, SurfaceSource)):
+        sources = [sources]
+    out = []
+    for k, s in enumerate(sources):
+        if isinstance(s, SurfaceSource):
+            out.append(s)
+        elif isinstance(s, NurbsSurface):
+            out.append(SurfaceSource(surface=s))
+        elif isinstance(s, TriangleMesh):
+            out.append(SurfaceSource(mesh=s))
+        else:
+            raise InvalidGeometryError(
+                f"source {k} must be a NurbsSurface, TriangleMesh or SurfaceSource, "
+                f"got {type(s).__name__}")
+    if not out:
+        raise InvalidGeometryError("no original surfaces given: nothing to approximate")
+    return tuple(out)
+
+
+@dataclass(frozen=True, eq=False)
+class ClippedTriangles:
+    """Triangles of all sources that may lie in the offsets' box.
+
+    Attributes
+    ----------
+    points : (t, 3, 3) float
+        Corners ``[triangle, corner, xyz]``.
+    uv : (t, 3, 2) float
+        Corner parameters on the triangle's source surface (NaN without one).
+    source : (t,) int
+        Index of the triangle's source in :attr:`sources`.
+    sources : tuple of SurfaceSource
+        All sources given (indices refer to them).
+    kept : (s,) bool
+        Sources whose box meets the offsets' box.
+    """
+
+    points: NDArray
+    uv: NDArray
+    source: NDArray
+    sources: tuple
+    kept: NDArray
+
+    @property
+    def n_triangles(self) -> int:
+        return self.points.shape[0]
+
+
+def _overlaps(box_a: NDArray, box_b: NDArray) -> NDArray:
+    """Closed overlap of box ``(2, 3)`` with boxes ``(..., 2, 3)``."""
+    return np.all((box_b[..., 0, :] <= box_a[1]) & (box_b[..., 1, :] >= box_a[0]), axis=-1)
+
+
+def _source_mesh(source: SurfaceSource, box: NDArray, mesh_tol: float
+                 ) -> tuple[NDArray, NDArray]:
+    """Triangle corners (t, 3, 3) and parameters (t, 3, 2) of one source near ``box``."""
+    if source.mesh is not None:
+        mesh = source.mesh
+    else:
+        mesh = tessellate(source.surface, mesh_tol, keep_boxes=box[None]).mesh
+    pts = mesh.triangle_points()
+    if source.surface is not None and mesh.uv is not None:
+        uv = mesh.triangle_uv()
+    else:
+        uv = np.full(pts.shape[:2] + (2,), np.nan)
+    boxes = np.stack([pts.min(axis=1), pts.max(axis=1)], axis=1)
+    keep = _overlaps(box, boxes)
+    return pts[keep], uv[keep]
+
+
+def clip_sources(sources: tuple[SurfaceSource, ...], box: NDArray, *, mesh_tol: float
+                 ) -> ClippedTriangles:
+    """Select, triangulate and clip the sources against ``box`` (module docstring).
+
+    Parameters
+    ----------
+    sources : tuple of SurfaceSource
+    box : (2, 3) float
+    mesh_tol : float > 0
+        Chord tolerance of the triangulation of surfaces without a mesh.
+    """
+    kept = np.array([bool(_overlaps(box, s.box())) for s in sources])
+    pts, uv, src = [np.zeros((0, 3, 3))], [np.zeros((0, 3, 2))], [np.zeros(0, np.int64)]
+    for k in np.flatnonzero(kept):
+        p, q = _source_mesh(sources[k], box, mesh_tol)
+        pts.append(p)
+        uv.append(q)
+        src.append(np.full(p.shape[0], k, np.int64))
+    return ClippedTriangles(np.concatenate(pts), np.concatenate(uv), np.concatenate(src),
+                            sources, kept)

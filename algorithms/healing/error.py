@@ -1,0 +1,204 @@
+"""Error of a local approximant (001 §7, eq. 19; 000 §29.3.6).
+
+The approximant ``s`` is measured at the points
+
+* ``e_{I,J} = s((ξ_I + ξ_{I+1}) / 2, η_J)``,
+* ``f_{I,J} = s(ξ_I, (η_J + η_{J+1}) / 2)``,
+* ``g_{I,J} = s((ξ_I + ξ_{I+1}) / 2, (η_J + η_{J+1}) / 2)`` (eq. 19),
+
+where bicubic interpolants deviate most, by their shortest distance to the
+original geometry. A point is measured only when the grid points around it
+(both ends of its edge for ``e`` and ``f``, all four corners for ``g``) are
+projections onto the originals, not artificial ones: the others lie over a
+hole and have nothing to be close to. The error is the largest distance; the
+RMS is reported too (003).
+
+Distances: to a parametric surface by Newton point inversion
+(:func:`..projection.project_to_surface`); to a triangulation by the exact
+closest point on its nearest triangles, and, for a surface given with its
+triangulation (a trimmed face), by point inversion started at the parameters
+of that closest point (so the foot stays on the part of the surface that
+exists).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from ..intersection.mesh import TriangleMesh
+from ..projection import project_to_surface
+from ..surface import NurbsSurface
+from .clipping import SurfaceSource
+
+__all__ = [
+    "ErrorSample",
+    "closest_on_triangles",
+    "distance_to_sources",
+    "error_parameters",
+    "measure_error",
+]
+
+_CANDIDATE_TRIANGLES = 12
+
+
+@dataclass(frozen=True, eq=False)
+class ErrorSample:
+    """Distances of an approximant to the originals at the points of eq. (19).
+
+    Attributes
+    ----------
+    uv : (k, 2) float
+        Parameters of the measured points on the approximant.
+    points : (k, 3) float
+    distance : (k,) float
+    max_error, rms_error : float
+        NaN when no point could be measured (every cell over a hole).
+    """
+
+    uv: NDArray
+    points: NDArray
+    distance: NDArray
+    max_error: float
+    rms_error: float
+
+    @property
+    def n_points(self) -> int:
+        return self.distance.size
+
+
+def error_parameters(found: NDArray) -> NDArray:
+    """Parameters of the points e, f, g of eq. (19) not over holes.
+
+    Parameters
+    ----------
+    found : (M + 1, N + 1) bool
+        Grid points that are projections onto the originals.
+
+    Returns
+    -------
+    (k, 2) float
+    """
+    m, n = found.shape[0] - 1, found.shape[1] - 1
+    xi, eta = np.linspace(0, 1, m + 1), np.linspace(0, 1, n + 1)
+    xm, em = 0.5 * (xi[:-1] + xi[1:]), 0.5 * (eta[:-1] + eta[1:])
+    e_ok = found[:-1, :] & found[1:, :]
+    f_ok = found[:, :-1] & found[:, 1:]
+    g_ok = e_ok[:, :-1] & e_ok[:, 1:]
+    parts = []
+    for us, vs, ok in ((xm, eta, e_ok), (xi, em, f_ok), (xm, em, g_ok)):
+        uu, vv = np.meshgrid(us, vs, indexing="ij")
+        parts.append(np.stack([uu[ok], vv[ok]], axis=1))
+    return np.concatenate(parts)
+
+
+def closest_on_triangles(points: NDArray, tri: NDArray) -> tuple[NDArray, NDArray]:
+    """Closest points of triangles to points, pairwise.
+
+    Parameters
+    ----------
+    points : (k, 3) float
+    tri : (k, 3, 3) float
+
+    Returns
+    -------
+    foot : (k, 3) float
+    barycentric : (k, 3) float
+    """
+    p0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    gram = np.stack([np.stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2)], 1),
+                     np.stack([np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e2)], 1)],
+                    1)
+    rhs = np.stack([np.einsum("ij,ij->i", points - p0, e1),
+                    np.einsum("ij,ij->i", points - p0, e2)], 1)
+    st = np.linalg.solve(gram, rhs[..., None])[..., 0]
+    bary = np.stack([1 - st[:, 0] - st[:, 1], st[:, 0], st[:, 1]], axis=1)
+    inside = np.all(bary >= 0, axis=1)
+    best_d = np.where(inside, np.linalg.norm(points - np.einsum("kc,kcd->kd", bary, tri), axis=1),
+                      np.inf)
+    best_b = bary.copy()
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        a, b = tri[:, i], tri[:, j]
+        ab = b - a
+        s = np.clip(np.einsum("ij,ij->i", points - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        d = np.linalg.norm(points - (a + s[:, None] * ab), axis=1)
+        better = ~inside & (d < best_d)
+        cand = np.zeros_like(bary)
+        cand[:, i], cand[:, j] = 1 - s, s
+        best_d = np.where(better, d, best_d)
+        best_b = np.where(better[:, None], cand, best_b)
+    return np.einsum("kc,kcd->kd", best_b, tri), best_b
+
+
+def _mesh_closest(mesh: TriangleMesh, points: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """Distance, triangle and barycentric weights of the closest mesh point to each point."""
+    tri = mesh.triangle_points()
+    k = min(_CANDIDATE_TRIANGLES, tri.shape[0])
+    _, cand = cKDTree(tri.mean(axis=1)).query(points, k=k)
+    cand = cand.reshape(points.shape[0], k)
+    rep = np.repeat(points, k, axis=0)
+    foot, bary = closest_on_triangles(rep, tri[cand.ravel()])
+    dist = np.linalg.norm(rep - foot, axis=1).reshape(-1, k)
+    best = np.argmin(dist, axis=1)
+    rows = np.arange(points.shape[0])
+    return dist[rows, best], cand[rows, best], bary.reshape(-1, k, 3)[rows, best]
+
+
+def _source_distance(source: SurfaceSource, points: NDArray, tol: float) -> NDArray:
+    if source.mesh is None:
+        return project_to_surface(source.surface, points, tol=tol, n_seeds=2).distance
+    dist, tri, bary = _mesh_closest(source.mesh, points)
+    if source.surface is None:
+        return dist
+    uv = np.einsum("kc,kcd->kd", bary, source.mesh.triangle_uv()[tri])
+    exact = project_to_surface(source.surface, points, tol=tol, guess=uv).distance
+    return np.minimum(dist, exact)
+
+
+def distance_to_sources(points: NDArray, sources: tuple[SurfaceSource, ...], *,
+                        tol: float) -> NDArray:
+    """Shortest distance of each point to any of the sources.
+
+    Parameters
+    ----------
+    points : (k, 3) float
+    sources : tuple of SurfaceSource
+    tol : float
+        Convergence of the point inversion, model units.
+
+    Returns
+    -------
+    (k,) float
+    """
+    best = np.full(points.shape[0], np.inf)
+    if points.shape[0] == 0:
+        return best
+    for source in sources:
+        best = np.minimum(best, _source_distance(source, points, tol))
+    return best
+
+
+def measure_error(surface: NurbsSurface, found: NDArray, sources: tuple[SurfaceSource, ...],
+                  *, tol: float) -> ErrorSample:
+    """The error of §7 (module docstring).
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+        The approximant over ``[0, 1]^2``.
+    found : (M + 1, N + 1) bool
+    sources : tuple of SurfaceSource
+        The sources that can be near the approximant (clipping's kept ones).
+    tol : float
+        Convergence of the point inversion, model units.
+    """
+    uv = error_parameters(found)
+    points = surface.evaluate(uv[:, 0], uv[:, 1]) if uv.size else np.zeros((0, 3))
+    distance = distance_to_sources(points, sources, tol=tol)
+    if distance.size == 0:
+        return ErrorSample(uv, points, distance, float("nan"), float("nan"))
+    return ErrorSample(uv, points, distance, float(distance.max()),
+                       float(np.sqrt(np.mean(distance ** 2))))

@@ -1,0 +1,142 @@
+"""Artificial projections over holes: Hardy's reciprocal multiquadric (001 §5, eqs. 12-15;
+000 §29.3.4).
+
+Where a segment ``a b`` hits nothing (a hole or gap in the original geometry)
+its position ``t`` on the segment is interpolated from the positions found
+elsewhere, as a bivariate function of the grid parameters ``(u, v)``:
+
+.. math:: t(u, v) = \\sum_i c_i \\left(R + (u - u_i)^2 + (v - v_i)^2\\right)^{-\\gamma}
+          \\qquad (12, 14)
+
+with ``R = (δ_u + δ_v) / 2`` (mean parameter spacings) and ``γ = 0.001``. The
+global version (eq. 12) uses every found position; the localized one (eq. 14)
+only the at least ``K`` found positions nearest in the Manhattan norm of the
+grid indices (eq. 13: all at index distance 1, then 2, ... until ``K`` is
+reached or exceeded). The artificial projection is ``z = (1 - t) a + t b``
+(eq. 15).
+"""
+
+from __future__ import annotations
+
+import enum
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import DegenerateGeometryError
+
+__all__ = ["HARDY_GAMMA", "HardyMode", "fill_positions", "hardy_parameters"]
+
+#: the exponent of 001 §5
+HARDY_GAMMA = 0.001
+
+
+class HardyMode(enum.Enum):
+    """Which found positions enter Hardy's interpolation."""
+
+    #: the K Manhattan-nearest found positions for every missing one (eq. 14)
+    LOCAL = "local"
+    #: all found positions, one system (eq. 12)
+    GLOBAL = "global"
+
+
+def hardy_parameters(u: NDArray, v: NDArray) -> float:
+    """``R = (δ_u + δ_v) / 2`` from the mean spacings of the boundary parameters (001 §5).
+
+    Parameters
+    ----------
+    u, v : (M + 1, N + 1) float
+    """
+    du = 0.5 * (np.mean(np.diff(u[:, 0])) + np.mean(np.diff(u[:, -1])))
+    dv = 0.5 * (np.mean(np.diff(v[0, :])) + np.mean(np.diff(v[-1, :])))
+    return 0.5 * float(du + dv)
+
+
+def _kernel(du: NDArray, dv: NDArray, radius: float, gamma: float) -> NDArray:
+    return (radius + du * du + dv * dv) ** (-gamma)
+
+
+def _solve(matrix: NDArray, rhs: NDArray) -> NDArray:
+    """Batched solve, least squares where a system is singular."""
+    try:
+        return np.linalg.solve(matrix, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.stack([np.linalg.lstsq(m, r, rcond=None)[0] for m, r in zip(matrix, rhs,
+                                                                              strict=True)])
+
+
+def _global(u: NDArray, v: NDArray, t: NDArray, found: NDArray, radius: float,
+            gamma: float) -> NDArray:
+    uf, vf, tf = u[found], v[found], t[found]
+    matrix = _kernel(uf[:, None] - uf[None], vf[:, None] - vf[None], radius, gamma)
+    c = _solve(matrix[None], tf[None])[0]
+    um, vm = u[~found], v[~found]
+    return _kernel(um[:, None] - uf[None], vm[:, None] - vf[None], radius, gamma) @ c
+
+
+def _local(u: NDArray, v: NDArray, t: NDArray, found: NDArray, radius: float,
+           gamma: float, neighbours: int) -> NDArray:
+    ii, jj = np.indices(found.shape)
+    fi, fj = ii[found], jj[found]
+    mi, mj = ii[~found], jj[~found]
+    dist = np.abs(mi[:, None] - fi[None]) + np.abs(mj[:, None] - fj[None])   # eq. (13)
+    k = min(neighbours, fi.size)
+    kth = np.partition(dist, k - 1, axis=1)[:, k - 1]
+    chosen = dist <= kth[:, None]                                           # "at least K"
+    count = chosen.sum(axis=1)
+    uf, vf, tf = u[found], v[found], t[found]
+    um, vm = u[~found], v[~found]
+    out = np.empty(mi.size)
+    for size in np.unique(count):
+        rows = np.flatnonzero(count == size)
+        cols = np.nonzero(chosen[rows])[1].reshape(rows.size, size)
+        pu, pv = uf[cols], vf[cols]                                         # (r, K)
+        matrix = _kernel(pu[:, :, None] - pu[:, None], pv[:, :, None] - pv[:, None],
+                         radius, gamma)
+        c = _solve(matrix, tf[cols])
+        weights = _kernel(um[rows, None] - pu, vm[rows, None] - pv, radius, gamma)
+        out[rows] = np.einsum("rk,rk->r", weights, c)
+    return out
+
+
+def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
+                   mode: HardyMode = HardyMode.LOCAL, neighbours: int = 8,
+                   radius: float | None = None, gamma: float = HARDY_GAMMA) -> NDArray:
+    """Segment positions ``t`` everywhere: found ones kept, missing ones by eq. (12) or (14).
+
+    Parameters
+    ----------
+    u, v : (M + 1, N + 1) float
+        Grid parameters.
+    t : (M + 1, N + 1) float
+        Found positions (anything where ``found`` is False).
+    found : (M + 1, N + 1) bool
+    mode : HardyMode
+    neighbours : int
+        ``K`` of the localized version (5-10 in 001).
+    radius : float, optional
+        ``R``; default :func:`hardy_parameters`.
+    gamma : float
+
+    Returns
+    -------
+    (M + 1, N + 1) float
+
+    Raises
+    ------
+    DegenerateGeometryError
+        No position was found at all (the boundary lies over no source).
+    """
+    if not np.any(found):
+        raise DegenerateGeometryError(
+            "no segment of the Coons patch meets the original surfaces: the boundary does not "
+            "lie over them (or the offset distance is too small)")
+    out = np.array(t, dtype=float)
+    if np.all(found):
+        return out
+    r = hardy_parameters(u, v) if radius is None else float(radius)
+    if mode is HardyMode.GLOBAL:
+        out[~found] = _global(u, v, out, found, r, gamma)
+    else:
+        out[~found] = _local(u, v, out, found, r, gamma, max(1, int(neighbours)))
+    return out
