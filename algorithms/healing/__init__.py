@@ -5,8 +5,17 @@ B-spline approximants joined G0/G1 (Hamann & Jean 1996, paper 001; handbook
 from .approximant import LocalApproximant, ResolutionStep, local_approximant
 from .boundary import Boundary, as_boundary, corners_boundary
 from .clipping import SurfaceSource
+from .connectivity import (
+    Connectivity,
+    NetworkTopologyError,
+    SharedEdge,
+    Side,
+    find_connectivity,
+)
 from .interpolant import Interpolant
+from .measure_joins import JoinReport, measure_join
 from .multiquadric import HardyMode
+from .network import Continuity, Network, connect
 
 # one local approximant (approximant.py and the modules of its steps)
 __all__ = [
@@ -19,4 +28,16 @@ __all__ = [
     "as_boundary",
     "corners_boundary",
     "local_approximant",
+    # the network of approximants (network.py, connectivity.py, compatibility.py,
+    # continuity.py, measure_joins.py)
+    "Connectivity",
+    "Continuity",
+    "JoinReport",
+    "Network",
+    "NetworkTopologyError",
+    "SharedEdge",
+    "Side",
+    "connect",
+    "find_connectivity",
+    "measure_join",
 ]
