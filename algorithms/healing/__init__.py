@@ -17,27 +17,26 @@ from .measure_joins import JoinReport, measure_join
 from .multiquadric import HardyMode
 from .network import Continuity, Network, connect
 
-# one local approximant (approximant.py and the modules of its steps)
+# one local approximant (approximant.py and the modules of its steps) and their
+# network (network.py, connectivity.py, compatibility.py, continuity.py, measure_joins.py)
 __all__ = [
     "Boundary",
-    "HardyMode",
-    "Interpolant",
-    "LocalApproximant",
-    "ResolutionStep",
-    "SurfaceSource",
-    "as_boundary",
-    "corners_boundary",
-    "local_approximant",
-    # the network of approximants (network.py, connectivity.py, compatibility.py,
-    # continuity.py, measure_joins.py)
     "Connectivity",
     "Continuity",
+    "HardyMode",
+    "Interpolant",
     "JoinReport",
+    "LocalApproximant",
     "Network",
     "NetworkTopologyError",
+    "ResolutionStep",
     "SharedEdge",
     "Side",
+    "SurfaceSource",
+    "as_boundary",
     "connect",
+    "corners_boundary",
     "find_connectivity",
+    "local_approximant",
     "measure_join",
 ]
