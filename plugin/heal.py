@@ -1,0 +1,379 @@
+"""Healing of a CAD model: :func:`heal` (001, 003, 000 §29.3) without clicks.
+
+Steps, on anything that holds faces (file path, :class:`CadModel`,
+``TopoDS_Shape``, cadquery / build123d object):
+
+1. every face is read as a :class:`TrimmedFace`; faces that lie on another face
+   within ``gap_tol`` (all their edges on its edges, interior points on its
+   surface; exact duplicates as in overture_marscapsule_proe.igs) are dropped,
+   so the output has no doubled area;
+2. edges of different faces within ``gap_tol`` of each other are paired; free
+   edges chained into loops of four from two or more faces are holes;
+3. every four-sided face (one loop of four real edges, trimmed or not) gets a
+   :func:`local_approximant` over its own four edges, projected onto all
+   original surfaces; every hole one over its four free edges; every directed
+   patch of ``patches`` (:mod:`.heal_spec`) one over its curves or corners;
+4. the approximants are joined by :func:`connect` (G0 or G1, topology
+   violations left unconnected and reported);
+5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
+   shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
+   untouched faces keep their names (a replaced face passes its name to its
+   approximant; holes are named ``heal_hole_<k>``).
+
+``heal`` is a function that also carries the two building blocks, so that
+``surfprep.heal.local_approximant(...)`` and ``surfprep.heal.connect(...)``
+work next to ``surfprep.heal(shape)``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+
+from ..algorithms.healing import (
+    Continuity,
+    JoinReport,
+    LocalApproximant,
+    Network,
+    connect,
+    local_approximant,
+)
+from ..algorithms.healing.connectivity import Side
+from ..algorithms.tolerance import check_tolerance
+from ..errors import InvalidGeometryError, SurfprepError
+from .faces import TrimmedFace, face_to_nurbs, make_face
+from .heal_spec import DirectedPatch, read_patch_spec
+from .heal_topology import (
+    count_free_edges,
+    duplicate_faces,
+    face_edges,
+    four_sided_boundary,
+    hole_loops,
+    is_valid,
+    max_edge_tolerance,
+    pair_edges,
+    sew,
+)
+from .io import CadModel, read, to_shape
+from .step_iges import _all_faces, _FaceNames
+
+__all__ = [
+    "DEFAULT_GAP_FACTOR",
+    "TIGHT_FACTOR",
+    "HealResult",
+    "PatchOrigin",
+    "PatchReport",
+    "heal",
+]
+
+#: default ``gap_tol``: this times the model's box diagonal ...
+DEFAULT_GAP_FACTOR = 1e-2
+#: ... and at most this times the median edge length
+_GAP_FACTOR_EDGE = 0.05
+#: free edges are also counted after sewing at this times the diagonal (geometric closure)
+TIGHT_FACTOR = 1e-7
+
+
+@dataclass(frozen=True)
+class PatchOrigin:
+    """Where an approximant comes from: ``kind`` "face", "hole" or "directed", and
+    the face indices (the face replaced, the faces bounding the hole)."""
+
+    kind: str
+    faces: tuple[int, ...]
+    index: int
+
+
+@dataclass(frozen=True)
+class PatchReport:
+    """One approximant: origin, name, resolution ``(M, N)``, errors of §7 (model
+    units), artificial share, whether ``tol`` was met."""
+
+    origin: PatchOrigin
+    name: str | None
+    resolution: tuple[int, int]
+    max_error: float
+    rms_error: float
+    artificial_share: float
+    converged: bool
+
+    def as_dict(self) -> dict:
+        return {"kind": self.origin.kind, "faces": list(self.origin.faces),
+                "index": self.origin.index, "name": self.name,
+                "resolution": list(self.resolution), "max_error": self.max_error,
+                "rms_error": self.rms_error, "artificial_share": self.artificial_share,
+                "converged": self.converged}
+
+
+@dataclass(frozen=True, eq=False)
+class HealResult:
+    """What :func:`heal` built and measured.
+
+    Attributes
+    ----------
+    model : CadModel
+        The healed shape with face names.
+    patches : tuple of PatchReport
+    approximants : tuple of LocalApproximant
+        Same order as :attr:`patches` (deviation maps in ``.error``).
+    network : Network or None
+        The joined patches, their connectivity and measured joins.
+    dropped : tuple of (int, int)
+        ``(kept, dropped)`` overlapping face pairs.
+    skipped : tuple of str
+        Faces or holes left as they were, and why.
+    free_edges_before, free_edges_after : int
+        Free edges after sewing at ``gap_tol`` (input) and in the result.
+    tight_free_edges_before, tight_free_edges_after : int
+        The same at ``TIGHT_FACTOR`` x size: edges not closed in the geometry.
+    valid_before, valid_after : bool
+        ``BRepCheck_Analyzer`` on the input shape and on the result.
+    max_edge_tolerance : float
+        Largest edge tolerance of the result (sewing raises it where it closes
+        a gap by tolerance instead of geometry).
+    tol, gap_tol : float
+    continuity : Continuity
+    time_s : float
+    """
+
+    model: CadModel
+    patches: tuple[PatchReport, ...]
+    approximants: tuple[LocalApproximant, ...]
+    network: Network | None
+    dropped: tuple[tuple[int, int], ...]
+    skipped: tuple[str, ...]
+    free_edges_before: int
+    free_edges_after: int
+    tight_free_edges_before: int
+    tight_free_edges_after: int
+    valid_before: bool
+    valid_after: bool
+    max_edge_tolerance: float
+    tol: float | None
+    gap_tol: float
+    continuity: Continuity
+    time_s: float
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def shape(self) -> TopoDS_Shape:
+        return self.model.shape
+
+    @property
+    def joins(self) -> tuple[JoinReport, ...]:
+        return () if self.network is None else self.network.joins
+
+    def report(self) -> dict:
+        """Plain-JSON report (per patch, per shared edge, free edges, validity)."""
+        net = self.network
+        return {
+            "continuity": self.continuity.value, "tol": self.tol, "gap_tol": self.gap_tol,
+            "time_s": self.time_s, "faces_in": self.extra.get("faces_in"),
+            "faces_out": self.model.n_faces,
+            "patches": [p.as_dict() for p in self.patches],
+            "shared_edges": [j.as_dict() for j in self.joins],
+            "shared_edges_before": [] if net is None else [j.as_dict() for j in
+                                                           net.joins_before],
+            "topology_violations": [] if net is None else list(net.connectivity.violations),
+            "dropped_overlaps": [{"kept": a, "dropped": b} for a, b in self.dropped],
+            "skipped": list(self.skipped),
+            "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,
+                           "tight_before": self.tight_free_edges_before,
+                           "tight_after": self.tight_free_edges_after},
+            "valid": {"before": self.valid_before, "after": self.valid_after},
+            "max_edge_tolerance": self.max_edge_tolerance,
+        }
+
+
+# --------------------------------------------------------------------- input
+def _as_model(shape: Any) -> CadModel:
+    if isinstance(shape, CadModel):
+        return shape
+    if isinstance(shape, (str, os.PathLike)):
+        return read(shape)
+    return CadModel.from_shape(to_shape(shape))
+
+
+def _read_faces(model: CadModel) -> tuple[list[TrimmedFace | None], list[str]]:
+    faces, skipped = [], []
+    for i, (f, name) in enumerate(zip(model.faces, model.face_names)):
+        try:
+            faces.append(face_to_nurbs(f, name))
+        except SurfprepError as exc:
+            faces.append(None)
+            skipped.append(f"face {i}: not readable as NURBS ({exc}); kept as it is")
+    return faces, skipped
+
+
+def _default_gap_tol(model: CadModel, edges) -> float:
+    lengths = [float(np.sum(np.linalg.norm(np.diff(e.samples, axis=0), axis=1))) for e in edges]
+    bound = _GAP_FACTOR_EDGE * float(np.median(lengths)) if lengths else np.inf
+    return float(min(DEFAULT_GAP_FACTOR * model.size, bound))
+
+
+# ------------------------------------------------------------------- patches
+@dataclass(frozen=True)
+class _Job:
+    origin: PatchOrigin
+    boundary: Any
+    name: str | None
+    reference: TrimmedFace | None     # face whose orientation the approximant takes
+
+
+def _jobs(faces, kept, holes, directed: list[DirectedPatch]) -> list[_Job]:
+    jobs = []
+    for i in kept:
+        curves = four_sided_boundary(faces[i])
+        if curves is not None:
+            jobs.append(_Job(PatchOrigin("face", (i,), i), curves, faces[i].name, faces[i]))
+    for k, loop in enumerate(holes):
+        jobs.append(_Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
+                         [e.curve for e in loop], f"heal_hole_{k}", None))
+    for k, patch in enumerate(directed):
+        jobs.append(_Job(PatchOrigin("directed", (), k), patch.boundary,
+                         patch.name or f"heal_patch_{k}", None))
+    return jobs
+
+
+def _approximate(jobs: list[_Job], sources, tol, gap_tol, skipped: list[str]
+                 ) -> list[tuple[_Job, LocalApproximant]]:
+    out = []
+    for job in jobs:
+        try:
+            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol)
+        except SurfprepError as exc:
+            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant ({exc}); "
+                           "left as it was")
+            continue
+        out.append((job, la))
+    return out
+
+
+def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
+    """A face on ``surface`` whose normal agrees with the replaced face's."""
+    if reference is None:
+        return make_face(surface)
+    n_new = surface.normals(0.5, 0.5)
+    center = surface.evaluate(0.5, 0.5)
+    from ..algorithms.projection import project_to_surface
+    foot = project_to_surface(reference.surface, center)
+    n_old = reference.surface.normals(foot.uv[0], foot.uv[1])
+    if reference.reversed:
+        n_old = -n_old
+    return make_face(surface, reversed=bool(np.dot(n_new, n_old) < 0))
+
+
+# ---------------------------------------------------------------------- heal
+def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
+         gap_tol: float | None = None, patches: Any = None) -> HealResult:
+    """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
+
+    Parameters
+    ----------
+    shape
+        Path of a STEP/IGES file, :class:`CadModel`, ``TopoDS_Shape``,
+        cadquery or build123d object.
+    tol : float, optional
+        Largest error of each approximant (001 §7), model units; default that
+        of :func:`local_approximant` (relative to each patch's size).
+    continuity : "G0" or "G1"
+    gap_tol : float, optional
+        Model units: edges closer than this are one edge (neighbours, gaps to
+        close, duplicates). Default ``min(1e-2 x model diagonal, 0.05 x median
+        edge length)``.
+    patches : path, dict or list, optional
+        Directed patches (:func:`.heal_spec.read_patch_spec`).
+
+    Returns
+    -------
+    HealResult
+        ``.model`` is the healed model; ``.report()`` the JSON report.
+    """
+    start = time.perf_counter()
+    continuity = Continuity.parse(continuity)
+    model = _as_model(shape)
+    faces, skipped = _read_faces(model)
+    edges = face_edges(faces)
+    gap_tol = (_default_gap_tol(model, edges) if gap_tol is None
+               else check_tolerance(gap_tol, "gap_tol", high=model.size))
+    if tol is not None:
+        tol = check_tolerance(tol, "tol", high=model.size)
+    pairs = pair_edges(edges, gap_tol)
+    dropped = duplicate_faces(faces, edges, pairs, gap_tol)
+    gone = {b for _, b in dropped}
+    kept = [i for i, f in enumerate(faces) if f is not None and i not in gone]
+    edges = [e for e in edges if e.face not in gone]
+    pairs = pair_edges(edges, gap_tol)
+    paired = {k for pair in pairs for k in pair}
+    free = [k for k in range(len(edges)) if k not in paired]
+    holes = hole_loops(edges, free, gap_tol)
+    directed = read_patch_spec(patches, faces) if patches is not None else []
+    sources = [faces[i].surface for i in kept]
+    if not sources and not directed:
+        raise InvalidGeometryError("heal: no face of the input could be read")
+    done = _approximate(_jobs(faces, kept, holes, directed), sources, tol, gap_tol, skipped)
+    network = None
+    if done:
+        network = connect([la.surface for _, la in done], continuity=continuity,
+                          gap_tol=gap_tol, strict=False)
+    return _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
+                     start)
+
+
+def _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity, start
+              ) -> HealResult:
+    replaced = {job.origin.faces[0] for job, _ in done if job.origin.kind == "face"}
+    gone = replaced | {b for _, b in dropped}
+    untouched = [i for i in range(model.n_faces) if i not in gone]
+    new_faces, names = [], _FaceNames()
+    for (job, _), surface in zip(done, network.patches if network else ()):
+        face = _oriented_face(surface, job.reference)
+        new_faces.append(face)
+        if job.name:
+            names.add(face, job.name)
+    originals = [model.faces[i] for i in untouched]
+    for i in untouched:
+        if model.face_names[i] is not None:
+            names.add(model.faces[i], model.face_names[i])
+    shape, sewing = sew(originals + new_faces, gap_tol)
+    out_faces = _all_faces(shape)
+    out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
+    result_model = CadModel(shape, out_faces, out_names, (None,) * len(out_faces),
+                            model.length_unit, None, model.file_format)
+    tight = TIGHT_FACTOR * model.size
+    before_sewn, _ = sew(list(model.faces), gap_tol)
+    tight_before, _ = sew(list(model.faces), tight)
+    tight_after, _ = sew(list(out_faces), tight)
+    reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
+                                la.artificial_share, la.converged) for job, la in done)
+    return HealResult(
+        model=result_model, patches=reports, approximants=tuple(la for _, la in done),
+        network=network, dropped=tuple(dropped), skipped=tuple(skipped),
+        free_edges_before=count_free_edges(before_sewn), free_edges_after=count_free_edges(shape),
+        tight_free_edges_before=count_free_edges(tight_before),
+        tight_free_edges_after=count_free_edges(tight_after),
+        valid_before=is_valid(model.shape), valid_after=is_valid(shape),
+        max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
+        continuity=continuity, time_s=time.perf_counter() - start,
+        extra={"faces_in": model.n_faces})
+
+
+def _sewn_name(face: TopoDS_Face, sewing, names: _FaceNames, inputs: list) -> str | None:
+    name = names.get(face)
+    if name is not None:
+        return name
+    for original in inputs:
+        if sewing.IsModified(original) and sewing.Modified(original).IsSame(face):
+            return names.get(original)
+    return None
+
+
+heal.local_approximant = local_approximant
+heal.connect = connect
+heal.Continuity = Continuity
+heal.Side = Side

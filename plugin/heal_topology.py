@@ -1,0 +1,266 @@
+"""Topology for :func:`surfprep.heal`: which faces are four-sided, which edges are free,
+which free loops are four-sided holes, which faces duplicate others, and the
+OpenCascade side of the result (sewing, shell/solid, free edges, validity).
+
+Edges are compared in space, by samples of their 3D curves: two edges of
+different faces are *paired* when every sample of each lies within ``gap_tol``
+of the other's polyline. An edge paired with none is *free*. Free edges whose
+ends meet (within ``gap_tol``) form loops; a loop of exactly four edges taken
+from at least two faces is a hole to fill (a loop of one face's own four edges
+is that face's open border, not a hole).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
+from OCP.Standard import Standard_Failure
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL
+from OCP.TopExp import TopExp, TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Shape
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from scipy.spatial import cKDTree
+
+from ..algorithms import NurbsCurve
+from ..algorithms.projection import distance_to_surface
+from ..errors import OpenCascadeError
+from .faces import TrimmedFace
+
+__all__ = [
+    "EDGE_SAMPLES",
+    "FaceEdge",
+    "count_free_edges",
+    "duplicate_faces",
+    "face_edges",
+    "four_sided_boundary",
+    "hole_loops",
+    "is_valid",
+    "max_edge_tolerance",
+    "pair_edges",
+    "sew",
+]
+
+#: samples per edge for the pairing test
+EDGE_SAMPLES = 17
+
+
+@dataclass(frozen=True, eq=False)
+class FaceEdge:
+    """One edge of one face: ``face`` index, position ``k`` in its outer loop,
+    the 3D curve and its samples ``(EDGE_SAMPLES, 3)``."""
+
+    face: int
+    k: int
+    curve: NurbsCurve
+    samples: NDArray
+
+    @property
+    def ends(self) -> NDArray:
+        return self.samples[[0, -1]]
+
+
+def four_sided_boundary(face: TrimmedFace) -> list[NurbsCurve] | None:
+    """The four 3D edge curves of a face bounded by one loop of four real edges, else None."""
+    if len(face.loops) != 1 or len(face.loops[0].edges) != 4:
+        return None
+    edges = face.loops[0].edges
+    if any(e.degenerated or e.curve3d is None or e.is_seam for e in edges):
+        return None
+    return [e.curve3d for e in edges]
+
+
+def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
+    """Every real edge of the faces' outer loops, sampled."""
+    out = []
+    for i, face in enumerate(faces):
+        if face is None or not face.loops:
+            continue
+        for k, e in enumerate(face.loops[face.outer_loop_index].edges):
+            if e.degenerated or e.curve3d is None or e.is_seam:
+                continue
+            t0, t1 = e.curve3d.domain
+            out.append(FaceEdge(i, k, e.curve3d, e.curve3d.evaluate(np.linspace(t0, t1,
+                                                                                EDGE_SAMPLES))))
+    return out
+
+
+def _polyline_distance(points: NDArray, line: NDArray) -> NDArray:
+    a, b = line[:-1], line[1:]
+    ab = b - a
+    denom = np.maximum(np.einsum("kc,kc->k", ab, ab), np.finfo(float).tiny)
+    t = np.clip(np.einsum("mkc,kc->mk", points[:, None] - a[None], ab) / denom, 0.0, 1.0)
+    return np.min(np.linalg.norm(points[:, None] - (a[None] + t[..., None] * ab[None]), axis=2),
+                  axis=1)
+
+
+def _dense(edge: FaceEdge, n: int = 129) -> NDArray:
+    t0, t1 = edge.curve.domain
+    return edge.curve.evaluate(np.linspace(t0, t1, n))
+
+
+def pair_edges(edges: list[FaceEdge], gap_tol: float) -> list[tuple[int, int]]:
+    """Index pairs of edges of different faces lying on each other within ``gap_tol``."""
+    if not edges:
+        return []
+    lo = np.array([e.samples.min(axis=0) for e in edges]) - gap_tol
+    hi = np.array([e.samples.max(axis=0) for e in edges]) + gap_tol
+    overlap = np.all((lo[:, None] <= hi[None]) & (lo[None] <= hi[:, None]), axis=2)
+    dense = {}
+    out = []
+    for i, j in zip(*np.nonzero(np.triu(overlap, 1))):
+        a, b = edges[i], edges[j]
+        if a.face == b.face:
+            continue
+        da = dense.setdefault(j, _dense(b))
+        if _polyline_distance(a.samples, da).max() > gap_tol:
+            continue
+        db = dense.setdefault(i, _dense(a))
+        if _polyline_distance(b.samples, db).max() <= gap_tol:
+            out.append((int(i), int(j)))
+    return out
+
+
+def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float
+               ) -> list[list[FaceEdge]]:
+    """Loops of four free edges from at least two faces, in loop order."""
+    if not free:
+        return []
+    ends = np.concatenate([edges[k].ends for k in free])          # (2 f, 3)
+    parent = np.arange(ends.shape[0])
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for x, y in cKDTree(ends).query_pairs(gap_tol):
+        parent[find(x)] = find(y)
+    vertex = np.array([find(x) for x in range(ends.shape[0])]).reshape(-1, 2)
+    incident: dict[int, list[int]] = {}
+    for n, (v0, v1) in enumerate(vertex):
+        incident.setdefault(int(v0), []).append(n)
+        incident.setdefault(int(v1), []).append(n)
+    loops, seen = [], set()
+    for start in range(len(free)):
+        if start in seen:
+            continue
+        loop = _walk(start, vertex, incident)
+        seen.update(loop or [start])
+        if loop and len(loop) == 4 and len({edges[free[n]].face for n in loop}) >= 2:
+            loops.append([edges[free[n]] for n in loop])
+    return loops
+
+
+def _walk(start: int, vertex: NDArray, incident: dict[int, list[int]]) -> list[int] | None:
+    """The cycle through edge ``start`` when every vertex on it has two free edges."""
+    loop, current, at = [start], start, int(vertex[start, 1])
+    while True:
+        nxt = [n for n in incident[at] if n != current]
+        if len(incident[at]) != 2 or not nxt:
+            return None
+        current = nxt[0]
+        if current == start:
+            return loop
+        if current in loop or len(loop) > 64:
+            return None
+        loop.append(current)
+        v0, v1 = int(vertex[current, 0]), int(vertex[current, 1])
+        at = v1 if v0 == at else v0
+
+
+def duplicate_faces(faces: list[TrimmedFace | None], edges: list[FaceEdge],
+                    pairs: list[tuple[int, int]], gap_tol: float) -> list[tuple[int, int]]:
+    """``(kept, dropped)`` face pairs where one face lies on the other within ``gap_tol``:
+    every edge of the dropped face pairs with an edge of the kept one and
+    points spread over the dropped face's surface lie on the kept surface."""
+    by_face: dict[int, list[int]] = {}
+    for n, e in enumerate(edges):
+        by_face.setdefault(e.face, []).append(n)
+    partners: dict[tuple[int, int], set[int]] = {}
+    for i, j in pairs:
+        a, b = edges[i].face, edges[j].face
+        partners.setdefault((a, b), set()).add(i)
+        partners.setdefault((b, a), set()).add(j)
+    out, dropped = [], set()
+    for (a, b), covered in sorted(partners.items()):
+        if a >= b or a in dropped or b in dropped:
+            continue
+        if len(covered) < len(by_face[a]) or len(partners.get((b, a), ())) < len(by_face[b]):
+            continue
+        if _lies_on(faces[b], faces[a], gap_tol):
+            out.append((a, b))
+            dropped.add(b)
+    return out
+
+
+def _lies_on(face: TrimmedFace, other: TrimmedFace, gap_tol: float) -> bool:
+    u0, u1, v0, v1 = face.surface.domain
+    t = np.linspace(0.2, 0.8, 4)
+    pts = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0)).reshape(-1, 3)
+    return bool(distance_to_surface(other.surface, pts).max() <= gap_tol)
+
+
+# ------------------------------------------------------------ OpenCascade side
+def sew(faces: list[TopoDS_Shape], tol: float) -> tuple[TopoDS_Shape, BRepBuilderAPI_Sewing]:
+    """Faces sewn at ``tol`` into a shell (a solid when closed), orientations fixed."""
+    sewing = BRepBuilderAPI_Sewing(tol)
+    for f in faces:
+        sewing.Add(f)
+    try:
+        sewing.Perform()
+    except Standard_Failure as exc:
+        raise OpenCascadeError(f"BRepBuilderAPI_Sewing failed: {exc}") from exc
+    shape = sewing.SewedShape()
+    if shape.IsNull():
+        raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")
+    return _shell_or_solid(shape), sewing
+
+
+def _shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
+    if shape.ShapeType() != TopAbs_SHELL:
+        return shape
+    fixer = ShapeFix_Shell(TopoDS.Shell_s(shape))
+    fixer.Perform()
+    shell = fixer.Shell()
+    if not BRep_Tool.IsClosed_s(shell):
+        return shell
+    maker = BRepBuilderAPI_MakeSolid(shell)
+    if not maker.IsDone():
+        return shell
+    fix = ShapeFix_Solid(maker.Solid())
+    fix.Perform()
+    return fix.Solid()
+
+
+def count_free_edges(shape: TopoDS_Shape) -> int:
+    """Edges used by exactly one face (degenerated edges not counted)."""
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    count = 0
+    for k in range(1, edge_faces.Extent() + 1):
+        edge = TopoDS.Edge_s(edge_faces.FindKey(k))
+        if BRep_Tool.Degenerated_s(edge):
+            continue
+        if edge_faces.FindFromIndex(k).Size() == 1:
+            count += 1
+    return count
+
+
+def is_valid(shape: TopoDS_Shape) -> bool:
+    return bool(BRepCheck_Analyzer(shape).IsValid())
+
+
+def max_edge_tolerance(shape: TopoDS_Shape) -> float:
+    out = 0.0
+    explorer = TopExp_Explorer(shape, TopAbs_EDGE)
+    while explorer.More():
+        out = max(out, BRep_Tool.Tolerance_s(TopoDS.Edge_s(explorer.Current())))
+        explorer.Next()
+    return out
