@@ -1,0 +1,64 @@
+"""``surfprep heal``: a STEP file with a 1e-3 gap in, a sewn shell out, report and plot."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.plugin import cli
+from surfprep.plugin.faces import make_face
+
+import surfprep
+
+
+def run(capsys, *argv) -> tuple[int, str, str]:
+    code = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def graph_patch(x0, x1, nu, dz):
+    x, y = np.linspace(x0, x1, nu), np.linspace(0, 1, 6)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    z = 0.3 * np.sin(1.3 * gx) * np.cos(0.9 * gy) + dz
+    return interpolate_surface(np.stack([gx, gy, z], axis=-1))
+
+
+@pytest.fixture(scope="module")
+def gap_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cli_heal") / "gap.step"
+    surfprep.write([make_face(graph_patch(0, 1, 6, 0.0)), make_face(graph_patch(1, 2, 8, 1e-3))],
+                   path)
+    return path
+
+
+def test_heal_gap_file(gap_file, tmp_path, capsys):
+    out, report, plot = tmp_path / "healed.step", tmp_path / "r.json", tmp_path / "d.png"
+    code, stdout, err = run(capsys, "heal", gap_file, "-o", out, "--continuity", "G1",
+                            "--json", report, "--plot", plot)
+    assert code == 0, err
+    assert "2 approximant(s)" in stdout and "valid True -> True" in stdout
+    rep = json.loads(report.read_text())
+    assert rep["continuity"] == "G1" and len(rep["shared_edges"]) == 1
+    edge = rep["shared_edges"][0]
+    assert edge["max_gap"] < 1e-12 and edge["max_angle_deg"] < 1e-2
+    assert rep["shared_edges_before"][0]["max_gap"] > 9e-4
+    assert rep["free_edges"]["tight_before"] == 8 and rep["free_edges"]["tight_after"] == 6
+    for p in rep["patches"]:
+        assert set(p) >= {"resolution", "max_error", "rms_error", "artificial_share"}
+    assert plot.stat().st_size > 10_000
+    healed = surfprep.read(out)
+    assert healed.n_faces == 2
+
+
+def test_heal_errors_are_one_line(gap_file, tmp_path, capsys):
+    code, _, err = run(capsys, "heal", gap_file, "-o", gap_file)
+    assert code != 0 and "overwrite" in err and len(err.strip().splitlines()) == 1
+    bad = tmp_path / "spec.json"
+    bad.write_text("{not json")
+    code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "x.step", "--patches", bad)
+    assert code != 0 and "JSON" in err
+    code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "y.step", "--gap-tol", "-1")
+    assert code != 0 and "gap_tol" in err
