@@ -29,7 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import (
+    DegenerateGeometryError,
+    InvalidGeometryError,
+    InvalidToleranceError,
+)
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .boundary import Boundary, BoundaryCurve, as_boundary
@@ -77,7 +81,8 @@ class LocalApproximant:
         Error of §7 at the points of eq. (19) not over holes (model units;
         NaN when nothing could be measured).
     artificial_share : float
-        Fraction of the grid points from Hardy's method (over holes or gaps).
+        Fraction of the grid points from Hardy's method (over holes or gaps;
+        boundary samples kept by ``keep_boundary`` are not artificial).
     converged : bool
         ``max_error <= tol``.
     tol : float
@@ -89,7 +94,8 @@ class LocalApproximant:
     artificial : (M + 1, N + 1) bool
         True at the artificial projections ``z``.
     source : (M + 1, N + 1) int
-        Index of the source each projection lies on, -1 at artificial points.
+        Index of the source each segment hit (the projection lies on it, or,
+        on kept boundary sides, the curve's point is over it), -1 where none.
     error : ErrorSample
         The measured points and their distances (a deviation map).
     history : tuple of ResolutionStep
@@ -135,6 +141,7 @@ class _Pass:
     surface: NurbsSurface
     grid: NDArray
     found: NDArray
+    artificial: NDArray
     source: NDArray
     error: ErrorSample
     offset: float
@@ -142,7 +149,7 @@ class _Pass:
 
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
-              mesh_tol: float | None, size: float) -> _Pass:
+              mesh_tol: float | None, keep_boundary: bool, tol: float, size: float) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
     clipped = clip_sources(sources, off.box,
@@ -151,13 +158,26 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
     y, t, found, src = project_grid(a, b, clipped, tol=_NEWTON_FRACTION * size)
     shape = (m + 1, n + 1)
     found, t = found.reshape(shape), t.reshape(shape)
-    t_all = fill_positions(coons.u, coons.v, t, found, mode=hardy, neighbours=neighbours)
+    if not np.any(found):
+        raise DegenerateGeometryError(
+            "no segment of the Coons patch meets the original surfaces: the boundary does not "
+            f"lie over them (or the offset distance {off.distance:.3g} is too small)")
+    rim = np.zeros(shape, bool)
+    y = y.reshape(shape + (3,))
+    if keep_boundary:           # the sides are the boundary curves: x itself, t = 1/2
+        rim[[0, -1], :] = rim[:, [0, -1]] = True
+        t = np.where(rim, 0.5, t)
+        # a side point is on the originals only where its curve is (not above or below)
+        off_surface = rim & found & (np.linalg.norm(y - coons.points, axis=-1) > tol)
+        found = found & ~off_surface
+    t_all = fill_positions(coons.u, coons.v, t, found | rim, mode=hardy, neighbours=neighbours)
     z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
-    grid = np.where(found[..., None], y.reshape(shape + (3,)), z)
+    grid = np.where(found[..., None], y, z)
+    grid[rim] = coons.points[rim]
     surface = interpolate_grid(grid, interpolant)
     near = tuple(s for s, k in zip(sources, clipped.kept, strict=True) if k)
     error = measure_error(surface, found, near, tol=_INVERSION_FRACTION * size)
-    return _Pass(surface, grid, found, src.reshape(shape), error, off.distance)
+    return _Pass(surface, grid, found, ~(found | rim), src.reshape(shape), error, off.distance)
 
 
 def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
@@ -168,7 +188,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       offset: float | None = None, neighbours: int = 8,
                       hardy: HardyMode = HardyMode.LOCAL, growth: float = 1.5,
                       gap_tol: float | None = None, mesh_tol: float | None = None,
-                      strict: bool = False) -> LocalApproximant:
+                      keep_boundary: bool = True, strict: bool = False) -> LocalApproximant:
     """A bicubic B-spline surface over four boundary curves that follows the sources.
 
     Parameters
@@ -200,6 +220,15 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         Largest gap between consecutive boundary curves (:func:`.as_boundary`).
     mesh_tol : float, optional
         Chord tolerance of the triangulation of the surfaces; default ``d / 50``.
+    keep_boundary : bool
+        The approximant's sides are the boundary curves (their arc-length
+        samples are interpolated, not projected), so approximants sharing a
+        curve meet; the samples also enter Hardy's interpolation (at ``t = 1/2``),
+        so a hole bounded by the curves is filled from its rim; side points
+        farther than ``tol`` from their projection (curves above or below the
+        originals) do not count as on the originals in the error of §7.
+        False: the boundary samples are projected like the interior (001 as
+        written; 003's four picked points on the originals).
     strict : bool
         Raise :class:`InvalidToleranceError` instead of returning an
         unconverged approximant.
@@ -237,8 +266,9 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     history, passes = [], []
     while True:
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
-                      hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol, size=size)
-        share = float(1.0 - p.found.mean())
+                      hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
+                      keep_boundary=keep_boundary, tol=tol, size=size)
+        share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)
         if p.error.max_error <= tol or current == limit:
@@ -257,5 +287,5 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         surface=p.surface, resolution=step.resolution, max_error=step.max_error,
         rms_error=step.rms_error, artificial_share=step.artificial_share, converged=converged,
         tol=float(tol), interpolant=interpolant, offset=p.offset, grid=p.grid,
-        artificial=~p.found, source=p.source, error=p.error, history=tuple(history),
+        artificial=p.artificial, source=p.source, error=p.error, history=tuple(history),
         boundary=bnd)

@@ -35,6 +35,7 @@ SIDE_NAMES = ("bottom", "right", "top", "left")
 #: default gap_tol: this fraction of the boundary's bounding-box diagonal
 DEFAULT_RELATIVE_GAP = 1e-4
 _ARC_SAMPLES = 64            # parameter samples per knot span for the arc-length table
+_ARC_NEWTON = 3              # Newton steps polishing the table's inverse
 
 BoundaryCurve = NurbsCurve | NDArray
 
@@ -223,7 +224,13 @@ def _uniform_points(c: BoundaryCurve, m: int, start: NDArray, end: NDArray) -> N
         length = cumulative_arc_length(c, t)
         if not length[-1] > 0:
             raise DegenerateGeometryError("a boundary curve has zero length")
-        pts = c.evaluate(np.interp(s * length[-1], length, t))
+        target = s * length[-1]
+        u = np.interp(target, length, t)
+        for _ in range(_ARC_NEWTON):              # arc length(u) = target, speed |C'|
+            speed = np.linalg.norm(c.derivatives(u, 1)[:, 1], axis=1)
+            step = (cumulative_arc_length(c, u) - target) / np.maximum(speed, 1e-300)
+            u = np.clip(u - step, t[0], t[-1])
+        pts = c.evaluate(u)
     else:
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
         target = s * chord[-1]

@@ -56,6 +56,34 @@ class SegmentHits:
     barycentric: NDArray
 
 
+def _all_hits(a: NDArray, b: NDArray, triangles: NDArray
+              ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Every segment-triangle hit: segment, triangle, ``t`` and barycentric weights."""
+    empty = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3)))
+    if triangles.shape[0] == 0 or a.shape[0] == 0:
+        return empty
+    seg_boxes = np.stack([np.minimum(a, b), np.maximum(a, b)], axis=1)
+    tri_boxes = np.stack([triangles.min(axis=1), triangles.max(axis=1)], axis=1)
+    scale = float(np.ptp(tri_boxes.reshape(-1, 3), axis=0).max())
+    pairs = candidate_pairs(seg_boxes, tri_boxes, pad=1e-12 * scale)
+    if pairs.shape[0] == 0:
+        return empty
+    s, k = pairs[:, 0], pairs[:, 1]
+    t, w1, w2, ok = _moller_trumbore(a[s], b[s] - a[s], triangles[k])
+    w1, w2 = np.clip(w1[ok], 0, 1), np.clip(w2[ok], 0, 1)
+    total = np.maximum(1.0, w1 + w2)
+    w1, w2 = w1 / total, w2 / total
+    return s[ok], k[ok], t[ok], np.stack([1 - w1 - w2, w1, w2], axis=1)
+
+
+def _nearest_midpoint(groups: NDArray, t: NDArray) -> NDArray:
+    """Index of the entry with ``t`` nearest 1/2 in every group (groups ascending)."""
+    order = np.lexsort((np.abs(t - 0.5), groups))
+    if order.size == 0:
+        return order
+    return order[np.r_[True, groups[order][1:] != groups[order][:-1]]]
+
+
 def intersect_segments(a: NDArray, b: NDArray, triangles: NDArray) -> SegmentHits:
     """Hits of segments ``a b`` with triangles, the one closest to the midpoint kept.
 
@@ -72,26 +100,10 @@ def intersect_segments(a: NDArray, b: NDArray, triangles: NDArray) -> SegmentHit
     out_t = np.full(n, np.nan)
     out_tri = np.full(n, -1, np.int64)
     out_bary = np.full((n, 3), np.nan)
-    if triangles.shape[0] == 0 or n == 0:
-        return SegmentHits(np.zeros(n, bool), out_t, out_tri, out_bary)
-    seg_boxes = np.stack([np.minimum(a, b), np.maximum(a, b)], axis=1)
-    tri_boxes = np.stack([triangles.min(axis=1), triangles.max(axis=1)], axis=1)
-    scale = float(np.ptp(tri_boxes.reshape(-1, 3), axis=0).max())
-    pairs = candidate_pairs(seg_boxes, tri_boxes, pad=1e-12 * scale)
-    if pairs.shape[0] == 0:
-        return SegmentHits(np.zeros(n, bool), out_t, out_tri, out_bary)
-    s, k = pairs[:, 0], pairs[:, 1]
-    t, w1, w2, ok = _moller_trumbore(a[s], b[s] - a[s], triangles[k])
-    s, k, t, w1, w2 = s[ok], k[ok], t[ok], w1[ok], w2[ok]
-    order = np.lexsort((np.abs(t - 0.5), s))           # per segment, nearest to x first
-    first = order[np.r_[True, s[order][1:] != s[order][:-1]]] if order.size else order
+    s, k, t, bary = _all_hits(a, b, triangles)
+    first = _nearest_midpoint(s, t)
     seg = s[first]
-    out_t[seg] = t[first]
-    out_tri[seg] = k[first]
-    w1, w2 = np.clip(w1[first], 0, 1), np.clip(w2[first], 0, 1)
-    total = np.maximum(1.0, w1 + w2)
-    w1, w2 = w1 / total, w2 / total
-    out_bary[seg] = np.stack([1 - w1 - w2, w1, w2], axis=1)
+    out_t[seg], out_tri[seg], out_bary[seg] = t[first], k[first], bary[first]
     return SegmentHits(out_tri >= 0, out_t, out_tri, out_bary)
 
 
@@ -163,6 +175,10 @@ def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: floa
                  ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Projections ``y`` of the grid onto the sources (eqs. 9-11 and the Newton polish).
 
+    The hit nearest the midpoint is chosen after the polish, among the nearest
+    hit on each source, so that where two sources cross the choice is made on
+    the exact surfaces, not on their triangulations.
+
     Parameters
     ----------
     a, b : (P, 3) float
@@ -181,27 +197,28 @@ def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: floa
     source : (P,) int
         Index of the source hit, -1 where nothing was hit.
     """
-    hits = intersect_segments(a, b, clipped.points)
-    found = hits.found
-    points = np.full(a.shape, np.nan)
-    t = hits.t.copy()
-    source = np.full(a.shape[0], -1, np.int64)
-    idx = np.flatnonzero(found)
-    tri = hits.triangle[idx]
-    bary = hits.barycentric[idx]
-    points[idx] = np.einsum("pk,pkc->pc", bary, clipped.points[tri])
-    source[idx] = clipped.source[tri]
+    n = a.shape[0]
+    seg, tri, t, bary = _all_hits(a, b, clipped.points)
+    src = clipped.source[tri]
+    keep = _nearest_midpoint(seg * len(clipped.sources) + src, t)   # best hit per source
+    seg, tri, t, bary, src = seg[keep], tri[keep], t[keep], bary[keep], src[keep]
+    points = np.einsum("pk,pkc->pc", bary, clipped.points[tri])
     uv = np.einsum("pk,pkc->pc", bary, clipped.uv[tri])
-    for k in np.unique(source[idx]):
+    for k in np.unique(src):
         surface = clipped.sources[k].surface
-        sel = (source[idx] == k) & np.all(np.isfinite(uv), axis=1)
-        if surface is None or not np.any(sel):
+        sel = np.flatnonzero((src == k) & np.all(np.isfinite(uv), axis=1))
+        if surface is None or sel.size == 0:
             continue
-        rows = idx[sel]
-        mapped_uv = uv[sel]
-        direction = b[rows] - a[rows]
-        new_uv, new_t, ok = pierce_surface(surface, a[rows], direction, mapped_uv, t[rows], tol)
-        final_uv = np.where(ok[:, None], new_uv, mapped_uv)
-        points[rows] = surface.evaluate(final_uv[:, 0], final_uv[:, 1])
-        t[rows] = np.where(ok, new_t, t[rows])
-    return points, t, found, source
+        rows = seg[sel]
+        new_uv, new_t, ok = pierce_surface(surface, a[rows], b[rows] - a[rows], uv[sel],
+                                           t[sel], tol)
+        final_uv = np.where(ok[:, None], new_uv, uv[sel])
+        points[sel] = surface.evaluate(final_uv[:, 0], final_uv[:, 1])
+        t[sel] = np.where(ok, new_t, t[sel])
+    best = _nearest_midpoint(seg, t)
+    out_points = np.full(a.shape, np.nan)
+    out_t = np.full(n, np.nan)
+    out_src = np.full(n, -1, np.int64)
+    rows = seg[best]
+    out_points[rows], out_t[rows], out_src[rows] = points[best], t[best], src[best]
+    return out_points, out_t, out_src >= 0, out_src

@@ -1,0 +1,223 @@
+"""One local approximant end to end (001 §§3-7, Figs. 5-8 kinds; 003 four points).
+
+Every deviation is checked densely: a grid of points on the approximant is projected
+onto the exact original surfaces (Newton point inversion), never only at the
+interpolated points."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from approx_cases import (
+    crossing_surfaces,
+    envelope_boundary,
+    holed_mesh,
+    iso_boundary,
+    oscillating_surface,
+    smooth_surface,
+    surrounding_patches,
+    upper_envelope,
+)
+from surfprep.algorithms.healing import (
+    HardyMode,
+    Interpolant,
+    SurfaceSource,
+    corners_boundary,
+    local_approximant,
+)
+from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
+
+from surfprep.errors import (
+    DegenerateGeometryError,
+    InvalidGeometryError,
+    InvalidToleranceError,
+)
+
+HOLE = (0.4, 0.6, 0.4, 0.6)          # in the smooth surface's parameters
+PATCH = (0.2, 0.8, 0.2, 0.8)         # the approximant's boundary, around the hole
+
+
+def _dense(result, n=61):
+    s = np.linspace(0.0, 1.0, n)
+    return s, result.surface.evaluate_grid(s, s)
+
+
+def _fixed(boundary, sources, res, **kw):
+    return local_approximant(boundary, sources, resolution=(res, res),
+                             max_resolution=(res, res), **kw)
+
+
+@pytest.fixture(scope="module")
+def smooth():
+    return smooth_surface()
+
+
+def test_part_of_a_single_patch(smooth):
+    r = local_approximant(iso_boundary(smooth, *PATCH), [smooth], tol=1e-4)
+    assert r.converged and r.max_error <= 1e-4
+    assert r.artificial_share == 0.0 and np.all(r.source == 0)
+    _, pts = _dense(r)
+    dense = distance_to_surface(smooth, pts.reshape(-1, 3))
+    assert dense.max() < 1.5e-4                       # the e/f/g estimate is close to the truth
+    assert dense.max() < 1.5 * r.max_error
+    assert r.rms_error <= r.max_error
+    # the grid points are on the surface, and the approximant's sides on the boundary curves
+    assert distance_to_surface(smooth, r.grid.reshape(-1, 3)).max() < 1e-9
+    s = np.linspace(0, 1, 41)
+    curves = iso_boundary(smooth, *PATCH)
+    sides = [r.surface.evaluate(s, 0.0), r.surface.evaluate(1.0, s),
+             r.surface.evaluate(s, 1.0), r.surface.evaluate(0.0, s)]
+    for side, curve in zip(sides, curves, strict=True):
+        assert distance_to_curve(curve, side).max() < r.tol
+
+
+def test_error_decreases_with_resolution(smooth):
+    errors = [_fixed(iso_boundary(smooth, *PATCH), [smooth], m).max_error for m in (4, 8, 16)]
+    assert errors[0] > 3 * errors[1] > 9 * errors[2]          # ~ h^2 at least
+
+
+def test_hole_between_four_patches(smooth):
+    sources = surrounding_patches(smooth, HOLE)
+    r = _fixed(iso_boundary(smooth, *PATCH), sources, 12)
+    assert r.artificial_share > 0.03
+    # the artificial points are exactly the grid points over the hole
+    xy = r.grid[..., :2]
+    inside = ((xy[..., 0] > HOLE[0] + 1e-6) & (xy[..., 0] < HOLE[1] - 1e-6)
+              & (xy[..., 1] > HOLE[2] + 1e-6) & (xy[..., 1] < HOLE[3] - 1e-6))
+    np.testing.assert_array_equal(r.artificial, inside)
+    assert r.max_error < 1e-4                          # measured away from the hole
+    # dense check away from the hole (cells with a found corner only)
+    _s, pts = _dense(r)
+    near_sources = np.min([distance_to_surface(p, pts.reshape(-1, 3)) for p in sources], axis=0)
+    around = ~np.asarray([(HOLE[0] - .05 < x < HOLE[1] + .05) and (HOLE[2] - .05 < y < HOLE[3] + .05)
+                          for x, y in pts.reshape(-1, 3)[:, :2]])
+    assert near_sources[around].max() < 2 * r.max_error
+    # over the hole the Hardy fill follows the surface that was cut away
+    assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 2e-3
+
+
+@pytest.mark.parametrize("with_surface", [False, True])
+def test_hole_in_a_triangle_mesh(smooth, with_surface):
+    mesh = holed_mesh(smooth, HOLE)
+    source = SurfaceSource(smooth, mesh) if with_surface else mesh
+    r = _fixed(iso_boundary(smooth, *PATCH), [source], 8)
+    assert r.artificial_share > 0.05
+    assert np.all(r.source[~r.artificial] == 0)
+    assert r.max_error < 2e-4
+    _, pts = _dense(r)
+    assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 2e-3
+
+
+def test_global_and_local_hardy_agree_roughly(smooth):
+    b, src = iso_boundary(smooth, *PATCH), surrounding_patches(smooth, HOLE)
+    local = _fixed(b, src, 10)
+    glob = _fixed(b, src, 10, hardy=HardyMode.GLOBAL)
+    np.testing.assert_array_equal(local.artificial, glob.artificial)
+    np.testing.assert_array_equal(local.grid[~local.artificial], glob.grid[~glob.artificial])
+    assert np.abs(local.grid - glob.grid).max() < 5e-3
+
+
+def test_patch_across_two_intersecting_surfaces():
+    surfaces = crossing_surfaces()
+    errors = []
+    for m in (4, 8, 16):
+        r = _fixed(envelope_boundary(0.2, 0.8, 0.2, 0.8), surfaces, m)
+        # every grid point lies on the upper envelope (the hit nearest the Coons patch)
+        # (inside exactly; the sides are samples of the polylines on it)
+        g = r.grid[1:-1, 1:-1].reshape(-1, 3)
+        np.testing.assert_allclose(g[:, 2], upper_envelope(g[:, 0], g[:, 1]), atol=1e-12)
+        g = r.grid.reshape(-1, 3)
+        np.testing.assert_allclose(g[:, 2], upper_envelope(g[:, 0], g[:, 1]), atol=1e-5)
+        assert set(np.unique(r.source)) == {0, 1}
+        errors.append(r.max_error)
+        _, pts = _dense(r)
+        dense = np.min([distance_to_surface(s, pts.reshape(-1, 3)) for s in surfaces], axis=0)
+        assert dense.max() < 2 * r.max_error
+    assert errors[0] > errors[1] > errors[2]           # the crease is rounded less and less
+    assert r.artificial_share == 0.0
+
+
+def test_four_picked_points_straight_boundary():
+    # 003: four points on the originals, straight lines between them (here across the
+    # crease, so the lines float above it); the block's points are all projected
+    surfaces = crossing_surfaces()
+    corners = [np.array([x, y, upper_envelope(x, y)]) for x, y in
+               ((0.2, 0.2), (0.8, 0.2), (0.8, 0.8), (0.2, 0.8))]
+    r = _fixed(corners_boundary(*corners), surfaces, 8, keep_boundary=False)
+    np.testing.assert_allclose(r.surface.evaluate([0, 1, 1, 0], [0, 0, 1, 1]), corners,
+                               atol=1e-9)
+    g = r.grid.reshape(-1, 3)
+    np.testing.assert_allclose(g[:, 2], upper_envelope(g[:, 0], g[:, 1]), atol=1e-12)
+    assert r.artificial_share == 0.0 and r.max_error < 0.01
+    _, pts = _dense(r)
+    dense = np.min([distance_to_surface(s, pts.reshape(-1, 3)) for s in surfaces], axis=0)
+    assert dense.max() < 2 * r.max_error
+    # kept straight sides: they float above the crease, so the error of §7 leaves out
+    # the cells along them, and the sides are the lines
+    kept = _fixed(corners_boundary(*corners), surfaces, 8)
+    side = kept.surface.evaluate(np.linspace(0, 1, 21), 0.0)
+    line = corners[0] + np.linspace(0, 1, 21)[:, None] * (corners[1] - corners[0])
+    np.testing.assert_allclose(side, line, atol=1e-12)
+    assert kept.max_error < 0.02 and kept.error.n_points < r.error.n_points
+
+
+def test_oscillating_surface_needs_more_resolution():
+    wavy = oscillating_surface()
+    boundary = iso_boundary(wavy, 0.1, 0.9, 0.1, 0.9)
+    coarse = _fixed(boundary, [wavy], 8, tol=1e-3)
+    assert not coarse.converged and coarse.max_error > 1e-3
+    with pytest.raises(InvalidToleranceError, match="not reached"):
+        _fixed(boundary, [wavy], 8, tol=1e-3, strict=True)
+    r = local_approximant(boundary, [wavy], tol=1e-3)
+    assert r.converged and r.resolution[0] > 8
+    assert next(h.resolution for h in r.history) == (8, 8)
+    assert r.history[-1].max_error <= 1e-3 < r.history[0].max_error
+    _, pts = _dense(r, 91)
+    assert distance_to_surface(wavy, pts.reshape(-1, 3)).max() < 1.5e-3
+
+
+def test_c2_interpolant_option(smooth):
+    r = _fixed(iso_boundary(smooth, *PATCH), [smooth], 8, interpolant=Interpolant.C2_BICUBIC)
+    assert r.surface.n_control == (9, 9) and r.interpolant is Interpolant.C2_BICUBIC
+    _, pts = _dense(r)
+    dense = distance_to_surface(smooth, pts.reshape(-1, 3))
+    assert dense.max() < 1e-4 and dense.max() < 1.5 * r.max_error
+
+
+def test_given_offset_and_unreachable_sources(smooth):
+    b = iso_boundary(smooth, *PATCH)
+    r = _fixed(b, [smooth], 6, offset=0.05)
+    assert r.offset == 0.05
+    far = smooth.control_points + np.array([0.0, 0.0, 5.0])
+    from surfprep.algorithms.surface import NurbsSurface
+    moved = NurbsSurface(far, smooth.knots_u, smooth.knots_v, 3, 3)
+    with pytest.raises(DegenerateGeometryError, match="no segment"):
+        _fixed(b, [moved], 6)
+
+
+@pytest.mark.parametrize("kwargs, error, match", [
+    ({"tol": 1e-20}, InvalidToleranceError, "double precision"),
+    ({"tol": 1e3}, InvalidToleranceError, "absurdly large"),
+    ({"tol": float("nan")}, InvalidToleranceError, "finite"),
+    ({"tol": -1.0}, InvalidToleranceError, "finite"),
+    ({"resolution": (1, 8)}, InvalidGeometryError, ">= 2"),
+    ({"resolution": (16, 16)}, InvalidGeometryError, "at least resolution"),
+    ({"offset": 0.0}, InvalidToleranceError, "offset"),
+])
+def test_bad_arguments(smooth, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        local_approximant(iso_boundary(smooth, *PATCH), [smooth],
+                          max_resolution=kwargs.pop("max_resolution", (12, 12)), **kwargs)
+
+
+def test_bad_boundary_and_sources(smooth):
+    b = iso_boundary(smooth, *PATCH)
+    with pytest.raises(InvalidGeometryError, match="no original surfaces"):
+        local_approximant(b, [])
+    with pytest.raises(InvalidGeometryError, match="source 0 must be"):
+        local_approximant(b, [np.zeros((3, 3))])
+    shifted = [b[0], b[1], b[2].evaluate(np.linspace(*b[2].domain, 9)) + [0, 0, 0.01], b[3]]
+    with pytest.raises(InvalidGeometryError, match=r"do not meet end to end.*0\.01"):
+        local_approximant(shifted, [smooth])
+    with pytest.raises(InvalidGeometryError, match="NaN"):
+        local_approximant([np.full((3, 3), np.nan)] + list(b[1:]), [smooth])

@@ -1,0 +1,74 @@
+"""Projection of the Coons grid onto the originals (001 §4, eqs. 9-11) and the error
+points of §7 (eq. 19): segment hits, exact piercing, closest points on triangles, hole rule."""
+
+from __future__ import annotations
+
+import numpy as np
+from approx_cases import smooth_surface
+from surfprep.algorithms.healing.error import closest_on_triangles, error_parameters
+from surfprep.algorithms.healing.segments import intersect_segments, pierce_surface
+
+RNG = np.random.default_rng(11)
+
+
+def test_segment_hits_keep_the_hit_nearest_the_midpoint():
+    low = np.array([[[-1, -1, 0.1], [2, -1, 0.1], [0, 2, 0.1]]], float)    # z = 0.1
+    high = np.array([[[-1, -1, 0.7], [2, -1, 0.7], [0, 2, 0.7]]], float)   # z = 0.7
+    tri = np.concatenate([low, high])
+    a = np.array([[0.2, 0.2, 1.0], [0.2, 0.2, 1.0], [5.0, 5.0, 1.0]])
+    b = np.array([[0.2, 0.2, 0.0], [0.2, 0.2, 0.5], [5.0, 5.0, 0.0]])
+    hits = intersect_segments(a, b, tri)
+    np.testing.assert_array_equal(hits.found, [True, True, False])
+    # first segment: z = 0.7 at t = 0.3 beats z = 0.1 at t = 0.9; second: only z = 0.7
+    np.testing.assert_array_equal(hits.triangle[:2], [1, 1])
+    np.testing.assert_allclose(hits.t[:2], [0.3, 0.6])
+    p = np.einsum("pk,pkc->pc", hits.barycentric[:2], tri[hits.triangle[:2]])
+    np.testing.assert_allclose(p, a[:2] + hits.t[:2, None] * (b[:2] - a[:2]), atol=1e-15)
+
+
+def test_hits_on_a_shared_edge_are_not_lost():
+    tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0], [0, 1, 0]]], float)
+    s = np.linspace(0.01, 0.99, 99)
+    a = np.stack([s, 1 - s, np.ones_like(s)], axis=1)          # all on the diagonal edge
+    hits = intersect_segments(a, a - [0, 0, 2], tri)
+    assert hits.found.all()
+
+
+def test_piercing_lands_on_the_exact_surface_and_the_segment():
+    s = smooth_surface()
+    uv_true = RNG.uniform(0.1, 0.9, (200, 2))
+    p = s.evaluate(uv_true[:, 0], uv_true[:, 1])
+    direction = RNG.normal(size=(200, 3)) * 0.05 + [0, 0, -1]
+    origin = p - 0.4 * direction
+    uv, t, ok = pierce_surface(s, origin, direction, uv_true + RNG.normal(size=(200, 2)) * 0.02,
+                               np.full(200, 0.3), 1e-12)
+    assert ok.all()
+    q = s.evaluate(uv[:, 0], uv[:, 1])
+    np.testing.assert_allclose(q, origin + t[:, None] * direction, atol=1e-12)
+    np.testing.assert_allclose(q, p, atol=1e-9)
+
+
+def test_closest_points_on_triangles_against_brute_force():
+    tri = RNG.normal(size=(300, 3, 3))
+    pts = RNG.normal(size=(300, 3)) * 2
+    foot, bary = closest_on_triangles(pts, tri)
+    assert np.all(bary >= -1e-12) and np.allclose(bary.sum(axis=1), 1)
+    w = RNG.dirichlet(np.ones(3), size=4000)                   # dense samples of each triangle
+    dense = np.einsum("sk,tkc->tsc", w, tri)
+    brute = np.linalg.norm(dense - pts[:, None], axis=2).min(axis=1)
+    got = np.linalg.norm(foot - pts, axis=1)
+    assert np.all(got <= brute + 1e-12)
+    assert np.all(brute - got < 0.05 * (1 + brute))
+
+
+def test_error_points_skip_cells_over_holes():
+    found = np.ones((5, 4), bool)
+    uv = error_parameters(found)
+    assert uv.shape == (4 * 4 + 5 * 3 + 4 * 3, 2)            # e, f, g of eq. (19)
+    found[2, 1] = False
+    uv = error_parameters(found)
+    # e: 2 edges along u touch (2, 1); f: 2 edges along v; g: 4 cells
+    assert uv.shape[0] == 4 * 4 + 5 * 3 + 4 * 3 - 2 - 2 - 4
+    hole = np.array([2 / 4, 1 / 3])
+    near = np.abs(uv - hole) < np.array([1 / 4, 1 / 3]) - 1e-12
+    assert not np.any(near.all(axis=1))
