@@ -10,12 +10,17 @@
      overlap boxes closer than ``4 mesh_tol`` are joined (004 §5);
      then chains are **cut where their (u, v) jumps across a seam** of a closed
      surface (see below);
-5-6. :func:`.result.intersection_curves`: auxiliary-plane refinement (eqs.
-     29.18-29.26) to ``tol``, chord-midpoint insertion, redundant points dropped,
-     interpolants checked between the samples; then every end the topology
-     found on a domain side is solved again on that side (Newton with the side
-     parameter held), because the anchored refinement lets it slide inward by
-     up to about ``mesh_tol`` (:func:`_close_boundary_gaps`).
+5.   :func:`.result.refine_chains`: every traced sample refined onto both
+     surfaces by the auxiliary-plane method (eqs. 29.18-29.26) to ``tol / 16``;
+     then every end the topology found on a domain side is solved again on
+     that side (Newton with the side parameter held), because the anchored
+     refinement lets it slide inward by up to about ``mesh_tol``
+     (:func:`_close_boundary_gaps`);
+6.   :func:`.result.sampled_curves`: only the samples the C2 cubic
+     interpolants need (:mod:`.sampling`: curvature-spaced subset, then
+     midpoints checked on both exact surfaces and inserted where a span
+     fails), so the sample count grows as ``L kappa^(3/4) / tol^(1/4)``, not as
+     ``L / sqrt(tol)`` for straight chords.
 
 Seams. A closed surface converted to a B-spline (a sphere, a cylinder, a
 torus) has two parameter lines that are one curve in space. The soup's ends on
@@ -44,12 +49,27 @@ from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .mesh import TriangleMesh
-from .result import IntersectionCurve, intersection_curves
+from .refine import RefinedCurve
+from .result import (
+    IntersectionCurve,
+    intersection_curves,
+    refine_chains,
+    sampled_curves,
+)
 from .segments import mesh_segments
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
-__all__ = ["intersect_surfaces", "StrayCurves", "operand_size", "default_mesh_tolerance", "closed_in_space",
-           "MESH_TOL_FACTOR", "MIN_TOL_FACTOR", "MAX_TOL_FACTOR", "MAX_MESH_TOL_FACTOR"]
+__all__ = [
+    "MAX_MESH_TOL_FACTOR",
+    "MAX_TOL_FACTOR",
+    "MESH_TOL_FACTOR",
+    "MIN_TOL_FACTOR",
+    "StrayCurves",
+    "closed_in_space",
+    "default_mesh_tolerance",
+    "intersect_surfaces",
+    "operand_size",
+]
 
 Operand = NurbsSurface | TriangleMesh
 
@@ -307,23 +327,27 @@ def _solve_on_side(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: NDArr
     return ua, ub, converged
 
 
-def _close_boundary_gaps(curves: list[IntersectionCurve], ends_uv: list, surface_a, surface_b,
-                         tol: float, reach: float) -> list[IntersectionCurve]:
-    """Put every BOUNDARY end back on the domain side its traced end was on.
+def _close_boundary_gaps(curves: list[RefinedCurve], chains: list[Chain], ends_uv: list,
+                         surface_a, surface_b, tol: float, reach: float) -> list[RefinedCurve]:
+    """Put every BOUNDARY end of the densely refined curves back on the domain side its
+    traced end was on.
 
     The auxiliary-plane refinement anchors ``F_n`` at the midpoint of the two
     start images; at an end on a domain side that midpoint is off the side by
     the mesh error, so the refined end slides along the curve, inside the
     domain, by up to about ``mesh_tol``: a gap in coverage. Each such end is
     solved again with its side parameter held (:func:`_solve_on_side`) and
-    added as a new end sample (replacing the old one when closer than ``tol``).
+    becomes a new end sample (replacing the old one when closer than ``tol / 16``
+    or than half the old end's dense spacing).
     ``ends_uv[i]`` holds the traced ``(uv_a, uv_b)`` of curve ``i``'s two ends.
+    Runs before :func:`.sampling.cubic_samples`, which then samples the closed
+    ends like any other part of the curve.
     """
-    jobs = []            # (curve, end (0 start / -1 end), side, coord, value, uv_a, uv_b)
-    for i, (curve, ends) in enumerate(zip(curves, ends_uv)):
-        if curve.closed or curve.uv_a is None or curve.uv_b is None:
+    jobs = []            # (curve, end (0 start / -1 end), side, coord, value)
+    for i, (curve, chain, ends) in enumerate(zip(curves, chains, ends_uv)):
+        if curve.closed:
             continue
-        for end, kind in ((0, curve.start_kind), (-1, curve.end_kind)):
+        for end, kind in ((0, chain.start_kind), (-1, chain.end_kind)):
             if kind is not EndKind.BOUNDARY:
                 continue
             traced_a, traced_b = ends[0 if end == 0 else 1]
@@ -351,22 +375,22 @@ def _close_boundary_gaps(curves: list[IntersectionCurve], ends_uv: list, surface
         moved = float(np.linalg.norm(new_points[k] - c.points[e]))
         if moved > reach:
             continue            # not the same end: leave it
-        pts, a, b, sing = c.points.copy(), c.uv_a.copy(), c.uv_b.copy(), c.singular.copy()
-        if moved <= tol / 16:
-            pts[e], a[e], b[e] = new_points[k], ua[k], ub[k]
+        fields = [c.points, c.uv_a, c.uv_b, c.converged, c.singular]
+        values = [new_points[k], ua[k], ub[k], True, False]
+        beside = 1 if e == 0 else -2                # the old end's dense neighbour
+        spacing = float(np.linalg.norm(c.points[beside] - c.points[e])) \
+            if c.points.shape[0] > 2 else np.inf
+        if moved <= tol / 16 or moved < 0.5 * spacing:       # replace: no tiny end span
+            fields = [f.copy() for f in fields]
+            for f, v in zip(fields, values):
+                f[e] = v
         elif e == 0:
-            pts, a, b = (np.vstack([new_points[k], pts]), np.vstack([ua[k], a]),
-                         np.vstack([ub[k], b]))
-            sing = np.concatenate([[False], sing])
+            fields = [np.concatenate([np.atleast_1d(np.asarray(v, dtype=f.dtype))[None]
+                                      if f.ndim == 2 else [v], f]) for f, v in zip(fields, values)]
         else:
-            pts, a, b = (np.vstack([pts, new_points[k]]), np.vstack([a, ua[k]]),
-                         np.vstack([b, ub[k]]))
-            sing = np.concatenate([sing, [False]])
-        try:
-            out[i] = IntersectionCurve.from_samples(pts, a, b, False, c.start_kind, c.end_kind,
-                                                    singular=sing)
-        except InvalidGeometryError:
-            continue
+            fields = [np.concatenate([f, np.atleast_1d(np.asarray(v, dtype=f.dtype))[None]
+                                      if f.ndim == 2 else [v]]) for f, v in zip(fields, values)]
+        out[i] = RefinedCurve(fields[0], fields[1], fields[2], False, fields[3], fields[4])
     return out
 
 
@@ -450,14 +474,15 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     surface_a = a if isinstance(a, NurbsSurface) else None
     surface_b = b if isinstance(b, NurbsSurface) else None
     topology = _cut_at_seams(topology, surface_a, surface_b, _JOIN_FACTOR * mesh_tol)
-    curves = intersection_curves(topology, surface_a, surface_b, tol=tol)
     if surface_a is None or surface_b is None:
-        return curves
-    kept = [c for c in topology.chains if len(c) >= 2 + c.closed]     # as intersection_curves
+        return intersection_curves(topology, surface_a, surface_b, tol=tol)
+    chains, dense = refine_chains(topology, surface_a, surface_b, tol=tol)
     ends = [((topology.uv_a[c.point_ids[0]], topology.uv_b[c.point_ids[0]]),
-             (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in kept]
-    curves = _close_boundary_gaps(curves, ends, surface_a, surface_b, tol,
-                                  reach=_JOIN_FACTOR * mesh_tol)
+             (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in chains]
+    dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
+                                 reach=_JOIN_FACTOR * mesh_tol)
+    curves = sampled_curves(dense, [(c.start_kind, c.end_kind) for c in chains],
+                            surface_a, surface_b, tol=tol)
     worst = np.array([c.max_deviation(surface_a, surface_b).max for c in curves])
     if stray is StrayCurves.DROP:
         if np.any(worst > tol):

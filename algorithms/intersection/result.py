@@ -8,14 +8,16 @@ the pcurves ``pcurve_a``, ``pcurve_b`` through the (u, v) on each surface, all
 from :func:`surfprep.algorithms.fitting.interpolate_curve` (cubic where there
 are 4 samples or more; a closed curve gets a C1 closure).
 
-:func:`intersection_curves` runs steps 4–6 on a segment topology: trace,
-refine onto the exact surfaces (or project onto the exact side of a
-mesh x NURBS pair, or nothing for mesh x mesh), interpolate, and split the
-spans whose interpolants stray from the surfaces by more than ``tol``.
+:func:`intersection_curves` runs steps 5–6 on a segment topology: refine every
+traced sample onto the exact surfaces (:func:`refine_chains`; or project onto
+the exact side of a mesh x NURBS pair, or nothing for mesh x mesh), then keep
+the samples the cubic interpolants need to stay within ``tol``
+(:func:`sampled_curves`, :mod:`.sampling`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,13 +25,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
-from ..fitting import interpolate_curve
+from ..measure import arc_length
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .refine import project_points, refine_curves, refine_points
-from .topology import EndKind, SegmentTopology
+from .refine import RefinedCurve, project_points, refine_curves
+from .sampling import cubic_samples, interpolate_samples, sample_parameters, span_errors
+from .topology import Chain, EndKind, SegmentTopology
 
-__all__ = ["IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples"]
+__all__ = ["IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
+           "refine_chains", "sampled_curves"]
 
 
 @dataclass(frozen=True)
@@ -53,36 +57,6 @@ class CurveDeviation:
     @property
     def max(self) -> float:
         return float(np.nanmax([self.to_a, self.to_b, self.gap, 0.0]))
-
-
-def _sample_parameters(points: NDArray, closed: bool) -> NDArray:
-    """Cumulative chord length ``(n,)`` (``(n + 1,)`` when closed: the closing chord too)."""
-    pts = np.vstack([points, points[:1]]) if closed else points
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-
-
-def interpolate_samples(values: ArrayLike, parameters: ArrayLike, closed: bool) -> NurbsCurve:
-    """The interpolant of samples: one call of :func:`fitting.interpolate_curve`.
-
-    Parameters
-    ----------
-    values : (n, d) float
-        A closed sequence does not repeat its first sample.
-    parameters : (n,) float, or (n + 1,) float when closed
-    closed : bool
-        Closed: the first sample is appended, with a C1 (Bessel) closure when
-        there are at least 4 samples.
-
-    Returns
-    -------
-    NurbsCurve of degree ``min(3, samples - 1)``
-    """
-    q = np.asarray(values, dtype=float)
-    if closed:
-        q = np.vstack([q, q[:1]])
-    degree = min(3, q.shape[0] - 1)
-    return interpolate_curve(q, degree=degree, parameters=parameters,
-                             smooth_closure=closed and q.shape[0] >= 4)
 
 
 @dataclass(frozen=True)
@@ -144,7 +118,7 @@ class IntersectionCurve:
             if uv is not None and uv.shape != (n, 2):
                 raise InvalidGeometryError(f"{name} must have shape ({n}, 2), got {uv.shape}")
             uvs.append(uv)
-        t = _sample_parameters(pts, bool(closed))
+        t = sample_parameters(pts, bool(closed))
         if np.any(np.diff(t) <= 0):
             raise InvalidGeometryError("coincident consecutive samples")
         sing = np.zeros(n, dtype=bool) if singular is None else np.asarray(singular, dtype=bool)
@@ -158,8 +132,15 @@ class IntersectionCurve:
 
     @property
     def length(self) -> float:
-        """Length of the polyline of the samples (closing chord included when closed)."""
-        return float(self.parameters[-1])
+        """Length of the curve: of ``curve3d`` (:func:`measure.arc_length`), or of the
+        polyline of the samples (closing chord included) without interpolants.
+
+        The samples are only as dense as the cubic interpolants need, so their
+        polyline is shorter than the curve by about ``kappa^2 h^2 / 24`` relative.
+        """
+        if self.curve3d is None:
+            return float(self.parameters[-1])
+        return arc_length(self.curve3d, tol=1e-12)
 
     def span_parameters(self, samples_per_span: int = 3) -> NDArray:
         """``(spans, samples_per_span) float``: interior parameters of every span,
@@ -175,19 +156,8 @@ class IntersectionCurve:
         """Per span: ``(to_a, to_b, gap)``, three (spans,) float (NaN where a side is missing)."""
         if self.curve3d is None:
             raise InvalidGeometryError("the curve was built without interpolants")
-        t = self.span_parameters(samples_per_span)
-        c = self.curve3d.evaluate(t)
-        on = []
-        for surface, pcurve in ((surface_a, self.pcurve_a), (surface_b, self.pcurve_b)):
-            if surface is None or pcurve is None:
-                on.append(None)
-                continue
-            uv = pcurve.evaluate(t)
-            on.append(surface.evaluate(uv[..., 0], uv[..., 1]))
-        nan = np.full(t.shape[0], np.nan)
-        dist = [nan if s is None else np.linalg.norm(s - c, axis=-1).max(axis=1) for s in on]
-        gap = nan if any(s is None for s in on) else np.linalg.norm(on[0] - on[1], axis=-1).max(axis=1)
-        return dist[0], dist[1], gap
+        return span_errors(self.span_parameters(samples_per_span), self.curve3d,
+                           self.pcurve_a, self.pcurve_b, surface_a, surface_b)
 
     def max_deviation(self, surface_a: NurbsSurface | None, surface_b: NurbsSurface | None,
                       samples_per_span: int = 3) -> CurveDeviation:
@@ -208,42 +178,47 @@ class IntersectionCurve:
 
 
 # ------------------------------------------------------------------ pipeline
-def _split_failing(curve: IntersectionCurve, surface_a, surface_b, tol: float
-                   ) -> IntersectionCurve | None:
-    """Insert refined midpoints in the spans whose interpolants stray by more than tol;
-    ``None`` when every span passes (or none can be split)."""
-    to_a, to_b, gap = curve.span_deviation(surface_a, surface_b)
-    bad = np.flatnonzero(np.nan_to_num(np.maximum(np.maximum(to_a, to_b), gap)) > tol)
-    n = curve.points.shape[0]
-    nxt = (bad + 1) % n
-    mid = refine_points(surface_a, surface_b, 0.5 * (curve.uv_a[bad] + curve.uv_a[nxt]),
-                        0.5 * (curve.uv_b[bad] + curve.uv_b[nxt]), tol=tol / 16,
-                        anchors=0.5 * (curve.points[bad] + curve.points[nxt]))
-    bad = bad[mid.converged]
-    if bad.size == 0:
-        return None
-    order = np.argsort(np.concatenate([2 * np.arange(n), 2 * bad + 1]), kind="stable")
+def refine_chains(topology: SegmentTopology, surface_a: NurbsSurface, surface_b: NurbsSurface,
+                  *, tol: float) -> tuple[list[Chain], list[RefinedCurve]]:
+    """Step 5 on every traced chain: all its samples refined onto both surfaces.
 
-    def merged(a, b):
-        return np.concatenate([a, b])[order]
+    :func:`refine.refine_curves` without insertion or removal (``F_n`` anchored
+    at each start point, to ``tol / 16``). Chains with fewer than 2 points (3
+    when closed) are skipped; returns the chains kept and their dense curves.
+    """
+    if topology.uv_a is None or topology.uv_b is None:
+        raise InvalidGeometryError("NURBS x NURBS refinement needs uv_a and uv_b")
+    chains = [c for c in topology.chains if len(c) >= 2 + c.closed]
+    refined = refine_curves(surface_a, surface_b, [topology.uv_a[c.point_ids] for c in chains],
+                            [topology.uv_b[c.point_ids] for c in chains],
+                            [c.closed for c in chains], tol=tol, max_passes=0, simplify=False)
+    return chains, refined
 
-    ok = mid.converged
-    return IntersectionCurve.from_samples(
-        merged(curve.points, mid.points[ok]), merged(curve.uv_a, mid.uv_a[ok]),
-        merged(curve.uv_b, mid.uv_b[ok]), curve.closed, curve.start_kind, curve.end_kind,
-        singular=merged(curve.singular, mid.singular[ok]))
+
+def sampled_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKind, EndKind]],
+                   surface_a: NurbsSurface, surface_b: NurbsSurface, *, tol: float,
+                   simplify: bool = True, max_rounds: int = 40) -> list[IntersectionCurve]:
+    """Step 6: the samples the cubic interpolants need (:func:`.sampling.cubic_samples`)
+    and the curves with their interpolants; ``kinds`` are the (start, end) kinds."""
+    sampled = cubic_samples(surface_a, surface_b, refined, tol=tol, simplify=simplify,
+                            max_rounds=max_rounds)
+    return [IntersectionCurve.from_samples(r.points, r.uv_a, r.uv_b, r.closed, start, end,
+                                           singular=r.singular)
+            for r, (start, end) in zip(sampled, kinds)]
 
 
 def intersection_curves(topology: SegmentTopology, surface_a: NurbsSurface | None,
                         surface_b: NurbsSurface | None, *, tol: float = 1e-7,
-                        simplify: bool = True, max_splits: int = 8
+                        simplify: bool = True, max_splits: int = 40
                         ) -> list[IntersectionCurve]:
-    """Steps 5–6 on traced chains: refine, interpolate, check the interpolants.
+    """Steps 5–6 on traced chains: refine, sample for the cubic interpolants, interpolate.
 
-    * NURBS x NURBS: :func:`refine.refine_curves` (auxiliary-plane method, chord
-      midpoint insertion, redundant-point removal), then interpolants; spans whose
-      interpolants stray by more than ``tol`` (:meth:`IntersectionCurve.span_deviation`)
-      get a refined midpoint, up to ``max_splits`` rounds.
+    * NURBS x NURBS: every traced sample refined (:func:`refine_chains`), then
+      :func:`.sampling.cubic_samples` keeps the samples the C2 cubic interpolants
+      need to stay within ``tol / 2`` of both surfaces at three points per span
+      (a curvature-spaced subset, then up to ``max_splits`` rounds inserting
+      dense or newly refined samples where a span fails); ``simplify=False``
+      keeps every traced sample and only inserts.
     * mesh x NURBS (one surface ``None``): the samples are projected onto the exact
       surface (:func:`refine.project_points`); no insertion.
     * mesh x mesh: the traced polyline is the result, without interpolants.
@@ -257,23 +232,10 @@ def intersection_curves(topology: SegmentTopology, surface_a: NurbsSurface | Non
     tol = check_tolerance(tol)
     chains = [c for c in topology.chains if len(c) >= 2 + c.closed]
     if surface_a is not None and surface_b is not None:
-        if topology.uv_a is None or topology.uv_b is None:
-            raise InvalidGeometryError("NURBS x NURBS refinement needs uv_a and uv_b")
-        refined = refine_curves(surface_a, surface_b, [topology.uv_a[c.point_ids] for c in chains],
-                                [topology.uv_b[c.point_ids] for c in chains],
-                                [c.closed for c in chains], tol=tol, simplify=simplify)
-        out = []
-        for chain, r in zip(chains, refined):
-            curve = IntersectionCurve.from_samples(r.points, r.uv_a, r.uv_b, r.closed,
-                                                   chain.start_kind, chain.end_kind,
-                                                   singular=r.singular)
-            for _ in range(max_splits):
-                split = _split_failing(curve, surface_a, surface_b, tol)
-                if split is None:
-                    break
-                curve = split
-            out.append(curve)
-        return out
+        chains, refined = refine_chains(topology, surface_a, surface_b, tol=tol)
+        return sampled_curves(refined, [(c.start_kind, c.end_kind) for c in chains],
+                              surface_a, surface_b, tol=tol, simplify=simplify,
+                              max_rounds=max_splits)
     exact = surface_a if surface_a is not None else surface_b
     side_uv = topology.uv_a if surface_a is not None else topology.uv_b
     if exact is not None and side_uv is None:

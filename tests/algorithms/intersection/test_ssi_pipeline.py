@@ -98,6 +98,20 @@ def dense_points(curves, per_span: int = 3) -> np.ndarray:
     return np.concatenate(out)
 
 
+def polylines(curves, per_span: int = 64) -> list[np.ndarray]:
+    """Our curves as dense polylines through their cubic interpolants (``per_span`` chords
+    per span; closed curves end where they start): what the distances to exact and
+    OpenCascade curves are measured to (the samples alone are only as dense as the
+    interpolants need)."""
+    out = []
+    for c in curves:
+        t = c.parameters
+        s = np.arange(per_span) / per_span
+        dense = np.append((t[:-1, None] + s[None, :] * np.diff(t)[:, None]).ravel(), t[-1])
+        out.append(c.curve3d.evaluate(dense))
+    return out
+
+
 def check_on_surfaces(curves, a, b, tol=TOL):
     assert curves, "no curve found"
     for c in curves:
@@ -109,15 +123,15 @@ def check_on_surfaces(curves, a, b, tol=TOL):
 def check_against_occ(curves, a, b, tol=TOL, expect_branches=None, match=1e-5):
     """Same branches as GeomAPI_IntSS, each side within a small distance of the other.
 
-    Our samples lie within tol of the true curve and are dense enough that
-    chords stay within tol, so OpenCascade's points (on the true curve to its own
-    accuracy) must be near our polylines and ours near its dense polylines.
+    Our interpolants lie within tol of the true curve, so OpenCascade's points
+    (on the true curve to its own accuracy) must be near dense polylines through
+    them and ours near its dense polylines.
     Returns OpenCascade's curves.
     """
     occ = intersect_surfaces_occ(a, b, tol, samples=OCC_SAMPLES)
     if expect_branches is not None:
         assert connected_branches(occ, 1e3 * tol) == expect_branches
-    distance = curve_set_distance(curves, occ)
+    distance = curve_set_distance(polylines(curves), occ)
     assert distance.unmatched_a(match).size == 0, distance.a_to_b     # nothing spurious
     assert distance.unmatched_b(match).size == 0, distance.b_to_a     # nothing missed
     return occ, distance
@@ -194,7 +208,7 @@ def test_cylinder_cylinder_unequal_radii_two_loops():
     exact = exact_cylinders(0.5)
     length = np.linalg.norm(np.diff(exact, axis=1), axis=2).sum()
     assert sum(c.length for c in curves) == pytest.approx(length, rel=1e-6)
-    assert polyline_distance(exact.reshape(-1, 3), curves).max() <= 1e-6     # coverage
+    assert polyline_distance(exact.reshape(-1, 3), polylines(curves)).max() <= 1e-6     # coverage
     check_against_occ(curves, a, b, expect_branches=2)
 
 
@@ -222,7 +236,7 @@ def test_cylinder_cylinder_equal_radii_two_ellipses_crossing():
     t = np.linspace(0, TAU, 20001)
     ellipses = np.concatenate([np.stack([np.cos(t), np.sin(t), s * np.cos(t)], 1)
                                for s in (1.0, -1.0)])
-    coverage = polyline_distance(ellipses, curves)
+    coverage = polyline_distance(ellipses, polylines(curves))
     assert coverage.max() <= 1e-3
     exact_length = 2 * np.linalg.norm(np.diff(ellipses[:20001], axis=0), axis=1).sum()
     total = sum(c.length for c in curves)
@@ -232,7 +246,7 @@ def test_cylinder_cylinder_equal_radii_two_ellipses_crossing():
     # there, so they agree to about sqrt(tol), not tol
     occ = intersect_surfaces_occ(a, b, TOL, samples=OCC_SAMPLES)
     assert connected_branches(occ, 1e-4) == 1
-    assert curve_set_distance(curves, occ).hausdorff <= 3 * np.sqrt(TOL)
+    assert curve_set_distance(polylines(curves), occ).hausdorff <= 3 * np.sqrt(TOL)
 
 
 # ---------------------------------------------------------------- sphere x cylinder
@@ -249,7 +263,7 @@ def test_sphere_cylinder_viviani_figure_eight():
     assert connected_branches(curves, 1e3 * TOL) == 1
     t = np.linspace(0, 2 * TAU, 40001)
     viviani = np.stack([1 + np.cos(t), np.sin(t), 2 * np.sin(t / 2)], 1)
-    assert polyline_distance(viviani, curves).max() <= 1e-5                 # coverage
+    assert polyline_distance(viviani, polylines(curves)).max() <= 1e-5                 # coverage
     exact_length = np.linalg.norm(np.diff(viviani, axis=0), axis=1).sum()
     assert sum(c.length for c in curves) == pytest.approx(exact_length, rel=1e-5)
     check_against_occ(curves, a, b, expect_branches=1)
@@ -292,7 +306,7 @@ def test_bumpy_bspline_plane_four_loops():
     assert lengths[-1] > 3 * lengths[0]                      # loops of different sizes
     reference = contour_reference(a, 0.2)
     assert len(reference) == 4
-    distance = curve_set_distance(curves, reference)
+    distance = curve_set_distance(polylines(curves), reference)
     assert distance.hausdorff <= 3e-5                        # the grid's own error
     for r, mine in zip(sorted(np.linalg.norm(np.diff(r, axis=0), axis=1).sum()
                               for r in reference), lengths):
@@ -314,7 +328,7 @@ def test_small_loop_needs_a_finer_mesh_tolerance():
     # every loop OpenCascade finds, we find; GeomAPI_IntSS (OCP 7.9.3) MISSES the small
     # loop here (about 0.03 long): the only branch of ours it has no counterpart for
     occ = intersect_surfaces_occ(a, b, TOL, samples=OCC_SAMPLES)
-    distance = curve_set_distance(fine, occ)
+    distance = curve_set_distance(polylines(fine), occ)
     assert distance.unmatched_b(1e-5).size == 0
     missed_by_occ = {int(i) for i in distance.unmatched_a(1e-5)}
     assert missed_by_occ == {i for i, c in enumerate(fine) if c is small[0]}   # pinned
@@ -370,7 +384,7 @@ def test_real_file_shared_sharp_edge_is_the_intersection(debis, ia, ib, exact):
     assert connected_branches(curves, 10 * tol) == 1
     edge, edge_tol = shared_edge_points(model, ia, ib)
     # the stored edge is covered by our curve, within its own tolerance
-    assert polyline_distance(edge, curves).max() <= (tol if exact else edge_tol + tol)
+    assert polyline_distance(edge, polylines(curves)).max() <= (tol if exact else edge_tol + tol)
     # GeomAPI_IntSS (asked for the same tol) agrees to within a few tol
     occ, distance = check_against_occ(curves, a, b, tol, expect_branches=1, match=10 * tol)
 
@@ -467,11 +481,11 @@ def test_every_sharp_edge_of_a_real_file(debis):
         a, b = faces[i].surface, faces[j].surface
         curves = intersect_surfaces(a, b, tol=tol)
         check_on_surfaces(curves, a, b, tol)
-        if polyline_distance(samples, curves).max() > 2 * edge_tol + tol:
+        if polyline_distance(samples, polylines(curves)).max() > 2 * edge_tol + tol:
             misses.append((i, j))
             continue
         occ = intersect_surfaces_occ(a, b, tol, samples=4001)
-        distance = curve_set_distance(curves, occ)
+        distance = curve_set_distance(polylines(curves), occ)
         assert distance.unmatched_b(10 * tol).size == 0, (i, j, distance.b_to_a)
     assert not misses, misses
 

@@ -1,0 +1,374 @@
+"""How many samples an intersection curve needs: enough for its cubic interpolants (000 §29.4.6).
+
+The result of an intersection is a set of refined samples *and* their C2 cubic
+interpolants (:func:`interpolate_samples`): ``curve3d`` through the points,
+``pcurve_a`` / ``pcurve_b`` through the (u, v) on each surface, all on the
+cumulative chord length of the 3D samples. Sampling so that straight chords
+meet ``tol`` needs about ``L / sqrt(8 tol / kappa)`` samples (9 000 on a unit
+circle at 1e-7); the cubic interpolant of samples ``h`` apart is off the
+curve by about ``kappa^3 h^4 / 384`` in the interior (measured: 0.0026
+``h^4`` on a unit circle; about ten times that in the end spans and at the C1
+closure of a closed curve), so it needs about ``L kappa^(3/4) / (384
+tol)^(1/4)`` samples: 80 on the unit circle at 1e-7, 450 at 1e-10.
+
+:func:`cubic_samples` chooses them from the densely refined traced samples
+of a curve (each within ``tol / 16`` of both surfaces):
+
+1. an initial subset spaced ``h(s) = (384 share tol / kappa^3)^(1/4)`` along
+   the curve, ``kappa`` the discrete (Menger) curvature of the 3D samples and
+   of both parameter-space polylines (scaled to model units), the ends always
+   kept (a closed curve keeps at least four samples);
+2. rounds of verification: every span of the interpolants is checked at a
+   quarter, the midpoint and three quarters on both exact surfaces
+   (``|S_a(pcurve_a(t)) - curve3d(t)|``, ``|S_b(pcurve_b(t)) - curve3d(t)|``
+   and ``|S_a - S_b|``), and every dense sample left out is projected onto
+   ``curve3d`` (Newton on the curve), so a feature between the kept samples
+   cannot be skipped. A span over ``share tol`` gets the dense sample nearest
+   its middle, or, with none inside, a new sample: the auxiliary-plane
+   refinement (:func:`.refine.refine_points`) started from the interpolants'
+   (u, v) at the span's midpoint, anchored at ``curve3d`` there. All spans of
+   all curves are refined in one batch per round.
+
+``share`` (1/2) leaves the rest of ``tol`` for what three points per span do
+not see (the sample count grows only as ``share^(-1/4)``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..curve import NurbsCurve
+from ..fitting import interpolate_curve
+from ..surface import NurbsSurface
+from .refine import RefinedCurve, refine_points
+
+__all__ = [
+    "CHECK_FRACTIONS",
+    "CUBIC_SHARE",
+    "cubic_samples",
+    "interpolate_samples",
+    "sample_parameters",
+    "span_errors",
+]
+
+#: interpolants are sampled until they are within this share of tol at the check points
+CUBIC_SHARE = 0.5
+#: where every span is checked (fractions of the span)
+CHECK_FRACTIONS = (0.25, 0.5, 0.75)
+#: interior error constant of the chord-length C2 cubic: kappa^3 h^4 / 384
+_CUBIC_CONSTANT = 384.0
+#: samples are refined to this share of tol (as in :mod:`.refine`)
+_POINT_SHARE = 1.0 / 16.0
+#: Newton steps projecting left-out dense samples onto curve3d
+_PROJECTION_STEPS = 4
+#: a span longer than this times a neighbour is split (graded sampling)
+_MAX_RATIO = 4.0
+#: a failing span takes a dense sample within this fraction of its middle, else a new one
+_MIDDLE = 0.25
+
+
+# ------------------------------------------------------------------ interpolants
+def sample_parameters(points: NDArray, closed: bool) -> NDArray:
+    """Cumulative chord length ``(n,)`` (``(n + 1,)`` when closed: the closing chord too)."""
+    pts = np.vstack([points, points[:1]]) if closed else points
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+
+
+def interpolate_samples(values: ArrayLike, parameters: ArrayLike, closed: bool) -> NurbsCurve:
+    """The interpolant of samples: one call of :func:`fitting.interpolate_curve`.
+
+    Parameters
+    ----------
+    values : (n, d) float
+        A closed sequence does not repeat its first sample.
+    parameters : (n,) float, or (n + 1,) float when closed
+    closed : bool
+        Closed: the first sample is appended, with a C1 (Bessel) closure when
+        there are at least 4 samples.
+
+    Returns
+    -------
+    NurbsCurve of degree ``min(3, samples - 1)``
+    """
+    q = np.asarray(values, dtype=float)
+    if closed:
+        q = np.vstack([q, q[:1]])
+    degree = min(3, q.shape[0] - 1)
+    return interpolate_curve(q, degree=degree, parameters=parameters,
+                             smooth_closure=closed and q.shape[0] >= 4)
+
+
+def span_errors(t: NDArray, curve3d: NurbsCurve, pcurve_a: NurbsCurve | None,
+                pcurve_b: NurbsCurve | None, surface_a: NurbsSurface | None,
+                surface_b: NurbsSurface | None) -> tuple[NDArray, NDArray, NDArray]:
+    """Per span, the largest of ``|S_a(pcurve_a) - curve3d|``, ``|S_b(pcurve_b) - curve3d|``
+    and ``|S_a(pcurve_a) - S_b(pcurve_b)|`` at the parameters ``t (spans, k)``:
+    three ``(spans,) float`` (NaN where a side is missing)."""
+    c = curve3d.evaluate(t)
+    on = []
+    for surface, pcurve in ((surface_a, pcurve_a), (surface_b, pcurve_b)):
+        if surface is None or pcurve is None:
+            on.append(None)
+            continue
+        uv = pcurve.evaluate(t)
+        on.append(surface.evaluate(uv[..., 0], uv[..., 1]))
+    nan = np.full(t.shape[0], np.nan)
+    dist = [nan if s is None else np.linalg.norm(s - c, axis=-1).max(axis=1) for s in on]
+    gap = nan if any(s is None for s in on) else np.linalg.norm(on[0] - on[1], axis=-1).max(axis=1)
+    return dist[0], dist[1], gap
+
+
+# ------------------------------------------------------------------ initial subset
+def _menger(points: NDArray, closed: bool) -> NDArray:
+    """Discrete curvature ``(n,)`` at every sample: 1 / radius of the circle through it
+    and its neighbours (0 at the ends of an open polyline)."""
+    n = points.shape[0]
+    kappa = np.zeros(n)
+    if n < 3:
+        return kappa
+    if closed:
+        prev, here, nxt = np.roll(points, 1, axis=0), points, np.roll(points, -1, axis=0)
+        idx = np.arange(n)
+    else:
+        prev, here, nxt = points[:-2], points[1:-1], points[2:]
+        idx = np.arange(1, n - 1)
+    a, b, c = here - prev, nxt - here, nxt - prev
+    la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+    area2 = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) if points.shape[1] == 2 \
+        else np.linalg.norm(np.cross(a, b), axis=1)
+    den = la * lb * lc
+    kappa[idx] = np.where(den > 0, 2.0 * area2 / np.where(den > 0, den, 1.0), 0.0)
+    return kappa
+
+
+def _scaled(uv: NDArray, points: NDArray) -> NDArray:
+    """``uv (n, 2)`` scaled to model units by the median ratio of 3D to uv chords."""
+    duv = np.linalg.norm(np.diff(uv, axis=0), axis=1)
+    dp = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    ok = duv > 0
+    return uv * (float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0)
+
+
+def _initial_subset(curve: RefinedCurve, target: float) -> NDArray:
+    """Indices of the dense samples to start from, sorted: spaced
+    ``(384 target / kappa^3)^(1/4)`` apart (module docstring, step 1)."""
+    pts, closed = curve.points, curve.closed
+    n = pts.shape[0]
+    kappa = np.maximum.reduce([_menger(pts, closed), _menger(_scaled(curve.uv_a, pts), closed),
+                               _menger(_scaled(curve.uv_b, pts), closed)])
+    ring = np.vstack([pts, pts[:1]]) if closed else pts
+    ds = np.linalg.norm(np.diff(ring, axis=0), axis=1)                   # (chords,)
+    k_chord = np.maximum(kappa, np.roll(kappa, -1))[: ds.size]
+    per_length = (np.maximum(k_chord, 0.0) ** 3 / (_CUBIC_CONSTANT * target)) ** 0.25
+    phase = np.concatenate([[0.0], np.cumsum(ds * per_length)])         # samples needed so far
+    steps = np.floor(phase).astype(np.int64)
+    chosen = np.flatnonzero(np.diff(steps) > 0) + 1                     # first past each step
+    # none within half a spacing of the closing end: no span much shorter than its neighbour
+    chosen = chosen[(chosen < n) & (phase[np.minimum(chosen, n - 1)] < phase[-1] - 0.5)]
+    keep = np.unique(np.concatenate([[0], chosen] if closed else [[0, n - 1], chosen]))
+    if closed and keep.size < 4:                                        # four by arc length
+        s = np.concatenate([[0.0], np.cumsum(ds)])[:n]
+        keep = np.unique(np.searchsorted(s, s[-1] * np.arange(4) / 4.0))
+    return keep
+
+
+# ------------------------------------------------------------------ verification
+@dataclass
+class _Work:
+    """One curve under sampling: its dense samples and which of them are kept."""
+
+    points: NDArray
+    uv_a: NDArray
+    uv_b: NDArray
+    converged: NDArray
+    singular: NDArray
+    closed: bool
+    kept: NDArray          # (m,) bool
+    stuck: NDArray         # (m,) bool: the span starting at this sample cannot be split
+    done: bool = False
+
+
+def _interpolants(w: _Work):
+    k = np.flatnonzero(w.kept)
+    t = sample_parameters(w.points[k], w.closed)
+    return k, t, [interpolate_samples(v[k], t, w.closed) for v in (w.points, w.uv_a, w.uv_b)]
+
+
+def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
+                      hi: NDArray) -> NDArray:
+    """Distances ``(m,)`` of points ``x (m, 3)`` to ``curve`` near ``t0`` (Newton within
+    ``[lo, hi]``)."""
+    t = t0.copy()
+    for _ in range(_PROJECTION_STEPS):
+        d = curve.derivatives(t, 2)
+        r = d[:, 0] - x
+        num = np.einsum("ij,ij->i", r, d[:, 1])
+        den = np.einsum("ij,ij->i", d[:, 1], d[:, 1]) + np.einsum("ij,ij->i", r, d[:, 2])
+        den = np.where(den > 0, den, np.einsum("ij,ij->i", d[:, 1], d[:, 1]))
+        t = np.clip(t - num / np.where(den > 0, den, 1.0), lo, hi)
+    return np.linalg.norm(curve.evaluate(t) - x, axis=1)
+
+
+def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
+    """Spans (by index into the kept samples) over ``target``, with what the check needs."""
+    k, t, (c3, pa, pb) = _interpolants(w)
+    dt = np.diff(t)
+    s = np.asarray(CHECK_FRACTIONS)
+    to_a, to_b, gap = span_errors(t[:-1, None] + s[None, :] * dt[:, None], c3, pa, pb,
+                                  surface_a, surface_b)
+    error = np.maximum(np.maximum(to_a, to_b), gap)
+    # left-out dense samples: projected onto curve3d within their span
+    m = w.points.shape[0]
+    ends = np.append(k, m) if w.closed else k                     # span j: ends[j]..ends[j+1]
+    span_of = np.searchsorted(ends, np.arange(m), side="right") - 1
+    inner = ~w.kept & w.converged & (span_of < dt.size)
+    ring = np.vstack([w.points, w.points[:1]]) if w.closed else w.points
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
+    if np.any(inner):
+        j = span_of[inner]
+        a0, a1 = arc[ends[j]], arc[ends[j + 1]]
+        frac = (arc[np.flatnonzero(inner)] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
+        dist = _project_on_curve(c3, w.points[inner], t[j] + frac * dt[j], t[j], t[j + 1])
+        np.maximum.at(error, j, dist)
+    # graded spans: one over _MAX_RATIO times a neighbour is split too (a C2 cubic
+    # swings between the check points of a long span next to a short one)
+    ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
+        np.concatenate([[np.inf], dt, [np.inf]])
+    steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
+    bad = ((np.nan_to_num(error) > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
+    return np.flatnonzero(bad), k, t, ends, span_of, arc, c3, pa, pb
+
+
+def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
+            singular: NDArray) -> None:
+    """New kept dense samples right after dense indices ``after`` (sorted, distinct)."""
+    pos = after + 1
+    w.points = np.insert(w.points, pos, points, axis=0)
+    w.uv_a = np.insert(w.uv_a, pos, uv_a, axis=0)
+    w.uv_b = np.insert(w.uv_b, pos, uv_b, axis=0)
+    w.converged = np.insert(w.converged, pos, True)
+    w.singular = np.insert(w.singular, pos, singular)
+    w.kept = np.insert(w.kept, pos, True)
+    w.stuck = np.insert(w.stuck, pos, False)
+
+
+def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
+    """Where new samples go in their spans ``start -> stop`` (dense indices, ``stop`` may
+    be ``m`` for the closing span): ``(inside, after)``, two ``(q,)`` arrays.
+
+    ``inside``: the point projects onto the span's chord at a fraction in
+    ``[0.1, 0.9]`` (near-tangential surfaces may let it slide along the curve, a
+    domain side onto the span's end); ``after``: the dense sample it follows
+    (by that fraction among the dense samples of the span).
+    """
+    m = w.points.shape[0]
+    p0, p1 = w.points[start], w.points[stop % m]
+    chord = p1 - p0
+    den = np.maximum(np.einsum("ij,ij->i", chord, chord), np.finfo(float).tiny)
+    frac = np.einsum("ij,ij->i", points - p0, chord) / den
+    inside = (frac >= 0.1) & (frac <= 0.9)
+    after = start.copy()
+    for i in np.flatnonzero(inside & (stop - start > 1)):
+        between = w.points[start[i] + 1: stop[i]]
+        f = (between - p0[i]) @ chord[i] / den[i]
+        after[i] = start[i] + np.count_nonzero(f < frac[i])
+    return inside, after
+
+
+def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
+           tangent_sin: float) -> None:
+    """One verification round over all unfinished curves (module docstring, step 2)."""
+    jobs = []        # per curve: work, span start / stop (dense), mid parameter, interpolants
+    for w in works:
+        if w.done:
+            continue
+        bad, _, t, ends, span_of, arc, c3, pa, pb = _failing_spans(w, surface_a, surface_b,
+                                                                   target, tol)
+        if bad.size == 0:
+            w.done = True
+            continue
+        fresh = []
+        for j in bad:
+            inside = np.flatnonzero((span_of == j) & ~w.kept & w.converged)
+            if inside.size:         # the dense sample nearest the middle, if near enough
+                a0, a1 = arc[ends[j]], arc[ends[j + 1]]
+                frac = (arc[inside] - a0) / (a1 - a0) if a1 > a0 else np.full(inside.size, 0.5)
+                best = int(np.argmin(np.abs(frac - 0.5)))
+                if abs(frac[best] - 0.5) <= _MIDDLE:
+                    w.kept[inside[best]] = True
+                    continue
+            fresh.append(j)
+        if fresh:
+            fresh = np.asarray(fresh)
+            jobs.append((w, ends[fresh], ends[fresh + 1], 0.5 * (t[fresh] + t[fresh + 1]),
+                         pa, pb, c3))
+    if not jobs:
+        return
+    uv_a = np.concatenate([pa.evaluate(mid) for *_, mid, pa, _, _ in jobs])
+    uv_b = np.concatenate([pb.evaluate(mid) for *_, mid, _, pb, _ in jobs])
+    anchors = np.concatenate([c3.evaluate(mid) for *_, mid, _, _, c3 in jobs])
+    new = refine_points(surface_a, surface_b, uv_a, uv_b, tol=_POINT_SHARE * tol,
+                        anchors=anchors, tangent_sin=tangent_sin)
+    offset = 0
+    for w, start, stop, *_ in jobs:
+        sl = slice(offset, offset + start.size)
+        offset += start.size
+        inside, after = _place(w, start, stop, new.points[sl])
+        ok = new.converged[sl] & inside
+        w.stuck[start[~ok]] = True
+        if np.any(ok):
+            order = np.argsort(after[ok], kind="stable")
+            _insert(w, after[ok][order], new.points[sl][ok][order], new.uv_a[sl][ok][order],
+                    new.uv_b[sl][ok][order], new.singular[sl][ok][order])
+
+
+def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
+                  curves: Sequence[RefinedCurve], *, tol: float, share: float = CUBIC_SHARE,
+                  simplify: bool = True, max_rounds: int = 40,
+                  tangent_sin: float = 1e-6) -> list[RefinedCurve]:
+    """The samples the cubic interpolants of refined curves need (module docstring).
+
+    Parameters
+    ----------
+    surface_a, surface_b : NurbsSurface
+    curves : sequence of RefinedCurve
+        Densely refined traced samples (e.g. :func:`.refine.refine_curves` with
+        ``max_passes=0, simplify=False``).
+    tol : float
+        Model units; the interpolants are sampled until within ``share * tol``
+        at the check points of every span.
+    share : float in (0, 1]
+    simplify : bool
+        Start from the curvature-spaced subset (step 1); without it every
+        dense sample is kept and only insertion happens.
+    max_rounds : int
+        Verification rounds at most.
+    tangent_sin : float
+        As in :func:`.refine.refine_points`.
+
+    Returns
+    -------
+    list of RefinedCurve
+        Each a subset of its dense samples plus inserted ones, in curve order;
+        the ends of open curves are kept.
+    """
+    target = share * tol
+    works = []
+    for c in curves:
+        m = c.points.shape[0]
+        kept = np.zeros(m, dtype=bool)
+        kept[_initial_subset(c, target) if simplify else np.arange(m)] = True
+        if c.closed and np.count_nonzero(kept) < 3:
+            kept[:] = True
+        works.append(_Work(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
+                           c.closed, kept, np.zeros(m, dtype=bool)))
+    for _ in range(max_rounds):
+        _round(works, surface_a, surface_b, target, tol, tangent_sin)
+        if all(w.done for w in works):
+            break
+    return [RefinedCurve(w.points[w.kept], w.uv_a[w.kept], w.uv_b[w.kept], w.closed,
+                         w.converged[w.kept], w.singular[w.kept]) for w in works]
