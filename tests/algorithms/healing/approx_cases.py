@@ -87,3 +87,42 @@ def envelope_boundary(x0: float, x1: float, y0: float, y1: float, samples: int =
 
     c = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
     return [line(c[k], c[(k + 1) % 4]) for k in range(4)]
+
+
+def stepped_gap(step: float = 0.01, gap: tuple = (0.45, 0.55), samples: int = 81
+                ) -> tuple[list, list[NurbsSurface]]:
+    """Two surfaces with a gap between them and a step across it (001 Fig. 6 kind).
+
+    The smooth surface is cut at ``x = gap[0]`` and ``x = gap[1]``; the right part is
+    raised by ``step``. The boundary runs around ``[0.2, 0.8]^2``: on the surfaces
+    where they exist, a straight bridge across the gap on the bottom and top sides.
+
+    Returns
+    -------
+    boundary : four (n, 3) polylines
+    sources : [left, right] NurbsSurface
+    """
+    smooth = smooth_surface()
+    left = smooth.restrict(None, gap[0], None, None)
+    right_part = smooth.restrict(gap[1], None, None, None)
+    right = NurbsSurface(right_part.control_points + np.array([0.0, 0.0, step]),
+                         right_part.knots_u, right_part.knots_v, 3, 3)
+
+    def height(x, y):
+        z = smooth.evaluate(x, y)[..., 2]
+        z = np.where(x >= gap[1], z + step, z)
+        z_left = smooth.evaluate(np.full_like(x, gap[0]), y)[..., 2]
+        z_right = smooth.evaluate(np.full_like(x, gap[1]), y)[..., 2] + step
+        bridge = (x - gap[0]) / (gap[1] - gap[0])
+        inside = (x > gap[0]) & (x < gap[1])
+        return np.where(inside, (1 - bridge) * z_left + bridge * z_right, z)
+
+    s = np.linspace(0.0, 1.0, samples)
+
+    def line(p, q):
+        x = p[0] + s * (q[0] - p[0])
+        y = p[1] + s * (q[1] - p[1])
+        return np.stack([x, y, height(x, y)], axis=1)
+
+    c = [(0.2, 0.2), (0.8, 0.2), (0.8, 0.8), (0.2, 0.8)]
+    return [line(c[k], c[(k + 1) % 4]) for k in range(4)], [left, right]

@@ -15,6 +15,7 @@ from approx_cases import (
     iso_boundary,
     oscillating_surface,
     smooth_surface,
+    stepped_gap,
     surrounding_patches,
     upper_envelope,
 )
@@ -94,6 +95,39 @@ def test_hole_between_four_patches(smooth):
     assert near_sources[around].max() < 2 * r.max_error
     # over the hole the Hardy fill follows the surface that was cut away
     assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 2e-3
+
+
+def test_hole_bounded_by_its_rim_is_filled_from_the_rim(smooth):
+    # the four-sided hole of a network: the boundary is the hole's edges, no interior
+    # segment meets anything; Hardy's fill from the rim follows the cut-away surface
+    r = _fixed(iso_boundary(smooth, *HOLE), surrounding_patches(smooth, HOLE), 8)
+    assert np.all(r.artificial[1:-1, 1:-1]) and not np.any(r.artificial[[0, -1]])
+    assert r.artificial_share == pytest.approx(49 / 81)
+    _, pts = _dense(r)
+    assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 2e-4
+
+
+def test_gap_with_a_step_between_two_surfaces():
+    boundary, sources = stepped_gap(step=0.01)
+    r = _fixed(boundary, sources, 8)
+    assert 0 < r.artificial_share < 0.2
+    assert set(np.unique(r.source)) == {-1, 0, 1}
+    xy = r.grid[..., 0]
+    np.testing.assert_array_equal(r.artificial[1:-1, 1:-1],
+                                  ((xy > 0.45) & (xy < 0.55))[1:-1, 1:-1])
+    assert r.max_error < 1e-3                          # cells over the gap left out
+    # dense check away from the gap, against both sources
+    _, pts = _dense(r)
+    pts = pts.reshape(-1, 3)
+    away = (pts[:, 0] < 0.4) | (pts[:, 0] > 0.6)
+    dense = np.min([distance_to_surface(src, pts[away]) for src in sources], axis=0)
+    assert dense.max() < 2 * r.max_error
+    # over the gap the approximant bridges the step between the two rims (no overshoot)
+    line = r.surface.evaluate(np.linspace(0, 1, 401), 0.5)
+    over = line[(line[:, 0] > 0.45) & (line[:, 0] < 0.55)]
+    rims = np.array([sources[0].evaluate(0.45, over[0, 1])[2],
+                     sources[1].evaluate(0.55, over[0, 1])[2]])
+    assert np.all(over[:, 2] > rims.min() - 2e-3) and np.all(over[:, 2] < rims.max() + 2e-3)
 
 
 @pytest.mark.parametrize("with_surface", [False, True])
