@@ -72,9 +72,9 @@ __all__ = [
 ]
 
 #: default ``gap_tol``: this times the model's box diagonal ...
-DEFAULT_GAP_FACTOR = 1e-2
+DEFAULT_GAP_FACTOR = 1e-3
 #: ... and at most this times the median edge length
-_GAP_FACTOR_EDGE = 0.05
+_GAP_FACTOR_EDGE = 0.01
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
 
@@ -284,7 +284,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     continuity : "G0" or "G1"
     gap_tol : float, optional
         Model units: edges closer than this are one edge (neighbours, gaps to
-        close, duplicates). Default ``min(1e-2 x model diagonal, 0.05 x median
+        close, duplicates). Default ``min(1e-3 x model diagonal, 0.01 x median
         edge length)``.
     patches : path, dict or list, optional
         Directed patches (:func:`.heal_spec.read_patch_spec`).

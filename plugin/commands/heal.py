@@ -63,7 +63,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="how approximants meet along shared edges (default G0)")
     parser.add_argument("--gap-tol", type=float, default=None, metavar="G", dest="gap_tol",
                         help="edges closer than this (mm) are one edge (default "
-                             "min(1e-2 x size, 0.05 x median edge length))")
+                             "min(1e-3 x size, 0.01 x median edge length))")
     parser.add_argument("--patches", type=Path, default=None, metavar="SPEC.json",
                         help="directed patches: four corners or four curves each")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
