@@ -175,8 +175,7 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
     grid = np.where(found[..., None], y, z)
     grid[rim] = coons.points[rim]
     surface = interpolate_grid(grid, interpolant)
-    near = tuple(s for s, k in zip(sources, clipped.kept, strict=True) if k)
-    error = measure_error(surface, found, near, tol=_INVERSION_FRACTION * size)
+    error = measure_error(surface, found, clipped, tol=_INVERSION_FRACTION * size)
     return _Pass(surface, grid, found, ~(found | rim), src.reshape(shape), error, off.distance)
 
 

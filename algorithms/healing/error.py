@@ -13,12 +13,13 @@ projections onto the originals, not artificial ones: the others lie over a
 hole and have nothing to be close to. The error is the largest distance; the
 RMS is reported too (003).
 
-Distances: to a parametric surface by Newton point inversion
-(:func:`..projection.project_to_surface`); to a triangulation by the exact
-closest point on its nearest triangles, and, for a surface given with its
-triangulation (a trimmed face), by point inversion started at the parameters
-of that closest point (so the foot stays on the part of the surface that
-exists).
+Distances (:func:`distance_to_triangles`): the exact closest point on the
+nearest clipped triangles of each source, and, on a parametric source, Newton
+point inversion (:func:`..projection.project_to_surface`) started at the
+parameters of that point (eq. 10), so the foot is found near the part of the
+surface that was triangulated (a trimmed face's mesh) without a global search.
+:func:`distance_to_sources` is the global version (every source, seeds from
+a sample grid).
 """
 
 from __future__ import annotations
@@ -32,12 +33,13 @@ from scipy.spatial import cKDTree
 from ..intersection.mesh import TriangleMesh
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
-from .clipping import SurfaceSource
+from .clipping import ClippedTriangles, SurfaceSource
 
 __all__ = [
     "ErrorSample",
     "closest_on_triangles",
     "distance_to_sources",
+    "distance_to_triangles",
     "error_parameters",
     "measure_error",
 ]
@@ -181,7 +183,55 @@ def distance_to_sources(points: NDArray, sources: tuple[SurfaceSource, ...], *,
     return best
 
 
-def measure_error(surface: NurbsSurface, found: NDArray, sources: tuple[SurfaceSource, ...],
+def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: float
+                          ) -> NDArray:
+    """Shortest distance of each point to the clipped sources, through their triangles.
+
+    The nearest triangles (by centroid) give, per point and source, the closest
+    point of the triangulation; on a parametric source its barycentric
+    ``(u, v)`` (eq. 10) starts Newton point inversion on the exact surface.
+
+    Parameters
+    ----------
+    points : (k, 3) float
+    clipped : ClippedTriangles
+    tol : float
+        Convergence of the point inversion, model units.
+
+    Returns
+    -------
+    (k,) float, ``inf`` where there is no triangle.
+    """
+    k_pts, n_tri = points.shape[0], clipped.n_triangles
+    best = np.full(k_pts, np.inf)
+    if k_pts == 0 or n_tri == 0:
+        return best
+    k = min(_CANDIDATE_TRIANGLES, n_tri)
+    _, cand = cKDTree(clipped.points.mean(axis=1)).query(points, k=k)
+    cand = cand.reshape(k_pts, k).ravel()
+    rows = np.repeat(np.arange(k_pts), k)
+    foot, bary = closest_on_triangles(points[rows], clipped.points[cand])
+    dist = np.linalg.norm(points[rows] - foot, axis=1)
+    src = clipped.source[cand]
+    order = np.lexsort((dist, rows * len(clipped.sources) + src))   # best per (point, source)
+    key = (rows * len(clipped.sources) + src)[order]
+    first = order[np.r_[True, key[1:] != key[:-1]]]
+    uv = np.einsum("pk,pkc->pc", bary[first], clipped.uv[cand[first]])
+    exact_uv = np.all(np.isfinite(uv), axis=1)
+    mesh_only = ~exact_uv          # chords, not the surface, where the surface is known
+    np.minimum.at(best, rows[first][mesh_only], dist[first][mesh_only])
+    for s_id in np.unique(src[first]):
+        surface = clipped.sources[s_id].surface
+        sel = np.flatnonzero((src[first] == s_id) & exact_uv)
+        if surface is None or sel.size == 0:
+            continue
+        exact = project_to_surface(surface, points[rows[first][sel]], tol=tol,
+                                   guess=uv[sel]).distance
+        np.minimum.at(best, rows[first][sel], exact)
+    return best
+
+
+def measure_error(surface: NurbsSurface, found: NDArray, clipped: ClippedTriangles,
                   *, tol: float) -> ErrorSample:
     """The error of §7 (module docstring).
 
@@ -190,14 +240,14 @@ def measure_error(surface: NurbsSurface, found: NDArray, sources: tuple[SurfaceS
     surface : NurbsSurface
         The approximant over ``[0, 1]^2``.
     found : (M + 1, N + 1) bool
-    sources : tuple of SurfaceSource
-        The sources that can be near the approximant (clipping's kept ones).
+    clipped : ClippedTriangles
+        The sources near the approximant and their triangles.
     tol : float
         Convergence of the point inversion, model units.
     """
     uv = error_parameters(found)
     points = surface.evaluate(uv[:, 0], uv[:, 1]) if uv.size else np.zeros((0, 3))
-    distance = distance_to_sources(points, sources, tol=tol)
+    distance = distance_to_triangles(points, clipped, tol=tol)
     if distance.size == 0:
         return ErrorSample(uv, points, distance, float("nan"), float("nan"))
     return ErrorSample(uv, points, distance, float(distance.max()),

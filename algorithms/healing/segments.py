@@ -162,7 +162,9 @@ def pierce_surface(surface: NurbsSurface, origin: NDArray, direction: NDArray, u
         good = np.abs(det) > 1e-300
         step = np.zeros((t.size, 3))
         if np.any(good):
-            step[good] = np.linalg.solve(jac[good], -f[good][..., None])[..., 0]
+            with np.errstate(all="ignore"):
+                step[good] = np.linalg.solve(jac[good], -f[good][..., None])[..., 0]
+        step[~np.all(np.isfinite(step), axis=1)] = 0.0
         uv = np.clip(uv + step[:, :2], lo, hi)
         t = t + step[:, 2]
     p = surface.evaluate(uv[:, 0], uv[:, 1])

@@ -5,7 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 from approx_cases import smooth_surface
-from surfprep.algorithms.healing.error import closest_on_triangles, error_parameters
+from surfprep.algorithms.healing.clipping import as_sources, clip_sources
+from surfprep.algorithms.healing.error import (
+    closest_on_triangles,
+    distance_to_sources,
+    distance_to_triangles,
+    error_parameters,
+)
 from surfprep.algorithms.healing.segments import intersect_segments, pierce_surface
 
 RNG = np.random.default_rng(11)
@@ -72,3 +78,15 @@ def test_error_points_skip_cells_over_holes():
     hole = np.array([2 / 4, 1 / 3])
     near = np.abs(uv - hole) < np.array([1 / 4, 1 / 3]) - 1e-12
     assert not np.any(near.all(axis=1))
+
+
+def test_distance_through_triangles_matches_global_inversion():
+    s = smooth_surface()
+    sources = as_sources([s.restrict(None, 0.5, None, None), s.restrict(0.5, None, None, None)])
+    box = np.array([[0.1, 0.1, -1.0], [0.9, 0.9, 2.0]])
+    clipped = clip_sources(sources, box, mesh_tol=0.01)       # coarse chords: 1e-2
+    uv = RNG.uniform(0.2, 0.8, (300, 2))
+    pts = s.evaluate(uv[:, 0], uv[:, 1]) + RNG.normal(scale=0.01, size=(300, 3))
+    local = distance_to_triangles(pts, clipped, tol=1e-12)
+    glob = distance_to_sources(pts, sources, tol=1e-12)
+    np.testing.assert_allclose(local, glob, atol=1e-10)       # exact, not the chords
