@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..curve import NurbsCurve
 from ..fitting import interpolate_curve
 from ..surface import NurbsSurface
-from .refine import RefinedCurve, refine_points
+from .refine import RefinedCurve, RefinedPoints, refine_points
 
 __all__ = [
     "CHECK_FRACTIONS",
@@ -61,6 +61,9 @@ CUBIC_SHARE = 0.5
 CHECK_FRACTIONS = (0.25, 0.5, 0.75)
 #: interior error constant of the chord-length C2 cubic: kappa^3 h^4 / 384
 _CUBIC_CONSTANT = 384.0
+#: the spacing is this share of what the constant predicts (the interior error then about
+#: 0.4 of the target; end spans and the closure of a closed curve are worse)
+_SPACING = 0.8
 #: samples are refined to this share of tol (as in :mod:`.refine`)
 _POINT_SHARE = 1.0 / 16.0
 #: Newton steps projecting left-out dense samples onto curve3d
@@ -69,6 +72,10 @@ _PROJECTION_STEPS = 4
 _MAX_RATIO = 4.0
 #: a failing span takes a dense sample within this fraction of its middle, else a new one
 _MIDDLE = 0.25
+#: a new sample must project onto its span's chord this far from both ends
+_INSIDE = 0.02
+#: a failing span is cut into at most this many pieces per round
+_MAX_PIECES = 8
 
 
 # ------------------------------------------------------------------ interpolants
@@ -153,27 +160,72 @@ def _scaled(uv: NDArray, points: NDArray) -> NDArray:
     return uv * (float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0)
 
 
-def _initial_subset(curve: RefinedCurve, target: float) -> NDArray:
-    """Indices of the dense samples to start from, sorted: spaced
-    ``(384 target / kappa^3)^(1/4)`` apart (module docstring, step 1)."""
+def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float) -> NDArray:
+    """Cumulative number of cubic spans needed ``(len(t),)`` at the dense samples:
+    the integral of ``(kappa^3 / (384 target))^(1/4)`` along the chord lengths ``t``."""
     pts, closed = curve.points, curve.closed
-    n = pts.shape[0]
     kappa = np.maximum.reduce([_menger(pts, closed), _menger(_scaled(curve.uv_a, pts), closed),
                                _menger(_scaled(curve.uv_b, pts), closed)])
-    ring = np.vstack([pts, pts[:1]]) if closed else pts
-    ds = np.linalg.norm(np.diff(ring, axis=0), axis=1)                   # (chords,)
+    ds = np.diff(t)
     k_chord = np.maximum(kappa, np.roll(kappa, -1))[: ds.size]
-    per_length = (np.maximum(k_chord, 0.0) ** 3 / (_CUBIC_CONSTANT * target)) ** 0.25
-    phase = np.concatenate([[0.0], np.cumsum(ds * per_length)])         # samples needed so far
-    steps = np.floor(phase).astype(np.int64)
-    chosen = np.flatnonzero(np.diff(steps) > 0) + 1                     # first past each step
-    # none within half a spacing of the closing end: no span much shorter than its neighbour
-    chosen = chosen[(chosen < n) & (phase[np.minimum(chosen, n - 1)] < phase[-1] - 0.5)]
-    keep = np.unique(np.concatenate([[0], chosen] if closed else [[0, n - 1], chosen]))
-    if closed and keep.size < 4:                                        # four by arc length
-        s = np.concatenate([[0.0], np.cumsum(ds)])[:n]
-        keep = np.unique(np.searchsorted(s, s[-1] * np.arange(4) / 4.0))
-    return keep
+    per_length = (np.maximum(k_chord, 0.0) ** 3 / (_CUBIC_CONSTANT * target)) ** 0.25 / _SPACING
+    return np.concatenate([[0.0], np.cumsum(ds * per_length)])
+
+
+def _resample_targets(curve: RefinedCurve, target: float
+                      ) -> tuple[NDArray, list[NurbsCurve], NDArray] | None:
+    """New sample positions of a densely refined curve (module docstring, step 1).
+
+    Returns ``(t, interpolants, positions)``: the dense chord-length parameters,
+    the interpolants through all dense samples (3D, uv_a, uv_b) and the interior
+    parameters where samples should go, equally many cubic spans apart (at least
+    four spans on a closed curve); None when the curve has too few converged
+    samples to interpolate (every dense sample is kept then).
+    """
+    if not curve.converged.all() or curve.points.shape[0] < 2 + 2 * curve.closed:
+        return None
+    t = sample_parameters(curve.points, curve.closed)
+    if np.any(np.diff(t) <= 0):
+        return None
+    phase = _spacing_phase(curve, t, target)
+    spans = max(int(np.ceil(phase[-1] - 1e-9)), 4 if curve.closed else 1)
+    goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
+        t[-1] * np.arange(1, spans) / spans
+    positions = np.interp(goal, phase, t) if phase[-1] > 0 else goal
+    interps = [interpolate_samples(v, t, curve.closed) for v in (curve.points, curve.uv_a,
+                                                                  curve.uv_b)]
+    return t, interps, positions
+
+
+def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _Work:
+    """Dense samples (left out) merged by parameter with the new ones (kept)."""
+    m = curve.points.shape[0]
+    t_dense = t[:m]
+    kept_dense = np.zeros(m, dtype=bool)
+    kept_dense[0] = True
+    if not curve.closed:
+        kept_dense[-1] = True
+    # a new sample on a dense one's parameter: keep the dense one instead
+    near = np.searchsorted(t_dense, positions)
+    lo = np.clip(near - 1, 0, m - 1)
+    hi = np.clip(near, 0, m - 1)
+    close_lo = np.abs(t_dense[lo] - positions) <= 1e-9 * t[-1]
+    close_hi = np.abs(t_dense[hi] - positions) <= 1e-9 * t[-1]
+    kept_dense[lo[close_lo]] = True
+    kept_dense[hi[close_hi & ~close_lo]] = True
+    fresh = ~(close_lo | close_hi)
+    key = np.concatenate([t_dense, positions[fresh]])
+    order = np.argsort(key, kind="stable")
+
+    def merge(dense, extra):
+        return np.concatenate([dense, extra])[order]
+
+    return _Work(merge(curve.points, new.points[fresh]), merge(curve.uv_a, new.uv_a[fresh]),
+                 merge(curve.uv_b, new.uv_b[fresh]),
+                 merge(curve.converged, np.ones(fresh.sum(), dtype=bool)),
+                 merge(curve.singular, new.singular[fresh]), curve.closed,
+                 merge(kept_dense, np.ones(fresh.sum(), dtype=bool)),
+                 np.zeros(key.size, dtype=bool))
 
 
 # ------------------------------------------------------------------ verification
@@ -214,7 +266,10 @@ def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
 
 
 def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
-    """Spans (by index into the kept samples) over ``target``, with what the check needs."""
+    """Spans (by index into the kept samples) over ``target`` at their check points or
+    too long beside a neighbour, their errors, the dense samples farther than
+    ``target`` from ``curve3d`` (the worst per span; those spans take them), and what
+    the insertion needs."""
     k, t, (c3, pa, pb) = _interpolants(w)
     dt = np.diff(t)
     s = np.asarray(CHECK_FRACTIONS)
@@ -228,19 +283,28 @@ def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
     inner = ~w.kept & w.converged & (span_of < dt.size)
     ring = np.vstack([w.points, w.points[:1]]) if w.closed else w.points
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
+    off = np.zeros(0, dtype=np.int64)           # dense samples off curve3d: kept next round
     if np.any(inner):
-        j = span_of[inner]
+        idx = np.flatnonzero(inner)
+        j = span_of[idx]
         a0, a1 = arc[ends[j]], arc[ends[j + 1]]
-        frac = (arc[np.flatnonzero(inner)] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
-        dist = _project_on_curve(c3, w.points[inner], t[j] + frac * dt[j], t[j], t[j + 1])
-        np.maximum.at(error, j, dist)
+        frac = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
+        dist = _project_on_curve(c3, w.points[idx], t[j] + frac * dt[j], t[j], t[j + 1])
+        far = dist > target
+        if np.any(far):                          # the worst of each span
+            order = np.lexsort((-dist[far], j[far]))
+            first = np.concatenate([[True], np.diff(j[far][order]) != 0])
+            off = idx[far][order][first]
     # graded spans: one over _MAX_RATIO times a neighbour is split too (a C2 cubic
     # swings between the check points of a long span next to a short one)
     ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
         np.concatenate([[np.inf], dt, [np.inf]])
     steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
-    bad = ((np.nan_to_num(error) > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
-    return np.flatnonzero(bad), k, t, ends, span_of, arc, c3, pa, pb
+    error = np.nan_to_num(error)
+    bad = ((error > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
+    bad[span_of[off]] = False                    # those get their dense sample instead
+    bad = np.flatnonzero(bad)
+    return bad, error[bad], off, t, ends, span_of, arc, c3, pa, pb
 
 
 def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
@@ -256,72 +320,97 @@ def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDAr
     w.stuck = np.insert(w.stuck, pos, False)
 
 
-def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray) -> tuple[NDArray, NDArray]:
+def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
+           ) -> tuple[NDArray, NDArray, NDArray]:
     """Where new samples go in their spans ``start -> stop`` (dense indices, ``stop`` may
-    be ``m`` for the closing span): ``(inside, after)``, two ``(q,)`` arrays.
+    be ``m`` for the closing span): ``(inside, after, fraction)``, three ``(q,)`` arrays.
 
-    ``inside``: the point projects onto the span's chord at a fraction in
-    ``[0.1, 0.9]`` (near-tangential surfaces may let it slide along the curve, a
-    domain side onto the span's end); ``after``: the dense sample it follows
-    (by that fraction among the dense samples of the span).
+    ``fraction``: where the point projects onto the span's chord; ``inside``:
+    in ``[_INSIDE, 1 - _INSIDE]`` (a point held on a domain side may slide onto
+    the span's end);
+    ``after``: the dense sample it follows (by that fraction among the dense
+    samples of the span).
     """
     m = w.points.shape[0]
     p0, p1 = w.points[start], w.points[stop % m]
     chord = p1 - p0
     den = np.maximum(np.einsum("ij,ij->i", chord, chord), np.finfo(float).tiny)
     frac = np.einsum("ij,ij->i", points - p0, chord) / den
-    inside = (frac >= 0.1) & (frac <= 0.9)
+    # anywhere strictly inside: near-tangential surfaces let points slide along the
+    # curve (consistently, so the order is kept), which does not hurt the sampling
+    inside = (frac >= _INSIDE) & (frac <= 1.0 - _INSIDE)
     after = start.copy()
     for i in np.flatnonzero(inside & (stop - start > 1)):
         between = w.points[start[i] + 1: stop[i]]
         f = (between - p0[i]) @ chord[i] / den[i]
         after[i] = start[i] + np.count_nonzero(f < frac[i])
-    return inside, after
+    return inside, after, frac
+
+
+def _pieces(error: NDArray, target: float) -> NDArray:
+    """Into how many pieces a failing span is cut: ``sqrt(error / target)`` (the error of
+    a C2 cubic across a kink in the second derivative, where a surface's parametrization
+    is only C1, falls only as ``h^2``), 2 to ``_MAX_PIECES``."""
+    ratio = np.maximum(error / target, 1.0)
+    return np.clip(np.ceil(np.sqrt(ratio)), 2, _MAX_PIECES).astype(np.int64)
 
 
 def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
            tangent_sin: float) -> None:
     """One verification round over all unfinished curves (module docstring, step 2)."""
-    jobs = []        # per curve: work, span start / stop (dense), mid parameter, interpolants
+    jobs = []        # per curve: work, span start / stop (dense), parameters of the pieces
+    curves = []      # per job: interpolants
     for w in works:
         if w.done:
             continue
-        bad, _, t, ends, span_of, arc, c3, pa, pb = _failing_spans(w, surface_a, surface_b,
-                                                                   target, tol)
-        if bad.size == 0:
+        bad, error, off, t, ends, span_of, arc, c3, pa, pb = _failing_spans(
+            w, surface_a, surface_b, target, tol)
+        if bad.size == 0 and off.size == 0:
             w.done = True
             continue
+        w.kept[off] = True
+        pieces = _pieces(error, target)
         fresh = []
-        for j in bad:
+        for j, n in zip(bad, pieces):
             inside = np.flatnonzero((span_of == j) & ~w.kept & w.converged)
-            if inside.size:         # the dense sample nearest the middle, if near enough
+            if n == 2 and inside.size:      # the dense sample nearest the middle, if near
                 a0, a1 = arc[ends[j]], arc[ends[j + 1]]
                 frac = (arc[inside] - a0) / (a1 - a0) if a1 > a0 else np.full(inside.size, 0.5)
                 best = int(np.argmin(np.abs(frac - 0.5)))
                 if abs(frac[best] - 0.5) <= _MIDDLE:
                     w.kept[inside[best]] = True
                     continue
-            fresh.append(j)
+            fresh.append((j, n))
         if fresh:
-            fresh = np.asarray(fresh)
-            jobs.append((w, ends[fresh], ends[fresh + 1], 0.5 * (t[fresh] + t[fresh + 1]),
-                         pa, pb, c3))
+            span = np.repeat([j for j, _ in fresh], [n - 1 for _, n in fresh])
+            count = np.repeat([n for _, n in fresh], [n - 1 for _, n in fresh])
+            local = np.concatenate([np.arange(1, n) for _, n in fresh])
+            expect = local / count
+            jobs.append((w, ends[span], ends[span + 1], t[span] + expect * np.diff(t)[span]))
+            curves.append((c3, pa, pb))
     if not jobs:
         return
-    uv_a = np.concatenate([pa.evaluate(mid) for *_, mid, pa, _, _ in jobs])
-    uv_b = np.concatenate([pb.evaluate(mid) for *_, mid, _, pb, _ in jobs])
-    anchors = np.concatenate([c3.evaluate(mid) for *_, mid, _, _, c3 in jobs])
+    anchors = np.concatenate([c[0].evaluate(j[3]) for j, c in zip(jobs, curves)])
+    uv_a = np.concatenate([c[1].evaluate(j[3]) for j, c in zip(jobs, curves)])
+    uv_b = np.concatenate([c[2].evaluate(j[3]) for j, c in zip(jobs, curves)])
     new = refine_points(surface_a, surface_b, uv_a, uv_b, tol=_POINT_SHARE * tol,
                         anchors=anchors, tangent_sin=tangent_sin)
     offset = 0
-    for w, start, stop, *_ in jobs:
+    for w, start, stop, _ in jobs:
         sl = slice(offset, offset + start.size)
         offset += start.size
-        inside, after = _place(w, start, stop, new.points[sl])
+        inside, after, frac = _place(w, start, stop, new.points[sl])
         ok = new.converged[sl] & inside
-        w.stuck[start[~ok]] = True
+        # two pieces of one span that slid onto each other: the first only
+        order = np.lexsort((frac, start))
+        same = np.zeros(start.size, dtype=bool)
+        same[order[1:]] = (start[order[1:]] == start[order[:-1]]) & \
+            (np.diff(frac[order]) < _INSIDE)
+        ok &= ~same
+        failed = np.setdiff1d(start[~ok], start[ok])
+        w.stuck[failed] = True                       # no piece of the span could be placed
         if np.any(ok):
-            order = np.argsort(after[ok], kind="stable")
+            order = np.lexsort((frac[ok], after[ok]))
             _insert(w, after[ok][order], new.points[sl][ok][order], new.uv_a[sl][ok][order],
                     new.uv_b[sl][ok][order], new.singular[sl][ok][order])
 
@@ -357,15 +446,33 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         the ends of open curves are kept.
     """
     target = share * tol
-    works = []
-    for c in curves:
+    plans = [_resample_targets(c, target) if simplify else None for c in curves]
+    starts = [(t, interps, pos) for t, interps, pos in filter(None, plans)]
+    new = None
+    if starts:
+        anchors = np.concatenate([c3.evaluate(pos) for _, (c3, _, _), pos in starts])
+        uv_a = np.concatenate([pa.evaluate(pos) for _, (_, pa, _), pos in starts])
+        uv_b = np.concatenate([pb.evaluate(pos) for _, (_, _, pb), pos in starts])
+        new = refine_points(surface_a, surface_b, uv_a, uv_b, tol=_POINT_SHARE * tol,
+                            anchors=anchors, tangent_sin=tangent_sin)
+        # a sample that slid along the curve (near-tangential surfaces) is left out
+        moved = np.linalg.norm(new.points - anchors, axis=1)
+    works, offset = [], 0
+    for c, plan in zip(curves, plans):
         m = c.points.shape[0]
-        kept = np.zeros(m, dtype=bool)
-        kept[_initial_subset(c, target) if simplify else np.arange(m)] = True
-        if c.closed and np.count_nonzero(kept) < 3:
-            kept[:] = True
-        works.append(_Work(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
-                           c.closed, kept, np.zeros(m, dtype=bool)))
+        if plan is None:
+            works.append(_Work(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
+                               c.closed, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
+            continue
+        t, _, pos = plan
+        sl = slice(offset, offset + pos.size)
+        offset += pos.size
+        spacing = t[-1] / (pos.size + 1)
+        ok = new.converged[sl] & (moved[sl] <= _MIDDLE * spacing)
+        part = RefinedPoints(new.points[sl][ok], new.uv_a[sl][ok], new.uv_b[sl][ok],
+                             new.gap[sl][ok], new.iterations[sl][ok], new.converged[sl][ok],
+                             new.singular[sl][ok])
+        works.append(_merged_work(c, t, pos[ok], part))
     for _ in range(max_rounds):
         _round(works, surface_a, surface_b, target, tol, tangent_sin)
         if all(w.done for w in works):
