@@ -212,7 +212,8 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     neighbours : int
         ``K`` of the localized Hardy method (5-10).
     hardy : HardyMode
-        Localized (default) or global Hardy interpolation.
+        Localized (default) or global Hardy interpolation (one dense system
+        over all found points: ``O(n^3)``, for small grids).
     growth : float > 1
         Resolution factor between passes (at least +2 each).
     gap_tol : float, optional
@@ -260,6 +261,8 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
             f"max_resolution {limit} must be at least resolution {current}")
     if not (np.isfinite(growth) and growth > 1):
         raise InvalidGeometryError(f"growth must be > 1, got {growth!r}")
+    if not (isinstance(neighbours, (int, np.integer)) and neighbours >= 1):
+        raise InvalidGeometryError(f"neighbours must be an integer >= 1, got {neighbours!r}")
     if offset is not None:
         offset = check_tolerance(offset, "offset", low=1e-12 * size)
     history, passes = [], []

@@ -26,6 +26,7 @@ from surfprep.algorithms.healing import (
     corners_boundary,
     local_approximant,
 )
+from surfprep.algorithms.intersection.mesh import TriangleMesh
 from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
 
 from surfprep.errors import (
@@ -237,6 +238,7 @@ def test_given_offset_and_unreachable_sources(smooth):
     ({"resolution": (1, 8)}, InvalidGeometryError, ">= 2"),
     ({"resolution": (16, 16)}, InvalidGeometryError, "at least resolution"),
     ({"offset": 0.0}, InvalidToleranceError, "offset"),
+    ({"neighbours": 0}, InvalidGeometryError, "neighbours"),
 ])
 def test_bad_arguments(smooth, kwargs, error, match):
     with pytest.raises(error, match=match):
@@ -255,3 +257,12 @@ def test_bad_boundary_and_sources(smooth):
         local_approximant(shifted, [smooth])
     with pytest.raises(InvalidGeometryError, match="NaN"):
         local_approximant([np.full((3, 3), np.nan)] + list(b[1:]), [smooth])
+
+
+def test_surface_source_validation(smooth):
+    with pytest.raises(InvalidGeometryError, match="surface, a mesh or both"):
+        SurfaceSource()
+    mesh = holed_mesh(smooth, HOLE)
+    plain = TriangleMesh(mesh.vertices, mesh.triangles)
+    with pytest.raises(InvalidGeometryError, match=r"mesh's \(u, v\)"):
+        SurfaceSource(smooth, plain)
