@@ -51,6 +51,7 @@ __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_
 DEFAULT_RELATIVE_TOL = 1e-3
 #: default chord tolerance of the triangulation of surfaces: this fraction of ``d``
 MESH_FRACTION = 0.02
+_BOX_PAD = 0.05             # clipping box margin reused by later passes, fraction of its size
 _NEWTON_FRACTION = 1e-9      # residual of the Newton polish, fraction of the size
 _INVERSION_FRACTION = 1e-10  # convergence of point inversion, fraction of the size
 
@@ -149,11 +150,18 @@ class _Pass:
 
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
-              mesh_tol: float | None, keep_boundary: bool, tol: float, size: float) -> _Pass:
+              mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
+              cache: dict) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
-    clipped = clip_sources(sources, off.box,
-                           mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    if cache.get("clipped") is None or not cache["clipped"].covers(off.box):
+        # triangulate a box a little larger than needed: later passes (finer grids,
+        # slightly different normals) reuse the triangles
+        pad = _BOX_PAD * np.ptp(off.box, axis=0).max()
+        cache["clipped"] = clip_sources(
+            sources, off.box + np.array([[-pad], [pad]]),
+            mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    clipped = cache["clipped"].restrict(off.box)
     a, b = off.upper.reshape(-1, 3), off.lower.reshape(-1, 3)
     y, t, found, src = project_grid(a, b, clipped, tol=_NEWTON_FRACTION * size)
     shape = (m + 1, n + 1)
@@ -265,11 +273,11 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         raise InvalidGeometryError(f"neighbours must be an integer >= 1, got {neighbours!r}")
     if offset is not None:
         offset = check_tolerance(offset, "offset", low=1e-12 * size)
-    history, passes = [], []
+    history, passes, cache = [], [], {}
     while True:
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
                       hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
-                      keep_boundary=keep_boundary, tol=tol, size=size)
+                      keep_boundary=keep_boundary, tol=tol, size=size, cache=cache)
         share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)

@@ -121,6 +121,8 @@ class ClippedTriangles:
         All sources given (indices refer to them).
     kept : (s,) bool
         Sources whose box meets the offsets' box.
+    box : (2, 3) float
+        The box clipped to.
     """
 
     points: NDArray
@@ -128,10 +130,24 @@ class ClippedTriangles:
     source: NDArray
     sources: tuple
     kept: NDArray
+    box: NDArray
 
     @property
     def n_triangles(self) -> int:
         return self.points.shape[0]
+
+    def restrict(self, box: NDArray) -> ClippedTriangles:
+        """The triangles (and sources) that may lie in a smaller ``box`` (2, 3)."""
+        tri_boxes = np.stack([self.points.min(axis=1), self.points.max(axis=1)], axis=1)
+        keep = _overlaps(box, tri_boxes) if self.n_triangles else np.zeros(0, bool)
+        kept = self.kept & np.array([bool(_overlaps(box, s.box())) for s in self.sources])
+        keep &= kept[self.source] if self.n_triangles else keep
+        return ClippedTriangles(self.points[keep], self.uv[keep], self.source[keep],
+                                self.sources, kept, np.array(box, dtype=float))
+
+    def covers(self, box: NDArray) -> bool:
+        """True when ``box`` lies inside the box these triangles were clipped to."""
+        return bool(np.all(box[0] >= self.box[0]) and np.all(box[1] <= self.box[1]))
 
 
 def _overlaps(box_a: NDArray, box_b: NDArray) -> NDArray:
@@ -175,4 +191,4 @@ def clip_sources(sources: tuple[SurfaceSource, ...], box: NDArray, *, mesh_tol: 
         uv.append(q)
         src.append(np.full(p.shape[0], k, np.int64))
     return ClippedTriangles(np.concatenate(pts), np.concatenate(uv), np.concatenate(src),
-                            sources, kept)
+                            sources, kept, np.array(box, dtype=float))
