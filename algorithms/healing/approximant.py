@@ -18,6 +18,12 @@
 If the error exceeds ``tol`` the resolution grows and everything is redone from
 the boundary, up to ``max_resolution``; the result then says
 ``converged=False`` (or, with ``strict=True``, an error is raised).
+
+Beyond the paper: by default the approximant's sides are the boundary curves
+(their samples are interpolated, not projected: ``keep_boundary``), so that
+approximants sharing a curve meet before any G0 averaging and a hole bounded
+by the curves is filled from its rim; and the projected points are put on
+the exact surfaces by Newton piercing of the segments (:mod:`.segments`).
 """
 
 from __future__ import annotations
@@ -148,6 +154,23 @@ class _Pass:
     offset: float
 
 
+def _sides(found: NDArray, t: NDArray, y: NDArray, x: NDArray, keep_boundary: bool,
+           tol: float) -> tuple[NDArray, NDArray, NDArray]:
+    """Grid points fixed to the boundary curves, and ``found``/``t`` updated for them.
+
+    Kept sides are the Coons points ``x`` themselves (``t = 1/2`` on their
+    segments, data for Hardy's fill); a side point counts as on the originals
+    only where the curve is (within ``tol`` of its projection), not where it
+    runs above or below them.
+    """
+    rim = np.zeros(found.shape, bool)
+    if not keep_boundary:
+        return rim, found, t
+    rim[[0, -1], :] = rim[:, [0, -1]] = True
+    off_surface = rim & found & (np.linalg.norm(y - x, axis=-1) > tol)
+    return rim, found & ~off_surface, np.where(rim, 0.5, t)
+
+
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
@@ -170,14 +193,8 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
         raise DegenerateGeometryError(
             "no segment of the Coons patch meets the original surfaces: the boundary does not "
             f"lie over them (or the offset distance {off.distance:.3g} is too small)")
-    rim = np.zeros(shape, bool)
     y = y.reshape(shape + (3,))
-    if keep_boundary:           # the sides are the boundary curves: x itself, t = 1/2
-        rim[[0, -1], :] = rim[:, [0, -1]] = True
-        t = np.where(rim, 0.5, t)
-        # a side point is on the originals only where its curve is (not above or below)
-        off_surface = rim & found & (np.linalg.norm(y - coons.points, axis=-1) > tol)
-        found = found & ~off_surface
+    rim, found, t = _sides(found, t, y, coons.points, keep_boundary, tol)
     t_all = fill_positions(coons.u, coons.v, t, found | rim, mode=hardy, neighbours=neighbours)
     z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
     grid = np.where(found[..., None], y, z)
