@@ -31,7 +31,19 @@ from ..intersection.mesh import TriangleMesh
 from ..intersection.tessellation import tessellate
 from ..surface import NurbsSurface
 
-__all__ = ["ClippedTriangles", "Source", "SurfaceSource", "as_sources", "clip_sources"]
+__all__ = [
+    "ClippedTriangles",
+    "Source",
+    "SurfaceSource",
+    "as_sources",
+    "clip_sources",
+    "inside_loops",
+    "trimmed_source",
+]
+
+#: default chord tolerance of :func:`trimmed_source`, fraction of the surface's box diagonal
+TRIM_MESH_FRACTION = 1e-3
+_PIP_CHUNK = 4096
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +88,70 @@ class SurfaceSource:
 
 
 Source = NurbsSurface | TriangleMesh | SurfaceSource
+
+
+def inside_loops(points: NDArray, loops: Sequence[NDArray]) -> NDArray:
+    """Even-odd test of parameter points against closed polygons.
+
+    Parameters
+    ----------
+    points : (m, 2) float
+    loops : sequence of (n_k, 2) float
+        Closed polygons (the last point joins the first), e.g. samples of a
+        face's trimming loops in ``(u, v)``: the outer loop and its holes.
+
+    Returns
+    -------
+    (m,) bool
+        Inside an odd number of loops.
+    """
+    edges = [np.stack([lp, np.roll(lp, -1, axis=0)], axis=1)
+             for lp in (np.asarray(x, dtype=float) for x in loops) if lp.shape[0] >= 3]
+    inside = np.zeros(points.shape[0], bool)
+    if not edges:
+        return inside
+    e = np.concatenate(edges)                                    # (E, 2, 2)
+    (x0, y0), (x1, y1) = e[:, 0].T, e[:, 1].T
+    for start in range(0, points.shape[0], _PIP_CHUNK):
+        px = points[start:start + _PIP_CHUNK, :1]
+        py = points[start:start + _PIP_CHUNK, 1:]
+        spans = (y0 > py) != (y1 > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xc = x0 + (py - y0) * (x1 - x0) / (y1 - y0)
+        inside[start:start + _PIP_CHUNK] = np.sum(spans & (px < xc), axis=1) % 2 == 1
+    return inside
+
+
+def trimmed_source(surface: NurbsSurface, loops: Sequence[NDArray], *,
+                   mesh_tol: float | None = None, name: str = "") -> SurfaceSource:
+    """A trimmed face as a source: its surface and a triangulation of the part that exists.
+
+    The surface is triangulated (:func:`..intersection.tessellation.tessellate`)
+    and the triangles whose parameter centroid lies outside the trimming loops
+    (even-odd, :func:`inside_loops`) are dropped, so projections onto the face
+    miss its holes and the parts trimmed away (the rim is as fine as the
+    triangulation).
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+    loops : sequence of (n_k, 2) float
+        The trimming loops sampled in ``(u, v)`` (e.g. the pcurves' points).
+    mesh_tol : float, optional
+        Chord tolerance, model units; default :data:`TRIM_MESH_FRACTION` times
+        the control-net box diagonal.
+    name : str
+    """
+    if mesh_tol is None:
+        mesh_tol = TRIM_MESH_FRACTION * float(np.linalg.norm(np.ptp(surface.bounding_box(),
+                                                                      axis=0)))
+    mesh = tessellate(surface, mesh_tol).mesh
+    keep = inside_loops(mesh.triangle_uv().mean(axis=1), loops)
+    if not np.any(keep):
+        raise InvalidGeometryError(
+            f"no part of the surface lies inside the trimming loops{f' of {name}' if name else ''}")
+    trimmed = TriangleMesh.from_arrays(mesh.vertices, mesh.triangles[keep], mesh.uv)
+    return SurfaceSource(surface, trimmed, name)
 
 
 def as_sources(sources: Sequence[Source] | Source) -> tuple[SurfaceSource, ...]:

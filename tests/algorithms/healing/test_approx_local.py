@@ -26,6 +26,7 @@ from surfprep.algorithms.healing import (
     corners_boundary,
     local_approximant,
 )
+from surfprep.algorithms.healing.clipping import inside_loops, trimmed_source
 from surfprep.algorithms.intersection.mesh import TriangleMesh
 from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
 
@@ -266,3 +267,24 @@ def test_surface_source_validation(smooth):
     plain = TriangleMesh(mesh.vertices, mesh.triangles)
     with pytest.raises(InvalidGeometryError, match=r"mesh's \(u, v\)"):
         SurfaceSource(smooth, plain)
+
+
+def test_trimmed_face_with_a_round_hole(smooth):
+    # a face trimmed by a square and a circular hole (loops in (u, v)): projections miss
+    # the hole, the error is measured around it, the fill follows the surface under it
+    angle = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    hole = np.stack([0.5 + 0.1 * np.cos(angle), 0.5 - 0.1 * np.sin(angle)], axis=1)
+    outer = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    face = trimmed_source(smooth, [outer, hole], name="holed")
+    uv = face.mesh.triangle_uv().mean(axis=1)
+    assert np.all(np.linalg.norm(uv - 0.5, axis=1) > 0.1)
+    assert inside_loops(np.array([[0.5, 0.5], [0.2, 0.2], [1.5, 0.5]]), [outer, hole]).tolist() \
+        == [False, True, False]
+    r = _fixed(iso_boundary(smooth, *PATCH), [face], 12)
+    xy = r.grid[..., :2]
+    assert np.all(r.artificial[np.linalg.norm(xy - 0.5, axis=-1) < 0.09])
+    assert r.artificial_share > 0.05 and r.max_error < 1e-3
+    _, pts = _dense(r)
+    assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 1e-3
+    with pytest.raises(InvalidGeometryError, match="inside the trimming loops"):
+        trimmed_source(smooth, [outer + 5.0])
