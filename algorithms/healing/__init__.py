@@ -4,7 +4,7 @@ B-spline approximants joined G0/G1 (Hamann & Jean 1996, paper 001; handbook
 
 from .approximant import LocalApproximant, ResolutionStep, local_approximant
 from .boundary import Boundary, as_boundary, corners_boundary
-from .clipping import SurfaceSource
+from .clipping import SurfaceSource, trimmed_source
 from .connectivity import (
     Connectivity,
     NetworkTopologyError,
@@ -39,4 +39,5 @@ __all__ = [
     "find_connectivity",
     "local_approximant",
     "measure_join",
+    "trimmed_source",
 ]
