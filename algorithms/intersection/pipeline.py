@@ -52,9 +52,9 @@ from .mesh import TriangleMesh
 from .refine import RefinedCurve
 from .result import (
     IntersectionCurve,
+    checked_curves,
     intersection_curves,
     refine_chains,
-    sampled_curves,
 )
 from .segments import mesh_segments
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
@@ -481,9 +481,8 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
              (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in chains]
     dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
                                  reach=_JOIN_FACTOR * mesh_tol)
-    curves = sampled_curves(dense, [(c.start_kind, c.end_kind) for c in chains],
-                            surface_a, surface_b, tol=tol)
-    worst = np.array([c.max_deviation(surface_a, surface_b).max for c in curves])
+    curves, worst = checked_curves(dense, [(c.start_kind, c.end_kind) for c in chains],
+                                   surface_a, surface_b, tol=tol)
     if stray is StrayCurves.DROP:
         if np.any(worst > tol):
             warnings.warn(

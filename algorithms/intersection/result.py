@@ -29,11 +29,17 @@ from ..measure import arc_length
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .refine import RefinedCurve, project_points, refine_curves
-from .sampling import cubic_samples, interpolate_samples, sample_parameters, span_errors
+from .sampling import (
+    cubic_samples,
+    interpolate_samples,
+    interpolate_stacked,
+    sample_parameters,
+    span_errors,
+)
 from .topology import Chain, EndKind, SegmentTopology
 
 __all__ = ["IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
-           "refine_chains", "sampled_curves"]
+           "refine_chains", "sampled_curves", "checked_curves"]
 
 
 @dataclass(frozen=True)
@@ -123,12 +129,17 @@ class IntersectionCurve:
             raise InvalidGeometryError("coincident consecutive samples")
         sing = np.zeros(n, dtype=bool) if singular is None else np.asarray(singular, dtype=bool)
         curves = [None, None, None]
-        if interpolate:
-            curves = [None if v is None else interpolate_samples(v, t, bool(closed))
-                      for v in (pts, uvs[0], uvs[1])]
-        for a in (pts, t, sing, *[u for u in uvs if u is not None]):
+        if interpolate:      # one collocation solve for all three (same parameters)
+            curves = interpolate_stacked([pts, uvs[0], uvs[1]], t, bool(closed))
+        return cls._frozen(pts, uvs[0], uvs[1], bool(closed), start_kind, end_kind, t, curves,
+                           sing)
+
+    @classmethod
+    def _frozen(cls, pts, uv_a, uv_b, closed, start_kind, end_kind, t, curves, sing
+                ) -> IntersectionCurve:
+        for a in (pts, t, sing, *[u for u in (uv_a, uv_b) if u is not None]):
             a.setflags(write=False)
-        return cls(pts, uvs[0], uvs[1], bool(closed), start_kind, end_kind, t, *curves, sing)
+        return cls(pts, uv_a, uv_b, closed, start_kind, end_kind, t, *curves, sing)
 
     @property
     def length(self) -> float:
@@ -200,11 +211,36 @@ def sampled_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKin
                    simplify: bool = True, max_rounds: int = 40) -> list[IntersectionCurve]:
     """Step 6: the samples the cubic interpolants need (:func:`.sampling.cubic_samples`)
     and the curves with their interpolants; ``kinds`` are the (start, end) kinds."""
-    sampled = cubic_samples(surface_a, surface_b, refined, tol=tol, simplify=simplify,
-                            max_rounds=max_rounds)
-    return [IntersectionCurve.from_samples(r.points, r.uv_a, r.uv_b, r.closed, start, end,
-                                           singular=r.singular)
-            for r, (start, end) in zip(sampled, kinds)]
+    return checked_curves(refined, kinds, surface_a, surface_b, tol=tol, simplify=simplify,
+                          max_rounds=max_rounds)[0]
+
+
+def checked_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKind, EndKind]],
+                   surface_a: NurbsSurface, surface_b: NurbsSurface, *, tol: float,
+                   simplify: bool = True, max_rounds: int = 40
+                   ) -> tuple[list[IntersectionCurve], NDArray]:
+    """:func:`sampled_curves` and each curve's largest deviation ``(c,) float`` (as
+    :meth:`IntersectionCurve.max_deviation` measures it: at a quarter, the midpoint
+    and three quarters of every span), taken from the sampling's last check
+    where it passed, measured otherwise."""
+    out, worst = [], []
+    for sampled, (start, end) in zip(cubic_samples(surface_a, surface_b, refined, tol=tol,
+                                                   simplify=simplify, max_rounds=max_rounds),
+                                     kinds):
+        r = sampled.curve
+        if sampled.interpolants is None:
+            curve = IntersectionCurve.from_samples(r.points, r.uv_a, r.uv_b, r.closed, start,
+                                                   end, singular=r.singular)
+            out.append(curve)
+            worst.append(curve.max_deviation(surface_a, surface_b).max)
+            continue
+        out.append(IntersectionCurve._frozen(
+            np.array(r.points, dtype=float), np.array(r.uv_a, dtype=float),
+            np.array(r.uv_b, dtype=float), bool(r.closed), start, end,
+            np.array(sampled.parameters, dtype=float), list(sampled.interpolants),
+            np.array(r.singular, dtype=bool)))
+        worst.append(sampled.error)
+    return out, np.array(worst, dtype=float)
 
 
 def intersection_curves(topology: SegmentTopology, surface_a: NurbsSurface | None,

@@ -48,6 +48,8 @@ from .refine import RefinedCurve, RefinedPoints, refine_points
 
 __all__ = [
     "CHECK_FRACTIONS",
+    "SampledCurve",
+    "interpolate_stacked",
     "CUBIC_SHARE",
     "cubic_samples",
     "interpolate_samples",
@@ -107,6 +109,29 @@ def interpolate_samples(values: ArrayLike, parameters: ArrayLike, closed: bool) 
     degree = min(3, q.shape[0] - 1)
     return interpolate_curve(q, degree=degree, parameters=parameters,
                              smooth_closure=closed and q.shape[0] >= 4)
+
+
+def interpolate_stacked(values: Sequence[NDArray | None], parameters: NDArray,
+                        closed: bool) -> list[NurbsCurve | None]:
+    """Interpolants of several sample sequences on one parametrization, by one solve.
+
+    ``values`` are ``(n, d_i)`` arrays (or None); the collocation system of
+    :func:`interpolate_samples` is the same for all of them, so they are
+    interpolated together as one ``(n, sum d_i)`` sequence and split again.
+    Returns one NurbsCurve per entry (None for None).
+    """
+    present = [v for v in values if v is not None]
+    stacked = interpolate_samples(np.hstack(present), parameters, closed)
+    out, col = [], 0
+    for v in values:
+        if v is None:
+            out.append(None)
+            continue
+        d = v.shape[1]
+        out.append(NurbsCurve(stacked.control_points[:, col:col + d], stacked.knots,
+                              stacked.degree))
+        col += d
+    return out
 
 
 def span_errors(t: NDArray, curve3d: NurbsCurve, pcurve_a: NurbsCurve | None,
@@ -173,11 +198,11 @@ def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float) -> NDArray:
 
 
 def _resample_targets(curve: RefinedCurve, target: float
-                      ) -> tuple[NDArray, list[NurbsCurve], NDArray] | None:
+                      ) -> tuple[NDArray, NurbsCurve, NDArray] | None:
     """New sample positions of a densely refined curve (module docstring, step 1).
 
-    Returns ``(t, interpolants, positions)``: the dense chord-length parameters,
-    the interpolants through all dense samples (3D, uv_a, uv_b) and the interior
+    Returns ``(t, stacked, positions)``: the dense chord-length parameters,
+    the interpolant through all dense samples (3D | uv_a | uv_b, 7 coordinates) and the interior
     parameters where samples should go, equally many cubic spans apart (at least
     four spans on a closed curve); None when the curve has too few converged
     samples to interpolate (every dense sample is kept then).
@@ -192,9 +217,9 @@ def _resample_targets(curve: RefinedCurve, target: float
     goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
         t[-1] * np.arange(1, spans) / spans
     positions = np.interp(goal, phase, t) if phase[-1] > 0 else goal
-    interps = [interpolate_samples(v, t, curve.closed) for v in (curve.points, curve.uv_a,
-                                                                  curve.uv_b)]
-    return t, interps, positions
+    stacked = interpolate_samples(np.hstack([curve.points, curve.uv_a, curve.uv_b]), t,
+                                  curve.closed)
+    return t, stacked, positions
 
 
 def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _Work:
@@ -229,6 +254,29 @@ def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _W
 
 
 # ------------------------------------------------------------------ verification
+@dataclass(frozen=True)
+class SampledCurve:
+    """Result of :func:`cubic_samples` for one curve.
+
+    Attributes
+    ----------
+    curve : RefinedCurve
+        The samples kept.
+    parameters : (n,) float, or (n + 1,) when closed, or None
+        Chord-length parameters of the samples (:func:`sample_parameters`).
+    interpolants : (curve3d, pcurve_a, pcurve_b) or None
+        The interpolants that passed the last check (None when the rounds ran
+        out before every span passed: rebuild and measure them then).
+    error : float
+        Their largest error at the check points (NaN without interpolants).
+    """
+
+    curve: RefinedCurve
+    parameters: NDArray | None
+    interpolants: tuple[NurbsCurve, NurbsCurve, NurbsCurve] | None
+    error: float
+
+
 @dataclass
 class _Work:
     """One curve under sampling: its dense samples and which of them are kept."""
@@ -242,40 +290,71 @@ class _Work:
     kept: NDArray          # (m,) bool
     stuck: NDArray         # (m,) bool: the span starting at this sample cannot be split
     done: bool = False
-
-
-def _interpolants(w: _Work):
-    k = np.flatnonzero(w.kept)
-    t = sample_parameters(w.points[k], w.closed)
-    return k, t, [interpolate_samples(v[k], t, w.closed) for v in (w.points, w.uv_a, w.uv_b)]
+    error: float = float("inf")    # largest check-point error in the last round
+    result: object = None          # the passing _Check (interpolants) once done
 
 
 def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
                       hi: NDArray) -> NDArray:
-    """Distances ``(m,)`` of points ``x (m, 3)`` to ``curve`` near ``t0`` (Newton within
-    ``[lo, hi]``)."""
+    """Distances ``(m,)`` of points ``x (m, 3)`` to the first three coordinates of
+    ``curve`` near ``t0`` (Newton within ``[lo, hi]``)."""
     t = t0.copy()
     for _ in range(_PROJECTION_STEPS):
-        d = curve.derivatives(t, 2)
+        d = curve.derivatives(t, 2)[..., :3]
         r = d[:, 0] - x
         num = np.einsum("ij,ij->i", r, d[:, 1])
-        den = np.einsum("ij,ij->i", d[:, 1], d[:, 1]) + np.einsum("ij,ij->i", r, d[:, 2])
-        den = np.where(den > 0, den, np.einsum("ij,ij->i", d[:, 1], d[:, 1]))
+        speed = np.einsum("ij,ij->i", d[:, 1], d[:, 1])
+        den = speed + np.einsum("ij,ij->i", r, d[:, 2])
+        den = np.where(den > 0, den, speed)
         t = np.clip(t - num / np.where(den > 0, den, 1.0), lo, hi)
-    return np.linalg.norm(curve.evaluate(t) - x, axis=1)
+    return np.linalg.norm(curve.evaluate(t)[:, :3] - x, axis=1)
 
 
-def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
+@dataclass
+class _Check:
+    """One curve's interpolants and their check points in a verification round."""
+
+    kept: NDArray          # kept dense indices
+    t: NDArray             # their parameters ((k + 1,) when closed)
+    stacked: NurbsCurve    # curve3d | pcurve_a | pcurve_b in one 7-dimensional curve
+    at: NDArray            # (spans * 3, 7) interpolant values at the check points
+
+
+def _checks(works: list[_Work]) -> list[_Check]:
+    out = []
+    s = np.asarray(CHECK_FRACTIONS)
+    for w in works:
+        k = np.flatnonzero(w.kept)
+        t = sample_parameters(w.points[k], w.closed)
+        stacked = interpolate_samples(np.hstack([w.points[k], w.uv_a[k], w.uv_b[k]]), t,
+                                      w.closed)
+        at = stacked.evaluate((t[:-1, None] + s[None, :] * np.diff(t)[:, None]).ravel())
+        out.append(_Check(k, t, stacked, at))
+    return out
+
+
+def _check_errors(checks: list[_Check], surface_a, surface_b) -> list[NDArray]:
+    """Per curve ``(spans,)``: the largest of ``|S_a(pcurve_a) - curve3d|``,
+    ``|S_b(pcurve_b) - curve3d|``, ``|S_a - S_b|`` at the check points; one
+    evaluation per surface for all curves."""
+    at = np.concatenate([c.at for c in checks])
+    on_a = surface_a.evaluate(at[:, 3], at[:, 4])
+    on_b = surface_b.evaluate(at[:, 5], at[:, 6])
+    err = np.maximum.reduce([np.linalg.norm(on_a - at[:, :3], axis=1),
+                             np.linalg.norm(on_b - at[:, :3], axis=1),
+                             np.linalg.norm(on_a - on_b, axis=1)])
+    split = np.cumsum([c.at.shape[0] for c in checks])[:-1]
+    return [e.reshape(-1, len(CHECK_FRACTIONS)).max(axis=1) for e in np.split(err, split)]
+
+
+def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float):
     """Spans (by index into the kept samples) over ``target`` at their check points or
     too long beside a neighbour, their errors, the dense samples farther than
     ``target`` from ``curve3d`` (the worst per span; those spans take them), and what
     the insertion needs."""
-    k, t, (c3, pa, pb) = _interpolants(w)
+    k, t = check.kept, check.t
     dt = np.diff(t)
-    s = np.asarray(CHECK_FRACTIONS)
-    to_a, to_b, gap = span_errors(t[:-1, None] + s[None, :] * dt[:, None], c3, pa, pb,
-                                  surface_a, surface_b)
-    error = np.maximum(np.maximum(to_a, to_b), gap)
+    error = np.nan_to_num(error)
     # left-out dense samples: projected onto curve3d within their span
     m = w.points.shape[0]
     ends = np.append(k, m) if w.closed else k                     # span j: ends[j]..ends[j+1]
@@ -289,7 +368,8 @@ def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
         j = span_of[idx]
         a0, a1 = arc[ends[j]], arc[ends[j + 1]]
         frac = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
-        dist = _project_on_curve(c3, w.points[idx], t[j] + frac * dt[j], t[j], t[j + 1])
+        dist = _project_on_curve(check.stacked, w.points[idx], t[j] + frac * dt[j], t[j],
+                                 t[j + 1])
         far = dist > target
         if np.any(far):                          # the worst of each span
             order = np.lexsort((-dist[far], j[far]))
@@ -300,11 +380,10 @@ def _failing_spans(w: _Work, surface_a, surface_b, target: float, tol: float):
     ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
         np.concatenate([[np.inf], dt, [np.inf]])
     steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
-    error = np.nan_to_num(error)
     bad = ((error > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
     bad[span_of[off]] = False                    # those get their dense sample instead
     bad = np.flatnonzero(bad)
-    return bad, error[bad], off, t, ends, span_of, arc, c3, pa, pb
+    return bad, error[bad], off, ends, span_of, arc
 
 
 def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
@@ -358,17 +437,20 @@ def _pieces(error: NDArray, target: float) -> NDArray:
 def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
            tangent_sin: float) -> None:
     """One verification round over all unfinished curves (module docstring, step 2)."""
+    todo = [w for w in works if not w.done]
+    checks = _checks(todo)
+    errors = _check_errors(checks, surface_a, surface_b)
     jobs = []        # per curve: work, span start / stop (dense), parameters of the pieces
-    curves = []      # per job: interpolants
-    for w in works:
-        if w.done:
-            continue
-        bad, error, off, t, ends, span_of, arc, c3, pa, pb = _failing_spans(
-            w, surface_a, surface_b, target, tol)
+    curves = []      # per job: the stacked interpolant
+    for w, check, error in zip(todo, checks, errors):
+        w.error = float(error.max()) if error.size else 0.0
+        bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
         if bad.size == 0 and off.size == 0:
             w.done = True
+            w.result = check
             continue
         w.kept[off] = True
+        t = check.t
         pieces = _pieces(error, target)
         fresh = []
         for j, n in zip(bad, pieces):
@@ -385,16 +467,14 @@ def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
             span = np.repeat([j for j, _ in fresh], [n - 1 for _, n in fresh])
             count = np.repeat([n for _, n in fresh], [n - 1 for _, n in fresh])
             local = np.concatenate([np.arange(1, n) for _, n in fresh])
-            expect = local / count
-            jobs.append((w, ends[span], ends[span + 1], t[span] + expect * np.diff(t)[span]))
-            curves.append((c3, pa, pb))
+            jobs.append((w, ends[span], ends[span + 1],
+                         t[span] + local / count * np.diff(t)[span]))
+            curves.append(check.stacked)
     if not jobs:
         return
-    anchors = np.concatenate([c[0].evaluate(j[3]) for j, c in zip(jobs, curves)])
-    uv_a = np.concatenate([c[1].evaluate(j[3]) for j, c in zip(jobs, curves)])
-    uv_b = np.concatenate([c[2].evaluate(j[3]) for j, c in zip(jobs, curves)])
-    new = refine_points(surface_a, surface_b, uv_a, uv_b, tol=_POINT_SHARE * tol,
-                        anchors=anchors, tangent_sin=tangent_sin)
+    at = np.concatenate([c.evaluate(j[3]) for j, c in zip(jobs, curves)])
+    new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
+                        anchors=at[:, :3], tangent_sin=tangent_sin)
     offset = 0
     for w, start, stop, _ in jobs:
         sl = slice(offset, offset + start.size)
@@ -441,19 +521,19 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
 
     Returns
     -------
-    list of RefinedCurve
-        Each a subset of its dense samples plus inserted ones, in curve order;
-        the ends of open curves are kept.
+    list of SampledCurve
+        Each with a subset of its dense samples plus inserted ones, in curve
+        order (the ends of open curves are kept), and, when it passed, its
+        interpolants and their largest check-point error.
     """
     target = share * tol
     plans = [_resample_targets(c, target) if simplify else None for c in curves]
-    starts = [(t, interps, pos) for t, interps, pos in filter(None, plans)]
+    starts = [(stacked, pos) for _, stacked, pos in filter(None, plans)]
     new = None
     if starts:
-        anchors = np.concatenate([c3.evaluate(pos) for _, (c3, _, _), pos in starts])
-        uv_a = np.concatenate([pa.evaluate(pos) for _, (_, pa, _), pos in starts])
-        uv_b = np.concatenate([pb.evaluate(pos) for _, (_, _, pb), pos in starts])
-        new = refine_points(surface_a, surface_b, uv_a, uv_b, tol=_POINT_SHARE * tol,
+        at = np.concatenate([stacked.evaluate(pos) for stacked, pos in starts])
+        anchors = at[:, :3]
+        new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
                             anchors=anchors, tangent_sin=tangent_sin)
         # a sample that slid along the curve (near-tangential surfaces) is left out
         moved = np.linalg.norm(new.points - anchors, axis=1)
@@ -477,5 +557,15 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         _round(works, surface_a, surface_b, target, tol, tangent_sin)
         if all(w.done for w in works):
             break
-    return [RefinedCurve(w.points[w.kept], w.uv_a[w.kept], w.uv_b[w.kept], w.closed,
-                         w.converged[w.kept], w.singular[w.kept]) for w in works]
+    out = []
+    for w in works:
+        curve = RefinedCurve(w.points[w.kept], w.uv_a[w.kept], w.uv_b[w.kept], w.closed,
+                             w.converged[w.kept], w.singular[w.kept])
+        if w.result is None:                       # rounds ran out: not verified as is
+            out.append(SampledCurve(curve, None, None, float("nan")))
+            continue
+        stacked = w.result.stacked
+        parts = tuple(NurbsCurve(stacked.control_points[:, a:b], stacked.knots, stacked.degree)
+                      for a, b in ((0, 3), (3, 5), (5, 7)))
+        out.append(SampledCurve(curve, w.result.t, parts, w.error))
+    return out
