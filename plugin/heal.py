@@ -6,13 +6,17 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
 1. every face is read as a :class:`TrimmedFace`; faces that lie on another face
    within ``gap_tol`` (all their edges on its edges, interior points on its
    surface; exact duplicates as in overture_marscapsule_proe.igs) are dropped,
-   so the output has no doubled area;
+   and of two four-sided faces overlapping over a strip the later one is
+   trimmed back to the other's side (:mod:`.heal_overlap`), so the output has
+   no doubled area;
 2. edges of different faces within ``gap_tol`` of each other are paired; free
    edges chained into loops of four from two or more faces are holes;
 3. every four-sided face (one loop of four real edges, trimmed or not) gets a
    :func:`local_approximant` over its own four edges, projected onto all
-   original surfaces; every hole one over its four free edges; every directed
-   patch of ``patches`` (:mod:`.heal_spec`) one over its curves or corners;
+   original surfaces (a face whose approximant misses ``tol`` at the largest
+   resolution is kept as it is, and the report says so); every hole one over
+   its four free edges; every directed patch of ``patches`` (:mod:`.heal_spec`)
+   one over its curves or corners;
 4. the approximants are joined by :func:`connect` (G0 or G1, topology
    violations left unconnected and reported);
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
@@ -47,6 +51,7 @@ from ..algorithms.healing.connectivity import Side
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
+from .heal_overlap import find_overlaps, trimmed_back_boundary
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
     count_free_edges,
@@ -130,7 +135,8 @@ class HealResult:
     free_edges_before, free_edges_after : int
         Free edges after sewing at ``gap_tol`` (input) and in the result.
     tight_free_edges_before, tight_free_edges_after : int
-        The same at ``TIGHT_FACTOR`` x size: edges not closed in the geometry.
+        Free edges when the input faces, and the output faces before sewing, are
+        sewn at ``TIGHT_FACTOR`` x size: edges not closed in the geometry.
     valid_before, valid_after : bool
         ``BRepCheck_Analyzer`` on the input shape and on the result.
     max_edge_tolerance : float
@@ -181,6 +187,7 @@ class HealResult:
                                                            net.joins_before],
             "topology_violations": [] if net is None else list(net.connectivity.violations),
             "dropped_overlaps": [{"kept": a, "dropped": b} for a, b in self.dropped],
+            "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
             "skipped": list(self.skipped),
             "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,
                            "tight_before": self.tight_free_edges_before,
@@ -225,10 +232,10 @@ class _Job:
     reference: TrimmedFace | None     # face whose orientation the approximant takes
 
 
-def _jobs(faces, kept, holes, directed: list[DirectedPatch]) -> list[_Job]:
+def _jobs(faces, kept, holes, directed: list[DirectedPatch], trimmed: dict) -> list[_Job]:
     jobs = []
     for i in kept:
-        curves = four_sided_boundary(faces[i])
+        curves = trimmed.get(i) or four_sided_boundary(faces[i])
         if curves is not None:
             jobs.append(_Job(PatchOrigin("face", (i,), i), curves, faces[i].name, faces[i]))
     for k, loop in enumerate(holes):
@@ -249,6 +256,11 @@ def _approximate(jobs: list[_Job], sources, tol, gap_tol, skipped: list[str]
         except SurfprepError as exc:
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant ({exc}); "
                            "left as it was")
+            continue
+        if job.origin.kind == "face" and not la.converged:
+            skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
+                           f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
+                           "kept as it was")
             continue
         out.append((job, la))
     return out
@@ -312,17 +324,26 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
     holes = hole_loops(edges, free, gap_tol)
+    four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
+    overlaps = find_overlaps(faces, four, gap_tol)
+    trimmed = {o.trimmed: trimmed_back_boundary(faces, o) for o in overlaps}
     directed = read_patch_spec(patches, faces) if patches is not None else []
     sources = [faces[i].surface for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    done = _approximate(_jobs(faces, kept, holes, directed), sources, tol, gap_tol, skipped)
+    done = _approximate(_jobs(faces, kept, holes, directed, trimmed), sources, tol, gap_tol,
+                        skipped)
     network = None
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
-    return _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
-                     start)
+    result = _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
+                       start)
+    result.extra["trimmed_overlaps"] = [
+        {"kept": o.kept, "trimmed": o.trimmed, "replaced": any(
+            j.origin.kind == "face" and j.origin.index == o.trimmed for j, _ in done)}
+        for o in overlaps]
+    return result
 
 
 def _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity, start
@@ -348,7 +369,7 @@ def _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, conti
     tight = TIGHT_FACTOR * model.size
     before_sewn, _ = sew(list(model.faces), gap_tol)
     tight_before, _ = sew(list(model.faces), tight)
-    tight_after, _ = sew(list(out_faces), tight)
+    tight_after, _ = sew(originals + new_faces, tight)       # the output faces, unsewn
     reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
                                 la.artificial_share, la.converged) for job, la in done)
     return HealResult(

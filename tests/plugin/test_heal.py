@@ -141,3 +141,38 @@ def test_public_entry_points():
     assert surfprep.heal.local_approximant is not None
     assert surfprep.heal.connect is not None
     assert callable(surfprep.heal)
+
+
+def _area(shape) -> float:
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props)
+    return props.Mass()
+
+
+def _graph_area(x0, x1) -> float:
+    x, y = np.linspace(x0, x1, 801), np.linspace(0, 1, 801)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    h = 1e-6
+    zx = (graph(gx + h, gy) - graph(gx - h, gy)) / (2 * h)
+    zy = (graph(gx, gy + h) - graph(gx, gy - h)) / (2 * h)
+    f = np.sqrt(1 + zx ** 2 + zy ** 2)
+    return float(np.trapezoid(np.trapezoid(f, y, axis=1), x))
+
+
+def test_overlapping_faces_trimmed_back():
+    continuity = "G1"
+    a = graph_patch(0, 1, 0, 1, 6, 6)
+    b = graph_patch(0.7, 1.7, 0, 1, 7, 6)          # overlaps a over 0.7 <= x <= 1
+    shape = compound([make_face(a), make_face(b)])
+    assert _area(shape) > _graph_area(0, 1.7) + 0.25      # the strip counted twice
+    r = heal(shape, continuity=continuity)
+    rep = r.report()
+    assert rep["trimmed_overlaps"] == [{"kept": 0, "trimmed": 1, "replaced": True}]
+    assert len(r.joins) == 1 and r.joins[0].max_gap < 1e-12
+    assert abs(_area(r.model.shape) - _graph_area(0, 1.7)) < 2e-3     # no doubled area
+    assert r.tight_free_edges_after == 6 and r.valid_after
+    assert deviation_from_graph(r) < 1.5e-3
+    if continuity == "G1":
+        assert r.joins[0].max_angle < 1e-2

@@ -1,0 +1,121 @@
+"""Overlapping four-sided faces for :func:`surfprep.heal`: one is trimmed back to the other.
+
+Two four-sided faces A and B *overlap* when a side of A lies on B's surface
+inside B (within ``gap_tol`` of the surface, farther than ``gap_tol`` from B's
+edges) and a side of B lies on A likewise: the strip between the two sides is
+covered twice. B (the later face) is trimmed back: its approximant is built
+over A's side, the parts of B's two adjacent sides beyond it (each curve cut
+at the closest point to the end of A's side) and B's far side. A and the
+trimmed B then share A's side as a full boundary curve, and the network joins
+them G0/G1 like any neighbours. Exact duplicates are handled before this
+(:func:`.heal_topology.duplicate_faces`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..algorithms import NurbsCurve
+from ..algorithms.projection import distance_to_surface, project_to_curve
+from .faces import TrimmedFace
+from .heal_topology import four_sided_boundary
+
+__all__ = ["Overlap", "find_overlaps", "trimmed_back_boundary"]
+
+_SAMPLES = 9
+
+
+@dataclass(frozen=True)
+class Overlap:
+    """Side ``side_kept`` (loop position) of face ``kept`` lies inside face ``trimmed``,
+    and side ``side_trimmed`` of ``trimmed`` inside ``kept``."""
+
+    kept: int
+    side_kept: int
+    trimmed: int
+    side_trimmed: int
+
+
+def _interior_samples(curve: NurbsCurve) -> NDArray:
+    t0, t1 = curve.domain
+    return curve.evaluate(np.linspace(t0, t1, _SAMPLES + 2)[1:-1])
+
+
+def _distance_to_curves(points: NDArray, curves: list[NurbsCurve]) -> NDArray:
+    return np.min([project_to_curve(c, points).distance for c in curves], axis=0)
+
+
+def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float) -> list[int]:
+    """Sides of ``a`` lying on ``b``'s surface and away from ``b``'s edges."""
+    sides_a, sides_b = four_sided_boundary(a), four_sided_boundary(b)
+    out = []
+    for k, curve in enumerate(sides_a):
+        pts = _interior_samples(curve)
+        if distance_to_surface(b.surface, pts).max() > gap_tol:
+            continue
+        if _distance_to_curves(pts, sides_b).min() > gap_tol:
+            out.append(k)
+    return out
+
+
+def _boxes_overlap(a: TrimmedFace, b: TrimmedFace, tol: float) -> bool:
+    ba, bb = a.surface.bounding_box(), b.surface.bounding_box()
+    return bool(np.all(ba[0] - tol <= bb[1]) and np.all(bb[0] - tol <= ba[1]))
+
+
+def find_overlaps(faces: list[TrimmedFace | None], candidates: list[int], gap_tol: float
+                  ) -> list[Overlap]:
+    """Overlapping pairs among the four-sided ``candidates`` (each face trimmed once)."""
+    out, used = [], set()
+    for n, i in enumerate(candidates):
+        for j in candidates[n + 1:]:
+            if i in used or j in used or not _boxes_overlap(faces[i], faces[j], gap_tol):
+                continue
+            ka = _inside_sides(faces[i], faces[j], gap_tol)
+            kb = _inside_sides(faces[j], faces[i], gap_tol)
+            if len(ka) == 1 and len(kb) == 1:
+                out.append(Overlap(i, ka[0], j, kb[0]))
+                used.add(j)
+    return out
+
+
+def _cut_away_from(curve: NurbsCurve, at: NDArray, away_from: NDArray) -> NurbsCurve:
+    """The piece of ``curve`` from its closest point to ``at`` to the end farther from
+    ``away_from``."""
+    t = float(project_to_curve(curve, at[None]).t[0])
+    t0, t1 = curve.domain
+    start_near = np.linalg.norm(curve.evaluate(t0) - away_from) < \
+        np.linalg.norm(curve.evaluate(t1) - away_from)
+    if start_near:
+        return curve.restrict(t, t1) if t < t1 else curve
+    return curve.restrict(t0, t) if t > t0 else curve
+
+
+def trimmed_back_boundary(faces: list[TrimmedFace | None], overlap: Overlap) -> list[NurbsCurve]:
+    """Four boundary curves (loop order) of the trimmed face without the doubled strip."""
+    sides = four_sided_boundary(faces[overlap.trimmed])
+    cut = four_sided_boundary(faces[overlap.kept])[overlap.side_kept]
+    k = overlap.side_trimmed
+    gone = sides[k]
+    ends = cut.evaluate(np.array(cut.domain))                 # (2, 3)
+    out = [cut]
+    for step in (1, 2, 3):
+        curve = sides[(k + step) % 4]
+        if step == 2:
+            out.append(curve)
+            continue
+        # the end of ``cut`` nearest to this adjacent side
+        end = ends[int(np.argmin(project_to_curve(curve, ends).distance))]
+        out.append(_cut_away_from(curve, end, _nearest_end(gone, curve)))
+    return out
+
+
+def _nearest_end(gone: NurbsCurve, curve: NurbsCurve) -> NDArray:
+    """The end of the removed side where ``curve`` starts or ends."""
+    g = gone.evaluate(np.array(gone.domain))
+    c = curve.evaluate(np.array(curve.domain))
+    d = np.linalg.norm(g[:, None] - c[None], axis=2)
+    return g[np.unravel_index(np.argmin(d), d.shape)[0]]
