@@ -28,13 +28,37 @@ is clipped to both faces' trimmed domains:
   touching an edge of ``a`` is an answer there).
 
 Each result is a :class:`FaceIntersection` (the piece, the two faces' indices
-and names); :meth:`FaceIntersection.to_edges` builds a ``TopoDS_Edge`` with the
-3D curve and a pcurve on each face (:func:`surfprep.plugin.edges.make_edge`,
-checked by BRepCheck).
+and names, and how it was found); :meth:`FaceIntersection.to_edges` builds a
+``TopoDS_Edge`` with the 3D curve and a pcurve on each face
+(:func:`surfprep.plugin.edges.make_edge`, checked by BRepCheck).
+
+**Methods** (``method=``, :class:`Method`):
+
+* ``"mesh"``: the triangle method alone
+  (:func:`surfprep.algorithms.intersection.intersect_surfaces`);
+* ``"characteristic"``: the characteristic-curve method of paper 002 alone
+  (:func:`surfprep.algorithms.characteristic.characteristic_intersection`);
+* ``"auto"`` (default): the triangle method, then the characteristic points as
+  a certificate (:func:`surfprep.algorithms.characteristic.certify`): every
+  closed loop they imply must be among the curves; a loop the triangles missed
+  is traced, refined to ``tol`` and added (``found_by`` ``"characteristic"``).
+  When the characteristic stage finds the surfaces coincident over their whole
+  grid, the triangle method is not run at all (it would only produce debris).
+
+**The result** is an :class:`IntersectionResult`: a ``list`` of
+FaceIntersection (so every existing use of the returned list works as
+before) with three more attributes: ``isolated_points`` (tangential contact
+points, :class:`ContactPoint`: a contact is a point, not a curve, and is not
+dropped), ``coincident`` (:class:`CoincidentFaces`: face pairs whose surfaces
+coincide within ``tol`` over a region, with that region) and ``records`` (the
+characteristic record of every face pair, :class:`PairRecord`, for reports and
+plots).
 """
 
 from __future__ import annotations
 
+import enum
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -46,16 +70,44 @@ from OCP.Geom import Geom_Surface
 from OCP.TopoDS import TopoDS_Face
 
 from ..algorithms import NurbsSurface
-from ..algorithms.intersection import (EndKind, IntersectionCurve, StrayCurves,
-                                       closed_in_space, intersect_surfaces, polyline_distance)
+from ..algorithms.characteristic import (
+    CharacteristicRecord,
+    CoincidentRegion,
+    FoundBy,
+    certify,
+    characteristic_analysis,
+    characteristic_intersection,
+)
+from ..algorithms.intersection import (
+    EndKind,
+    IntersectionCurve,
+    StrayCurves,
+    closed_in_space,
+    intersect_surfaces,
+    polyline_distance,
+)
 from ..errors import InvalidGeometryError, InvalidToleranceError, OpenCascadeError
 from .convert import to_nurbs
 from .edges import make_edge
 from .faces import TrimmedFace, make_face, needs_nurbs_convert, trimmed_face_to_occ
 from .io import CadModel
 
-__all__ = ["intersect", "FaceIntersection", "FaceOperand", "face_operands",
-           "inside_face", "clip_curve", "DEFAULT_TOL_FACTOR", "MIN_TOL_FACTOR"]
+__all__ = [
+    "DEFAULT_TOL_FACTOR",
+    "MIN_TOL_FACTOR",
+    "CoincidentFaces",
+    "ContactPoint",
+    "FaceIntersection",
+    "FaceOperand",
+    "FoundBy",
+    "IntersectionResult",
+    "Method",
+    "PairRecord",
+    "clip_curve",
+    "face_operands",
+    "inside_face",
+    "intersect",
+]
 
 #: default ``tol``: this times the diagonal of the box of all faces
 DEFAULT_TOL_FACTOR = 1e-6
@@ -205,7 +257,7 @@ def _loop_segments(face: TrimmedFace) -> tuple[NDArray, NDArray, NDArray]:
 def _is_rectangle(seg: NDArray, domain, eps: float) -> bool:
     """True when every loop segment lies on a side of the parameter rectangle."""
     u0, u1, v0, v1 = domain
-    on = lambda x, lo, hi: (np.abs(x - lo) <= eps) | (np.abs(x - hi) <= eps)   # noqa: E731
+    on = lambda x, lo, hi: (np.abs(x - lo) <= eps) | (np.abs(x - hi) <= eps)
     pts = seg.reshape(-1, 2)
     same_u = on(seg[:, 0, 0], u0, u1) & (np.abs(seg[:, 0, 0] - seg[:, 1, 0]) <= eps)
     same_v = on(seg[:, 0, 1], v0, v1) & (np.abs(seg[:, 0, 1] - seg[:, 1, 1]) <= eps)
@@ -447,12 +499,16 @@ class FaceIntersection:
         The faces (``face_b`` from ``b``, or from ``a`` when ``b`` was None).
     tol : float
         The tolerance the curve was computed to (model units).
+    found_by : FoundBy
+        ``MESH`` (the triangle method) or ``CHARACTERISTIC`` (traced from a
+        characteristic point: with ``method="auto"``, a loop the triangles missed).
     """
 
     curve: IntersectionCurve
     face_a: FaceOperand
     face_b: FaceOperand
     tol: float
+    found_by: FoundBy = FoundBy.MESH
 
     @property
     def points(self) -> NDArray:
@@ -494,6 +550,84 @@ class FaceIntersection:
         return [make_edge(c.curve3d, pcurves, tol)]
 
 
+class Method(str, enum.Enum):
+    """How :func:`intersect` finds the curves of a face pair."""
+
+    MESH = "mesh"
+    CHARACTERISTIC = "characteristic"
+    AUTO = "auto"
+
+
+@dataclass(frozen=True, eq=False)
+class ContactPoint:
+    """A tangential contact of two faces: an isolated point of their intersection.
+
+    Attributes
+    ----------
+    point : (3,) float
+    uv_a, uv_b : (2,) float
+        Parameters on each face's surface.
+    face_a, face_b : FaceOperand
+    """
+
+    point: NDArray
+    uv_a: NDArray
+    uv_b: NDArray
+    face_a: FaceOperand
+    face_b: FaceOperand
+
+    @property
+    def faces(self) -> tuple[int, int]:
+        return self.face_a.index, self.face_b.index
+
+
+@dataclass(frozen=True, eq=False)
+class CoincidentFaces:
+    """Two faces whose surfaces coincide within ``tol`` over ``region`` (no curves there)."""
+
+    face_a: FaceOperand
+    face_b: FaceOperand
+    region: CoincidentRegion
+
+    @property
+    def faces(self) -> tuple[int, int]:
+        return self.face_a.index, self.face_b.index
+
+
+@dataclass(frozen=True, eq=False)
+class PairRecord:
+    """The characteristic record of one face pair (None with ``method="mesh"``), and
+    the untrimmed curves before clipping."""
+
+    face_a: FaceOperand
+    face_b: FaceOperand
+    record: CharacteristicRecord | None
+    curves: tuple[IntersectionCurve, ...]
+    time_s: float
+
+
+class IntersectionResult(list):
+    """The curves of :func:`intersect` (a ``list`` of :class:`FaceIntersection`) and more.
+
+    Attributes
+    ----------
+    isolated_points : list of ContactPoint
+        Tangential contact points inside both faces.
+    coincident : list of CoincidentFaces
+    records : list of PairRecord
+        One per face pair whose boxes overlap.
+    method : Method
+    """
+
+    def __init__(self, curves=(), *, isolated_points=(), coincident=(), records=(),
+                 method: Method = Method.AUTO) -> None:
+        super().__init__(curves)
+        self.isolated_points = list(isolated_points)
+        self.coincident = list(coincident)
+        self.records = list(records)
+        self.method = Method(method)
+
+
 # ------------------------------------------------------------------ driver
 def _boxes(faces: Sequence[FaceOperand]) -> NDArray:
     return np.stack([np.asarray(f.surface.bounding_box(), dtype=float) for f in faces]) \
@@ -524,9 +658,68 @@ def _along_a_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand
     return False
 
 
+def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None
+                 ) -> list[IntersectionCurve]:
+    try:
+        return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
+                                  stray=StrayCurves.DROP)
+    except (InvalidGeometryError, InvalidToleranceError) as exc:
+        warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
+                      stacklevel=3)
+        return []
+
+
+def _pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
+                 method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
+                                          CharacteristicRecord | None]:
+    """Untrimmed curves of one face pair by ``method``, how each was found, the record."""
+    if method is Method.MESH:
+        curves = _mesh_curves(fa, fb, tol, mesh_tol)
+        return curves, [FoundBy.MESH] * len(curves), None
+    a, b = fa.surface, fb.surface
+    try:
+        if method is Method.CHARACTERISTIC:
+            record = characteristic_intersection(a, b, tol=tol)
+        else:
+            analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False)
+            whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
+            mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol)
+            record = certify(a, b, mesh, tol=tol, analysis=analysis)
+    except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
+        warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
+                      stacklevel=3)
+        if method is Method.CHARACTERISTIC:
+            return [], [], None
+        curves = _mesh_curves(fa, fb, tol, mesh_tol)
+        return curves, [FoundBy.MESH] * len(curves), None
+    return list(record.curves), list(record.found_by), record
+
+
+def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOperand,
+              tol: float, within: bool) -> list[ContactPoint]:
+    """The record's isolated points inside both faces (not on a shared edge within a shape)."""
+    if record is None:
+        return []
+    out = []
+    for p in record.isolated_points:
+        if not (inside_face(fa, p.uv_a[None], tol)[0] and inside_face(fb, p.uv_b[None], tol)[0]):
+            continue
+        if within:
+            near = max(10 * tol, 2 * max(fa.edge_tolerance(), fb.edge_tolerance()))
+            lines = fa.boundary_polylines() + fb.boundary_polylines()
+            if lines and polyline_distance(p.point[None], lines)[0] <= near:
+                continue
+        out.append(ContactPoint(p.point, p.uv_a, p.uv_b, fa, fb))
+    return out
+
+
+#: a coincident region with this share of the grid: the triangle method is not run
+FULL_COINCIDENCE = 0.95
+
+
 def intersect(a: Any, b: Any = None, *, tol: float | None = None,
-              mesh_tol: float | None = None,
-              progress: Callable[[int, int], None] | None = None) -> list[FaceIntersection]:
+              mesh_tol: float | None = None, method: Method | str = Method.AUTO,
+              progress: Callable[[int, int], None] | None = None) -> IntersectionResult:
     """Intersection curves of the faces of ``a`` with those of ``b`` (or among ``a``'s).
 
     Parameters
@@ -543,16 +736,21 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
         times that diagonal.
     mesh_tol : float, optional
         Tessellation tolerance per pair (default: 1e-3 times the pair's size).
+    method : Method or str
+        ``"auto"`` (default), ``"mesh"`` or ``"characteristic"`` (module docstring).
     progress : callable(done, total), optional
         Called after each face pair whose boxes overlap.
 
     Returns
     -------
-    list of FaceIntersection
-        Pieces clipped to both faces, in face-pair order. Curves that break
-        ``tol`` (near-tangential or overlapping surfaces, where the refinement
-        does not converge) are left out (``StrayCurves.DROP``); a pair whose
-        intersection fails raises no error: it is skipped with a warning.
+    IntersectionResult
+        A list of FaceIntersection: pieces clipped to both faces, in face-pair
+        order, each with ``found_by``. Curves that break ``tol`` (near-tangential
+        or overlapping surfaces, where the refinement does not converge) are left
+        out (``StrayCurves.DROP``); a pair whose intersection fails raises no
+        error: it is skipped with a warning. Also ``isolated_points``
+        (tangential contacts), ``coincident`` (face pairs coinciding over a
+        region) and ``records`` (the characteristic record per pair).
 
     Raises
     ------
@@ -560,7 +758,10 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
         ``tol`` not finite and positive, or below ``MIN_TOL_FACTOR`` times the size.
     ConversionError
         An operand without faces or of an unsupported type.
+    ValueError
+        An unknown ``method``.
     """
+    method = Method(method)
     faces_a = face_operands(a)
     faces_b = faces_a if b is None else face_operands(b)
     boxes_a, boxes_b = _boxes(faces_a), _boxes(faces_b)
@@ -583,20 +784,20 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
     if b is None:
         overlap &= np.triu(np.ones_like(overlap), k=1).astype(bool)
     pairs = np.argwhere(overlap)
-    out: list[FaceIntersection] = []
+    out = IntersectionResult(method=method)
     for done, (i, j) in enumerate(pairs, start=1):
         fa, fb = faces_a[i], faces_b[j]
-        try:
-            curves = intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                        stray=StrayCurves.DROP)
-        except (InvalidGeometryError, InvalidToleranceError) as exc:
-            warnings.warn(f"faces {i} and {j}: intersection skipped: {exc}", stacklevel=2)
-            curves = []
-        for curve in curves:
+        start = time.perf_counter()
+        curves, found_by, record = _pair_curves(fa, fb, tol, mesh_tol, method)
+        for curve, how in zip(curves, found_by):
             for piece in clip_curve(curve, fa, fb, tol):
                 if b is None and _along_a_boundary(piece, fa, fb, tol):
                     continue
-                out.append(FaceIntersection(piece, fa, fb, tol))
+                out.append(FaceIntersection(piece, fa, fb, tol, how))
+        out.isolated_points += _contacts(record, fa, fb, tol, b is None)
+        if record is not None:
+            out.coincident += [CoincidentFaces(fa, fb, r) for r in record.coincident]
+        out.records.append(PairRecord(fa, fb, record, tuple(curves), time.perf_counter() - start))
         if progress is not None:
             progress(done, len(pairs))
     return out

@@ -1,3 +1,59 @@
 """Surface-surface intersection with a no-missed-loop guarantee: the oriented
 distance function, characteristic points and characteristic curves
-(Wang, Gursoz, Chen, Prinz, Patrikalakis 1990; paper 002)."""
+(Wang, Gursoz, Chen, Prinz, Patrikalakis 1990; paper 002).
+
+* :mod:`.projection`: orthogonal projection onto a surface (eqs. 3-4, §6.2 cases);
+* :mod:`.distance`: the oriented distance ``phi`` and its derivatives (A.1, eqs. 24-31);
+* :mod:`.points`: border, turning, singular and critical points (§3.3, §4.2);
+* :mod:`.curves`: u-/v-characteristic curves and intersection curves traced as
+  ODEs with a corrector (eqs. 15-21, 33);
+* :mod:`.trace`: intersection curves from start points, refined to ``tol``;
+* :mod:`.algorithm`: the algorithm of §6.3 (:func:`characteristic_intersection`)
+  and the certificate for the triangle method (:func:`certify`);
+* :mod:`.evaluator`: fast power-basis evaluation for the tracers.
+"""
+
+from .algorithm import (
+                        CharacteristicAnalysis,
+                        CharacteristicRecord,
+                        CoincidentRegion,
+                        FoundBy,
+                        certify,
+                        characteristic_analysis,
+                        characteristic_intersection,
+                        choose_field,
+)
+from .curves import CurveKind, EndReason, TracedCurve, trace_curves
+from .distance import DistanceField, DistanceJet, distance_jet
+from .evaluator import PatchEvaluator
+from .points import CharacteristicPoint, PointKind, classify_critical, critical_points
+from .projection import Projection, ProjectionStatus, Projector
+from .trace import to_intersection_curve, trace_intersections
+
+__all__ = [
+                        "CharacteristicAnalysis",
+                        "CharacteristicPoint",
+                        "CharacteristicRecord",
+                        "CoincidentRegion",
+                        "CurveKind",
+                        "DistanceField",
+                        "DistanceJet",
+                        "EndReason",
+                        "FoundBy",
+                        "PatchEvaluator",
+                        "PointKind",
+                        "Projection",
+                        "ProjectionStatus",
+                        "Projector",
+                        "TracedCurve",
+                        "certify",
+                        "characteristic_analysis",
+                        "characteristic_intersection",
+                        "choose_field",
+                        "classify_critical",
+                        "critical_points",
+                        "distance_jet",
+                        "to_intersection_curve",
+                        "trace_curves",
+                        "trace_intersections",
+]

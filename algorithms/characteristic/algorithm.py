@@ -1,0 +1,718 @@
+"""The algorithm of 002 §6.3 end to end, and the certificate for the triangle method.
+
+:func:`characteristic_analysis` (the *characteristic stage*):
+
+0. ``phi`` on a grid of ``r``'s domain (which surface is ``r`` is chosen by
+   :func:`choose_field`); samples with ``|phi| <= tol`` over a patch of the
+   grid mean the surfaces coincide there (:class:`CoincidentRegion`: reported,
+   nothing traced there: a clear answer instead of a hang);
+1. border points (:func:`.points.border_points`);
+2. roots of ``phi_u`` and ``phi_v`` on the sides of ``r``'s domain
+   (:func:`.points.edge_roots`);
+3. the u- and v-characteristic curves traced from them (:mod:`.curves`); a
+   sign change of the *other* derivative along one gives a critical point (by
+   Newton, :func:`.points.critical_points`), a sign change of ``phi`` a turning
+   point, i.e. a start on the intersection. Critical points are also sought
+   from a seed grid (the paper's remedy when no side root exists, §5), and the
+   characteristic curves through every critical point are traced too, until no
+   new critical point appears (capped rounds);
+4. from every maximum with ``phi > tol`` and minimum with ``phi < -tol`` (the
+   extrema a closed loop must encircle, §4.2), rays along the Hessian's
+   eigenvectors, started at the quadratic model's zero distance ``sqrt(2 |phi|
+   / |lambda|)``, find a start on the loop around it however small it is;
+5. critical points with ``|phi| <= tol`` are singular (eq. 8): an isolated
+   point (tangential contact) when ``det H > 0``.
+
+:func:`characteristic_intersection` adds step 4 of §6.3: the intersection
+curves traced from every start (:mod:`.trace`). :func:`certify` is the
+``auto`` mode: the characteristic stage checks curves found by the triangle
+method: every start must lie on one of them; the loops through starts that do
+not are traced and added (``FoundBy.CHARACTERISTIC``), and tiny curves around a
+tangential contact point are replaced by the isolated point.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..intersection import IntersectionCurve
+from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
+from .curves import CurveKind, TracedCurve, curve_value, trace_curves
+from .distance import DistanceField, DistanceJet
+from .points import (
+    CharacteristicPoint,
+    PointKind,
+    border_points,
+    classify_critical,
+    critical_points,
+    edge_roots,
+    grid_seeds,
+    make_points,
+)
+from .projection import ProjectionStatus, Projector
+from .trace import (
+    dense_polyline,
+    polyline_gap,
+    to_intersection_curve,
+    trace_intersections,
+)
+
+__all__ = [
+    "GRID_MAX",
+    "GRID_MIN",
+    "CharacteristicAnalysis",
+    "CharacteristicRecord",
+    "CoincidentRegion",
+    "FoundBy",
+    "certify",
+    "characteristic_analysis",
+    "characteristic_intersection",
+    "choose_field",
+]
+
+#: grid samples per direction of r's domain for the critical-point seeds
+GRID_MIN, GRID_MAX = 33, 129
+#: rounds of "trace through new critical points" at most
+MAX_ROUNDS = 3
+#: rounds of "trace the uncovered starts" at most
+MAX_TRACE_ROUNDS = 6
+#: a grid share of |phi| <= tol above this means the surfaces coincide over a region
+COINCIDENT_SHARE = 0.01
+
+
+class FoundBy(str, enum.Enum):
+    """How an intersection curve was found."""
+
+    MESH = "mesh"
+    CHARACTERISTIC = "characteristic"
+
+
+@dataclass(frozen=True)
+class CoincidentRegion:
+    """Where two surfaces coincide within ``tol``.
+
+    Attributes
+    ----------
+    box_a, box_b : (2, 2) float
+        ``[[u_min, v_min], [u_max, v_max]]`` of the grid samples with
+        ``|phi| <= tol`` on each surface.
+    share : float
+        Share of ``r``'s grid samples with a regular projection that coincide.
+    max_distance : float
+        Largest ``|phi|`` among them.
+    """
+
+    box_a: NDArray
+    box_b: NDArray
+    share: float
+    max_distance: float
+
+
+@dataclass(frozen=True)
+class Start:
+    """Starts on the intersection: ``uv`` on ``r``, feet ``st``, feature ``scale``."""
+
+    uv: NDArray
+    st: NDArray
+    scale: NDArray
+    group: NDArray
+
+    @staticmethod
+    def empty() -> Start:
+        return Start(np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0), np.zeros(0, dtype=int))
+
+    @staticmethod
+    def stack(items: Sequence[Start]) -> Start:
+        """Starts of all ``items``, groups kept as they are."""
+        return Start(np.concatenate([s.uv for s in items]), np.concatenate([s.st for s in items]),
+                     np.concatenate([s.scale for s in items]),
+                     np.concatenate([s.group for s in items]))
+
+    @staticmethod
+    def concat(items: Sequence[Start]) -> Start:
+        """Starts of all ``items``, each item's groups renumbered after the previous ones."""
+        items = [s for s in items if s.uv.shape[0]]
+        if not items:
+            return Start.empty()
+        groups, offset = [], 0
+        for s in items:
+            groups.append(s.group + offset)
+            offset += int(s.group.max()) + 1 if s.group.size else 0
+        return Start(np.concatenate([s.uv for s in items]), np.concatenate([s.st for s in items]),
+                     np.concatenate([s.scale for s in items]), np.concatenate(groups))
+
+
+@dataclass(frozen=True)
+class CharacteristicAnalysis:
+    """What the characteristic stage found (steps 0-5 of the module docstring)."""
+
+    field: DistanceField
+    points: tuple[CharacteristicPoint, ...]
+    characteristic_curves: tuple[TracedCurve, ...]
+    starts: Start
+    coincident: tuple[CoincidentRegion, ...]
+    time_s: float
+
+    def of_kind(self, *kinds: PointKind) -> tuple[CharacteristicPoint, ...]:
+        return tuple(p for p in self.points if p.kind in kinds)
+
+
+@dataclass(frozen=True)
+class CharacteristicRecord:
+    """The answer of :func:`characteristic_intersection` or :func:`certify`, with its record.
+
+    Attributes
+    ----------
+    curves : tuple of IntersectionCurve
+    found_by : tuple of FoundBy
+        One per curve.
+    isolated_points : tuple of CharacteristicPoint
+        Tangential contact points (kind ``ISOLATED``): not curves.
+    coincident : tuple of CoincidentRegion
+    points : tuple of CharacteristicPoint
+        Every characteristic point, all kinds.
+    characteristic_curves : tuple of TracedCurve
+    phi_on : str
+        ``"a"`` or ``"b"``: the surface whose domain ``phi`` lives on.
+    characteristic_time_s, intersection_time_s : float
+        Time of the characteristic stage and of tracing + refining the curves.
+    dropped : int
+        Curves of the triangle method replaced by an isolated point.
+    """
+
+    curves: tuple[IntersectionCurve, ...]
+    found_by: tuple[FoundBy, ...]
+    isolated_points: tuple[CharacteristicPoint, ...]
+    coincident: tuple[CoincidentRegion, ...]
+    points: tuple[CharacteristicPoint, ...]
+    characteristic_curves: tuple[TracedCurve, ...]
+    phi_on: str
+    characteristic_time_s: float
+    intersection_time_s: float
+    dropped: int = 0
+    extra: dict = field(default_factory=dict, repr=False)
+
+    def of_kind(self, *kinds: PointKind) -> tuple[CharacteristicPoint, ...]:
+        return tuple(p for p in self.points if p.kind in kinds)
+
+    def counts(self) -> dict[str, int]:
+        """Characteristic points per kind (``PointKind.value``)."""
+        out: dict[str, int] = {}
+        for p in self.points:
+            out[p.kind.value] = out.get(p.kind.value, 0) + 1
+        return out
+
+    @property
+    def added(self) -> tuple[IntersectionCurve, ...]:
+        """Curves found only by the characteristic method."""
+        return tuple(c for c, f in zip(self.curves, self.found_by) if f is FoundBy.CHARACTERISTIC)
+
+
+# ------------------------------------------------------------------ roles
+def _normal_spread(surface: NurbsSurface, n: int = 9) -> float:
+    """Largest angle (radians) between the normals on an ``n x n`` grid and their mean."""
+    d = surface.domain
+    g = surface.derivatives_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n), 1)
+    normal = np.cross(g[:, :, 1, 0], g[:, :, 0, 1]).reshape(-1, 3)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+    mean = normal.mean(axis=0)
+    mean /= max(np.linalg.norm(mean), 1e-300)
+    return float(np.arccos(np.clip(normal @ mean, -1, 1)).max())
+
+
+def _coverage(r: NurbsSurface, projector: Projector, n: int = 17) -> float:
+    d = r.domain
+    pts = r.evaluate_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)).reshape(-1, 3)
+    return float(np.mean(projector.project(pts).status != ProjectionStatus.NONE))
+
+
+def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | None = None
+                 ) -> DistanceField:
+    """The role of each surface: ``phi`` on the domain of ``r``, projection onto ``q``.
+
+    ``q`` should be the surface onto which more of the other projects (coverage
+    of a coarse grid) and, between near ties, the flatter one (smaller spread
+    of normals: projections onto it are unique farther out). ``phi_on`` forces
+    the choice (``"a"`` or ``"b"``).
+    """
+    proj_b, proj_a = Projector(b, tol=tol * 1e-3), Projector(a, tol=tol * 1e-3)
+    if phi_on is None:
+        cover_ab, cover_ba = _coverage(a, proj_b), _coverage(b, proj_a)
+        if abs(cover_ab - cover_ba) > 0.1:
+            phi_on = "a" if cover_ab > cover_ba else "b"
+        else:
+            phi_on = "a" if _normal_spread(b) <= _normal_spread(a) else "b"
+    if phi_on == "a":
+        return DistanceField(a, proj_b, False)
+    if phi_on == "b":
+        return DistanceField(b, proj_a, True)
+    raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
+
+
+# ------------------------------------------------------------------ stage helpers
+def _grid(field: DistanceField) -> tuple[DistanceJet, tuple[int, int]]:
+    counts = []
+    for knots, degree in ((field.r.knots_u, field.r.degree_u), (field.r.knots_v, field.r.degree_v)):
+        spans = np.unique(knots[degree:knots.size - degree]).size - 1
+        counts.append(int(np.clip(4 * spans + 1, GRID_MIN, GRID_MAX)))
+    u = np.linspace(field.lower[0], field.upper[0], counts[0])
+    v = np.linspace(field.lower[1], field.upper[1], counts[1])
+    uv = np.stack(np.meshgrid(u, v, indexing="ij"), -1).reshape(-1, 2)
+    return field.jet(uv), (counts[0], counts[1])
+
+
+def _coincident(field: DistanceField, jet: DistanceJet, shape: tuple[int, int], tol: float
+                ) -> tuple[CoincidentRegion, ...]:
+    """The grid cells whose four corners all have a regular projection and ``|phi| <= tol``:
+    when they are more than ``COINCIDENT_SHARE`` of the valid cells, the surfaces
+    coincide over a region (a curve through grid samples is not a region)."""
+    nu, nv = shape
+    valid = (jet.status == ProjectionStatus.UNIQUE).reshape(nu, nv)
+    near = valid & (np.abs(jet.phi) <= tol).reshape(nu, nv)
+    corners = [(slice(0, -1), slice(0, -1)), (slice(1, None), slice(0, -1)),
+               (slice(0, -1), slice(1, None)), (slice(1, None), slice(1, None))]
+    valid_cells = np.logical_and.reduce([valid[c] for c in corners])
+    near_cells = np.logical_and.reduce([near[c] for c in corners])
+    if valid_cells.sum() == 0 or near_cells.sum() <= COINCIDENT_SHARE * valid_cells.sum():
+        return ()
+    mask = np.zeros((nu, nv), dtype=bool)
+    for c in corners:
+        mask[c] |= near_cells
+    mask = mask.ravel()
+    ua, ub = field.ab(jet.uv[mask], jet.st[mask])
+    box = lambda x: np.stack([x.min(axis=0), x.max(axis=0)])
+    return (CoincidentRegion(box(ua), box(ub), float(near_cells.sum() / valid_cells.sum()),
+                             float(np.abs(jet.phi[mask]).max())),)
+
+
+def _label(mask: NDArray) -> NDArray:
+    """4-connected components of a boolean grid: labels ``1, 2, ...`` (0 outside the mask),
+    by propagating the smallest label to neighbours until nothing changes."""
+    big = mask.size + 1
+    lab = np.where(mask, np.arange(1, mask.size + 1).reshape(mask.shape), big)
+    while True:
+        new = lab.copy()
+        new[1:] = np.minimum(new[1:], lab[:-1])
+        new[:-1] = np.minimum(new[:-1], lab[1:])
+        new[:, 1:] = np.minimum(new[:, 1:], lab[:, :-1])
+        new[:, :-1] = np.minimum(new[:, :-1], lab[:, 1:])
+        new = np.where(mask, new, big)
+        if np.array_equal(new, lab):
+            break
+        lab = new
+    return np.where(mask, lab, 0)
+
+
+def _loop_keys(field: DistanceField, grid: DistanceJet, shape: tuple[int, int],
+               start: Start) -> NDArray:
+    """A key per start naming the curve it likely lies on: the pair of grid components
+    (connected ``phi > 0`` and ``phi < 0`` regions) its grid cell joins. Starts in
+    cells of one sign (a loop smaller than the grid) keep their own group."""
+    nu, nv = shape
+    phi = grid.phi.reshape(nu, nv)
+    ok = (grid.status != ProjectionStatus.NONE).reshape(nu, nv)
+    pos = _label(ok & (phi > 0))
+    neg = _label(ok & (phi <= 0))
+    cell = (field.upper - field.lower) / (np.array(shape) - 1)
+    ij = np.clip(((start.uv - field.lower) / cell).astype(int), 0, np.array(shape) - 2)
+    keys = np.empty(start.uv.shape[0], dtype=np.int64)
+    base = (nu * nv + 1) ** 2
+    for k, (i, j) in enumerate(ij):
+        p = pos[i:i + 2, j:j + 2]
+        n = neg[i:i + 2, j:j + 2]
+        if p.max() > 0 and n.max() > 0:
+            keys[k] = int(p[p > 0].min()) * (nu * nv + 1) + int(n[n > 0].min())
+        else:
+            keys[k] = base + int(start.group[k])
+    return keys
+
+
+def _border_keys(start: Start) -> Start:
+    """Border starts keyed ``-1, -2, ...`` (each its own group, told apart from loop starts)."""
+    return Start(start.uv, start.st, start.scale, -1 - np.arange(start.uv.shape[0]))
+
+
+def _sign_changes(curve: TracedCurve, values: NDArray) -> NDArray:
+    """Indices ``i`` with a sign change between samples ``i`` and ``i + 1``."""
+    s = np.sign(values)
+    return np.flatnonzero(s[:-1] * s[1:] < 0)
+
+
+def _turning_points(field: DistanceField, uv: NDArray, st: NDArray, kind: CurveKind,
+                    iterations: int = 12) -> tuple[DistanceJet, NDArray]:
+    """Newton on ``(phi, g) = 0`` (g the curve's function): exact turning points (eq. 7)."""
+    x = uv.copy()
+    jet = field.jet(x, st)
+    for _ in range(iterations):
+        g, dg = curve_value(jet, kind)
+        jac = np.stack([jet.grad, dg], axis=1)                        # (m, 2, 2)
+        rhs = -np.stack([jet.phi, g], -1)
+        det = np.linalg.det(jac)
+        ok = np.abs(det) > 1e-300
+        step = np.zeros_like(x)
+        if ok.any():
+            step[ok] = np.linalg.solve(jac[ok], rhs[ok][..., None])[..., 0]
+        x = np.clip(x + step, field.lower, field.upper)
+        jet = field.jet(x, jet.st)
+        if np.all(np.linalg.norm(step, axis=1) <= 1e-13 * field.diagonal):
+            break
+    g, _ = curve_value(jet, kind)
+    ok = (jet.status == ProjectionStatus.UNIQUE) & (np.abs(g) <= 1e-8 * np.abs(jet.hess).max(
+        axis=(1, 2)).clip(1e-300)) & np.all(np.linalg.norm(x - uv, axis=1)[:, None] < 0.1
+                                            * field.diagonal, axis=1)
+    return jet, ok
+
+
+def _trace_characteristic(field: DistanceField, kind, uv: NDArray, st: NDArray,
+                          direction: NDArray, h_max: float) -> list[TracedCurve]:
+    return trace_curves(field, kind, uv, st, direction, h0=0.2 * h_max, h_max=h_max,
+                        max_steps=400)
+
+
+def _from_critical(field: DistanceField, crit: DistanceJet, h_max: float) -> list[TracedCurve]:
+    """Both characteristic curves through each critical point, both ways (§5)."""
+    uvs, sts, dirs, kinds = [], [], [], []
+    for kind in (CurveKind.U_CHARACTERISTIC, CurveKind.V_CHARACTERISTIC):
+        _, dg = curve_value(crit, kind)
+        tangent = np.stack([-dg[:, 1], dg[:, 0]], -1)
+        for sign in (1.0, -1.0):
+            uvs.append(crit.uv)
+            sts.append(crit.st)
+            dirs.append(sign * tangent)
+            kinds += [kind] * crit.uv.shape[0]
+    return _trace_characteristic(field, kinds, np.concatenate(uvs), np.concatenate(sts),
+                                 np.concatenate(dirs), h_max)
+
+
+def _ray_starts(field: DistanceField, crit: DistanceJet, kinds: list[PointKind], tol: float,
+                max_steps: int = 40) -> Start:
+    """Starts on the loops around maxima with phi > tol and minima with phi < -tol (step 4)."""
+    pick = [i for i, k in enumerate(kinds)
+            if (k is PointKind.MAXIMUM and crit.phi[i] > tol)
+            or (k is PointKind.MINIMUM and crit.phi[i] < -tol)]
+    if not pick:
+        return Start.empty()
+    pick = np.array(pick)
+    lam, vec = np.linalg.eigh(crit.hess[pick])                       # (k, 2), (k, 2, 2)
+    origin, dirs, r0, group = [], [], [], []
+    for j in range(2):
+        for sign in (1.0, -1.0):
+            origin.append(crit.uv[pick])
+            dirs.append(sign * vec[:, :, j])
+            r0.append(np.sqrt(2 * np.abs(crit.phi[pick]) / np.maximum(np.abs(lam[:, j]), 1e-300)))
+            group.append(pick)
+    origin, dirs = np.concatenate(origin), np.concatenate(dirs)
+    r0, group = np.concatenate(r0), np.concatenate(group)
+    st = np.tile(crit.st[pick], (4, 1))
+    sign0 = np.sign(np.tile(crit.phi[pick], 4))
+    lo = np.zeros(r0.size)
+    hi = np.full(r0.size, np.nan)
+    t = np.minimum(0.5 * r0, 0.5 * field.diagonal)
+    alive = np.ones(r0.size, dtype=bool)
+    for _ in range(max_steps):                            # march outward to a sign change
+        todo = np.flatnonzero(alive & np.isnan(hi))
+        if todo.size == 0:
+            break
+        x = origin[todo] + t[todo, None] * dirs[todo]
+        inside = field.inside(x)
+        jet = field.jet(np.clip(x, field.lower, field.upper), st[todo])
+        st[todo] = jet.st
+        lost = ~inside | (jet.status == ProjectionStatus.NONE)
+        alive[todo[lost]] = False
+        flip = ~lost & (np.sign(jet.phi) != sign0[todo])
+        hi[todo[flip]] = t[todo[flip]]
+        stay = todo[~lost & ~flip]
+        lo[stay] = t[stay]
+        t[stay] *= 1.5
+    found = np.flatnonzero(alive & ~np.isnan(hi))
+    if found.size == 0:
+        return Start.empty()
+    a, b = lo[found], hi[found]
+    for _ in range(40):                                   # bisection on the ray
+        mid = 0.5 * (a + b)
+        jet = field.jet(origin[found] + mid[:, None] * dirs[found], st[found])
+        st[found] = jet.st
+        same = np.sign(jet.phi) == sign0[found]
+        a, b = np.where(same, mid, a), np.where(same, b, mid)
+        if np.all(b - a <= 1e-12 * field.diagonal):
+            break
+    uv = origin[found] + (0.5 * (a + b))[:, None] * dirs[found]
+    return Start(uv, st[found], 0.5 * (a + b), group[found])
+
+
+# ------------------------------------------------------------------ the stage
+def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
+                            phi_on: str | None = None, trace_critical: bool = True
+                            ) -> CharacteristicAnalysis:
+    """The characteristic stage (module docstring, steps 0-5).
+
+    ``trace_critical`` False skips tracing the characteristic curves through
+    the critical points found from the seed grid (the ``auto`` certificate:
+    those points are already known; the curves from the sides are traced).
+    """
+    start_time = time.perf_counter()
+    tol = check_tolerance(tol)
+    fld = choose_field(a, b, tol=tol, phi_on=phi_on)
+    other = DistanceField(fld.q, Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
+    h_max = 0.08 * fld.diagonal
+    grid, shape = _grid(fld)
+    coincident = _coincident(fld, grid, shape, tol)
+    points: list[CharacteristicPoint] = []
+    starts: list[Start] = []
+    border_start = Start.empty()
+    # step 1: border points (starts of open curves)
+    pair = (fld, other) if not fld.swapped else (other, fld)
+    bp, bua, bub = border_points(pair, tol)
+    if bp.shape[0]:
+        uv_r, st_q = (bub, bua) if fld.swapped else (bua, bub)
+        points += make_points(fld, PointKind.BORDER, uv_r, st_q, bp, np.zeros(bp.shape[0]))
+        border_start = Start(uv_r, st_q, np.full(bp.shape[0], 0.1 * fld.diagonal),
+                             np.arange(bp.shape[0]))
+    if coincident:
+        return CharacteristicAnalysis(fld, tuple(points), (), _border_keys(border_start),
+                                      coincident, time.perf_counter() - start_time)
+    # step 2: roots of phi_u, phi_v on the sides; step 3: characteristic curves
+    curves: list[TracedCurve] = []
+    uvs, sts, dirs, kinds = [], [], [], []
+    families = ((0, CurveKind.U_CHARACTERISTIC, PointKind.EDGE_ROOT_U),
+                (1, CurveKind.V_CHARACTERISTIC, PointKind.EDGE_ROOT_V))
+    for comp, kind, root_kind in families[:2 if trace_critical else 1]:
+        uv, st, _ = edge_roots(fld, comp)
+        if uv.shape[0] == 0:
+            continue
+        jet = fld.jet(uv, st)
+        points += make_points(fld, root_kind, uv, jet.st, jet.point, jet.phi)
+        uvs.append(uv)
+        sts.append(jet.st)
+        dirs.append(0.5 * (fld.lower + fld.upper) - uv)             # inward
+        kinds += [kind] * uv.shape[0]
+    if uvs:
+        curves += _trace_characteristic(fld, kinds, np.concatenate(uvs), np.concatenate(sts),
+                                        np.concatenate(dirs), h_max)
+    # critical points: seed grid, then along the characteristic curves, in rounds
+    crit = critical_points(fld, grid_seeds(grid, shape))
+    traced_from = 0 if trace_critical else (0 if crit is None else crit.uv.shape[0])
+    for _ in range(MAX_ROUNDS):
+        seeds = []
+        for c in curves:
+            other_comp = 1 if c.kind is CurveKind.U_CHARACTERISTIC else 0
+            for i in _sign_changes(c, c.grad[:, other_comp]):
+                g0, g1 = c.grad[i, other_comp], c.grad[i + 1, other_comp]
+                w = g0 / (g0 - g1)
+                seeds.append(c.uv[i] + w * (c.uv[i + 1] - c.uv[i]))
+        found = critical_points(fld, np.array(seeds)) if seeds else None
+        merged = _merge_critical(fld, crit, found)
+        crit = merged
+        if crit is None:
+            break
+        new = crit.uv.shape[0] - traced_from
+        if new <= 0 or not trace_critical:
+            break
+        fresh = _subset(fld, crit, np.arange(traced_from, crit.uv.shape[0]))
+        traced_from = crit.uv.shape[0]
+        curves += _from_critical(fld, fresh, h_max)
+    # turning points: sign changes of phi along the characteristic curves
+    turning_uv, turning_st, turning_kind, scale = [], [], [], []
+    for c in curves:
+        for i in _sign_changes(c, c.phi):
+            w = c.phi[i] / (c.phi[i] - c.phi[i + 1])
+            turning_uv.append(c.uv[i] + w * (c.uv[i + 1] - c.uv[i]))
+            turning_st.append(c.st[i])
+            turning_kind.append(c.kind)
+            scale.append(5 * np.linalg.norm(c.uv[i + 1] - c.uv[i]))
+    for kind, pk in ((CurveKind.U_CHARACTERISTIC, PointKind.TURNING_V),
+                     (CurveKind.V_CHARACTERISTIC, PointKind.TURNING_U)):
+        rows = [i for i, k in enumerate(turning_kind) if k is kind]
+        if not rows:
+            continue
+        jet, ok = _turning_points(fld, np.array([turning_uv[i] for i in rows]),
+                                  np.array([turning_st[i] for i in rows]), kind)
+        if ok.any():
+            points += make_points(fld, pk, jet.uv[ok], jet.st[ok], jet.point[ok], jet.phi[ok])
+            n = int(ok.sum())
+            starts.append(Start(jet.uv[ok], jet.st[ok], np.array(scale)[rows][ok], np.arange(n)))
+    # critical points: classify; rays from the extrema a loop must encircle
+    if crit is not None:
+        kinds = classify_critical(crit.phi, crit.hess, tol)
+        points += make_points(fld, kinds, crit.uv, crit.st, crit.point, crit.phi)
+        starts.append(_ray_starts(fld, crit, kinds, tol))
+    start = Start.concat(starts)
+    start = Start.stack([Start(start.uv, start.st, start.scale, _loop_keys(fld, grid, shape, start)),
+                         _border_keys(border_start)])
+    return CharacteristicAnalysis(fld, tuple(points), tuple(curves), start, (),
+                                  time.perf_counter() - start_time)
+
+
+def _subset(field: DistanceField, jet: DistanceJet, rows: NDArray) -> DistanceJet:
+    return field.jet(jet.uv[rows], jet.st[rows])
+
+
+def _merge_critical(field: DistanceField, old: DistanceJet | None, new: DistanceJet | None
+                    ) -> DistanceJet | None:
+    """Critical points of ``old`` then the ones of ``new`` not already there."""
+    if new is None:
+        return old
+    if old is None:
+        return new
+    d = np.linalg.norm(new.uv[:, None] - old.uv[None], axis=-1).min(axis=1)
+    fresh = np.flatnonzero(d > 1e-7 * field.diagonal)
+    if fresh.size == 0:
+        return old
+    return field.jet(np.concatenate([old.uv, new.uv[fresh]]),
+                     np.concatenate([old.st, new.st[fresh]]))
+
+
+# ------------------------------------------------------------------ curves
+def _settle(field: DistanceField, start: Start) -> tuple[Start, NDArray]:
+    """Starts moved onto ``phi = 0`` (Newton along grad phi); ``ok (m,)``."""
+    x, st = start.uv.copy(), start.st.copy()
+    jet = field.jet(x, st)
+    for _ in range(12):
+        g = jet.grad
+        n2 = np.einsum("mi,mi->m", g, g)
+        step = -(jet.phi / np.maximum(n2, 1e-300))[:, None] * g
+        x = np.clip(x + step, field.lower, field.upper)
+        jet = field.jet(x, jet.st)
+        if np.all(np.linalg.norm(step, axis=1) <= 1e-14 * field.diagonal):
+            break
+    ok = (jet.status != ProjectionStatus.NONE) & (np.linalg.norm(x - start.uv, axis=1)
+                                                  <= np.maximum(start.scale, 1e-9 * field.diagonal))
+    return Start(x, jet.st, start.scale, start.group), ok
+
+
+def _points_3d(field: DistanceField, uv: NDArray) -> NDArray:
+    return field.r.evaluate(uv[:, 0], uv[:, 1])
+
+
+def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
+                     known_closed: list[bool], tol: float, size: float
+                     ) -> list[IntersectionCurve]:
+    """Trace the starts that lie on none of the ``known`` polylines (3D), in rounds."""
+    settled, ok = _settle(field, starts)
+    uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
+    pts = _points_3d(field, uv)
+    cover = 10 * tol + 1e-12 * size
+    polylines, closed = list(known), list(known_closed)
+    out: list[IntersectionCurve] = []
+    todo = np.arange(uv.shape[0])
+    for _ in range(MAX_TRACE_ROUNDS):
+        if todo.size == 0:
+            break
+        gap = polyline_gap(pts[todo], polylines, closed)
+        todo = todo[gap > cover]
+        if todo.size == 0:
+            break
+        # one start per group and round (several starts of one loop trace once)
+        _, first = np.unique(group[todo], return_index=True)
+        batch = todo[np.sort(first)]
+        traced = trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol)
+        for t in traced:
+            curve = to_intersection_curve(field, t, tol)
+            if curve is None:
+                continue
+            gap_new = polyline_gap(curve.points[:1], polylines, closed)[0]
+            if gap_new <= cover and polylines:
+                continue                                  # a loop traced twice in one round
+            out.append(curve)
+            polylines.append(dense_polyline(curve))
+            closed.append(curve.closed)
+        todo = np.setdiff1d(todo, batch)
+    return out
+
+
+def _pair(field: DistanceField) -> tuple[NurbsSurface, NurbsSurface]:
+    return (field.q, field.r) if field.swapped else (field.r, field.q)
+
+
+def _size(a: NurbsSurface, b: NurbsSurface) -> float:
+    boxes = np.stack([a.bounding_box(), b.bounding_box()])
+    return float(np.linalg.norm(boxes[:, 1].max(axis=0) - boxes[:, 0].min(axis=0)))
+
+
+def characteristic_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float = 1e-7,
+                                phi_on: str | None = None) -> CharacteristicRecord:
+    """Intersection of two surfaces by the characteristic method alone (§6.3 steps 1-4).
+
+    Returns
+    -------
+    CharacteristicRecord
+        Curves (all ``FoundBy.CHARACTERISTIC``) within ``tol`` of both surfaces,
+        isolated (tangential contact) points, coincident regions and the record.
+    """
+    analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on)
+    return _finish(analysis, [], tol, a, b)
+
+
+def certify(a: NurbsSurface, b: NurbsSurface, curves: Sequence[IntersectionCurve], *,
+            tol: float = 1e-7, phi_on: str | None = None,
+            analysis: CharacteristicAnalysis | None = None, open_curves: bool = False
+            ) -> CharacteristicRecord:
+    """The ``auto`` certificate: check ``curves`` (the triangle method's) against the
+    characteristic points; trace and add the loops they miss (module docstring).
+
+    Parameters
+    ----------
+    analysis : CharacteristicAnalysis, optional
+        The characteristic stage, when already run (e.g. to learn before the
+        triangle method whether the surfaces coincide).
+    open_curves : bool
+        Also check the border points (open curves); by default only the loops
+        the critical points imply (the triangle method does not miss curves
+        that cross the boundary unless they are tiny).
+    """
+    if analysis is None:
+        analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on, trace_critical=False)
+    return _finish(analysis, list(curves), tol, a, b, borders=open_curves)
+
+
+def _near_isolated(curve: IntersectionCurve, isolated: Sequence[CharacteristicPoint],
+                   radius: float) -> bool:
+    return any(np.linalg.norm(curve.points - p.point, axis=1).max() <= radius for p in isolated)
+
+
+def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]) -> bool:
+    """True when all samples of ``curve`` lie in the boxes of a coincident region."""
+    for reg in regions:
+        ok = True
+        for uv, box in ((curve.uv_a, reg.box_a), (curve.uv_b, reg.box_b)):
+            if uv is None:
+                continue
+            pad = 1e-6 * np.maximum(box[1] - box[0], 1e-12)
+            ok &= bool(np.all((uv >= box[0] - pad) & (uv <= box[1] + pad)))
+        if ok:
+            return True
+    return False
+
+
+def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], tol: float,
+            a: NurbsSurface, b: NurbsSurface, borders: bool = True) -> CharacteristicRecord:
+    start = time.perf_counter()
+    fld = analysis.field
+    size = _size(a, b)
+    isolated = analysis.of_kind(PointKind.ISOLATED)
+    # a tangential contact is a point: tiny curves around it are not curves
+    radius = max(1e3 * tol, 1e-4 * size)
+    kept = [c for c in known if not _near_isolated(c, isolated, radius)
+            and not _inside_region(c, analysis.coincident)]
+    dropped = len(known) - len(kept)
+    added: list[IntersectionCurve] = []
+    starts = analysis.starts
+    if not borders:
+        loop = starts.group >= 0
+        starts = Start(starts.uv[loop], starts.st[loop], starts.scale[loop], starts.group[loop])
+    if not analysis.coincident:
+        added = _trace_uncovered(fld, starts, [dense_polyline(c) for c in kept],
+                                 [c.closed for c in kept], tol, size)
+        added = [c for c in added if c.max_deviation(a, b).max <= tol]
+    curves = tuple(kept) + tuple(added)
+    found = (FoundBy.MESH,) * len(kept) + (FoundBy.CHARACTERISTIC,) * len(added)
+    return CharacteristicRecord(curves, found, isolated, analysis.coincident, analysis.points,
+                                analysis.characteristic_curves, "b" if fld.swapped else "a",
+                                analysis.time_s, time.perf_counter() - start, dropped)

@@ -1,0 +1,97 @@
+"""Fast evaluation of a surface and its derivatives to second order at a few points.
+
+The curve tracers of this package evaluate both surfaces hundreds of times at
+a few dozen points each; :meth:`NurbsSurface.derivatives` spends most of such a
+call on per-call set-up (basis triangles, einsum path search). Here every
+Bézier patch (:func:`surfprep.algorithms.bezier.bezier_patches`) is converted
+once to the power basis in its local coordinates, so one evaluation is a span
+lookup, the monomials and two batched matrix products; rational surfaces go
+through :func:`surfprep.algorithms.rational.surface_derivatives_from_homogeneous`.
+Outside the domain the end patches' polynomials continue (the same extension
+as :meth:`NurbsSurface.derivatives`). Same results as
+:meth:`NurbsSurface.derivatives` to rounding (tested).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from math import comb, factorial
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..bezier import bezier_patches
+from ..rational import surface_derivatives_from_homogeneous
+from ..surface import NurbsSurface
+
+__all__ = ["PatchEvaluator"]
+
+
+def _bernstein_to_monomial(degree: int) -> NDArray:
+    """``M (p+1, p+1)``: ``B_i(x) = sum_k M[i, k] x^k``."""
+    m = np.zeros((degree + 1, degree + 1))
+    for i in range(degree + 1):
+        for k in range(i, degree + 1):
+            m[i, k] = comb(degree, k) * comb(k, i) * (-1) ** (k - i)
+    return m
+
+
+def _monomial_table(degree: int, order: int) -> tuple[NDArray, NDArray]:
+    """``coef (o+1, p+1)`` and exponent ``index (o+1, p+1)`` of ``d^o/dx^o x^k``."""
+    coef = np.zeros((order + 1, degree + 1))
+    index = np.zeros((order + 1, degree + 1), dtype=int)
+    for o in range(order + 1):
+        for k in range(o, degree + 1):
+            coef[o, k] = factorial(k) / factorial(k - o)
+            index[o, k] = k - o
+    return coef, index
+
+
+def _monomials(x: NDArray, degree: int, order: int, scale: NDArray) -> NDArray:
+    """``(m, order + 1, degree + 1)``: ``d^o/du^o x^k`` with ``x = (u - a) * scale``."""
+    coef, index = _monomial_table(degree, order)
+    powers = x[:, None] ** np.arange(degree + 1)                          # (m, p+1)
+    chain = scale[:, None] ** np.arange(order + 1)                        # (m, o+1)
+    return powers[:, index] * coef * chain[:, :, None]
+
+
+@dataclass(frozen=True, eq=False)
+class PatchEvaluator:
+    """Power-basis form of a :class:`NurbsSurface`, for repeated small evaluations."""
+
+    surface: NurbsSurface
+    _data: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        patches, iu, iv = bezier_patches(self.surface)
+        mu = _bernstein_to_monomial(self.surface.degree_u)
+        mv = _bernstein_to_monomial(self.surface.degree_v)
+        coef = np.einsum("ik,jl,abijc->abklc", mu, mv, patches)
+        self._data.update(coef=coef, iu=iu, iv=iv)
+
+    @property
+    def domain(self) -> tuple[float, float, float, float]:
+        return self.surface.domain
+
+    def derivatives(self, u: ArrayLike, v: ArrayLike, order: int = 2) -> NDArray:
+        """``(m, order + 1, order + 1, 3)``, as :meth:`NurbsSurface.derivatives` on 1-D input."""
+        u = np.asarray(u, dtype=float).reshape(-1)
+        v = np.asarray(v, dtype=float).reshape(-1)
+        coef, iu, iv = self._data["coef"], self._data["iu"], self._data["iv"]
+        su = np.clip(np.searchsorted(iu[:, 0], u, side="right") - 1, 0, iu.shape[0] - 1)
+        sv = np.clip(np.searchsorted(iv[:, 0], v, side="right") - 1, 0, iv.shape[0] - 1)
+        scale_u = 1.0 / (iu[su, 1] - iu[su, 0])
+        scale_v = 1.0 / (iv[sv, 1] - iv[sv, 0])
+        pu = _monomials((u - iu[su, 0]) * scale_u, self.surface.degree_u, order, scale_u)
+        pv = _monomials((v - iv[sv, 0]) * scale_v, self.surface.degree_v, order, scale_v)
+        c = coef[su, sv]                                            # (m, p+1, q+1, 4)
+        m, p1, q1, d1 = c.shape
+        tmp = np.matmul(pu, c.reshape(m, p1, q1 * d1)).reshape(m, order + 1, q1, d1)
+        hom = np.matmul(pv[:, None], tmp)                           # (m, k, l, 4)
+        if self.surface.weights is None:
+            return hom[..., :-1]
+        return surface_derivatives_from_homogeneous(hom[..., :-1], hom[..., -1])
+
+    def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray:
+        """Points ``(m, 3)``."""
+        return self.derivatives(u, v, 0)[:, 0, 0]

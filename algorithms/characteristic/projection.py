@@ -1,0 +1,235 @@
+"""Orthogonal projection of points of one surface onto another (002 eqs. 3-4, §6.2).
+
+The foot ``Q = q(s, t)`` of a point ``r`` on the surface ``q`` solves
+
+.. math:: (r - q(s, t)) \\cdot q_s = 0, \\qquad (r - q(s, t)) \\cdot q_t = 0
+          \\qquad (3), (4)
+
+by Newton's method: the Jacobian of the left-hand sides with respect to
+``(s, t)`` is ``-K`` with ``K_ij = q_i . q_j - (r - q) . q_ij`` (eq. 22), so the
+step is ``K^{-1} F``. Where ``K`` is not positive definite (the foot is not a
+local minimum of the distance) the Gauss-Newton step ``(J^T J)^{-1} F`` is
+taken instead.
+
+§6.2 distinguishes three cases, reported per point by :class:`ProjectionStatus`:
+
+* ``UNIQUE``: the projection exists, converged, and ``det K > 0`` (a strict
+  local minimum of the distance: the regular case);
+* ``MULTIPLE``: ``det K <= 0`` at the foot (the point lies on or beyond a focal
+  point of ``q``: several projections meet there and ``K^{-1}`` does not exist;
+  [15] checks for a sign change of ``det K`` along a traced curve, which
+  :mod:`.curves` does);
+* ``NONE``: the foot leaves ``q``'s parameter domain (or Newton does not
+  converge): the point has no orthogonal projection on the finite patch. The
+  foot found on the polynomial extension of the end spans is kept, so a caller
+  can record where the boundary was crossed.
+
+Start values come from the caller (continuation along a traced curve) or from
+the nearest sample of a grid over ``q`` (:class:`Projector` caches it).
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
+
+from ...errors import InvalidGeometryError
+from ..surface import NurbsSurface
+from ..tolerance import check_tolerance
+from .evaluator import PatchEvaluator
+
+__all__ = [
+    "EXTENSION",
+    "GRID_SAMPLES",
+    "Projection",
+    "ProjectionStatus",
+    "Projector",
+    "projection_matrix",
+]
+
+#: samples per direction of the seed grid (at least; more for many knot spans)
+GRID_SAMPLES = 33
+#: Newton may run this share of the domain beyond its sides (polynomial extension)
+EXTENSION = 0.05
+
+
+class ProjectionStatus(enum.IntEnum):
+    """The three cases of §6.2 for one point."""
+
+    UNIQUE = 0
+    MULTIPLE = 1
+    NONE = 2
+
+
+@dataclass(frozen=True)
+class Projection:
+    """Feet of ``n`` points on ``q``.
+
+    Attributes
+    ----------
+    st : (n, 2) float
+        Foot parameters (on the extension of ``q`` where ``status`` is NONE).
+    foot : (n, 3) float
+    status : (n,) int
+        :class:`ProjectionStatus` values.
+    det_k : (n,) float
+        ``det K`` at the foot (eq. 22).
+    """
+
+    st: NDArray
+    foot: NDArray
+    status: NDArray
+    det_k: NDArray
+
+    @property
+    def regular(self) -> NDArray:
+        """``(n,) bool``: the UNIQUE case."""
+        return self.status == ProjectionStatus.UNIQUE
+
+
+def _dot(a: NDArray, b: NDArray) -> NDArray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+def projection_matrix(offset: NDArray, qd: NDArray) -> NDArray:
+    """``K (n, 2, 2)`` of eq. (22): ``K_ij = q_i . q_j - (r - q) . q_ij``.
+
+    Parameters
+    ----------
+    offset : (n, 3) float
+        ``r - q``.
+    qd : (n, 3, 3, 3) float
+        ``q.derivatives(s, t, 2)``.
+    """
+    qs, qt = qd[:, 1, 0], qd[:, 0, 1]
+    k00 = _dot(qs, qs) - _dot(offset, qd[:, 2, 0])
+    k01 = _dot(qs, qt) - _dot(offset, qd[:, 1, 1])
+    k11 = _dot(qt, qt) - _dot(offset, qd[:, 0, 2])
+    return np.stack([np.stack([k00, k01], -1), np.stack([k01, k11], -1)], -2)
+
+
+@dataclass(frozen=True, eq=False)
+class Projector:
+    """Orthogonal projection onto one surface, with a cached seed grid.
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+        ``q``, in 3D.
+    tol : float
+        Model units: Newton stops when the step moves the foot by less than this.
+    max_iter : int
+        Newton iterations at most (a cap: never a hang).
+    """
+
+    surface: NurbsSurface
+    tol: float
+    max_iter: int = 30
+    _grid: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.surface, NurbsSurface) or self.surface.dimension != 3:
+            raise InvalidGeometryError("projection needs a NurbsSurface in 3D")
+        object.__setattr__(self, "tol", check_tolerance(self.tol))
+        self._grid["evaluator"] = PatchEvaluator(self.surface)
+
+    @property
+    def evaluator(self) -> PatchEvaluator:
+        return self._grid["evaluator"]
+
+    # ------------------------------------------------------------ domain
+    @property
+    def lower(self) -> NDArray:
+        d = self.surface.domain
+        return np.array([d[0], d[2]])
+
+    @property
+    def upper(self) -> NDArray:
+        d = self.surface.domain
+        return np.array([d[1], d[3]])
+
+    def inside(self, st: NDArray, rel: float = 1e-9) -> NDArray:
+        """``(n,) bool``: ``st (n, 2)`` within the domain (``rel`` of its size)."""
+        eps = rel * (self.upper - self.lower)
+        return np.all((st >= self.lower - eps) & (st <= self.upper + eps), axis=-1)
+
+    # ------------------------------------------------------------ seeds
+    def _seed_grid(self) -> tuple[NDArray, NDArray, cKDTree]:
+        if "tree" not in self._grid:
+            s = self.surface
+            counts = []
+            for knots, degree in ((s.knots_u, s.degree_u), (s.knots_v, s.degree_v)):
+                spans = np.unique(knots[degree:knots.size - degree]).size - 1
+                counts.append(max(GRID_SAMPLES, 4 * spans + 1))
+            su = np.linspace(self.lower[0], self.upper[0], counts[0])
+            sv = np.linspace(self.lower[1], self.upper[1], counts[1])
+            pts = s.evaluate_grid(su, sv).reshape(-1, 3)
+            params = np.stack(np.meshgrid(su, sv, indexing="ij"), -1).reshape(-1, 2)
+            self._grid.update(params=params, points=pts, tree=cKDTree(pts))
+        return self._grid["params"], self._grid["points"], self._grid["tree"]
+
+    def seeds(self, points: NDArray) -> NDArray:
+        """``(n, 2)`` parameters of the nearest grid sample to each of ``points (n, 3)``."""
+        params, _, tree = self._seed_grid()
+        _, idx = tree.query(points)
+        return params[idx]
+
+    # ------------------------------------------------------------ Newton
+    def project(self, points: ArrayLike, st0: ArrayLike | None = None) -> Projection:
+        """Feet of ``points (n, 3)`` by Newton on eqs. (3)-(4), from ``st0 (n, 2)``
+        (default: :meth:`seeds`)."""
+        return self.project_with_derivatives(points, st0)[0]
+
+    def project_with_derivatives(self, points: ArrayLike, st0: ArrayLike | None = None
+                                 ) -> tuple[Projection, NDArray]:
+        """:meth:`project` and ``q``'s derivatives at the feet ``(n, 3, 3, 3)``."""
+        ev = self.evaluator
+        x = np.asarray(points, dtype=float).reshape(-1, 3)
+        st = self.seeds(x) if st0 is None else np.array(st0, dtype=float).reshape(-1, 2)
+        span = self.upper - self.lower
+        lo, hi = self.lower - EXTENSION * span, self.upper + EXTENSION * span
+        st = np.clip(st, lo, hi)
+        moved = np.full(x.shape[0], np.inf)
+        before = np.full(x.shape[0], np.inf)
+        active = np.arange(x.shape[0])
+        for _ in range(self.max_iter):
+            if active.size == 0:
+                break
+            qd = ev.derivatives(st[active, 0], st[active, 1], 2)
+            off = x[active] - qd[:, 0, 0]
+            qs, qt = qd[:, 1, 0], qd[:, 0, 1]
+            f = np.stack([_dot(off, qs), _dot(off, qt)], -1)
+            k = projection_matrix(off, qd)
+            det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
+            jtj = np.stack([np.stack([_dot(qs, qs), _dot(qs, qt)], -1),
+                            np.stack([_dot(qs, qt), _dot(qt, qt)], -1)], -2)
+            good = (det > 0) & (k[:, 0, 0] > 0)
+            mat = np.where(good[:, None, None], k, jtj)
+            mdet = mat[:, 0, 0] * mat[:, 1, 1] - mat[:, 0, 1] ** 2
+            mdet = np.where(np.abs(mdet) > 1e-300, mdet, 1e-300)
+            step = np.stack([mat[:, 1, 1] * f[:, 0] - mat[:, 0, 1] * f[:, 1],
+                             mat[:, 0, 0] * f[:, 1] - mat[:, 0, 1] * f[:, 0]], -1) / mdet[:, None]
+            # limit a step to a quarter of the domain (far seeds must not jump around)
+            scale = np.max(np.abs(step) / (0.25 * span), axis=1)
+            step /= np.maximum(scale, 1.0)[:, None]
+            new = np.clip(st[active] + step, lo, hi)
+            d = new - st[active]
+            before[active] = moved[active]
+            moved[active] = np.linalg.norm(qs * d[:, :1] + qt * d[:, 1:], axis=1)
+            st[active] = new
+            # quadratic convergence: the next step would move about moved^3 / before^2
+            m, b = moved[active], before[active]
+            nxt = np.where(m < b, m ** 3 / np.maximum(b, 1e-300) ** 2, np.inf)
+            active = active[(m > self.tol) & (nxt > self.tol)]
+        qd = ev.derivatives(st[:, 0], st[:, 1], 2)
+        k = projection_matrix(x - qd[:, 0, 0], qd)
+        det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
+        status = np.full(x.shape[0], int(ProjectionStatus.UNIQUE), dtype=np.int8)
+        status[det <= 0] = ProjectionStatus.MULTIPLE
+        lost = (moved > 10 * self.tol) & (moved ** 3 / np.maximum(before, 1e-300) ** 2 > self.tol)
+        status[~self.inside(st) | lost] = ProjectionStatus.NONE
+        return Projection(st, qd[:, 0, 0], status, det), qd

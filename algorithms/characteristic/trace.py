@@ -1,0 +1,250 @@
+"""Tracing intersection curves ``phi(u, v) = 0`` from start points (002 eq. 33, §6.3 step 4).
+
+From each start the curve is traced one way by :func:`.curves.trace_curves`
+with the tangent of eq. (33) and the Newton corrector; if it does not close,
+the other way too, and the two halves are joined. A trace ends where the curve
+closes, on a side of ``r``'s domain, or where its image leaves ``q``'s domain
+(a border point of ``q``'s boundary curve, §6.2).
+
+The traced samples then go through the refinement of the triangle method
+(:func:`surfprep.algorithms.intersection.refine_curves`: auxiliary-plane
+refinement to ``tol``, chord-midpoint insertion, redundant samples dropped);
+every end on a domain side is solved again with that side's parameter held
+(:func:`.points.solve_held`), and spans whose interpolants stray by more than
+``tol`` get refined midpoints (:func:`refine_points`), so the result is an
+:class:`~surfprep.algorithms.intersection.IntersectionCurve` with the same
+contract as the triangle method's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError
+from ..intersection import (
+    EndKind,
+    IntersectionCurve,
+    RefinedCurve,
+    refine_curves,
+    refine_points,
+)
+from ..intersection import result as _result
+from .curves import CurveKind, EndReason, TracedCurve, curve_value, trace_curves
+from .distance import DistanceField
+from .points import solve_held
+
+__all__ = [
+    "MAX_STEPS",
+    "dense_polyline",
+    "polyline_gap",
+    "to_intersection_curve",
+    "trace_intersections",
+]
+
+#: accepted steps per intersection curve at most (a cap: never a hang)
+MAX_STEPS = 4000
+#: rounds of midpoint insertion at most
+_SPLIT_ROUNDS = 8
+
+
+def _join(forward: TracedCurve, backward: TracedCurve) -> TracedCurve:
+    """``backward`` reversed, then ``forward`` (their common start once)."""
+    b = backward.reversed()
+    return TracedCurve(forward.kind, np.vstack([b.uv[:-1], forward.uv]),
+                       np.vstack([b.st[:-1], forward.st]),
+                       np.concatenate([b.phi[:-1], forward.phi]),
+                       np.vstack([b.grad[:-1], forward.grad]),
+                       np.concatenate([b.det_k[:-1], forward.det_k]),
+                       b.start_reason, forward.end_reason)
+
+
+def trace_intersections(field: DistanceField, uv: NDArray, st: NDArray, scale: NDArray, *,
+                        tol: float, h_max: float | None = None) -> list[TracedCurve]:
+    """Trace the intersection curve through each start ``uv (m, 2)`` (feet ``st``).
+
+    ``scale (m,)`` is the size of the feature each start belongs to (parameter
+    units: a loop's radius estimate); the first step is a tenth of it, so loops
+    far smaller than the domain are traced with steps to match. The corrector
+    runs until ``|phi| <= tol / 16`` (a parameter step below ``tol / (16 |r_u|)``),
+    so every sample lies within ``tol / 16`` of both surfaces: the samples are
+    refined points of the intersection already.
+    """
+    m = uv.shape[0]
+    if m == 0:
+        return []
+    diag = field.diagonal
+    h_max = 0.03 * diag if h_max is None else h_max
+    h0 = np.clip(0.1 * np.asarray(scale, float), 1e-7 * diag, h_max)
+    jet = field.jet(uv, st)
+    _, dg = curve_value(jet, CurveKind.INTERSECTION)
+    tangent = np.stack([dg[:, 1], -dg[:, 0]], -1)
+    ctol = tol / (16 * field.speed)
+    forward = trace_curves(field, CurveKind.INTERSECTION, uv, st, tangent, h0=h0, h_max=h_max,
+                           max_steps=MAX_STEPS, ctol=ctol)
+    again = [i for i, c in enumerate(forward) if not c.closed]
+    backward = trace_curves(field, CurveKind.INTERSECTION, uv[again], st[again],
+                            -tangent[again], h0=h0[again], h_max=h_max, max_steps=MAX_STEPS,
+                            ctol=ctol)
+    out = list(forward)
+    for i, b in zip(again, backward):
+        out[i] = _join(forward[i], b)
+    return out
+
+
+def dense_polyline(curve: IntersectionCurve, per_span: int = 32) -> NDArray:
+    """``(k, 3)`` points of the curve's 3D interpolant, ``per_span`` per span (its
+    samples when it has none): a polyline whose chords follow the curve closely."""
+    if curve.curve3d is None:
+        return curve.points
+    t = curve.parameters
+    s = np.arange(per_span) / per_span
+    dense = (t[:-1, None] + s[None, :] * np.diff(t)[:, None]).ravel()
+    if not curve.closed:
+        dense = np.append(dense, t[-1])
+    return curve.curve3d.evaluate(dense)
+
+
+def polyline_gap(points: NDArray, polylines: list[NDArray], closed: list[bool]) -> NDArray:
+    """Distance ``(n,)`` from each of ``points (n, d)`` to the nearest segment of the polylines."""
+    if not polylines:
+        return np.full(points.shape[0], np.inf)
+    a, b = [], []
+    for p, c in zip(polylines, closed):
+        q = np.vstack([p, p[:1]]) if c else p
+        if q.shape[0] < 2:
+            q = np.vstack([q, q])
+        a.append(q[:-1])
+        b.append(q[1:])
+    a, b = np.concatenate(a), np.concatenate(b)
+    d = b - a
+    dd = np.einsum("sc,sc->s", d, d)
+    t = np.clip(np.einsum("nsc,sc->ns", points[:, None] - a[None], d) / np.where(dd > 0, dd, 1.0),
+                0.0, 1.0)
+    return np.linalg.norm(a[None] + t[..., None] * d[None] - points[:, None], axis=-1).min(axis=1)
+
+
+def _held_side(uv: NDArray, lower: NDArray, upper: NDArray) -> tuple[int, float]:
+    """``(coordinate, value)`` of the domain side nearest to ``uv (2,)``."""
+    gaps = np.array([uv[0] - lower[0], upper[0] - uv[0], uv[1] - lower[1], upper[1] - uv[1]])
+    k = int(np.argmin(np.abs(gaps)))
+    coord = k // 2
+    return coord, float(lower[coord] if k % 2 == 0 else upper[coord])
+
+
+def _fix_ends(field: DistanceField, traced: TracedCurve, uv_a: NDArray, uv_b: NDArray,
+              tol: float) -> tuple[NDArray, NDArray]:
+    """Solve each BOUNDARY end again on its side (r's side, or q's for a lost projection)."""
+    a, b = (field.q, field.r) if field.swapped else (field.r, field.q)
+    uv_a, uv_b = uv_a.copy(), uv_b.copy()
+    for end, reason in ((0, traced.start_reason), (-1, traced.end_reason)):
+        if reason not in (EndReason.DOMAIN, EndReason.PROJECTION):
+            continue
+        on_q = reason is EndReason.PROJECTION
+        surface_is_b = on_q != field.swapped
+        side_uv = uv_b[end] if surface_is_b else uv_a[end]
+        dom = (b if surface_is_b else a).domain
+        coord, value = _held_side(side_uv, np.array(dom[0::2]), np.array(dom[1::2]))
+        ua, ub, ok = solve_held(a, b, uv_a[end][None], uv_b[end][None], np.array([int(surface_is_b)]),
+                                np.array([coord]), np.array([value]), tol / 16)
+        if ok[0]:
+            uv_a[end], uv_b[end] = ua[0], ub[0]
+    return uv_a, uv_b
+
+
+def _split_failing(curve: IntersectionCurve, a, b, tol: float) -> IntersectionCurve | None:
+    """Refined midpoints inserted in spans whose interpolants stray by more than ``tol``."""
+    to_a, to_b, gap = curve.span_deviation(a, b)
+    bad = np.flatnonzero(np.nan_to_num(np.maximum(np.maximum(to_a, to_b), gap)) > tol)
+    if bad.size == 0:
+        return None
+    n = curve.points.shape[0]
+    nxt = (bad + 1) % n
+    mid = refine_points(a, b, 0.5 * (curve.uv_a[bad] + curve.uv_a[nxt]),
+                        0.5 * (curve.uv_b[bad] + curve.uv_b[nxt]), tol=tol / 16,
+                        anchors=0.5 * (curve.points[bad] + curve.points[nxt]))
+    ok = mid.converged
+    if not ok.any():
+        return None
+    bad = bad[ok]
+    order = np.argsort(np.concatenate([2 * np.arange(n), 2 * bad + 1]), kind="stable")
+
+    def merged(x, y):
+        return np.concatenate([x, y])[order]
+
+    return IntersectionCurve.from_samples(
+        merged(curve.points, mid.points[ok]), merged(curve.uv_a, mid.uv_a[ok]),
+        merged(curve.uv_b, mid.uv_b[ok]), curve.closed, curve.start_kind, curve.end_kind,
+        singular=merged(curve.singular, mid.singular[ok]))
+
+
+def _closing_count(uv: NDArray) -> int:
+    """Samples of a closed trace to keep: the last ones that reach or pass the start
+    (ahead of it along the first step, or closer than half of it) are dropped, so
+    the closing chord runs forward."""
+    first = uv[1] - uv[0]
+    step = float(np.linalg.norm(first))
+    n = uv.shape[0]
+    while n > 3:
+        d = uv[n - 1] - uv[0]
+        if float(d @ first) > 0 or float(np.linalg.norm(d)) < 0.5 * step:
+            n -= 1
+        else:
+            break
+    return n
+
+
+def _end_kind(reason: EndReason) -> EndKind:
+    if reason in (EndReason.DOMAIN, EndReason.PROJECTION):
+        return EndKind.BOUNDARY
+    if reason is EndReason.SINGULAR:
+        return EndKind.BIFURCATION
+    return EndKind.OPEN
+
+
+def to_intersection_curve(field: DistanceField, traced: TracedCurve, tol: float
+                          ) -> IntersectionCurve | None:
+    """A traced ``phi = 0`` curve refined to ``tol`` (module docstring); None when too short."""
+    uv_a, uv_b = field.ab(traced.uv, traced.st)
+    closed = traced.closed
+    if closed:                  # the trace ends back near its start: drop the overlap
+        n = _closing_count(traced.uv)
+        uv_a, uv_b = uv_a[:n], uv_b[:n]
+    a, b = (field.q, field.r) if field.swapped else (field.r, field.q)
+    pts = a.evaluate(uv_a[:, 0], uv_a[:, 1])
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-3 * tol])
+    uv_a, uv_b = uv_a[keep], uv_b[keep]
+    if uv_a.shape[0] < 2 + closed:
+        return None
+    sampled = getattr(_result, "sampled_curves", None)      # the cubic sampling, when there
+    ua, ub = uv_a, uv_b
+    if sampled is None:          # older intersection package: polyline refinement
+        refined = refine_curves(a, b, [uv_a], [uv_b], [closed], tol=tol)[0]
+        ua, ub = refined.uv_a, refined.uv_b
+    if not closed:
+        ua, ub = _fix_ends(field, traced, ua, ub, tol)
+    pts = 0.5 * (a.evaluate(ua[:, 0], ua[:, 1]) + b.evaluate(ub[:, 0], ub[:, 1]))
+    step = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    keep = np.concatenate([[True], step > 1e-3 * tol])
+    if not closed and not keep[-1]:          # keep the solved end, drop its neighbour
+        keep[-1], keep[-2] = True, pts.shape[0] <= 2
+    pts, ua, ub = pts[keep], ua[keep], ub[keep]
+    kinds = ((EndKind.CLOSED, EndKind.CLOSED) if closed else
+             (_end_kind(traced.start_reason), _end_kind(traced.end_reason)))
+    if pts.shape[0] < 2 + closed:
+        return None
+    try:
+        if sampled is not None:
+            dense = RefinedCurve(pts, ua, ub, closed, np.ones(pts.shape[0], dtype=bool),
+                                 np.zeros(pts.shape[0], dtype=bool))
+            curve = sampled([dense], [kinds], a, b, tol=tol)[0]
+        else:
+            curve = IntersectionCurve.from_samples(pts, ua, ub, closed, *kinds)
+    except InvalidGeometryError:
+        return None
+    for _ in range(_SPLIT_ROUNDS):
+        split = _split_failing(curve, a, b, tol)
+        if split is None:
+            break
+        curve = split
+    return curve
