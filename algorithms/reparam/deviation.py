@@ -1,0 +1,140 @@
+"""Dense error of the approximation, eq. 29.3 (section 29.2.3), measured both ways.
+
+.. math:: \\max_{i,j} \\; \\min_{k,l} \\| s(u_i, v_j) - r(u_k, v_l) \\| < \\varepsilon  \\qquad (29.3)
+
+``s`` is the original, ``r`` the new surface. Two dense samples are measured
+by closest-point projection (:func:`~surfprep.algorithms.projection.project_to_surface`):
+
+* **new on original**: ``r`` at ``per_span x per_span`` points of every
+  interpolation cell (so at least that many per knot span, the interpolation
+  parameters containing the knots), projected onto ``s`` starting from the
+  original parameters interpolated from the relocation grid. A local
+  projection can only overestimate the distance, so the figure is safe.
+* **original on new** (eq. 29.3 as written): ``s`` at ``per_span x per_span``
+  points per knot span of ``s`` (at least :data:`MIN_ORIGINAL_SAMPLES` per
+  direction), projected onto ``r`` with seeds.
+
+The first also gives the error along the grid lines ``U = U_i`` (a pure v
+interpolation) and ``V = V_j`` (pure u), which tells in which direction a cell
+needs another knot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.interpolate import RegularGridInterpolator
+from scipy.spatial import cKDTree
+
+from ..projection import project_to_surface
+from ..surface import NurbsSurface
+
+__all__ = [
+    "MIN_ORIGINAL_SAMPLES",
+    "DeviationMap",
+    "deviation_map",
+    "original_on_new",
+    "subdivide",
+]
+
+#: Samples of the original per direction at least in the eq. 29.3 direction.
+MIN_ORIGINAL_SAMPLES = 60
+
+
+def subdivide(values: NDArray, parts: int) -> NDArray:
+    """Every interval of ``values (n,)`` split into ``parts`` equal steps: ``(parts (n-1) + 1,)``."""
+    steps = np.linspace(0.0, 1.0, parts + 1)[:-1]
+    return np.append((values[:-1, None] + steps * np.diff(values)[:, None]).ravel(), values[-1])
+
+
+@dataclass(frozen=True)
+class DeviationMap:
+    """Distances of the new surface from the original on a dense grid of its cells.
+
+    Attributes
+    ----------
+    distance : (a, b) float
+        ``a = per_span (n_u - 1) + 1`` rows over the new u parameters, likewise b.
+    per_span : int
+    u_errors : (n_u - 1,) float
+        Largest distance on the lines ``V = V_j`` inside each u interval.
+    v_errors : (n_v - 1,) float
+        Largest distance on the lines ``U = U_i`` inside each v interval.
+    cell_errors : (n_u - 1, n_v - 1) float
+        Largest distance inside each cell.
+    """
+
+    distance: NDArray
+    per_span: int
+    u_errors: NDArray
+    v_errors: NDArray
+    cell_errors: NDArray
+
+    @property
+    def max(self) -> float:
+        return float(self.distance.max())
+
+
+def deviation_map(original: NurbsSurface, new: NurbsSurface, params_u: NDArray,
+                  params_v: NDArray, uv: NDArray, per_span: int = 10) -> DeviationMap:
+    """Dense distances of ``new`` from ``original`` (see module docstring).
+
+    Parameters
+    ----------
+    original, new : NurbsSurface
+    params_u, params_v : (n_u,), (n_v,) float
+        Interpolation parameters of ``new``.
+    uv : (n_u, n_v, 2) float
+        Original parameters of the interpolation points (start of the projections).
+    per_span : int
+    """
+    gu, gv = subdivide(params_u, per_span), subdivide(params_v, per_span)
+    points = new.evaluate_grid(gu, gv)                               # (a, b, 3)
+    lookup = RegularGridInterpolator((params_u, params_v), uv)
+    mesh = np.stack(np.meshgrid(gu, gv, indexing="ij"), axis=-1)
+    guess = lookup(mesh.reshape(-1, 2)).reshape(mesh.shape)
+    distance = project_to_surface(original, points, guess=guess).distance
+    nu, nv, p = len(params_u) - 1, len(params_v) - 1, per_span
+    on_rows = distance[:, ::p]                                       # lines V = V_j
+    on_cols = distance[::p, :]                                       # lines U = U_i
+    u_err = np.array([on_rows[i * p:(i + 1) * p + 1].max() for i in range(nu)])
+    v_err = np.array([on_cols[:, j * p:(j + 1) * p + 1].max() for j in range(nv)])
+    blocks = np.maximum.reduceat(np.maximum.reduceat(distance, np.arange(0, nu * p, p), axis=0),
+                                 np.arange(0, nv * p, p), axis=1)
+    return DeviationMap(distance, per_span, u_err, v_err, blocks)
+
+
+def original_on_new(original: NurbsSurface, new: NurbsSurface, params_u: NDArray,
+                    params_v: NDArray, uv: NDArray, per_span: int = 10
+                    ) -> tuple[NDArray, NDArray]:
+    """Eq. 29.3: distances of dense samples of ``original`` from ``new``.
+
+    The projections start from the inverse of the reparametrization map (the
+    nearest of a dense sample of the map given by the interpolation nodes
+    ``uv (n_u, n_v, 2)`` at the new parameters ``params_u x params_v``); a
+    local projection can only overestimate the distance.
+
+    Returns
+    -------
+    distance : (m,) float
+    uv_new : (m, 2) float
+        Foot points in ``new``'s domain (where it needs another knot).
+    """
+    grids = []
+    for knots, degree, n in ((original.knots_u, original.degree_u, original.n_control[0]),
+                             (original.knots_v, original.degree_v, original.n_control[1])):
+        breaks = np.unique(knots[degree:n + 1])
+        parts = max(per_span, -(-MIN_ORIGINAL_SAMPLES // (len(breaks) - 1)))
+        grids.append(subdivide(breaks, parts))
+    points = original.evaluate_grid(*grids).reshape(-1, original.dimension)
+    fine_u, fine_v = subdivide(params_u, 4), subdivide(params_v, 4)
+    mesh = np.stack(np.meshgrid(fine_u, fine_v, indexing="ij"), axis=-1).reshape(-1, 2)
+    forward = RegularGridInterpolator((params_u, params_v), uv)(mesh)        # original uv
+    queries = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, 2)
+    scale = np.ptp(queries, axis=0) + 1e-300
+    _, nearest = cKDTree(forward / scale).query(queries / scale)
+    guess = mesh[nearest]
+    result = project_to_surface(new, points, guess=guess)
+    return result.distance, result.uv

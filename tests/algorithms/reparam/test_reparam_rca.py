@@ -1,0 +1,167 @@
+"""RCA reparametrization (section 29.2) on surfaces with known bad parametrizations.
+
+Every result is checked independently of the method's own error loop: the new
+surface is sampled densely (>= 10 x 10 per interpolation cell) and projected
+onto the original with seeds, and the original is sampled densely and
+projected onto the new surface. The chord-length mismatch (eqs. 29.1/29.2) is
+compared as its excess over the perfect value 1.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import pytest
+from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.algorithms.projection import project_to_surface
+from surfprep.algorithms.reparam import reparametrize_surface
+from surfprep.algorithms.reparam.deviation import subdivide
+from surfprep.algorithms.surface import NurbsSurface
+
+from surfprep.errors import (
+    DegenerateGeometryError,
+    InvalidGeometryError,
+    InvalidToleranceError,
+)
+
+
+def _geometry(a, b):
+    """A smooth, doubly curved sheet over [0, 2] x [0, 1.5] (a, b in [0, 1])."""
+    return np.stack([2 * a, 1.5 * b, 0.4 * np.sin(np.pi * a) * np.cos(0.8 * np.pi * (b - 0.5))], -1)
+
+
+def warped(warp, n: int = 12) -> NurbsSurface:
+    """C2 interpolant of the sheet at ``warp(u, v)`` on a uniform n x n grid."""
+    t = np.linspace(0.0, 1.0, n)
+    uu, vv = np.meshgrid(t, t, indexing="ij")
+    a, b = warp(uu, vv)
+    return interpolate_surface(_geometry(a, b), params_u=t, params_v=t)
+
+
+def u_cubed(u, v):
+    return u ** 3, v
+
+
+def clustered_ends(u, v):
+    return 0.5 - 0.5 * np.cos(np.pi * u), 0.5 - 0.5 * np.cos(np.pi * v)
+
+
+def sheared(u, v):
+    """u is distorted as u^(1 + 1.5 sin(pi v)): straight along v = 0 and v = 1, u^2.5
+    in the middle; the distortion mixes u and v."""
+    return u ** (1.0 + 1.5 * np.sin(np.pi * v)), v
+
+
+def dense_deviation(original: NurbsSurface, result) -> float:
+    """Both ways, projections seeded from sample grids (not the method's map):
+    10 x 10 per interpolation cell of the result, 150 x 150 on the original."""
+    new = result.surface
+    gu, gv = subdivide(result.params_u, 10), subdivide(result.params_v, 10)
+    forward = project_to_surface(original, new.evaluate_grid(gu, gv), n_seeds=1).distance.max()
+    ou = np.linspace(*original.domain[:2], 150)
+    ov = np.linspace(*original.domain[2:], 150)
+    backward = project_to_surface(new, original.evaluate_grid(ou, ov), n_seeds=1).distance.max()
+    return float(max(forward, backward))
+
+
+def excess(mismatch: float) -> float:
+    return mismatch - 1.0
+
+
+@functools.cache
+def reparametrized(warp, **options):
+    """(original, result), computed once per warp and options for all tests."""
+    original = warped(warp)
+    return original, reparametrize_surface(original, **options)
+
+
+@pytest.mark.parametrize("warp", [u_cubed, clustered_ends, sheared])
+def test_within_tol_and_chord_length(warp):
+    original, result = reparametrized(warp)
+    assert result.within_tolerance
+    assert result.max_deviation <= result.tol
+    assert dense_deviation(original, result) <= result.tol
+    assert excess(result.mismatch_before) > 0.3                      # really distorted
+    assert excess(result.mismatch_after) * 10 <= excess(result.mismatch_before)
+    assert result.relocation_converged
+    # the parameters follow arc length: the domain is about the boundary lengths
+    u0, u1, v0, v1 = result.surface.domain
+    assert u1 - u0 == pytest.approx(2.0 * 1.2, rel=0.2)
+    assert v1 - v0 == pytest.approx(1.5, rel=0.05)
+
+
+def test_shear_needs_the_interior_relocation():
+    """Per-direction arc length (straight lines in the original domain) leaves the
+    shear in; the penalty relocation removes it."""
+    _, without = reparametrized(sheared, relocation=False)
+    _, with_it = reparametrized(sheared)
+    assert excess(without.mismatch_after) > 0.5 * excess(original_mismatch := without.mismatch_before)
+    assert excess(with_it.mismatch_after) * 10 <= excess(original_mismatch)
+
+
+@pytest.mark.slow
+def test_tighter_tolerance_inserts_knots():
+    original = warped(u_cubed)
+    loose = reparametrize_surface(original, tol=1e-3)
+    tight = reparametrize_surface(original, tol=5e-5)
+    assert tight.within_tolerance and loose.within_tolerance
+    assert dense_deviation(original, tight) <= 5e-5
+    assert tight.surface.n_control[0] > loose.surface.n_control[0]
+
+
+def test_limit_reached_is_reported_not_hidden():
+    original, full = reparametrized(u_cubed)
+    assert full.iterations > 1 and full.within_tolerance
+    cut = reparametrize_surface(original, max_iterations=1)
+    assert not cut.within_tolerance
+    assert cut.max_deviation > cut.tol
+
+
+def _cone_with_pole(n: int = 10) -> NurbsSurface:
+    """Quarter cone, apex along v = 0 (a collapsed edge), u distorted as u^2."""
+    t = np.linspace(0.0, 1.0, n)
+    uu, vv = np.meshgrid(t, t, indexing="ij")
+    angle = 0.5 * np.pi * uu ** 2
+    points = np.stack([vv * np.cos(angle), vv * np.sin(angle), 1.0 - vv], -1)
+    return interpolate_surface(points, params_u=t, params_v=t)
+
+
+def test_collapsed_edge_stays_collapsed():
+    original = _cone_with_pole()
+    result = reparametrize_surface(original)
+    assert result.within_tolerance
+    assert dense_deviation(original, result) <= result.tol
+    new = result.surface
+    u0, u1, v0, _ = new.domain
+    apex = new.evaluate(np.linspace(u0, u1, 50), np.full(50, v0))
+    assert np.ptp(apex, axis=0).max() <= result.tol
+    assert excess(result.mismatch_after) * 10 <= excess(result.mismatch_before)
+
+
+def test_point_and_collapsed_direction_are_degenerate():
+    point = NurbsSurface(np.ones((4, 4, 3)), [0] * 4 + [1] * 4, [0] * 4 + [1] * 4, 3, 3)
+    with pytest.raises(DegenerateGeometryError):
+        reparametrize_surface(point)
+    t = np.linspace(0.0, 1.0, 5)
+    line = np.zeros((5, 5, 3))
+    line[:, :, 0] = t[None, :]                       # independent of u
+    ribbon = interpolate_surface(line, params_u=t, params_v=t)
+    with pytest.raises(DegenerateGeometryError, match="collapsed"):
+        reparametrize_surface(ribbon)
+
+
+@pytest.mark.parametrize("tol", [math.nan, -1.0, 0.0, 1e3, 1e-14, "abc"])
+def test_bad_tolerance(tol):
+    with pytest.raises(InvalidToleranceError):
+        reparametrize_surface(warped(u_cubed, 6), tol=tol)
+
+
+def test_bad_input():
+    with pytest.raises(InvalidGeometryError):
+        reparametrize_surface(np.zeros((4, 4, 3)))
+    cp = np.zeros((4, 4, 3))
+    cp[1, 1, 2] = np.nan
+    with pytest.raises(InvalidGeometryError, match="NaN"):
+        NurbsSurface(cp, [0] * 4 + [1] * 4, [0] * 4 + [1] * 4, 3, 3)
