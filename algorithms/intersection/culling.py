@@ -31,7 +31,8 @@ from ..surface import NurbsSurface
 
 __all__ = ["BoxTree", "build_tree", "tree_pairs", "candidate_pairs", "PatchOverlap",
            "overlap_boxes", "overlap_patches", "surface_patch_boxes", "patch_rectangles",
-           "subpatch_boxes"]
+           "subpatch_boxes", "span_patches", "span_hull_boxes", "grid_tree", "surface_tree",
+           "exact_patch_boxes"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -272,13 +273,58 @@ def _blossom_restrict(coeffs: NDArray, s0: NDArray, s1: NDArray) -> NDArray:
     return current[:, :, 0]
 
 
+def _spans(knots: NDArray, degree: int, n: int) -> NDArray:
+    """Indices ``i`` of the non-empty knot spans ``[knots[i], knots[i+1])`` of the domain."""
+    return np.flatnonzero(knots[degree:n] < knots[degree + 1:n + 1]) + degree
+
+
+def _blossom_spans(net: NDArray, knots: NDArray, degree: int) -> NDArray:
+    """Bernstein coefficients of single knot spans along axis 1, many spans at once.
+
+    ``net (k, p + 1, ...)`` are the ``p + 1`` homogeneous poles of each span and
+    ``knots (k, 2p + 2)`` the knots around it (span ``[knots[:, p], knots[:, p+1]]``);
+    coefficient ``i`` is the blossom ``f(a^{p-i}, b^i)`` (the de Boor triangle of
+    :func:`surfprep.algorithms.bezier.bezier_decompose_array`, per span).
+    """
+    p = degree
+    extra = (1,) * (net.ndim - 2)
+    a, b = knots[:, p], knots[:, p + 1]
+    i = np.arange(p + 1)
+    current = net[:, None]                                          # (k, 1, p+1, ...)
+    for r in range(1, p + 1):
+        x = np.where(r <= p - i, a[:, None], b[:, None])            # (k, p+1)
+        local = np.arange(r, p + 1)
+        lo, hi = knots[:, local], knots[:, p + 1 - r + local]        # (k, p+1-r)
+        alpha = (x[:, :, None] - lo[:, None, :]) / (hi - lo)[:, None, :]
+        alpha = alpha.reshape(alpha.shape + extra)
+        current = (1.0 - alpha) * current[:, :, :-1] + alpha * current[:, :, 1:]
+    return current[:, :, 0]
+
+
+def span_patches(surface: NurbsSurface, span_u: ArrayLike, span_v: ArrayLike) -> NDArray:
+    """Homogeneous Bernstein coefficients ``(k, p + 1, q + 1, d + 1)`` of the Bézier
+    patches on knot spans ``(span_u[i], span_v[i])`` only (knot indices, as
+    :func:`surfprep.algorithms.bezier.bezier_patches` gives for all of them)."""
+    iu, iv = np.asarray(span_u, dtype=np.int64), np.asarray(span_v, dtype=np.int64)
+    p, q = surface.degree_u, surface.degree_v
+    pw = surface.homogeneous_points()
+    rows = iu[:, None] - p + np.arange(p + 1)                        # (k, p+1)
+    cols = iv[:, None] - q + np.arange(q + 1)                        # (k, q+1)
+    net = pw[rows[:, :, None], cols[:, None, :]]                      # (k, p+1, q+1, d+1)
+    ku = surface.knots_u[iu[:, None] - p + np.arange(2 * p + 2)]
+    kv = surface.knots_v[iv[:, None] - q + np.arange(2 * q + 2)]
+    net = _blossom_spans(net, ku, p)
+    return np.swapaxes(_blossom_spans(np.swapaxes(net, 1, 2), kv, q), 1, 2)
+
+
 def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
     """Control-net boxes of the surface over parameter rectangles inside Bézier patches.
 
     The restriction of a (rational) Bézier patch to a sub-rectangle is again one,
     whose Cartesian control points bound it (positive weights), so the box
     encloses the surface over the rectangle (004 §4.1's secondary decomposition,
-    without building the refined patches).
+    without building the refined patches). Only the patches holding the
+    rectangles are extracted (:func:`span_patches`).
 
     Parameters
     ----------
@@ -296,17 +342,112 @@ def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
         A rectangle spanning more than one Bézier patch.
     """
     rects = np.asarray(rects, dtype=float).reshape(-1, 4)
-    patches, int_u, int_v = bezier_patches(surface)
-    iu = np.clip(np.searchsorted(int_u[:, 1], rects[:, 0], side="right"), 0, len(int_u) - 1)
-    iv = np.clip(np.searchsorted(int_v[:, 1], rects[:, 2], side="right"), 0, len(int_v) - 1)
-    a, b = int_u[iu, 0], int_u[iu, 1]
-    c, d = int_v[iv, 0], int_v[iv, 1]
+    nu, nv = surface.n_control
+    su = _spans(surface.knots_u, surface.degree_u, nu)
+    sv = _spans(surface.knots_v, surface.degree_v, nv)
+    ku, kv = surface.knots_u, surface.knots_v
+    iu = su[np.clip(np.searchsorted(ku[su + 1], rects[:, 0], side="right"), 0, su.size - 1)]
+    iv = sv[np.clip(np.searchsorted(kv[sv + 1], rects[:, 2], side="right"), 0, sv.size - 1)]
+    a, b, c, d = ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]
     if np.any((rects[:, 0] < a) | (rects[:, 1] > b) | (rects[:, 2] < c) | (rects[:, 3] > d)):
         raise InvalidGeometryError("every rectangle must lie inside one Bézier patch")
-    coeffs = patches[iu, iv]                                      # (k, p+1, q+1, d+1)
+    pairs, inverse = np.unique(np.stack([iu, iv], 1), axis=0, return_inverse=True)
+    coeffs = span_patches(surface, pairs[:, 0], pairs[:, 1])[inverse.ravel()]
     coeffs = _blossom_restrict(coeffs, (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a))
     coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), (rects[:, 2] - c) / (d - c),
                                (rects[:, 3] - c) / (d - c))
+    cartesian = coeffs[..., :-1] / coeffs[..., -1:]
+    return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
+
+
+# ------------------------------------------------------------ span grid trees
+def span_hull_boxes(surface: NurbsSurface) -> NDArray:
+    """``(ku, kv, 2, d)`` boxes of the ``(p + 1) x (q + 1)`` poles of every non-empty knot
+    span: with positive weights the surface over the span lies in their convex
+    hull (looser than the Bézier box, but a sliding min/max over the net)."""
+    p, q = surface.degree_u, surface.degree_v
+    nu, nv = surface.n_control
+    su, sv = _spans(surface.knots_u, p, nu), _spans(surface.knots_v, q, nv)
+    cp = np.asarray(surface.control_points, dtype=float)
+    lo, hi = cp, cp
+    for axis, width in ((0, p + 1), (1, q + 1)):             # separable sliding min / max
+        count = lo.shape[axis] - width + 1
+
+        def window(x, k, axis=axis, count=count):
+            return x[(slice(None),) * axis + (slice(k, k + count),)]
+
+        new_lo, new_hi = window(lo, 0).copy(), window(hi, 0).copy()
+        for k in range(1, width):
+            np.minimum(new_lo, window(lo, k), out=new_lo)
+            np.maximum(new_hi, window(hi, k), out=new_hi)
+        lo, hi = new_lo, new_hi
+    # window start i - p holds span i
+    return np.stack([lo[su - p][:, sv - q], hi[su - p][:, sv - q]], axis=2)
+
+
+def grid_tree(boxes: ArrayLike) -> BoxTree:
+    """Box tree over a ``(ku, kv)`` grid of boxes ``(ku, kv, 2, 3)``, without sorting.
+
+    Nodes are index rectangles of the grid, split in half across their longer
+    side; leaf items are flat indices ``i * kv + j``. Built level by level (top
+    down), boxes bottom up; ``2 ku kv - 1`` nodes.
+    """
+    boxes = np.asarray(boxes, dtype=float)
+    ku, kv = boxes.shape[:2]
+    m = ku * kv
+    n = 2 * m - 1
+    left = np.full(n, -1, np.int64)
+    right = np.full(n, -1, np.int64)
+    item = np.full(n, -1, np.int64)
+    size = np.zeros(n, np.int64)
+    rect = np.zeros((n, 4), np.int64)                      # i0, i1, j0, j1
+    rect[0] = (0, ku, 0, kv)
+    size[0] = m
+    levels, frontier, next_id = [np.array([0])], np.array([0]), 1
+    while True:
+        split = frontier[size[frontier] > 1]
+        if split.size == 0:
+            break
+        i0, i1, j0, j1 = rect[split].T
+        along_u = (i1 - i0) >= (j1 - j0)
+        mid_i = np.where(along_u, (i0 + i1) // 2, i1)
+        mid_j = np.where(along_u, j1, (j0 + j1) // 2)
+        kids = next_id + np.arange(2 * split.size)
+        left[split], right[split] = kids[0::2], kids[1::2]
+        rect[kids[0::2]] = np.stack([i0, mid_i, j0, mid_j], 1)
+        rect[kids[1::2]] = np.stack([np.where(along_u, mid_i, i0), i1,
+                                     np.where(along_u, j0, mid_j), j1], 1)
+        r = rect[kids]
+        size[kids] = (r[:, 1] - r[:, 0]) * (r[:, 3] - r[:, 2])
+        next_id += kids.size
+        frontier = kids
+        levels.append(kids)
+    leaves = left < 0
+    item[leaves] = rect[leaves, 0] * kv + rect[leaves, 2]
+    flat = boxes.reshape(m, 2, -1)
+    lo, hi = np.zeros((n, flat.shape[2])), np.zeros((n, flat.shape[2]))
+    lo[leaves], hi[leaves] = flat[item[leaves], 0], flat[item[leaves], 1]
+    for level in reversed(levels):
+        inner = level[left[level] >= 0]
+        lo[inner] = np.minimum(lo[left[inner]], lo[right[inner]])
+        hi[inner] = np.maximum(hi[left[inner]], hi[right[inner]])
+    return BoxTree(lo, hi, left, right, item, size, len(levels))
+
+
+def surface_tree(surface: NurbsSurface, pad: float = 0.0) -> BoxTree:
+    """:func:`grid_tree` over the span hull boxes, widened by ``pad``."""
+    boxes = span_hull_boxes(surface)
+    return grid_tree(boxes + np.array([-pad, pad])[:, None])
+
+
+def exact_patch_boxes(surface: NurbsSurface, patches: ArrayLike) -> NDArray:
+    """Bézier control-net boxes ``(k, 2, d)`` of patches given by flat index
+    ``i * kv + j`` (the order of :func:`surface_patch_boxes`), extracting only them."""
+    p, q = surface.degree_u, surface.degree_v
+    nu, nv = surface.n_control
+    su, sv = _spans(surface.knots_u, p, nu), _spans(surface.knots_v, q, nv)
+    patches = np.asarray(patches, dtype=np.int64)
+    coeffs = span_patches(surface, su[patches // sv.size], sv[patches % sv.size])
     cartesian = coeffs[..., :-1] / coeffs[..., -1:]
     return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
 

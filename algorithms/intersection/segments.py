@@ -2,7 +2,10 @@
 
 :func:`mesh_segments` runs the first half of the SSI pipeline:
 
-1. overlap boxes of the Bézier patch boxes (004 §4.2, :func:`.culling.overlap_boxes`);
+1. overlap boxes of the Bézier patch boxes (004 §4.2): the span hull boxes of
+   both surfaces descended as grid trees (:func:`.culling.surface_tree`), then
+   the exact Bézier boxes of the candidate patches only, so the work follows the
+   intersection and not the pole count;
 2. adaptive tessellation of only the patches that take part (004 §4.3,
    :func:`.tessellation.tessellate`), pruned during refinement so the work
    follows the intersection: a's sub-rectangles must come near a coarse
@@ -28,7 +31,8 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..surface import NurbsSurface
-from .culling import candidate_pairs, overlap_boxes, surface_patch_boxes
+from .culling import (BoxTree, PatchOverlap, build_tree, candidate_pairs,
+                      exact_patch_boxes, patch_rectangles, surface_tree, tree_pairs)
 from .mesh import TriangleMesh
 from .tessellation import tessellate
 from .triangles import TriangleHits, intersect_triangles
@@ -156,18 +160,58 @@ class SegmentSoup:
 
 
 # ----------------------------------------------------------------- driver
-def _operand_boxes(operand: Operand, tol: float) -> tuple[NDArray, NDArray | None, int, float]:
-    """Boxes to cull with, parameter rectangles (surfaces), patch count, padding."""
+def _check_operand(operand: Operand) -> None:
     if isinstance(operand, NurbsSurface):
         if operand.dimension != 3:
             raise InvalidGeometryError(
                 f"intersection needs surfaces in 3D, got dimension {operand.dimension}")
-        boxes, rects = surface_patch_boxes(operand)
-        return boxes, rects, boxes.shape[0], 2.0 * tol
-    if isinstance(operand, TriangleMesh):
-        return operand.triangle_boxes(), None, 0, 0.0
-    raise InvalidGeometryError(
-        f"an operand must be a NurbsSurface or a TriangleMesh, got {type(operand).__name__}")
+        return
+    if not isinstance(operand, TriangleMesh):
+        raise InvalidGeometryError(
+            f"an operand must be a NurbsSurface or a TriangleMesh, got {type(operand).__name__}")
+
+
+def _cull_tree(operand: Operand, pad: float) -> BoxTree:
+    """Tree over a surface's span hull boxes (a grid, no sort) or a mesh's triangle boxes."""
+    if isinstance(operand, NurbsSurface):
+        return surface_tree(operand, pad)
+    return build_tree(operand.triangle_boxes())
+
+
+def _exact_boxes(operand: Operand, items: NDArray, pad: float) -> NDArray:
+    """Bézier boxes of surface patches (padded), or triangle boxes, of ``items``."""
+    if isinstance(operand, NurbsSurface):
+        return exact_patch_boxes(operand, items) + np.array([-pad, pad])[:, None]
+    return operand.triangle_boxes()[items]
+
+
+def _overlap(a: Operand, b: Operand, pad_a: float, pad_b: float) -> PatchOverlap:
+    """Overlapping patch (triangle) pairs and their overlap boxes (004 §4.2).
+
+    The span hull boxes of each surface (boxes of the poles of every knot span)
+    are descended as grid trees against each other, so only the spans near the
+    other operand are ever looked at; the candidate pairs are then tested with
+    their exact Bézier patch boxes, extracted for those patches only. Each box is
+    widened by its side's pad.
+    """
+    pairs = tree_pairs(_cull_tree(a, pad_a), _cull_tree(b, pad_b))
+    patches_a, inv_a = np.unique(pairs[:, 0], return_inverse=True)
+    patches_b, inv_b = np.unique(pairs[:, 1], return_inverse=True)
+    box_a = _exact_boxes(a, patches_a, pad_a)[inv_a.ravel()]
+    box_b = _exact_boxes(b, patches_b, pad_b)[inv_b.ravel()]
+    lo, hi = np.maximum(box_a[:, 0], box_b[:, 0]), np.minimum(box_a[:, 1], box_b[:, 1])
+    keep = np.all(lo <= hi, axis=1)
+    pairs = pairs[keep]
+    return PatchOverlap(pairs, np.stack([lo[keep], hi[keep]], axis=1), np.unique(pairs[:, 0]),
+                        np.unique(pairs[:, 1]))
+
+
+def _rects(operand: Operand) -> tuple[NDArray | None, int, float]:
+    """Parameter rectangles of a surface's patches, the patch count, and the pad."""
+    if isinstance(operand, NurbsSurface):
+        rects = patch_rectangles(operand)
+        return rects, rects.shape[0], 0.0
+    return None, 0, 0.0
 
 
 def _mesh_of(operand: Operand, rects: NDArray | None, patches: NDArray, keep: NDArray,
@@ -263,11 +307,15 @@ def mesh_segments(a: Operand, b: Operand, *, tol: float, max_depth: int = 24) ->
     if not (np.isfinite(tol) and tol > 0):
         raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
     tol = float(tol)
-    boxes_a, rects_a, n_a, pad_a = _operand_boxes(a, tol)
-    boxes_b, rects_b, n_b, pad_b = _operand_boxes(b, tol)
+    _check_operand(a)
+    _check_operand(b)
+    rects_a, n_a, _ = _rects(a)
+    rects_b, n_b, _ = _rects(b)
     # each side's boxes widened by its own pad (2 tol for a surface: its triangles
     # stray that little from it), so the overlap boxes hold every close triangle pair
-    overlap = overlap_boxes(boxes_a + [[-pad_a], [pad_a]], boxes_b + [[-pad_b], [pad_b]])
+    pad_a = 2.0 * tol if isinstance(a, NurbsSurface) else 0.0
+    pad_b = 2.0 * tol if isinstance(b, NurbsSurface) else 0.0
+    overlap = _overlap(a, b, pad_a, pad_b)
     guide, guide_pad = _guide(b, rects_b, overlap, tol, max_depth)
     mesh_a = _mesh_of(a, rects_a, overlap.patches_a, guide, tol, pad_a + guide_pad, max_depth)
     # b is refined only near a's triangles

@@ -162,3 +162,52 @@ def test_subpatch_boxes_enclose_the_surface():
     assert np.all(np.ptp(subpatch_boxes(surface, tiny)[0], axis=0) < 1e-3)
     with pytest.raises(InvalidGeometryError, match="one Bézier patch"):
         subpatch_boxes(surface, [[0.2, 0.3, 0, 1]])
+
+
+# ---------------------------------------------------------------- span grid trees
+def random_bspline(rng, n_u: int, n_v: int, rational: bool) -> NurbsSurface:
+    """A random bicubic (biquadratic in v) net with interior knots, some repeated."""
+    def knots(n, p):
+        inner = np.sort(rng.choice(np.linspace(0.1, 0.9, 9), n - p - 1))
+        return np.concatenate([[0.0] * (p + 1), inner, [1.0] * (p + 1)])
+    cp = rng.normal(size=(n_u, n_v, 3))
+    w = rng.uniform(0.5, 2.0, (n_u, n_v)) if rational else None
+    return NurbsSurface(cp, knots(n_u, 3), knots(n_v, 2), 3, 2, w)
+
+
+@pytest.mark.parametrize("seed, rational", [(0, False), (1, True), (2, True)])
+def test_span_hulls_exact_boxes_and_grid_tree(seed, rational):
+    from surfprep.algorithms.intersection.culling import (exact_patch_boxes, grid_tree,
+                                                          span_hull_boxes)
+    s = random_bspline(np.random.default_rng(seed), 9, 7, rational)
+    exact, _ = surface_patch_boxes(s)                        # whole Bezier decomposition
+    np.testing.assert_allclose(exact_patch_boxes(s, np.arange(exact.shape[0])), exact,
+                               atol=1e-12)
+    hull = span_hull_boxes(s).reshape(-1, 2, 3)
+    assert hull.shape == exact.shape
+    assert np.all(hull[:, 0] <= exact[:, 0] + 1e-12) and np.all(hull[:, 1] >= exact[:, 1] - 1e-12)
+    tree = grid_tree(span_hull_boxes(s))
+    leaves = tree.item >= 0
+    assert np.array_equal(np.sort(tree.item[leaves]), np.arange(hull.shape[0]))
+    inner = ~leaves                                          # parents hold their children
+    for side in (tree.left, tree.right):
+        assert np.all(tree.lo[inner] <= tree.lo[side[inner]])
+        assert np.all(tree.hi[inner] >= tree.hi[side[inner]])
+    np.testing.assert_array_equal(tree.lo[leaves], hull[tree.item[leaves], 0])
+
+
+def test_hierarchical_overlap_equals_exact_patch_overlap():
+    """mesh_segments' culling (hull grid trees, then exact boxes of the candidates only)
+    gives exactly the pairs of overlapping exact Bezier boxes."""
+    from surfprep.algorithms.intersection.segments import _overlap
+    rng = np.random.default_rng(5)
+    a = random_bspline(rng, 12, 10, True)
+    b = random_bspline(rng, 8, 9, False)
+    pad = 0.05
+    ov = _overlap(a, b, pad, pad)
+    ea, _ = surface_patch_boxes(a)
+    eb, _ = surface_patch_boxes(b)
+    ref = brute_force_pairs(ea + [[-pad], [pad]], eb + [[-pad], [pad]])
+    assert ref.shape[0] > 0
+    np.testing.assert_array_equal(ov.pairs[np.lexsort(ov.pairs.T[::-1])],
+                                  ref[np.lexsort(ref.T[::-1])])
