@@ -663,7 +663,8 @@ def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float |
     try:
         return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
                                   stray=StrayCurves.DROP)
-    except (InvalidGeometryError, InvalidToleranceError) as exc:
+    except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
+            FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
                       stacklevel=3)
         return []
@@ -681,7 +682,8 @@ def _pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float |
         if method is Method.CHARACTERISTIC:
             record = characteristic_intersection(a, b, tol=tol)
         else:
-            analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False)
+            analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False,
+                                               borders=False)
             whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
             mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol)
             record = certify(a, b, mesh, tol=tol, analysis=analysis)

@@ -79,6 +79,8 @@ __all__ = [
 
 #: grid samples per direction of r's domain for the critical-point seeds
 GRID_MIN, GRID_MAX = 33, 129
+#: largest turn per step on a characteristic curve (only sign changes are read off it)
+CHARACTERISTIC_TURN = 0.5
 #: rounds of "trace through new critical points" at most
 MAX_ROUNDS = 3
 #: rounds of "trace the uncovered starts" at most
@@ -373,7 +375,7 @@ def _turning_points(field: DistanceField, uv: NDArray, st: NDArray, kind: CurveK
 def _trace_characteristic(field: DistanceField, kind, uv: NDArray, st: NDArray,
                           direction: NDArray, h_max: float) -> list[TracedCurve]:
     return trace_curves(field, kind, uv, st, direction, h0=0.2 * h_max, h_max=h_max,
-                        max_steps=400)
+                        max_steps=400, max_turn=CHARACTERISTIC_TURN)
 
 
 def _from_critical(field: DistanceField, crit: DistanceJet, h_max: float) -> list[TracedCurve]:
@@ -449,27 +451,29 @@ def _ray_starts(field: DistanceField, crit: DistanceJet, kinds: list[PointKind],
 
 # ------------------------------------------------------------------ the stage
 def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
-                            phi_on: str | None = None, trace_critical: bool = True
-                            ) -> CharacteristicAnalysis:
+                            phi_on: str | None = None, trace_critical: bool = True,
+                            borders: bool = True) -> CharacteristicAnalysis:
     """The characteristic stage (module docstring, steps 0-5).
 
-    ``trace_critical`` False skips tracing the characteristic curves through
-    the critical points found from the seed grid (the ``auto`` certificate:
-    those points are already known; the curves from the sides are traced).
+    ``trace_critical`` False is the ``auto`` certificate's lighter stage: only
+    the u-characteristic curves from the sides are traced (a critical point on
+    them shows as a sign change of ``phi_v``), none through the critical points
+    (those from the seed grid are known already). ``borders`` False skips the
+    border points (the certificate checks closed loops).
     """
     start_time = time.perf_counter()
     tol = check_tolerance(tol)
     fld = choose_field(a, b, tol=tol, phi_on=phi_on)
     other = DistanceField(fld.q, Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
-    h_max = 0.08 * fld.diagonal
+    h_max = 0.12 * fld.diagonal
     grid, shape = _grid(fld)
     coincident = _coincident(fld, grid, shape, tol)
     points: list[CharacteristicPoint] = []
     starts: list[Start] = []
     border_start = Start.empty()
-    # step 1: border points (starts of open curves)
+    # step 1: border points (starts of open curves; the certificate checks loops only)
     pair = (fld, other) if not fld.swapped else (other, fld)
-    bp, bua, bub = border_points(pair, tol)
+    bp, bua, bub = border_points(pair, tol) if borders else (np.zeros((0, 3)),) * 3
     if bp.shape[0]:
         uv_r, st_q = (bub, bua) if fld.swapped else (bua, bub)
         points += make_points(fld, PointKind.BORDER, uv_r, st_q, bp, np.zeros(bp.shape[0]))
@@ -598,7 +602,7 @@ def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
     settled, ok = _settle(field, starts)
     uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
     pts = _points_3d(field, uv)
-    cover = 10 * tol + 1e-12 * size
+    cover = 10 * tol + 1e-9 * size
     polylines, closed = list(known), list(known_closed)
     out: list[IntersectionCurve] = []
     todo = np.arange(uv.shape[0])
@@ -621,7 +625,7 @@ def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
             if gap_new <= cover and polylines:
                 continue                                  # a loop traced twice in one round
             out.append(curve)
-            polylines.append(dense_polyline(curve))
+            polylines.append(dense_polyline(curve, 64))
             closed.append(curve.closed)
         todo = np.setdiff1d(todo, batch)
     return out
@@ -668,13 +672,26 @@ def certify(a: NurbsSurface, b: NurbsSurface, curves: Sequence[IntersectionCurve
         that cross the boundary unless they are tiny).
     """
     if analysis is None:
-        analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on, trace_critical=False)
+        analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on, trace_critical=False,
+                                           borders=open_curves)
     return _finish(analysis, list(curves), tol, a, b, borders=open_curves)
 
 
 def _near_isolated(curve: IntersectionCurve, isolated: Sequence[CharacteristicPoint],
                    radius: float) -> bool:
     return any(np.linalg.norm(curve.points - p.point, axis=1).max() <= radius for p in isolated)
+
+
+def _away_from(starts: Start, isolated: Sequence[CharacteristicPoint], field: DistanceField
+               ) -> Start:
+    """Starts farther than ``1e-3`` of the domain diagonal from every isolated point
+    (sign changes of rounding noise around a tangential contact are not curves)."""
+    if not isolated or starts.uv.shape[0] == 0:
+        return starts
+    at = np.array([p.uv_b if field.swapped else p.uv_a for p in isolated])
+    d = np.linalg.norm(starts.uv[:, None] - at[None], axis=-1).min(axis=1)
+    keep = d > 1e-3 * field.diagonal
+    return Start(starts.uv[keep], starts.st[keep], starts.scale[keep], starts.group[keep])
 
 
 def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]) -> bool:
@@ -703,12 +720,12 @@ def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], to
             and not _inside_region(c, analysis.coincident)]
     dropped = len(known) - len(kept)
     added: list[IntersectionCurve] = []
-    starts = analysis.starts
+    starts = _away_from(analysis.starts, isolated, fld)
     if not borders:
         loop = starts.group >= 0
         starts = Start(starts.uv[loop], starts.st[loop], starts.scale[loop], starts.group[loop])
     if not analysis.coincident:
-        added = _trace_uncovered(fld, starts, [dense_polyline(c) for c in kept],
+        added = _trace_uncovered(fld, starts, [dense_polyline(c, 64) for c in kept],
                                  [c.closed for c in kept], tol, size)
         added = [c for c in added if c.max_deviation(a, b).max <= tol]
     curves = tuple(kept) + tuple(added)

@@ -199,7 +199,7 @@ def _correct(field: DistanceField, kind: NDArray, uv: NDArray, st: NDArray,
 def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: NDArray, st0: NDArray,
                  direction: NDArray, *, h0: float | NDArray, h_max: float,
                  h_min: float | None = None, max_steps: int = 2000,
-                 ctol: float | None = None) -> list[TracedCurve]:
+                 ctol: float | None = None, max_turn: float = MAX_TURN) -> list[TracedCurve]:
     """Trace ``m`` curves of ``kind`` from ``uv0 (m, 2)`` one way each, all at once.
 
     Parameters
@@ -217,6 +217,8 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         Step bounds (default ``h_min`` 1e-9 of the domain diagonal).
     max_steps : int
         Accepted steps per curve at most.
+    max_turn : float
+        Largest accepted turn of the tangent per step (radians).
     ctol : float
         Corrector convergence in parameter units (default 1e-7 of the diagonal;
         never more than ``RELATIVE_CTOL`` of the step). The samples are starts
@@ -244,7 +246,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
     bend = np.zeros((m, 2))                   # d tangent / d w of the last step
     start = uv.copy()
     length = np.zeros(m)
-    samples = [[(uv[i], jet.st[i], jet.phi[i], jet.grad[i], jet.projection.det_k[i])]
+    samples = [[(uv[i].copy(), jet.st[i].copy(), jet.phi[i], jet.grad[i], jet.projection.det_k[i])]
                for i in range(m)]
     reason = [None] * m
     st = jet.st.copy()
@@ -285,13 +287,13 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         status = nj.status
         moved = np.linalg.norm(x - pred, axis=1)
         lost = status == ProjectionStatus.NONE
-        accept = conv & ~lost & (turn <= MAX_TURN) & (moved <= 0.5 * hh + ctol)
+        accept = conv & ~lost & (turn <= max_turn) & (moved <= 0.5 * hh + ctol)
         for k, i in enumerate(active):
             if accept[k]:
                 w = np.linalg.norm(x[k] - x0[k])
                 bend[i] = (ntan[k] - t0[k]) / w if w > 0 else 0.0
                 uv[i], tan[i], st[i], jac[i] = x[k], ntan[k], nj.st[k], nj.st_jacobian[k]
-                samples[i].append((x[k], nj.st[k], nj.phi[k], nj.grad[k],
+                samples[i].append((x[k].copy(), nj.st[k].copy(), nj.phi[k], nj.grad[k],
                                    nj.projection.det_k[k]))
                 length[i] += w
                 steps[i] += 1

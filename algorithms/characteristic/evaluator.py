@@ -15,6 +15,7 @@ as :meth:`NurbsSurface.derivatives`). Same results as
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from math import comb, factorial
 
 import numpy as np
@@ -36,6 +37,7 @@ def _bernstein_to_monomial(degree: int) -> NDArray:
     return m
 
 
+@lru_cache(maxsize=64)
 def _monomial_table(degree: int, order: int) -> tuple[NDArray, NDArray]:
     """``coef (o+1, p+1)`` and exponent ``index (o+1, p+1)`` of ``d^o/dx^o x^k``."""
     coef = np.zeros((order + 1, degree + 1))

@@ -13,9 +13,10 @@ taken instead.
 
 §6.2 distinguishes three cases, reported per point by :class:`ProjectionStatus`:
 
-* ``UNIQUE``: the projection exists, converged, and ``det K > 0`` (a strict
-  local minimum of the distance: the regular case);
-* ``MULTIPLE``: ``det K <= 0`` at the foot (the point lies on or beyond a focal
+* ``UNIQUE``: the projection exists, converged, and ``K`` is positive definite
+  (a strict local minimum of the distance: the regular case);
+* ``MULTIPLE``: ``K`` is not positive definite at the foot (``det K <= 0``, or
+  both eigenvalues negative: the point lies on or beyond a focal
   point of ``q``: several projections meet there and ``K^{-1}`` does not exist;
   [15] checks for a sign change of ``det K`` along a traced curve, which
   :mod:`.curves` does);
@@ -223,13 +224,15 @@ class Projector:
             st[active] = new
             # quadratic convergence: the next step would move about moved^3 / before^2
             m, b = moved[active], before[active]
-            nxt = np.where(m < b, m ** 3 / np.maximum(b, 1e-300) ** 2, np.inf)
+            nxt = np.where((m < b) & np.isfinite(b), m ** 3 / np.maximum(b, 1e-300) ** 2, np.inf)
             active = active[(m > self.tol) & (nxt > self.tol)]
         qd = ev.derivatives(st[:, 0], st[:, 1], 2)
         k = projection_matrix(x - qd[:, 0, 0], qd)
         det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
         status = np.full(x.shape[0], int(ProjectionStatus.UNIQUE), dtype=np.int8)
-        status[det <= 0] = ProjectionStatus.MULTIPLE
-        lost = (moved > 10 * self.tol) & (moved ** 3 / np.maximum(before, 1e-300) ** 2 > self.tol)
+        scale = (k[:, 0, 0] + k[:, 1, 1]) ** 2
+        status[(det <= 1e-12 * scale) | (k[:, 0, 0] <= 0)] = ProjectionStatus.MULTIPLE
+        lost = (moved > 10 * self.tol) & ~((moved < before) & np.isfinite(before)
+                                            & (moved ** 3 / np.maximum(before, 1e-300) ** 2 <= self.tol))
         status[~self.inside(st) | lost] = ProjectionStatus.NONE
         return Projection(st, qd[:, 0, 0], status, det), qd

@@ -105,10 +105,13 @@ def dense_polyline(curve: IntersectionCurve, per_span: int = 32) -> NDArray:
     return curve.curve3d.evaluate(dense)
 
 
-def polyline_gap(points: NDArray, polylines: list[NDArray], closed: list[bool]) -> NDArray:
-    """Distance ``(n,)`` from each of ``points (n, d)`` to the nearest segment of the polylines."""
-    if not polylines:
+def polyline_gap(points: NDArray, polylines: list[NDArray], closed: list[bool],
+                 k: int = 8) -> NDArray:
+    """Distance ``(n,)`` from each of ``points (n, d)`` to the nearest segment of the
+    polylines (the ``k`` segments with the nearest midpoints, by a k-d tree)."""
+    if not polylines or points.shape[0] == 0:
         return np.full(points.shape[0], np.inf)
+    from scipy.spatial import cKDTree
     a, b = [], []
     for p, c in zip(polylines, closed):
         q = np.vstack([p, p[:1]]) if c else p
@@ -118,10 +121,14 @@ def polyline_gap(points: NDArray, polylines: list[NDArray], closed: list[bool]) 
         b.append(q[1:])
     a, b = np.concatenate(a), np.concatenate(b)
     d = b - a
-    dd = np.einsum("sc,sc->s", d, d)
-    t = np.clip(np.einsum("nsc,sc->ns", points[:, None] - a[None], d) / np.where(dd > 0, dd, 1.0),
+    k = min(k, a.shape[0])
+    _, idx = cKDTree(a + 0.5 * d).query(points, k=k)
+    idx = idx.reshape(points.shape[0], k)
+    pa, pd = a[idx], d[idx]
+    dd = np.einsum("nkc,nkc->nk", pd, pd)
+    t = np.clip(np.einsum("nkc,nkc->nk", points[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0),
                 0.0, 1.0)
-    return np.linalg.norm(a[None] + t[..., None] * d[None] - points[:, None], axis=-1).min(axis=1)
+    return np.linalg.norm(pa + t[..., None] * pd - points[:, None], axis=-1).min(axis=1)
 
 
 def _held_side(uv: NDArray, lower: NDArray, upper: NDArray) -> tuple[int, float]:

@@ -1,0 +1,112 @@
+"""Projection (eqs. 3-4, §6.2 cases), the oriented distance and its derivatives (A.1),
+checked against finite differences, exact distances and the reference evaluation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from char_surfaces import DIAGONAL, height_field, plane_patch, sphere_band
+from surfprep.algorithms.characteristic import (
+    DistanceField,
+    PatchEvaluator,
+    ProjectionStatus,
+    Projector,
+    distance_jet,
+)
+
+
+def random_pair(seed: int = 1):
+    rng = np.random.default_rng(seed)
+    a = height_field(0.2 * rng.random((6, 6)))
+    z = 0.1 + 0.2 * rng.random((6, 6))
+    b = height_field(z)
+    # stretch b beyond a so every point of a has a foot on b
+    cp = b.control_points.copy()
+    cp[..., :2] = 1.2 * cp[..., :2] - 0.1
+    return a, type(b)(cp, b.knots_u, b.knots_v, 3, 3)
+
+
+@pytest.mark.parametrize("surface", [random_pair()[0], sphere_band()], ids=["bicubic", "sphere"])
+def test_patch_evaluator_matches_the_reference_evaluation(surface):
+    rng = np.random.default_rng(3)
+    u, v = rng.uniform(-0.05, 1.05, 200), rng.uniform(-0.05, 1.05, 200)
+    ours = PatchEvaluator(surface).derivatives(u, v, 2)
+    ref = surface.derivatives(u, v, 2)
+    scale = np.abs(ref).max(axis=0)
+    assert np.all(np.abs(ours - ref) <= 1e-10 * np.maximum(scale, 1.0))
+
+
+def finite_difference_check(field: DistanceField, uv: np.ndarray, h: float = 1e-5):
+    jet = field.jet(uv)
+    assert np.all(jet.status == ProjectionStatus.UNIQUE)
+    for k in range(2):
+        e = np.zeros(2)
+        e[k] = h
+        plus, minus = field.jet(uv + e, jet.st), field.jet(uv - e, jet.st)
+        fd_phi = (plus.phi - minus.phi) / (2 * h)
+        fd_grad = (plus.grad - minus.grad) / (2 * h)
+        fd_st = (plus.st - minus.st) / (2 * h)
+        scale = 1.0 + np.abs(jet.hess).max()
+        np.testing.assert_allclose(jet.grad[:, k], fd_phi, atol=1e-7 * scale)          # (24)-(25)
+        np.testing.assert_allclose(jet.hess[:, :, k], fd_grad, atol=1e-6 * scale)      # (26)-(31)
+        np.testing.assert_allclose(jet.st_jacobian[:, :, k], fd_st, atol=1e-6 * scale)  # (21)
+    return jet
+
+
+def test_derivatives_of_phi_against_finite_differences_bicubic():
+    a, b = random_pair()
+    field = DistanceField(a, Projector(b, tol=1e-14))
+    uv = np.random.default_rng(5).uniform(0.1, 0.9, (40, 2))
+    jet = finite_difference_check(field, uv)
+    # the Hessian is symmetric by construction and the mixed terms (27), (28) agree
+    assert np.abs(jet.hess[:, 0, 1] - jet.hess[:, 1, 0]).max() == 0.0
+
+
+def test_derivatives_of_phi_against_finite_differences_rational_sphere():
+    """phi on a plane against the rational sphere: phi = |p| - 1 up to the sign, exactly."""
+    a = plane_patch(0.9 * DIAGONAL, DIAGONAL)
+    field = DistanceField(a, Projector(sphere_band(), tol=1e-14))
+    uv = np.random.default_rng(6).uniform(0.05, 0.95, (30, 2))
+    jet = finite_difference_check(field, uv)
+    exact = np.linalg.norm(jet.point, axis=1) - 1.0
+    np.testing.assert_allclose(np.abs(jet.phi), np.abs(exact), atol=1e-13)
+    # oriented: n_q (outward normal of the band) . (r - q) is negative inside the sphere
+    assert np.all(np.sign(jet.phi) == np.sign(exact) * np.sign(jet.phi[0] / exact[0]))
+
+
+def test_phi_against_a_plane_is_the_signed_height():
+    a, _ = random_pair()
+    flat = plane_patch([0.5, 0.5, 0.05], [0, 0, 1], half=0.8)
+    jet = DistanceField(a, Projector(flat, tol=1e-14)).jet(np.random.default_rng(7).random((50, 2)))
+    normal = np.cross(flat.control_points[1, 0] - flat.control_points[0, 0],
+                      flat.control_points[0, 1] - flat.control_points[0, 0])
+    sign = np.sign(normal[2])
+    np.testing.assert_allclose(jet.phi, sign * (jet.point[:, 2] - 0.05), atol=1e-14)
+    np.testing.assert_allclose(jet.projection.foot[:, :2], jet.point[:, :2], atol=1e-12)
+
+
+def test_projection_cases_of_section_6_2():
+    """UNIQUE outside the sphere; MULTIPLE beyond the centre (the foot on the near side is
+    a maximum of the distance) and at the centre (K = 0); NONE past the band's rim."""
+    projector = Projector(sphere_band(), tol=1e-13)
+    pts = np.array([[1.05, 1.05, 0.1], [0.2, 0.2, 0.0], [-0.3, -0.3, 0.0], [0.0, 0.0, 3.0],
+                    [0.0, 0.0, 0.0]])
+    res = projector.project(pts, np.tile([0.125, 0.5], (5, 1)))
+    assert res.status.tolist() == [ProjectionStatus.UNIQUE, ProjectionStatus.UNIQUE,
+                                   ProjectionStatus.MULTIPLE, ProjectionStatus.NONE,
+                                   ProjectionStatus.MULTIPLE]
+    # the regular feet are the radial projections
+    for i in (0, 1):
+        np.testing.assert_allclose(res.foot[i], pts[i] / np.linalg.norm(pts[i]), atol=1e-12)
+    # from the seed grid (no start given) the same feet
+    np.testing.assert_allclose(projector.project(pts[:2]).foot, res.foot[:2], atol=1e-12)
+
+
+def test_distance_jet_function_and_field_agree():
+    a, b = random_pair(2)
+    projector = Projector(b, tol=1e-14)
+    uv = np.random.default_rng(8).uniform(0.2, 0.8, (10, 2))
+    one = distance_jet(a, projector, uv)
+    two = DistanceField(a, projector).jet(uv)
+    np.testing.assert_allclose(one.phi, two.phi, atol=1e-14)
+    np.testing.assert_allclose(one.hess, two.hess, atol=1e-9)
