@@ -214,28 +214,59 @@ def _rects(operand: Operand) -> tuple[NDArray | None, int, float]:
     return None, 0, 0.0
 
 
-def _mesh_of(operand: Operand, rects: NDArray | None, patches: NDArray, keep: NDArray,
-             tol: float, pad: float, max_depth: int) -> TriangleMesh:
+def _tessellation(operand: Operand, rects: NDArray | None, patches: NDArray, keep: NDArray,
+                  tol: float, pad: float, max_depth: int, keep_patch: NDArray | None = None
+                  ) -> tuple[TriangleMesh, NDArray | None]:
+    """Tessellation of the patches ``patches`` pruned by ``keep`` boxes (for each
+    patch only the keep boxes whose ``keep_patch`` it is, when given), and the patch
+    of every triangle (None for a mesh operand)."""
     if isinstance(operand, TriangleMesh):
-        return operand
-    return tessellate(operand, tol, rects[patches], max_depth=max_depth, keep_boxes=keep,
-                      keep_pad=pad).mesh
+        return operand, None
+    region = None if keep_patch is None else np.searchsorted(patches, keep_patch)
+    tess = tessellate(operand, tol, rects[patches], max_depth=max_depth, keep_boxes=keep,
+                      keep_pad=pad, keep_region=region)
+    return tess.mesh, patches[tess.leaf_region[tess.mesh.patch]]
+
+
+def _partner_boxes(mesh: TriangleMesh, tri_patch: NDArray | None, own: NDArray,
+                   other: NDArray) -> tuple[NDArray, NDArray | None]:
+    """Keep boxes for tessellating one side near the other side's triangles.
+
+    With the other side's triangle patches known, each overlap pair ``(own[i],
+    other[i])`` contributes the boxes of the triangles of ``other[i]``, owned by
+    ``own[i]``: a patch is then tested only against triangles of the patches whose
+    boxes overlap its own (any intersection point lies in such a pair), instead of a
+    tree over all triangles, whose pairs explode with the wide padding of a coarse
+    guide. Returns ``(boxes, owner patch)``; owner None without patches (a mesh).
+    """
+    boxes = mesh.triangle_boxes()
+    if tri_patch is None:
+        return boxes, None
+    order = np.argsort(tri_patch, kind="stable")
+    sorted_patch = tri_patch[order]
+    lo = np.searchsorted(sorted_patch, other, side="left")
+    counts = np.searchsorted(sorted_patch, other, side="right") - lo
+    pair = np.repeat(np.arange(other.size), counts)
+    tri = order[np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(pair.size)]
+    return boxes[tri], own[pair]
 
 
 def _guide(b: Operand, rects_b: NDArray | None, overlap, tol: float, max_depth: int
-           ) -> tuple[NDArray, float]:
-    """Boxes near operand b to prune a's refinement with, and their padding.
+           ) -> tuple[TriangleMesh, NDArray | None, float]:
+    """A mesh near operand b to prune a's refinement with, its triangles' patches, and
+    the padding of its boxes.
 
-    A mesh gives its triangle boxes; a surface a coarse tessellation (tolerance
+    A mesh operand is itself; a surface gives a coarse tessellation (tolerance
     ``_COARSE tol``, itself pruned by the overlap boxes) whose triangle boxes,
     widened by twice the coarse tolerance, hold the surface b near the overlap.
     """
     if isinstance(b, TriangleMesh):
-        return b.triangle_boxes(), 0.0
+        return b, None, 0.0
     coarse = _COARSE * tol
-    mesh = _mesh_of(b, rects_b, overlap.patches_b, overlap.boxes, coarse, 2.0 * coarse,
-                    max_depth)
-    return mesh.triangle_boxes(), 2.0 * coarse
+    # an overlap box lies in its b patch's box: each patch is pruned by its own boxes
+    mesh, tri_patch = _tessellation(b, rects_b, overlap.patches_b, overlap.boxes, coarse,
+                                    2.0 * coarse, max_depth, keep_patch=overlap.pairs[:, 1])
+    return mesh, tri_patch, 2.0 * coarse
 
 
 def _interpolate_uv(mesh: TriangleMesh, tri: NDArray, bary: NDArray) -> NDArray | None:
@@ -316,11 +347,19 @@ def mesh_segments(a: Operand, b: Operand, *, tol: float, max_depth: int = 24) ->
     pad_a = 2.0 * tol if isinstance(a, NurbsSurface) else 0.0
     pad_b = 2.0 * tol if isinstance(b, NurbsSurface) else 0.0
     overlap = _overlap(a, b, pad_a, pad_b)
-    guide, guide_pad = _guide(b, rects_b, overlap, tol, max_depth)
-    mesh_a = _mesh_of(a, rects_a, overlap.patches_a, guide, tol, pad_a + guide_pad, max_depth)
+    own_a, own_b = overlap.pairs[:, 0], overlap.pairs[:, 1]
+    guide, guide_patch, guide_pad = _guide(b, rects_b, overlap, tol, max_depth)
+    keep, owner = _partner_boxes(guide, guide_patch, own_a, own_b)
+    if owner is not None and not isinstance(a, NurbsSurface):
+        keep, owner = guide.triangle_boxes(), None
+    mesh_a, patch_a = _tessellation(a, rects_a, overlap.patches_a, keep, tol,
+                                    pad_a + guide_pad, max_depth, keep_patch=owner)
     # b is refined only near a's triangles
-    mesh_b = _mesh_of(b, rects_b, overlap.patches_b, mesh_a.triangle_boxes(), tol, pad_b,
-                      max_depth)
+    keep, owner = _partner_boxes(mesh_a, patch_a, own_b, own_a)
+    if owner is not None and not isinstance(b, NurbsSurface):
+        keep, owner = mesh_a.triangle_boxes(), None
+    mesh_b, _ = _tessellation(b, rects_b, overlap.patches_b, keep, tol, pad_b, max_depth,
+                              keep_patch=owner)
     pairs = candidate_pairs(mesh_a.triangle_boxes(), mesh_b.triangle_boxes())
     hits = intersect_triangles(mesh_a.triangle_points()[pairs[:, 0]],
                                mesh_b.triangle_points()[pairs[:, 1]])

@@ -171,25 +171,51 @@ def _split(rects: NDArray, region: NDArray, split_u: NDArray, split_v: NDArray
     return np.stack([ua, ub, va, vb], axis=1), region[parent]
 
 
-def _near(surface: NurbsSurface, rects: NDArray, keep: BoxTree | None, pad: float) -> NDArray:
-    """Mask of rectangles whose sub-patch box is within ``pad`` of some keep box."""
+@dataclass(frozen=True, eq=False)
+class _RegionBoxes:
+    """Keep boxes grouped by the region they belong to: ``boxes[start[r]:start[r + 1]]``."""
+
+    boxes: NDArray
+    start: NDArray
+
+
+def _region_boxes(boxes: NDArray, owner: NDArray, n_regions: int) -> _RegionBoxes:
+    order = np.argsort(owner, kind="stable")
+    counts = np.bincount(owner, minlength=n_regions)
+    return _RegionBoxes(boxes[order], np.concatenate([[0], np.cumsum(counts)]))
+
+
+def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
+          keep: BoxTree | _RegionBoxes | None, pad: float) -> NDArray:
+    """Mask of rectangles whose sub-patch box is within ``pad`` of some keep box (of
+    their own region only, for keep boxes given per region)."""
     if keep is None:
         return np.ones(rects.shape[0], bool)
-    pairs = tree_pairs(build_tree(subpatch_boxes(surface, rects)), keep, pad=pad)
-    mask = np.zeros(rects.shape[0], bool)
-    mask[pairs[:, 0]] = True
-    return mask
+    boxes = subpatch_boxes(surface, rects)
+    if isinstance(keep, BoxTree):
+        pairs = tree_pairs(build_tree(boxes), keep, pad=pad)
+        mask = np.zeros(rects.shape[0], bool)
+        mask[pairs[:, 0]] = True
+        return mask
+    lo, hi = keep.start[region], keep.start[region + 1]
+    counts = hi - lo
+    rect = np.repeat(np.arange(rects.shape[0]), counts)
+    other = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(rect.size)
+    k = keep.boxes[other]
+    hit = np.all((boxes[rect, 0] <= k[:, 1] + pad) & (k[:, 0] <= boxes[rect, 1] + pad), axis=1)
+    return np.bincount(rect[hit], minlength=rects.shape[0]) > 0
 
 
 def _refine(surface: NurbsSurface, regions: NDArray, tol: float, max_depth: int,
-            keep: BoxTree | None, pad: float) -> tuple[NDArray, NDArray, NDArray, NDArray, int]:
+            keep: BoxTree | _RegionBoxes | None, pad: float
+            ) -> tuple[NDArray, NDArray, NDArray, NDArray, int]:
     """Breadth-first refinement: leaves, their regions, errors and diagonals."""
     rects, region = regions, np.arange(regions.shape[0])
     out_rects, out_region = [np.zeros((0, 4))], [np.zeros(0, np.int64)]
     out_err, out_diag = [np.zeros(0)], [np.zeros(0, np.int64)]
     depth = 0
     while rects.shape[0]:
-        near = _near(surface, rects, keep, pad)
+        near = _near(surface, rects, region, keep, pad)
         rects, region = rects[near], region[near]
         if rects.shape[0] == 0:
             break
@@ -338,7 +364,7 @@ def _check_regions(surface: NurbsSurface, regions: ArrayLike | None) -> NDArray:
 
 def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = None, *,
                max_depth: int = 24, keep_boxes: ArrayLike | None = None,
-               keep_pad: float = 0.0) -> Tessellation:
+               keep_pad: float = 0.0, keep_region: ArrayLike | None = None) -> Tessellation:
     """Adaptive crack-free triangulation of ``surface`` over parameter regions.
 
     Parameters
@@ -362,6 +388,10 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
         dropped, so only the surface near the boxes is triangulated. Needs every
         region inside one Bézier patch (as the default regions are).
     keep_pad : float >= 0
+    keep_region : (b,) int, optional
+        The region each keep box belongs to: a rectangle is then tested against
+        the keep boxes of its own region only (the overlap boxes of its patch),
+        in work proportional to their number instead of a tree over all of them.
 
     Returns
     -------
@@ -381,7 +411,16 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
     if not (np.isfinite(tol) and tol > 0):
         raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
     regions = _check_regions(surface, regions)
-    keep = None if keep_boxes is None else build_tree(np.reshape(keep_boxes, (-1, 2, 3)))
+    keep = None
+    if keep_boxes is not None:
+        boxes = np.reshape(keep_boxes, (-1, 2, 3))
+        if keep_region is None:
+            keep = build_tree(boxes)
+        else:
+            owner = np.asarray(keep_region, dtype=np.int64).reshape(-1)
+            if owner.shape != (boxes.shape[0],) or np.any((owner < 0) | (owner >= regions.shape[0])):
+                raise InvalidGeometryError("keep_region needs one region index per keep box")
+            keep = _region_boxes(boxes, owner, regions.shape[0])
     leaves, region, err, diag, depth = _refine(surface, regions, float(tol), int(max_depth),
                                                keep, float(keep_pad))
     if leaves.shape[0] == 0:
