@@ -228,3 +228,21 @@ def test_keep_boxes_prune_the_refinement():
     assert max_deviation(surface, pruned.mesh) <= tol
     far = tessellate(surface, tol, keep_boxes=box + 10.0)
     assert far.mesh.n_triangles == 0 and far.leaves.shape == (0, 4)
+
+
+def test_keep_boxes_per_region_prune_only_their_own_region():
+    """keep_region: a rectangle is tested against the keep boxes of its own region only."""
+    cp = np.zeros((4, 4, 3))
+    g = np.linspace(0, 1, 4)
+    cp[..., 0], cp[..., 1] = np.meshgrid(g, g, indexing="ij")
+    plane = NurbsSurface(cp, [0, 0, 0, 0, 1, 1, 1, 1], [0, 0, 0, 0, 1, 1, 1, 1], 3, 3)
+    regions = np.array([[0, 0.5, 0, 0.5], [0.5, 1, 0, 0.5]])
+    box = np.array([[[0.1, 0.1, -0.1], [0.2, 0.2, 0.1]]])         # over region 0 only
+    for owner, kept in ((0, {0}), (1, set())):
+        t = tessellate(plane, 1e-3, regions, keep_boxes=box, keep_pad=0.01, keep_region=[owner])
+        assert set(np.unique(t.leaf_region).tolist()) == kept
+        if kept:
+            uv = t.mesh.uv[t.mesh.triangles].reshape(-1, 2)
+            assert uv[:, 0].max() <= 0.5
+    with pytest.raises(InvalidGeometryError):
+        tessellate(plane, 1e-3, regions, keep_boxes=box, keep_region=[2])
