@@ -81,6 +81,8 @@ __all__ = [
 GRID_MIN, GRID_MAX = 33, 129
 #: largest turn per step on a characteristic curve (only sign changes are read off it)
 CHARACTERISTIC_TURN = 0.5
+#: derivatives of phi below this share of its largest gradient on the grid are rounding
+NOISE_SHARE = 1e-9
 #: rounds of "trace through new critical points" at most
 MAX_ROUNDS = 3
 #: rounds of "trace the uncovered starts" at most
@@ -468,6 +470,8 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     h_max = 0.12 * fld.diagonal
     grid, shape = _grid(fld)
     coincident = _coincident(fld, grid, shape, tol)
+    regular = grid.status == ProjectionStatus.UNIQUE
+    noise = NOISE_SHARE * float(np.abs(grid.grad[regular]).max()) if regular.any() else 0.0
     points: list[CharacteristicPoint] = []
     starts: list[Start] = []
     border_start = Start.empty()
@@ -488,7 +492,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     families = ((0, CurveKind.U_CHARACTERISTIC, PointKind.EDGE_ROOT_U),
                 (1, CurveKind.V_CHARACTERISTIC, PointKind.EDGE_ROOT_V))
     for comp, kind, root_kind in families[:2 if trace_critical else 1]:
-        uv, st, _ = edge_roots(fld, comp)
+        uv, st, _ = edge_roots(fld, comp, noise=noise)
         if uv.shape[0] == 0:
             continue
         jet = fld.jet(uv, st)
@@ -501,7 +505,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         curves += _trace_characteristic(fld, kinds, np.concatenate(uvs), np.concatenate(sts),
                                         np.concatenate(dirs), h_max)
     # critical points: seed grid, then along the characteristic curves, in rounds
-    crit = critical_points(fld, grid_seeds(grid, shape))
+    crit = critical_points(fld, grid_seeds(grid, shape, noise=noise))
     traced_from = 0 if trace_critical else (0 if crit is None else crit.uv.shape[0])
     for _ in range(MAX_ROUNDS):
         seeds = []

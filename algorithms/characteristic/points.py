@@ -188,13 +188,15 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
     return field.jet(pts[order], jet.st[keep][order])
 
 
-def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400) -> NDArray:
+def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400,
+               noise: float = 0.0) -> NDArray:
     """Seeds ``(k, 2)`` for critical points from a jet on a tensor grid ``shape``.
 
     A cell whose corners see both ``phi_u`` and ``phi_v`` change sign, or a grid
     sample that is a local extremum of ``phi`` among its 8 neighbours, seeds
     Newton (the cell centre / the sample). Samples without a regular projection
-    take no part.
+    take no part; gradient components within ``noise`` of zero count as zero of
+    either sign only when the cell also holds a value beyond it.
     """
     nu, nv = shape
     uv = jet.uv.reshape(nu, nv, 2)
@@ -206,7 +208,8 @@ def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400) -
     change = np.ones((nu - 1, nv - 1), dtype=bool)
     for k in range(2):
         vals = np.stack([g[c][..., k] for c in corners])
-        change &= (vals.min(axis=0) <= 0) & (vals.max(axis=0) >= 0)
+        change &= ((vals.min(axis=0) <= 0) & (vals.max(axis=0) >= 0)
+                   & (np.abs(vals).max(axis=0) > noise))
     centre = 0.25 * sum(uv[c] for c in corners)
     seeds = [centre[change & cell_ok]]
     phi = np.where(ok, jet.phi.reshape(nu, nv), np.nan)
@@ -218,6 +221,10 @@ def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400) -
         bottom = np.all((phi <= neigh) | np.isnan(neigh), axis=0) & ok
     seeds.append(uv[top | bottom])
     out = np.concatenate(seeds)
+    if noise > 0:          # a flat grid (phi constant along lines) is no seed
+        flat = np.all(np.abs(jet.grad) <= noise, axis=1).reshape(nu, nv)
+        extreme = (top | bottom) & ~flat
+        out = np.concatenate([seeds[0], uv[extreme]])
     if out.shape[0] > max_seeds:
         out = out[np.linspace(0, out.shape[0] - 1, max_seeds).astype(int)]
     return out
@@ -242,12 +249,15 @@ def _edge_count(surface: NurbsSurface) -> int:
     return max(EDGE_SAMPLES, 4 * spans + 1)
 
 
-def edge_roots(field: DistanceField, component: int, iterations: int = 12
+def edge_roots(field: DistanceField, component: int, iterations: int = 12, noise: float = 0.0
                ) -> tuple[NDArray, NDArray, NDArray]:
     """Roots of ``phi_u`` (``component`` 0) or ``phi_v`` (1) on the sides of ``r``'s domain.
 
     Sampling, then batched regula falsi (Illinois) on each bracket with a regular
-    projection at both ends (§6.3 step 2).
+    projection at both ends (§6.3 step 2). A sign change between values both
+    within ``noise`` of zero is rounding, not a root (a side along which
+    ``phi_u`` vanishes identically, e.g. a surface of revolution against a
+    plane normal to its axis).
 
     Returns
     -------
@@ -262,7 +272,8 @@ def edge_roots(field: DistanceField, component: int, iterations: int = 12
         jet = field.jet(uv)
         g = jet.grad[:, component]
         ok = jet.status == ProjectionStatus.UNIQUE
-        k = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) != np.sign(g[1:])))
+        k = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) != np.sign(g[1:]))
+                           & (np.maximum(np.abs(g[:-1]), np.abs(g[1:])) > noise))
         for i in k:
             brackets.append((uv[i], uv[i + 1], g[i], g[i + 1], jet.st[i], coord))
     if not brackets:

@@ -12,7 +12,14 @@ from ...errors import OutputFileError
 from ..io import read, write
 from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
 
-__all__ = ["COMMAND", "intersection_report", "compare_with_occ", "plot_curves"]
+__all__ = [
+    "COMMAND",
+    "characteristic_report",
+    "compare_with_occ",
+    "intersection_report",
+    "plot_characteristic",
+    "plot_curves",
+]
 
 #: samples per OpenCascade section edge (chord sag about 3e-7 of a unit circle)
 OCC_SAMPLES = 4001
@@ -34,9 +41,45 @@ def intersection_report(results, time_s: float, tol: float | None, files) -> dic
             "max_distance_b": dev.to_b,
             "start": r.curve.start_kind,
             "end": r.curve.end_kind,
+            "found_by": getattr(r, "found_by", "mesh"),
         })
-    return {"files": [str(f) for f in files], "tol": tol, "time_s": time_s,
-            "n_curves": len(results), "curves": curves}
+    report = {"files": [str(f) for f in files], "tol": tol, "time_s": time_s,
+              "n_curves": len(results), "curves": curves}
+    report.update(characteristic_report(results))
+    return report
+
+
+def characteristic_report(results) -> dict:
+    """Method, isolated (tangential contact) points, coincident regions and, per face
+    pair, the characteristic points by kind and the times of the two stages."""
+    method = getattr(results, "method", None)
+    if method is None:
+        return {}
+    pairs = []
+    for rec in results.records:
+        entry = {"faces": [rec.face_a.index, rec.face_b.index], "time_s": rec.time_s,
+                 "curves_before_clipping": len(rec.curves)}
+        if rec.record is not None:
+            r = rec.record
+            entry.update({
+                "phi_on": r.phi_on,
+                "characteristic_points": r.counts(),
+                "characteristic_curves": len(r.characteristic_curves),
+                "found_by_characteristic": len(r.added),
+                "characteristic_time_s": r.characteristic_time_s,
+                "intersection_time_s": r.intersection_time_s,
+            })
+        pairs.append(entry)
+    return {
+        "method": method.value,
+        "isolated_points": [{"faces": list(p.faces), "point": p.point.tolist(),
+                             "uv_a": p.uv_a.tolist(), "uv_b": p.uv_b.tolist()}
+                            for p in results.isolated_points],
+        "coincident": [{"faces": list(c.faces), "share": c.region.share,
+                        "box_a": c.region.box_a.tolist(), "box_b": c.region.box_b.tolist(),
+                        "max_distance": c.region.max_distance} for c in results.coincident],
+        "pairs": pairs,
+    }
 
 
 def compare_with_occ(results, model_a, model_b) -> dict:
@@ -81,9 +124,25 @@ def plot_curves(results, path: Path) -> Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig = plt.figure(figsize=(15, 5))
-    ax3 = fig.add_subplot(1, 3, 1, projection="3d")
-    axa, axb = fig.add_subplot(1, 3, 2), fig.add_subplot(1, 3, 3)
+    pairs = _characteristic_pairs(results)
+    rows = 1 + len(pairs)
+    fig = plt.figure(figsize=(15, 5 * rows))
+    ax3 = fig.add_subplot(rows, 3, 1, projection="3d")
+    axa, axb = fig.add_subplot(rows, 3, 2), fig.add_subplot(rows, 3, 3)
+    for k, pair in enumerate(pairs, start=1):
+        ax_r, ax_q = fig.add_subplot(rows, 3, 3 * k + 1), fig.add_subplot(rows, 3, 3 * k + 2)
+        plot_characteristic(ax_r, ax_q, pair)
+        note = fig.add_subplot(rows, 3, 3 * k + 3)
+        note.axis("off")
+        counts = pair.record.counts()
+        text = "\n".join([f"{kind}: {n}" for kind, n in sorted(counts.items())]
+                         + [f"characteristic curves: {len(pair.record.characteristic_curves)}",
+                            f"curves (before clipping): {len(pair.curves)}",
+                            f"found only by characteristic: {len(pair.record.added)}",
+                            "curves: red mesh, black characteristic",
+                            "dashed: u- (blue), v- (green)",
+                            "        characteristic curves"])
+        note.text(0.0, 1.0, text, va="top", fontsize="small", family="monospace")
     colors = plt.get_cmap("tab10")
     for k, r in enumerate(results):
         c = colors(k % 10)
@@ -110,6 +169,55 @@ def plot_curves(results, path: Path) -> Path:
     return path.resolve()
 
 
+#: marker and colour of each characteristic point kind in --plot (paper Fig. 3 style)
+_KIND_STYLE = {
+    "border": ("s", "black"), "edge_root_u": ("|", "tab:blue"), "edge_root_v": ("_", "tab:green"),
+    "turning_u": ("<", "tab:green"), "turning_v": ("^", "tab:blue"),
+    "maximum": ("o", "tab:red"), "minimum": ("o", "tab:purple"), "saddle": ("X", "tab:orange"),
+    "degenerate": ("D", "grey"), "isolated": ("*", "magenta"), "double_point": ("P", "brown"),
+    "cusp": ("d", "brown"),
+}
+
+
+def plot_characteristic(ax_r, ax_q, pair) -> None:
+    """One face pair on two axes: ``phi``'s domain (characteristic curves, points by kind,
+    intersection curves) and the other surface's domain (curves, points' feet)."""
+    rec = pair.record
+    swapped = rec.phi_on == "b"
+    for c in rec.characteristic_curves:
+        style = {"color": "tab:blue" if c.kind.value == "u" else "tab:green", "lw": 0.7, "ls": "--"}
+        ax_r.plot(c.uv[:, 0], c.uv[:, 1], **style)
+        ax_q.plot(c.st[:, 0], c.st[:, 1], **style)
+    for curve, how in zip(rec.curves, rec.found_by):
+        color = "tab:red" if how.value == "mesh" else "black"
+        for ax, uv in ((ax_r, curve.uv_b if swapped else curve.uv_a),
+                       (ax_q, curve.uv_a if swapped else curve.uv_b)):
+            if uv is None:
+                continue
+            uv = np.vstack([uv, uv[:1]]) if curve.closed else uv
+            ax.plot(uv[:, 0], uv[:, 1], color=color, lw=1.6)
+    seen = set()
+    for p in rec.points:
+        marker, color = _KIND_STYLE.get(p.kind.value, (".", "grey"))
+        on_r, on_q = (p.uv_b, p.uv_a) if swapped else (p.uv_a, p.uv_b)
+        label = p.kind.value if p.kind.value not in seen else None
+        seen.add(p.kind.value)
+        ax_r.plot(*on_r, marker=marker, color=color, ls="", ms=6, label=label)
+        ax_q.plot(*on_q, marker=marker, color=color, ls="", ms=6)
+    faces = (pair.face_a.index, pair.face_b.index)
+    names = ("b", "a") if swapped else ("a", "b")
+    ax_r.set_title(f"faces {faces}: phi on {names[0]} (u, v)", fontsize="small")
+    ax_q.set_title(f"faces {faces}: feet on {names[1]} (s, t)", fontsize="small")
+    if seen:
+        ax_r.legend(fontsize="x-small", loc="best")
+
+
+def _characteristic_pairs(results, limit: int = 4) -> list:
+    records = getattr(results, "records", [])
+    with_points = [r for r in records if r.record is not None and (r.record.points or r.curves)]
+    return with_points[:limit]
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file_a", type=Path, metavar="A", help="STEP or IGES file")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
@@ -125,6 +233,15 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="draw the curves in 3D and in the parameter domains")
     parser.add_argument("--compare-occ", action="store_true",
                         help="also run OpenCascade's BRepAlgoAPI_Section and report both")
+    parser.add_argument("--method", choices=[m.value for m in _methods()], default="auto",
+                        help="auto (default): triangles, then characteristic points as a "
+                             "certificate (missed loops traced and added); mesh: triangles "
+                             "only; characteristic: the characteristic-curve method only")
+
+
+def _methods():
+    from ..intersect import Method
+    return list(Method)
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
@@ -137,7 +254,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     model_a = read(args.file_a)
     model_b = read(args.file_b) if args.file_b is not None else None
     start = time.perf_counter()
-    results = intersect(model_a, model_b, tol=args.tol,
+    results = intersect(model_a, model_b, tol=args.tol, method=args.method,
                         progress=lambda done, total: console.progress(done, total, "face pair"))
     elapsed = time.perf_counter() - start
     tol = results[0].tol if results else args.tol
@@ -158,6 +275,15 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         console.print(f"{len(results)} intersection curve(s) in {elapsed:.3f} s"
                       + (f", written to {report['output']}" if results else
                          f"; nothing written to {args.output}"))
+        added = sum(1 for c in report["curves"] if c["found_by"] == "characteristic")
+        if args.method == "auto" and added:
+            console.print(f"{added} of them found only by the characteristic method")
+        if report.get("isolated_points"):
+            console.print(f"{len(report['isolated_points'])} isolated (tangential contact) "
+                          "point(s)")
+        for c in report.get("coincident", []):
+            console.print(f"faces {c['faces']} coincide over a region "
+                          f"({100 * c['share']:.0f} % of the first face's grid)")
         if args.compare_occ:
             occ = report["occ"]
             h = "-" if occ["hausdorff"] is None else f"{occ['hausdorff']:.3g}"
@@ -179,12 +305,15 @@ COMMAND = Command(
         "Every curve lies within the tolerance of both surfaces (checked between the "
         "samples too). The JSON report gives the time spent intersecting (without "
         "start-up and file I/O) and, per curve, the faces, whether it is closed, its "
-        "points, length and largest distance from each surface."),
+        "points, length, largest distance from each surface and how it was found "
+        "(found_by: mesh or characteristic); tangential contact points and faces that "
+        "coincide over a region are reported too."),
     epilog=(
         "examples:\n"
         "  surfprep intersect wing.step fuselage.step -o cut.step\n"
         "  surfprep intersect part.step -o self.step --json report.json --plot curves.png\n"
         "  surfprep intersect a.stp b.stp -o c.stp --tol 1e-5 --compare-occ --json -\n"
+        "  surfprep intersect a.stp b.stp -o c.stp --method characteristic --plot p.png\n"
         "\n"
         "Lengths and tolerances are in millimetres."),
     add_arguments=_add_arguments,

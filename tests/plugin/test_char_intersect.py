@@ -1,0 +1,123 @@
+"""surfprep.intersect(method=...) and ``surfprep intersect --method``: the characteristic
+method in the product (issue 4): small loops added by the certificate, tangential
+contact points returned as isolated points, the result still a list."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from OCP.BRepCheck import BRepCheck_Analyzer
+from surfprep.plugin import cli
+from surfprep.plugin.intersect import FoundBy, IntersectionResult, Method, intersect
+
+import surfprep
+
+cq = pytest.importorskip("cadquery")
+R2 = np.sqrt(0.5)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return cq.Solid.makeSphere(1.0, angleDegrees1=-90, angleDegrees2=90)
+
+
+def plane_at(loop_radius: float):
+    """A square face facing (1, 1, 0) cutting the unit sphere in a circle of
+    ``loop_radius`` (0: touching it at (R2, R2, 0))."""
+    d = np.sqrt(1 - loop_radius ** 2)
+    return cq.Face.makePlane(0.6, 0.6, basePnt=(d * R2, d * R2, 0), dir=(R2, R2, 0))
+
+
+def test_small_loop_missed_by_the_triangles_is_added(sphere):
+    """A circle of radius 5e-4 (the triangles, at their default mesh tolerance, miss it):
+    ``auto`` traces it from the characteristic points, within tol of both faces."""
+    mesh = intersect(sphere, plane_at(5e-4), tol=1e-8, method="mesh")
+    auto = intersect(sphere, plane_at(5e-4), tol=1e-8)
+    assert isinstance(auto, IntersectionResult) and auto.method is Method.AUTO
+    assert len(auto) == 1 and auto[0].closed
+    assert len(auto) > len(mesh)                         # pinned: the triangles miss it
+    assert auto[0].found_by is FoundBy.CHARACTERISTIC
+    assert auto[0].max_deviation().max <= 1e-8
+    p = auto[0].points
+    np.testing.assert_allclose(np.linalg.norm(p, axis=1), 1.0, atol=1e-8)
+    centre = np.sqrt(1 - 5e-4 ** 2) * np.array([R2, R2, 0])
+    np.testing.assert_allclose(np.linalg.norm(p - centre, axis=1), 5e-4, atol=1e-8 / 5e-4)
+    (edge,) = auto[0].to_edges()
+    assert BRepCheck_Analyzer(edge).IsValid()
+
+
+def test_tangent_plane_gives_an_isolated_point_not_a_curve(sphere):
+    for method in (Method.AUTO, "characteristic"):
+        res = intersect(sphere, plane_at(0.0), tol=1e-8, method=method)
+        assert res == [] and len(res) == 0
+        (p,) = res.isolated_points
+        np.testing.assert_allclose(p.point, [R2, R2, 0], atol=1e-6)
+        assert p.faces == (0, 0)
+    assert intersect(sphere, plane_at(0.0), tol=1e-8, method="mesh").isolated_points == []
+
+
+def test_methods_agree_on_an_ordinary_cut(sphere):
+    cut = cq.Face.makePlane(4, 4, basePnt=(0, 0, 0.3))
+    lengths = {}
+    for method in Method:
+        res = intersect(sphere, cut, tol=1e-7, method=method)
+        assert len(res) == 1 and res[0].closed
+        assert res[0].max_deviation().max <= 1e-7
+        lengths[method] = float(res[0].curve.parameters[-1])
+        assert all(r.found_by is (FoundBy.MESH if method is not Method.CHARACTERISTIC
+                                  else FoundBy.CHARACTERISTIC) for r in res)
+        assert len(res.records) == 1
+        assert (res.records[0].record is None) == (method is Method.MESH)
+    ref = 2 * np.pi * np.sqrt(0.91)
+    for value in lengths.values():
+        assert value == pytest.approx(ref, rel=1e-4)
+
+
+def test_bad_method_is_refused(sphere):
+    with pytest.raises(ValueError):
+        intersect(sphere, plane_at(0.0), method="triangles")
+
+
+def run(capsys, *argv):
+    code = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_method_found_by_and_plot(sphere, tmp_path, capsys):
+    a, b = tmp_path / "sphere.step", tmp_path / "plane.step"
+    surfprep.write(sphere, a)
+    surfprep.write(plane_at(5e-4), b)
+    out, report, plot = tmp_path / "cut.step", tmp_path / "r.json", tmp_path / "p.png"
+    code, stdout, err = run(capsys, "intersect", a, b, "-o", out, "--json", report,
+                            "--plot", plot, "--tol", "1e-8", "--method", "auto")
+    assert code == 0, err
+    assert "found only by the characteristic method" in stdout
+    r = json.loads(report.read_text())
+    assert r["method"] == "auto" and r["n_curves"] == 1
+    assert r["curves"][0]["found_by"] == "characteristic"
+    (pair,) = r["pairs"]
+    assert pair["found_by_characteristic"] == 1
+    assert pair["characteristic_points"].get("minimum", 0) + \
+        pair["characteristic_points"].get("maximum", 0) == 1
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, stdout, err = run(capsys, "intersect", a, b, "-o", tmp_path / "m.step", "--json", "-",
+                            "--tol", "1e-8", "--method", "mesh")
+    assert code == 0 and json.loads(stdout)["n_curves"] == 0
+    code, stdout, err = run(capsys, "intersect", a, b, "-o", tmp_path / "x.step",
+                            "--method", "bogus")
+    assert code != 0
+
+
+def test_cli_reports_the_contact_point(sphere, tmp_path, capsys):
+    a, b = tmp_path / "sphere.step", tmp_path / "touch.step"
+    surfprep.write(sphere, a)
+    surfprep.write(plane_at(0.0), b)
+    code, stdout, err = run(capsys, "intersect", a, b, "-o", tmp_path / "c.step", "--json", "-",
+                            "--tol", "1e-8")
+    assert code == 0, err
+    r = json.loads(stdout)
+    assert r["n_curves"] == 0 and len(r["isolated_points"]) == 1
+    np.testing.assert_allclose(r["isolated_points"][0]["point"], [R2, R2, 0], atol=1e-6)
