@@ -80,7 +80,7 @@ __all__ = [
 #: grid samples per direction of r's domain for the critical-point seeds
 GRID_MIN, GRID_MAX = 33, 129
 #: largest turn per step on a characteristic curve (only sign changes are read off it)
-CHARACTERISTIC_TURN = 0.5
+CHARACTERISTIC_TURN = 0.6
 #: derivatives of phi below this share of its largest gradient on the grid are rounding
 NOISE_SHARE = 1e-9
 #: rounds of "trace through new critical points" at most
@@ -439,7 +439,7 @@ def _ray_starts(field: DistanceField, crit: DistanceJet, kinds: list[PointKind],
     if found.size == 0:
         return Start.empty()
     a, b = lo[found], hi[found]
-    for _ in range(40):                                   # bisection on the ray
+    for _ in range(8):            # a few bisections: _settle finishes the job by Newton
         mid = 0.5 * (a + b)
         jet = field.jet(origin[found] + mid[:, None] * dirs[found], st[found])
         st[found] = jet.st
@@ -467,7 +467,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     tol = check_tolerance(tol)
     fld = choose_field(a, b, tol=tol, phi_on=phi_on)
     other = DistanceField(fld.q, Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
-    h_max = 0.12 * fld.diagonal
+    h_max = 0.15 * fld.diagonal
     grid, shape = _grid(fld)
     coincident = _coincident(fld, grid, shape, tol)
     regular = grid.status == ProjectionStatus.UNIQUE
@@ -595,6 +595,28 @@ def _settle(field: DistanceField, start: Start) -> tuple[Start, NDArray]:
     return Start(x, jet.st, start.scale, start.group), ok
 
 
+def _on_trace(uv: NDArray, trace: TracedCurve) -> bool:
+    """True when ``uv (2,)`` lies on the traced polyline in the parameter plane: closer to
+    one of its chords than a tenth of that chord (the chords of a trace sag by about
+    ``MAX_TURN / 8`` of their length)."""
+    p = trace.uv
+    q = np.vstack([p, p[:1]]) if trace.closed else p
+    a, d = q[:-1], np.diff(q, axis=0)
+    dd = np.einsum("sc,sc->s", d, d)
+    t = np.clip(np.einsum("sc,sc->s", uv - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    gap = np.linalg.norm(a + t[:, None] * d - uv, axis=1)
+    return bool(np.any(gap <= 0.1 * np.sqrt(dd) + 1e-14))
+
+
+def _sine(field: DistanceField, uv: NDArray, st: NDArray) -> NDArray:
+    """``(m,)`` sine of the angle between the two surfaces at ``uv`` (feet ``st``)."""
+    jet = field.jet(uv, st)
+    d = field.evaluator.derivatives(uv[:, 0], uv[:, 1], 1)
+    n_r = np.cross(d[:, 1, 0], d[:, 0, 1])
+    n_r /= np.maximum(np.linalg.norm(n_r, axis=1), 1e-300)[:, None]
+    return np.linalg.norm(np.cross(n_r, jet.normal), axis=1)
+
+
 def _points_3d(field: DistanceField, uv: NDArray) -> NDArray:
     return field.r.evaluate(uv[:, 0], uv[:, 1])
 
@@ -606,7 +628,9 @@ def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
     settled, ok = _settle(field, starts)
     uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
     pts = _points_3d(field, uv)
-    cover = 10 * tol + 1e-9 * size
+    # a curve within tol of both surfaces may sit tol / sin(angle) off the exact point
+    # along the surfaces where they meet at a small angle
+    cover = 10 * tol / np.maximum(_sine(field, uv, st), 1e-6) + 1e-9 * size
     polylines, closed = list(known), list(known_closed)
     out: list[IntersectionCurve] = []
     todo = np.arange(uv.shape[0])
@@ -614,20 +638,21 @@ def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
         if todo.size == 0:
             break
         gap = polyline_gap(pts[todo], polylines, closed)
-        todo = todo[gap > cover]
+        todo = todo[gap > cover[todo]]
         if todo.size == 0:
             break
         # one start per group and round (several starts of one loop trace once)
         _, first = np.unique(group[todo], return_index=True)
         batch = todo[np.sort(first)]
         traced = trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol)
+        kept_traces: list[TracedCurve] = []
         for t in traced:
+            if any(_on_trace(t.uv[0], k) for k in kept_traces):
+                continue                                  # a loop traced twice in one round
             curve = to_intersection_curve(field, t, tol)
             if curve is None:
                 continue
-            gap_new = polyline_gap(curve.points[:1], polylines, closed)[0]
-            if gap_new <= cover and polylines:
-                continue                                  # a loop traced twice in one round
+            kept_traces.append(t)
             out.append(curve)
             polylines.append(dense_polyline(curve, 64))
             closed.append(curve.closed)

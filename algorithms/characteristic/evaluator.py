@@ -57,6 +57,35 @@ def _monomials(x: NDArray, degree: int, order: int, scale: NDArray) -> NDArray:
     return powers[:, index] * coef * chain[:, :, None]
 
 
+def _rational_to_second_order(hom: NDArray, order: int) -> NDArray:
+    """Quotient rule (eq. 4.20 of Piegl & Tiller) written out for ``order <= 2``."""
+    a, w = hom[..., :-1], hom[..., -1:]
+    out = np.empty_like(a)
+    inv = 1.0 / w[:, 0, 0]
+    out[:, 0, 0] = a[:, 0, 0] * inv
+    if order >= 1:
+        s = out[:, 0, 0]
+        out[:, 1, 0] = (a[:, 1, 0] - w[:, 1, 0] * s) * inv
+        out[:, 0, 1] = (a[:, 0, 1] - w[:, 0, 1] * s) * inv
+    if order >= 1:
+        out[:, 1, 1] = (a[:, 1, 1] - w[:, 1, 0] * out[:, 0, 1] - w[:, 0, 1] * out[:, 1, 0]
+                        - w[:, 1, 1] * s) * inv
+    if order >= 2:
+        out[:, 2, 0] = (a[:, 2, 0] - 2 * w[:, 1, 0] * out[:, 1, 0] - w[:, 2, 0] * s) * inv
+        out[:, 0, 2] = (a[:, 0, 2] - 2 * w[:, 0, 1] * out[:, 0, 1] - w[:, 0, 2] * s) * inv
+        out[:, 2, 1] = (a[:, 2, 1] - w[:, 2, 0] * out[:, 0, 1] - w[:, 0, 1] * out[:, 2, 0]
+                        - 2 * w[:, 1, 0] * out[:, 1, 1]
+                        - 2 * w[:, 1, 1] * out[:, 1, 0] - w[:, 2, 1] * s) * inv
+        out[:, 1, 2] = (a[:, 1, 2] - w[:, 0, 2] * out[:, 1, 0] - w[:, 1, 0] * out[:, 0, 2]
+                        - 2 * w[:, 0, 1] * out[:, 1, 1]
+                        - 2 * w[:, 1, 1] * out[:, 0, 1] - w[:, 1, 2] * s) * inv
+        out[:, 2, 2] = (a[:, 2, 2] - w[:, 2, 0] * out[:, 0, 2] - w[:, 0, 2] * out[:, 2, 0]
+                        - 2 * w[:, 1, 0] * out[:, 1, 2] - 2 * w[:, 0, 1] * out[:, 2, 1]
+                        - 4 * w[:, 1, 1] * out[:, 1, 1] - 2 * w[:, 2, 1] * out[:, 0, 1]
+                        - 2 * w[:, 1, 2] * out[:, 1, 0] - w[:, 2, 2] * s) * inv
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class PatchEvaluator:
     """Power-basis form of a :class:`NurbsSurface`, for repeated small evaluations."""
@@ -92,6 +121,8 @@ class PatchEvaluator:
         hom = np.matmul(pv[:, None], tmp)                           # (m, k, l, 4)
         if self.surface.weights is None:
             return hom[..., :-1]
+        if order <= 2:
+            return _rational_to_second_order(hom, order)
         return surface_derivatives_from_homogeneous(hom[..., :-1], hom[..., -1])
 
     def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray:
