@@ -18,7 +18,9 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    its four free edges; every directed patch of ``patches`` (:mod:`.heal_spec`)
    one over its curves or corners;
 4. the approximants are joined by :func:`connect` (G0 or G1, topology
-   violations left unconnected and reported);
+   violations left unconnected and reported); a side that meets a face kept
+   as it was (not re-approximated) is fitted to that face's edge, so the gap
+   to it closes up to the fit error too;
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
    shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
    untouched faces keep their names (a replaced face passes its name to its
@@ -33,10 +35,11 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms.healing import (
@@ -47,14 +50,18 @@ from ..algorithms.healing import (
     connect,
     local_approximant,
 )
-from ..algorithms.healing.connectivity import Side
+from ..algorithms.healing.connectivity import Side, _corner_number, side_points
+from ..algorithms.healing.continuity import fit_side_to_curve
+from ..algorithms.healing.measure_joins import measure_join
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_overlap import find_overlaps, trimmed_back_boundary
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
+    FaceEdge,
     count_free_edges,
+    dense_edge,
     duplicate_faces,
     face_edges,
     four_sided_boundary,
@@ -62,6 +69,7 @@ from .heal_topology import (
     is_valid,
     max_edge_tolerance,
     pair_edges,
+    polyline_distance,
     sew,
 )
 from .io import CadModel, read, to_shape
@@ -80,6 +88,8 @@ __all__ = [
 DEFAULT_GAP_FACTOR = 1e-3
 #: ... and at most this times the median edge length
 _GAP_FACTOR_EDGE = 0.01
+#: a side fitted to an untouched face's edge gets at most this many knot spans
+MAX_SNAP_SPANS = 64
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
 
@@ -188,6 +198,7 @@ class HealResult:
             "topology_violations": [] if net is None else list(net.connectivity.violations),
             "dropped_overlaps": [{"kept": a, "dropped": b} for a, b in self.dropped],
             "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
+            "snapped_sides": self.extra.get("snapped_sides", 0),
             "skipped": list(self.skipped),
             "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,
                            "tight_before": self.tight_free_edges_before,
@@ -280,6 +291,54 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
     return make_face(surface, reversed=bool(np.dot(n_new, n_old) < 0))
 
 
+# ------------------------------------------------------- untouched neighbours
+def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], gap_tol: float):
+    """The edge lying closest along the whole side, within ``gap_tol`` both ways, or None."""
+    lo, hi = side.min(axis=0) - gap_tol, side.max(axis=0) + gap_tol
+    best, best_distance = None, gap_tol
+    for e in edges:
+        if np.any(e.samples.min(axis=0) > hi) or np.any(e.samples.max(axis=0) < lo):
+            continue
+        distance = max(polyline_distance(e.samples, dense_side).max(),
+                       polyline_distance(side, dense_edge(e)).max())
+        if distance <= best_distance:
+            best, best_distance = e.curve, distance
+    return best
+
+
+def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
+    """Whether the corner at ``end`` of ``side`` is shared with another approximant."""
+    number = _corner_number(side, end)
+    return any(_corner_number(s, e) == number for p, s, e in members if p == patch)
+
+
+def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float
+                       ) -> tuple[Network, int]:
+    """Sides of approximants that meet a face kept as it was (not another approximant)
+    fitted to that face's edge (:func:`fit_side_to_curve`), joins measured again."""
+    if not edges:
+        return network, 0
+    shared = {(e.a, e.side_a) for e in network.edges} | {(e.b, e.side_b) for e in network.edges}
+    patches, snapped = list(network.patches), 0
+    in_clusters = {(m[0], m[1], m[2]) for c in network.connectivity.corners for m in c.members}
+    for p in range(len(patches)):
+        for side in Side:
+            if (p, side) in shared:
+                continue
+            target = _matching_edge(side_points(patches[p], side, 17),
+                                    side_points(patches[p], side, 129), edges, gap_tol)
+            if target is not None:
+                spans = min(MAX_SNAP_SPANS, 2 * (np.unique(target.knots).size - 1) + 8)
+                free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
+                patches[p] = fit_side_to_curve(patches[p], side, target, min_spans=spans,
+                                               free_corners=free)
+                snapped += 1
+    if not snapped:
+        return network, 0
+    joins = tuple(measure_join(patches, e) for e in network.edges)
+    return replace(network, patches=tuple(patches), joins=joins), snapped
+
+
 # ---------------------------------------------------------------------- heal
 def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None) -> HealResult:
@@ -337,8 +396,12 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
+        replaced = {job.origin.index for job, _ in done if job.origin.kind == "face"}
+        network, snapped = _snap_to_originals(
+            network, [e for e in edges if e.face not in replaced], gap_tol)
     result = _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start)
+    result.extra["snapped_sides"] = snapped if network is not None else 0
     result.extra["trimmed_overlaps"] = [
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": any(
             j.origin.kind == "face" and j.origin.index == o.trimmed for j, _ in done)}

@@ -90,7 +90,7 @@ def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
     return out
 
 
-def _polyline_distance(points: NDArray, line: NDArray) -> NDArray:
+def polyline_distance(points: NDArray, line: NDArray) -> NDArray:
     a, b = line[:-1], line[1:]
     ab = b - a
     denom = np.maximum(np.einsum("kc,kc->k", ab, ab), np.finfo(float).tiny)
@@ -99,7 +99,7 @@ def _polyline_distance(points: NDArray, line: NDArray) -> NDArray:
                   axis=1)
 
 
-def _dense(edge: FaceEdge, n: int = 129) -> NDArray:
+def dense_edge(edge: FaceEdge, n: int = 129) -> NDArray:
     t0, t1 = edge.curve.domain
     return edge.curve.evaluate(np.linspace(t0, t1, n))
 
@@ -117,11 +117,11 @@ def pair_edges(edges: list[FaceEdge], gap_tol: float) -> list[tuple[int, int]]:
         a, b = edges[i], edges[j]
         if a.face == b.face:
             continue
-        da = dense.setdefault(j, _dense(b))
-        if _polyline_distance(a.samples, da).max() > gap_tol:
+        da = dense.setdefault(j, dense_edge(b))
+        if polyline_distance(a.samples, da).max() > gap_tol:
             continue
-        db = dense.setdefault(i, _dense(a))
-        if _polyline_distance(b.samples, db).max() <= gap_tol:
+        db = dense.setdefault(i, dense_edge(a))
+        if polyline_distance(b.samples, db).max() <= gap_tol:
             out.append((int(i), int(j)))
     return out
 

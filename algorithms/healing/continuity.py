@@ -45,7 +45,10 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.sparse.linalg import lsqr
 
+from ..basis import collocation_matrix
+from ..curve import NurbsCurve
 from ..measure import normals
+from ..projection import project_to_curve
 from ..surface import NurbsSurface
 from .connectivity import (
     Connectivity,
@@ -55,7 +58,7 @@ from .connectivity import (
     side_indices,
 )
 
-__all__ = ["PointClasses", "enforce_g0", "enforce_g1", "point_classes"]
+__all__ = ["PointClasses", "enforce_g0", "enforce_g1", "fit_side_to_curve", "point_classes"]
 
 
 @dataclass(frozen=True)
@@ -298,3 +301,76 @@ def _solve(cons: _Constraints, points: NDArray, free: NDArray) -> NDArray:
     out = x0.copy()
     out[cols] += step
     return out.reshape(points.shape)
+
+
+# ------------------------------------------------ joining a fixed neighbour
+#: samples per knot span of the side for :func:`fit_side_to_curve`
+FIT_SAMPLES_PER_SPAN = 8
+
+
+def _refined_along(surface: NurbsSurface, side, min_spans: int) -> NurbsSurface:
+    """Knots inserted at the midpoint of the longest span along ``side`` until it has
+    ``min_spans`` spans: the same surface with more freedom in the boundary row."""
+    from ..knots import refine_surface
+    knots = surface.knots_v if side.along.name == "V" else surface.knots_u
+    breaks = list(np.unique(knots))
+    new = []
+    while len(breaks) - 1 < min_spans:
+        k = int(np.argmax(np.diff(breaks)))
+        mid = 0.5 * (breaks[k] + breaks[k + 1])
+        breaks.insert(k + 1, mid)
+        new.append(mid)
+    return refine_surface(surface, np.sort(new), side.along) if new else surface
+
+
+def fit_side_to_curve(surface: NurbsSurface, side, target: NurbsCurve, *,
+                      min_spans: int = 0, free_corners: tuple[bool, bool] = (False, False)
+                      ) -> NurbsSurface:
+    """``surface`` with the boundary row of ``side`` fitted to ``target`` (corners kept).
+
+    For a side that meets a face which is not re-approximated (its edge is
+    ``target``): the side's samples (``FIT_SAMPLES_PER_SPAN`` per knot span) are
+    projected onto ``target`` and the inner control points of the boundary row
+    are the least-squares fit of those foot points with the side's own knots;
+    the two corners stay (they may be shared with other patches). Only the
+    boundary row moves, so the gap to ``target`` closes up to the fit error.
+
+    Parameters
+    ----------
+    surface : NurbsSurface (non-rational)
+    side : connectivity.Side
+    target : NurbsCurve, 3D
+    min_spans : int
+        Knots are first inserted along the side (geometry unchanged) until it has
+        this many spans, so the row can follow a target with more detail.
+    free_corners : (bool, bool)
+        Move the corner at the start / end of the side onto the nearer end of
+        ``target`` (for corners no other patch shares).
+
+    Returns
+    -------
+    NurbsSurface
+    """
+    from .connectivity import side_indices
+    surface = _refined_along(surface, side, min_spans)
+    knots = surface.knots_v if side.along.name == "V" else surface.knots_u
+    degree = surface.degree_v if side.along.name == "V" else surface.degree_u
+    lo, hi = side.running_domain(surface)
+    spans = max(1, np.unique(knots).size - 1)
+    t = np.linspace(lo, hi, FIT_SAMPLES_PER_SPAN * spans + 1)
+    uv = side.uv(surface, t)
+    feet = project_to_curve(target, surface.evaluate(uv[:, 0], uv[:, 1])).points
+    basis = collocation_matrix(knots, degree, t)                  # (m, n)
+    i, j = side_indices(surface.n_control, side)
+    row = surface.control_points[i, j].copy()                     # (n, 3)
+    ends = target.evaluate(np.array(target.domain))
+    for k, free in zip((0, -1), free_corners):
+        if free:
+            row[k] = ends[int(np.argmin(np.linalg.norm(ends - row[k], axis=1)))]
+    rhs = feet - basis[:, [0]] * row[0] - basis[:, [-1]] * row[-1]
+    inner, *_ = np.linalg.lstsq(basis[:, 1:-1], rhs, rcond=None)
+    net = surface.control_points.copy()
+    net[i[1:-1], j[1:-1]] = inner
+    net[i[[0, -1]], j[[0, -1]]] = row[[0, -1]]
+    return NurbsSurface(net, surface.knots_u, surface.knots_v, surface.degree_u,
+                        surface.degree_v, surface.weights)

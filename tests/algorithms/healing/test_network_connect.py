@@ -173,3 +173,19 @@ def test_single_patch_and_bad_continuity():
     assert net.edges == () and len(net.free_sides()) == 4
     with pytest.raises(InvalidGeometryError, match="G0"):
         connect([a], continuity="C2")
+
+
+def test_fit_side_to_curve_closes_gap_to_a_kept_face():
+    from surfprep.algorithms.healing.continuity import fit_side_to_curve
+    from surfprep.algorithms.projection import project_to_curve
+    a = patch(0, 1, 0, 1, 5, 5)
+    kept = patch(1, 2, 0, 1, 12, 9, dz=1e-3)           # an untouched neighbour, finer
+    edge = kept.isocurve(kept.domain[0], "u")           # its side at x = 1
+    before = project_to_curve(edge, side_points(a, Side.U1, 300)).distance.max()
+    snapped = fit_side_to_curve(a, Side.U1, edge, min_spans=16, free_corners=(True, True))
+    after = project_to_curve(edge, side_points(snapped, Side.U1, 300)).distance.max()
+    assert before > 9e-4 and after < 1e-6
+    # the opposite side and the interior away from the edge are untouched
+    t = np.linspace(0, 1, 50)
+    np.testing.assert_allclose(snapped.evaluate(np.zeros(50), t),
+                               a.evaluate(np.zeros(50), t), atol=1e-12)
