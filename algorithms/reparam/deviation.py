@@ -32,13 +32,17 @@ from ..projection import project_to_surface
 from ..surface import NurbsSurface
 
 __all__ = [
+    "CHUNK",
     "MIN_ORIGINAL_SAMPLES",
     "DeviationMap",
     "deviation_map",
+    "inverse_map",
     "original_on_new",
     "subdivide",
 ]
 
+#: Points per projection call (memory stays below ~100 MB).
+CHUNK = 50_000
 #: Samples of the original per direction at least in the eq. 29.3 direction.
 MIN_ORIGINAL_SAMPLES = 60
 
@@ -95,7 +99,8 @@ def deviation_map(original: NurbsSurface, new: NurbsSurface, params_u: NDArray,
     lookup = RegularGridInterpolator((params_u, params_v), uv)
     mesh = np.stack(np.meshgrid(gu, gv, indexing="ij"), axis=-1)
     guess = lookup(mesh.reshape(-1, 2)).reshape(mesh.shape)
-    distance = project_to_surface(original, points, guess=guess).distance
+    distance = _chunked(original, points.reshape(-1, 3), guess.reshape(-1, 2))[0]
+    distance = distance.reshape(points.shape[:-1])
     nu, nv, p = len(params_u) - 1, len(params_v) - 1, per_span
     on_rows = distance[:, ::p]                                       # lines V = V_j
     on_cols = distance[::p, :]                                       # lines U = U_i
@@ -129,12 +134,39 @@ def original_on_new(original: NurbsSurface, new: NurbsSurface, params_u: NDArray
         parts = max(per_span, -(-MIN_ORIGINAL_SAMPLES // (len(breaks) - 1)))
         grids.append(subdivide(breaks, parts))
     points = original.evaluate_grid(*grids).reshape(-1, original.dimension)
+    queries = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, 2)
+    guess = inverse_map(params_u, params_v, uv, queries)
+    return _chunked(new, points, guess)
+
+
+def inverse_map(params_u: NDArray, params_v: NDArray, uv: NDArray, queries: NDArray
+                ) -> NDArray:
+    """Approximate new parameters of original parameters ``queries (m, 2)``.
+
+    The map new -> original is known at the interpolation nodes
+    (``uv (n_u, n_v, 2)`` at ``params_u x params_v``); it is sampled 4 x 4 per
+    cell (bilinearly) and each query takes the new parameters of the nearest
+    sample (k-d tree in the original domain, axes scaled to the queries'
+    extent). A start for a local projection, not an exact inverse.
+
+    Returns
+    -------
+    (m, 2) float
+    """
     fine_u, fine_v = subdivide(params_u, 4), subdivide(params_v, 4)
     mesh = np.stack(np.meshgrid(fine_u, fine_v, indexing="ij"), axis=-1).reshape(-1, 2)
     forward = RegularGridInterpolator((params_u, params_v), uv)(mesh)        # original uv
-    queries = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, 2)
-    scale = np.ptp(queries, axis=0) + 1e-300
-    _, nearest = cKDTree(forward / scale).query(queries / scale)
-    guess = mesh[nearest]
-    result = project_to_surface(new, points, guess=guess)
-    return result.distance, result.uv
+    scale = np.ptp(uv.reshape(-1, 2), axis=0) + 1e-300
+    _, nearest = cKDTree(forward / scale).query(np.asarray(queries, float) / scale)
+    return mesh[nearest]
+
+
+def _chunked(surface: NurbsSurface, points: NDArray, guess: NDArray) -> tuple[NDArray, NDArray]:
+    """Local projections of ``points (m, 3)`` from ``guess (m, 2)`` in chunks of
+    :data:`CHUNK` (bounded memory): distances ``(m,)`` and foot parameters ``(m, 2)``."""
+    distance, uv = np.empty(len(points)), np.empty((len(points), 2))
+    for start in range(0, len(points), CHUNK):
+        part = slice(start, start + CHUNK)
+        result = project_to_surface(surface, points[part], guess=guess[part])
+        distance[part], uv[part] = result.distance, result.uv
+    return distance, uv

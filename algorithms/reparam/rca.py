@@ -49,6 +49,7 @@ from .reconcile import insert_midpoints, reconcile_fractions
 __all__ = [
     "DEFAULT_RELATIVE_TOL",
     "ReparametrizationResult",
+    "crease_knots",
     "default_tolerance",
     "reparametrize_surface",
 ]
@@ -59,6 +60,8 @@ DEFAULT_RELATIVE_TOL = 1e-4
 MIN_RELATIVE_TOL, MAX_RELATIVE_TOL = 1e-9, 0.1
 #: Share of ``tol`` for the boundary fits and for the error along grid lines.
 BOUNDARY_SHARE = 0.5
+#: Turn of the cross derivative (radians) across a knot line that makes it a crease.
+CREASE_ANGLE = 1e-4
 #: Fewest interpolation points per direction (a cubic not-a-knot spline).
 MIN_POINTS = 4
 
@@ -239,7 +242,8 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
     Raises
     ------
     InvalidGeometryError
-        Not a 3D NurbsSurface.
+        Not a 3D NurbsSurface, or it has creases (:func:`crease_knots`),
+        which a C2 surface cannot follow.
     DegenerateGeometryError
         The surface is a point, or collapsed along a whole direction.
     InvalidToleranceError
@@ -252,6 +256,7 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         raise DegenerateGeometryError("the surface is a single point")
     tol = default_tolerance(surface) if tol is None else tol
     tol = check_tolerance(tol, "tol", low=MIN_RELATIVE_TOL * size, high=MAX_RELATIVE_TOL * size)
+    _refuse_creases(surface)
     if per_span < 10:
         raise InvalidGeometryError(f"per_span must be >= 10, got {per_span}")
     du, fu = _boundaries(surface, Direction.U, tol)
@@ -286,6 +291,47 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         mismatch_before=_mismatch(surface), mismatch_after=_mismatch(new),
         iterations=iteration, knots_inserted=inserted, relocation_sweeps=sweeps,
         relocation_converged=bool(settled), params_u=pu, params_v=pv, uv=uv)
+
+
+def crease_knots(surface: NurbsSurface, angle: float = CREASE_ANGLE) -> tuple[NDArray, NDArray]:
+    """Interior knot lines in u and in v where the surface has a crease.
+
+    A candidate is an interior knot of multiplicity >= degree (only C0 by the
+    knots); it is a crease when the cross derivative turns by more than
+    ``angle`` (radians) across it at one of 17 points along the line (knots
+    of full multiplicity with collinear poles are smooth and pass).
+    """
+    out = []
+    along = np.linspace(0.0, 1.0, 17)
+    for axis, (knots, degree, n) in enumerate(
+            ((surface.knots_u, surface.degree_u, surface.n_control[0]),
+             (surface.knots_v, surface.degree_v, surface.n_control[1]))):
+        values, counts = np.unique(knots[degree + 1:n], return_counts=True)
+        found = []
+        for value in values[counts >= degree]:
+            lo, hi = (surface.domain[2:] if axis == 0 else surface.domain[:2])
+            other = lo + along * (hi - lo)
+            eps = 1e-9 * (knots[-1] - knots[0])
+            sides = []
+            for x in (value - eps, value + eps):
+                uv = (np.full_like(other, x), other) if axis == 0 else (other, np.full_like(other, x))
+                d = surface.derivatives(*uv, 1)
+                sides.append(d[:, 1, 0] if axis == 0 else d[:, 0, 1])
+            cos = np.sum(sides[0] * sides[1], -1) / np.maximum(
+                np.linalg.norm(sides[0], axis=-1) * np.linalg.norm(sides[1], axis=-1), 1e-300)
+            if np.arccos(np.clip(cos, -1.0, 1.0)).max() > angle:
+                found.append(value)
+        out.append(np.array(found))
+    return out[0], out[1]
+
+
+def _refuse_creases(surface: NurbsSurface) -> None:
+    cu, cv = crease_knots(surface)
+    if cu.size or cv.size:
+        raise InvalidGeometryError(
+            f"the surface has creases (tangent-discontinuous knot lines u = "
+            f"{[round(float(x), 9) for x in cu]}, v = {[round(float(x), 9) for x in cv]}): a C2 "
+            "reparametrization cannot follow them; split the surface there first")
 
 
 def _mismatch(surface: NurbsSurface) -> float:
