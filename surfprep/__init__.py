@@ -37,6 +37,7 @@ _PLUGIN_EXPORTS = {
     "make_face": "surfprep.plugin.topology",
     "make_edge": "surfprep.plugin.topology",
     "intersect": "surfprep.plugin.intersect",
+    "reparametrize": "surfprep.plugin.reparam",
     "heal": "surfprep.plugin.heal",
 }
 
