@@ -321,9 +321,11 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
     """
     from OCP.BRepTools import BRepTools_ReShape
 
+    from ..algorithms.tolerance import check_tolerance
     from ..errors import SurfprepError
     from .convert import faces_of
     tol = DEFAULT_MODEL_RELATIVE_TOL * model.size if tol is None else tol
+    tol = check_tolerance(tol, "tol", low=1e-9 * model.size, high=0.1 * model.size)
     copier = BRepBuilderAPI_Copy(model.shape)
     if not copier.IsDone():
         raise OpenCascadeError("BRepBuilderAPI_Copy failed")

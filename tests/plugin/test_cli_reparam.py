@@ -1,0 +1,65 @@
+"""``surfprep reparam``: report, output file, faces, plot and errors."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import pytest
+from OCP.BRep import BRep_Tool
+from OCP.BRepCheck import BRepCheck_Analyzer
+from surfprep.plugin.cli import main
+from surfprep.plugin.geom import surface_from_occ
+
+import surfprep
+
+
+@pytest.fixture(scope="module")
+def fuselage_run(data_dir, tmp_path_factory):
+    """One run on faces 0 and 4 of the fuselage (4 has creases: skipped)."""
+    out = tmp_path_factory.mktemp("reparam")
+    source = data_dir / "occt_fuselage.stp"
+    code = main(["reparam", str(source), "-o", str(out / "out.step"), "--faces", "0", "4",
+                 "--json", str(out / "r.json"), "--plot", str(out / "iso.png")])
+    return code, out, source
+
+
+def test_report_and_output(fuselage_run, capsys):
+    code, out, source = fuselage_run
+    assert code == 1                                   # face 4 was skipped
+    report = json.loads((out / "r.json").read_text())
+    ok, skipped = report["faces"]
+    assert ok["index"] == 0 and ok["status"] == "ok"
+    assert ok["max_deviation"] <= ok["tol"]
+    assert ok["mismatch_before"] > 10 and ok["mismatch_after"] < 1.5
+    assert ok["poles_before"] == 40 and ok["poles_after"] > 40
+    assert skipped["status"] == "skipped" and "creases" in skipped["error"]
+    model = surfprep.read(out / "out.step")
+    original = surfprep.read(source)
+    assert model.n_faces == original.n_faces
+    assert BRepCheck_Analyzer(model.shape).IsValid()
+    new = surface_from_occ(BRep_Tool.Surface_s(model.faces[0]))
+    assert new.n_control[0] * new.n_control[1] == ok["poles_after"]
+    old4 = surface_from_occ(BRep_Tool.Surface_s(original.faces[4]))
+    assert surface_from_occ(BRep_Tool.Surface_s(model.faces[4])).n_control == old4.n_control
+    assert (out / "iso.png").stat().st_size > 10_000
+
+
+def test_errors_are_one_line(data_dir, tmp_path, capsys):
+    source = data_dir / "occt_fuselage.stp"
+    code = main(["reparam", str(source), "-o", str(tmp_path / "o.step"), "--tol", "-1",
+                 "--faces", "0"])
+    err = capsys.readouterr().err
+    assert code != 0 and "tol" in err and len(err.strip().splitlines()) == 1 + 0
+    code = main(["reparam", str(source), "-o", str(source)])
+    assert code != 0 and "refusing to overwrite" in capsys.readouterr().err
+    code = main(["reparam", str(source), "-o", str(tmp_path / "o.step"), "--faces", "99"])
+    assert code != 0 and "out of range" in capsys.readouterr().err
+
+
+def test_plot_without_matplotlib(data_dir, tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    code = main(["reparam", str(data_dir / "occt_fuselage.stp"), "-o", str(tmp_path / "o.step"),
+                 "--faces", "0", "--plot", str(tmp_path / "p.png")])
+    assert code != 0 and "matplotlib" in capsys.readouterr().err
+    assert not (tmp_path / "o.step").exists()
