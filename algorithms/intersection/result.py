@@ -227,6 +227,8 @@ def checked_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKin
     for sampled, (start, end) in zip(cubic_samples(surface_a, surface_b, refined, tol=tol,
                                                    simplify=simplify, max_rounds=max_rounds),
                                      kinds):
+        if sampled is None:                    # collapsed onto a point
+            continue
         r = sampled.curve
         if sampled.interpolants is None:
             curve = IntersectionCurve.from_samples(r.points, r.uv_a, r.uv_b, r.closed, start,

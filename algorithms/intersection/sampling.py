@@ -36,7 +36,7 @@ not see (the sample count grows only as ``share^(-1/4)``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -78,6 +78,12 @@ _MIDDLE = 0.25
 _INSIDE = 0.02
 #: a failing span is cut into at most this many pieces per round
 _MAX_PIECES = 8
+#: a curve whose error has not halved in this many rounds is given up
+_STALL_ROUNDS = 3
+#: kept samples closer than this times tol to the previous one are duplicates
+_DUPLICATE = 1e-3
+#: spans within this many of a new sample are checked again (0.27^8 = 3e-5)
+_LOCALITY = 8
 
 
 # ------------------------------------------------------------------ interpolants
@@ -292,6 +298,10 @@ class _Work:
     done: bool = False
     error: float = float("inf")    # largest check-point error in the last round
     result: object = None          # the passing _Check (interpolants) once done
+    history: list = field(default_factory=list)     # error of every round
+    degenerate: bool = False       # all samples on one point (left out of the result)
+    fresh: NDArray | None = None   # (m,) bool: kept since the last check
+    span_error: NDArray | None = None   # (m,) float: last checked error of the span from here
 
 
 def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
@@ -317,19 +327,61 @@ class _Check:
     kept: NDArray          # kept dense indices
     t: NDArray             # their parameters ((k + 1,) when closed)
     stacked: NurbsCurve    # curve3d | pcurve_a | pcurve_b in one 7-dimensional curve
-    at: NDArray            # (spans * 3, 7) interpolant values at the check points
+    at: NDArray            # (dirty * 3, 7) interpolant values at the check points
+    dirty: NDArray         # the spans checked this round
 
 
-def _checks(works: list[_Work]) -> list[_Check]:
+def _drop_duplicates(w: _Work, tol: float) -> NDArray:
+    """Kept indices, after dropping kept samples within ``_DUPLICATE tol`` of the previous
+    one (near-tangential refinement can land two samples on one point); they are
+    marked unconverged so that no later round takes them again."""
+    k = np.flatnonzero(w.kept)
+    ring = np.vstack([w.points[k], w.points[k[:1]]]) if w.closed else w.points[k]
+    step = np.linalg.norm(np.diff(ring, axis=0), axis=1)
+    dup = step <= _DUPLICATE * tol                      # step i: kept i -> i + 1 (wrapping)
+    drop = k[1:][dup[: k.size - 1]]
+    if w.closed and k.size > 1 and dup[-1] and k[-1] not in drop:
+        drop = np.append(drop, k[-1])
+    w.kept[drop] = False
+    w.converged[drop] = False
+    if drop.size:                                        # their neighbours' spans changed
+        w.fresh[k[np.maximum(np.searchsorted(k, drop) - 1, 0)]] = True
+    return np.flatnonzero(w.kept)
+
+
+def _dirty_spans(w: _Work, k: NDArray, spans: int) -> NDArray:
+    """Spans (indices into the kept samples) to check this round: those within
+    ``_LOCALITY`` spans of a sample kept since the last check (all in the first
+    round). A C2 cubic interpolant moves by a factor ``2 - sqrt(3)`` less per span
+    away from a changed sample, so farther spans keep their checked error."""
+    if w.span_error is None:
+        return np.arange(spans)
+    pos = np.flatnonzero(w.fresh[k])
+    if pos.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    near = (pos[:, None] + np.arange(-_LOCALITY - 1, _LOCALITY + 1)[None, :]).ravel()
+    near = np.mod(near, spans) if w.closed else near[(near >= 0) & (near < spans)]
+    return np.unique(near)
+
+
+def _checks(works: list[_Work], tol: float) -> list[_Check]:
     out = []
     s = np.asarray(CHECK_FRACTIONS)
     for w in works:
-        k = np.flatnonzero(w.kept)
+        if w.fresh is None:
+            w.fresh = np.zeros(w.points.shape[0], dtype=bool)
+        k = _drop_duplicates(w, tol)
+        if k.size < 2 + w.closed:          # collapsed onto a point: nothing to interpolate
+            out.append(None)
+            continue
         t = sample_parameters(w.points[k], w.closed)
         stacked = interpolate_samples(np.hstack([w.points[k], w.uv_a[k], w.uv_b[k]]), t,
                                       w.closed)
-        at = stacked.evaluate((t[:-1, None] + s[None, :] * np.diff(t)[:, None]).ravel())
-        out.append(_Check(k, t, stacked, at))
+        dirty = _dirty_spans(w, k, t.size - 1)
+        w.fresh[:] = False
+        dt = np.diff(t)[dirty]
+        at = stacked.evaluate((t[dirty, None] + s[None, :] * dt[:, None]).ravel())
+        out.append(_Check(k, t, stacked, at, dirty))
     return out
 
 
@@ -347,6 +399,16 @@ def _check_errors(checks: list[_Check], surface_a, surface_b) -> list[NDArray]:
     return [e.reshape(-1, len(CHECK_FRACTIONS)).max(axis=1) for e in np.split(err, split)]
 
 
+def _span_errors_now(w: _Work, check: _Check, dirty_error: NDArray) -> NDArray:
+    """Errors ``(spans,)`` of all spans: just checked, or as last checked."""
+    m = w.points.shape[0]
+    if w.span_error is None or w.span_error.shape[0] != m:
+        w.span_error = np.full(m, np.nan)
+    spans = check.t.size - 1
+    w.span_error[check.kept[check.dirty]] = dirty_error
+    return w.span_error[check.kept[:spans]]
+
+
 def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float):
     """Spans (by index into the kept samples) over ``target`` at their check points or
     too long beside a neighbour, their errors, the dense samples farther than
@@ -359,7 +421,10 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
     m = w.points.shape[0]
     ends = np.append(k, m) if w.closed else k                     # span j: ends[j]..ends[j+1]
     span_of = np.searchsorted(ends, np.arange(m), side="right") - 1
+    checked = np.zeros(dt.size + 1, dtype=bool)
+    checked[check.dirty] = True
     inner = ~w.kept & w.converged & (span_of < dt.size)
+    inner &= checked[np.clip(span_of, 0, dt.size)]
     ring = np.vstack([w.points, w.points[:1]]) if w.closed else w.points
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
     off = np.zeros(0, dtype=np.int64)           # dense samples off curve3d: kept next round
@@ -397,6 +462,8 @@ def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDAr
     w.singular = np.insert(w.singular, pos, singular)
     w.kept = np.insert(w.kept, pos, True)
     w.stuck = np.insert(w.stuck, pos, False)
+    w.fresh = np.insert(w.fresh, pos, True)
+    w.span_error = np.insert(w.span_error, pos, np.nan)
 
 
 def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
@@ -426,6 +493,15 @@ def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
     return inside, after, frac
 
 
+def _stalled(history: list[float], target: float) -> bool:
+    """True when a curve still fails and its largest error has not halved over the last
+    ``_STALL_ROUNDS`` rounds (near-tangential surfaces, where the samples themselves are
+    only as good as the refinement's convergence): it is given up, measured as it is."""
+    if len(history) <= _STALL_ROUNDS or history[-1] <= target:
+        return False
+    return history[-1] > 0.5 * history[-1 - _STALL_ROUNDS]
+
+
 def _pieces(error: NDArray, target: float) -> NDArray:
     """Into how many pieces a failing span is cut: ``sqrt(error / target)`` (the error of
     a C2 cubic across a kink in the second derivative, where a surface's parametrization
@@ -438,18 +514,31 @@ def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
            tangent_sin: float) -> None:
     """One verification round over all unfinished curves (module docstring, step 2)."""
     todo = [w for w in works if not w.done]
-    checks = _checks(todo)
+    checks = _checks(todo, tol)
+    for w, check in zip(todo, checks):
+        if check is None:
+            w.done, w.degenerate = True, True
+    todo = [w for w, check in zip(todo, checks) if check is not None]
+    checks = [check for check in checks if check is not None]
+    if not todo:
+        return
     errors = _check_errors(checks, surface_a, surface_b)
     jobs = []        # per curve: work, span start / stop (dense), parameters of the pieces
     curves = []      # per job: the stacked interpolant
     for w, check, error in zip(todo, checks, errors):
-        w.error = float(error.max()) if error.size else 0.0
+        error = _span_errors_now(w, check, error)
+        w.error = float(np.nanmax(error)) if error.size else 0.0
+        w.history.append(w.error)
+        if _stalled(w.history, target):         # near-tangential: splitting does not help
+            w.done = True
+            continue
         bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
         if bad.size == 0 and off.size == 0:
             w.done = True
             w.result = check
             continue
         w.kept[off] = True
+        w.fresh[off] = True
         t = check.t
         pieces = _pieces(error, target)
         fresh = []
@@ -461,6 +550,7 @@ def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
                 best = int(np.argmin(np.abs(frac - 0.5)))
                 if abs(frac[best] - 0.5) <= _MIDDLE:
                     w.kept[inside[best]] = True
+                    w.fresh[inside[best]] = True
                     continue
             fresh.append((j, n))
         if fresh:
@@ -521,10 +611,11 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
 
     Returns
     -------
-    list of SampledCurve
+    list of SampledCurve or None
         Each with a subset of its dense samples plus inserted ones, in curve
         order (the ends of open curves are kept), and, when it passed, its
-        interpolants and their largest check-point error.
+        interpolants and their largest check-point error; None for a curve whose
+        samples all collapse onto one point (within ``tol / 1000``).
     """
     target = share * tol
     plans = [_resample_targets(c, target) if simplify else None for c in curves]
@@ -559,6 +650,9 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
             break
     out = []
     for w in works:
+        if w.degenerate:
+            out.append(None)
+            continue
         curve = RefinedCurve(w.points[w.kept], w.uv_a[w.kept], w.uv_b[w.kept], w.closed,
                              w.converged[w.kept], w.singular[w.kept])
         if w.result is None:                       # rounds ran out: not verified as is

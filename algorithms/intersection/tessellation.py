@@ -69,6 +69,9 @@ _SAMPLES = 5                 # test grid per rectangle and direction (quarter po
 #: bicubic tessellations)
 _MARGIN = 0.8
 _MAX_LEAVES = 4_000_000
+#: per-region keep tests are used while they cost less than this many box tests per
+#: rectangle and keep box; a tree over all keep boxes otherwise
+_REGION_BUDGET = 16
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,6 +180,7 @@ class _RegionBoxes:
 
     boxes: NDArray
     start: NDArray
+    tree: BoxTree | None = None        # over all boxes, built when the regions are too big
 
 
 def _region_boxes(boxes: NDArray, owner: NDArray, n_regions: int) -> _RegionBoxes:
@@ -199,6 +203,11 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         return mask
     lo, hi = keep.start[region], keep.start[region + 1]
     counts = hi - lo
+    if counts.sum() > _REGION_BUDGET * (rects.shape[0] + keep.boxes.shape[0]):
+        # few large regions (a face of one or two Bezier patches): a tree is cheaper
+        if keep.tree is None:
+            object.__setattr__(keep, "tree", build_tree(keep.boxes))
+        return _near(surface, rects, region, keep.tree, pad)
     rect = np.repeat(np.arange(rects.shape[0]), counts)
     other = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(rect.size)
     k = keep.boxes[other]
