@@ -59,7 +59,7 @@ DEFAULT_RELATIVE_TOL = 1e-4
 #: Smallest and largest ``tol`` accepted, as fractions of the diagonal.
 MIN_RELATIVE_TOL, MAX_RELATIVE_TOL = 1e-9, 0.1
 #: Share of ``tol`` for the boundary fits and for the error along grid lines.
-BOUNDARY_SHARE = 0.5
+BOUNDARY_SHARE = 0.8
 #: Turn of the cross derivative (radians) across a knot line that makes it a crease.
 CREASE_ANGLE = 1e-4
 #: Fewest interpolation points per direction (a cubic not-a-knot spline).
