@@ -34,10 +34,12 @@ import time
 
 import numpy as np
 from intersect import bumpy, cylinder, flat, plane, sphere, torus
-
 from surfprep.algorithms import NurbsSurface
-from surfprep.algorithms.intersection import (connected_branches, intersect_surfaces,
-                                              polyline_distance)
+from surfprep.algorithms.intersection import (
+    connected_branches,
+    intersect_surfaces,
+    polyline_distance,
+)
 from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.geom import surface_to_occ
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
@@ -216,8 +218,8 @@ def scaling_rows(sizes, full: bool, repeat: int, tol: float = 1e-7) -> list[dict
 
 # ------------------------------------------------------------------ tables
 def exact_table(rows) -> str:
-    lines = ["| case | tol | ours s | OCC s | ours/OCC | branches ours / OCC / exact | samples "
-             "| max dev ours | max dev OCC | coverage gap ours | coverage gap OCC |",
+    lines = [("| case | tol | ours s | OCC s | ours/OCC | branches ours / OCC / exact | samples "
+             "| max dev ours | max dev OCC | coverage gap ours | coverage gap OCC |"),
              "|" + "---|" * 11]
     for r in rows:
         lines.append(f"| {r['case']} | {r['tol']:.0e} | {r['t_ours']:.3f} | {r['t_occ']:.3f} | "
@@ -233,8 +235,8 @@ def exact_table(rows) -> str:
 
 
 def scaling_table(rows) -> str:
-    lines = ["| poles | cut by | ours s | OCC s | ours/OCC | branches ours / OCC | samples | "
-             "curve length |", "|" + "---|" * 8]
+    lines = [("| poles | cut by | ours s | OCC s | ours/OCC | branches ours / OCC | samples | "
+             "curve length |"), "|" + "---|" * 8]
     for r in rows:
         ratio = r["t_ours"] / r["t_occ"] if np.isfinite(r["t_occ"]) else float("nan")
         occ = f"{r['t_occ']:.3f}" if np.isfinite(r["t_occ"]) else "skipped"

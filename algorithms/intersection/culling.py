@@ -26,13 +26,26 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
-from ..bezier import bezier_patches, patch_bounding_boxes
+from ..bezier import patch_bounding_boxes
 from ..surface import NurbsSurface
 
-__all__ = ["BoxTree", "build_tree", "tree_pairs", "candidate_pairs", "PatchOverlap",
-           "overlap_boxes", "overlap_patches", "surface_patch_boxes", "patch_rectangles",
-           "subpatch_boxes", "span_patches", "span_hull_boxes", "grid_tree", "surface_tree",
-           "exact_patch_boxes"]
+__all__ = [
+    "BoxTree",
+    "PatchOverlap",
+    "build_tree",
+    "candidate_pairs",
+    "exact_patch_boxes",
+    "grid_tree",
+    "overlap_boxes",
+    "overlap_patches",
+    "patch_rectangles",
+    "span_hull_boxes",
+    "span_patches",
+    "subpatch_boxes",
+    "surface_patch_boxes",
+    "surface_tree",
+    "tree_pairs",
+]
 
 
 @dataclass(frozen=True, eq=False)

@@ -48,11 +48,11 @@ from .refine import RefinedCurve, RefinedPoints, refine_points
 
 __all__ = [
     "CHECK_FRACTIONS",
-    "SampledCurve",
-    "interpolate_stacked",
     "CUBIC_SHARE",
+    "SampledCurve",
     "cubic_samples",
     "interpolate_samples",
+    "interpolate_stacked",
     "sample_parameters",
     "span_errors",
 ]

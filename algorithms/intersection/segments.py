@@ -31,8 +31,16 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..surface import NurbsSurface
-from .culling import (BoxTree, PatchOverlap, build_tree, candidate_pairs,
-                      exact_patch_boxes, patch_rectangles, surface_tree, tree_pairs)
+from .culling import (
+    BoxTree,
+    PatchOverlap,
+    build_tree,
+    candidate_pairs,
+    exact_patch_boxes,
+    patch_rectangles,
+    surface_tree,
+    tree_pairs,
+)
 from .mesh import TriangleMesh
 from .tessellation import tessellate
 from .triangles import TriangleHits, intersect_triangles

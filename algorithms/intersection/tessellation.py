@@ -60,7 +60,7 @@ from ..surface import NurbsSurface
 from .culling import BoxTree, build_tree, patch_rectangles, subpatch_boxes, tree_pairs
 from .mesh import TriangleMesh, collinear_mask
 
-__all__ = ["Tessellation", "tessellate", "patch_rectangles"]
+__all__ = ["Tessellation", "patch_rectangles", "tessellate"]
 
 _SAMPLES = 5                 # test grid per rectangle and direction (quarter points)
 #: leaves are split until their estimated error is below _MARGIN * tol: the margin
