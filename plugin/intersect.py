@@ -57,9 +57,7 @@ plots).
 
 from __future__ import annotations
 
-import enum
 import time
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -70,26 +68,26 @@ from OCP.Geom import Geom_Surface
 from OCP.TopoDS import TopoDS_Face
 
 from ..algorithms import NurbsSurface
-from ..algorithms.characteristic import (
-    CharacteristicRecord,
-    CoincidentRegion,
-    FoundBy,
-    certify,
-    characteristic_analysis,
-    characteristic_intersection,
-)
+from ..algorithms.characteristic import CharacteristicRecord
 from ..algorithms.intersection import (
     EndKind,
     IntersectionCurve,
-    StrayCurves,
     closed_in_space,
-    intersect_surfaces,
     polyline_distance,
 )
 from ..errors import InvalidGeometryError, InvalidToleranceError, OpenCascadeError
 from .convert import to_nurbs
 from .edges import make_edge
 from .faces import TrimmedFace, make_face, needs_nurbs_convert, trimmed_face_to_occ
+from .intersect_methods import (
+    CoincidentFaces,
+    ContactPoint,
+    FoundBy,
+    IntersectionResult,
+    Method,
+    PairRecord,
+    pair_curves,
+)
 from .io import CadModel
 
 __all__ = [
@@ -550,84 +548,6 @@ class FaceIntersection:
         return [make_edge(c.curve3d, pcurves, tol)]
 
 
-class Method(str, enum.Enum):
-    """How :func:`intersect` finds the curves of a face pair."""
-
-    MESH = "mesh"
-    CHARACTERISTIC = "characteristic"
-    AUTO = "auto"
-
-
-@dataclass(frozen=True, eq=False)
-class ContactPoint:
-    """A tangential contact of two faces: an isolated point of their intersection.
-
-    Attributes
-    ----------
-    point : (3,) float
-    uv_a, uv_b : (2,) float
-        Parameters on each face's surface.
-    face_a, face_b : FaceOperand
-    """
-
-    point: NDArray
-    uv_a: NDArray
-    uv_b: NDArray
-    face_a: FaceOperand
-    face_b: FaceOperand
-
-    @property
-    def faces(self) -> tuple[int, int]:
-        return self.face_a.index, self.face_b.index
-
-
-@dataclass(frozen=True, eq=False)
-class CoincidentFaces:
-    """Two faces whose surfaces coincide within ``tol`` over ``region`` (no curves there)."""
-
-    face_a: FaceOperand
-    face_b: FaceOperand
-    region: CoincidentRegion
-
-    @property
-    def faces(self) -> tuple[int, int]:
-        return self.face_a.index, self.face_b.index
-
-
-@dataclass(frozen=True, eq=False)
-class PairRecord:
-    """The characteristic record of one face pair (None with ``method="mesh"``), and
-    the untrimmed curves before clipping."""
-
-    face_a: FaceOperand
-    face_b: FaceOperand
-    record: CharacteristicRecord | None
-    curves: tuple[IntersectionCurve, ...]
-    time_s: float
-
-
-class IntersectionResult(list):
-    """The curves of :func:`intersect` (a ``list`` of :class:`FaceIntersection`) and more.
-
-    Attributes
-    ----------
-    isolated_points : list of ContactPoint
-        Tangential contact points inside both faces.
-    coincident : list of CoincidentFaces
-    records : list of PairRecord
-        One per face pair whose boxes overlap.
-    method : Method
-    """
-
-    def __init__(self, curves=(), *, isolated_points=(), coincident=(), records=(),
-                 method: Method = Method.AUTO) -> None:
-        super().__init__(curves)
-        self.isolated_points = list(isolated_points)
-        self.coincident = list(coincident)
-        self.records = list(records)
-        self.method = Method(method)
-
-
 # ------------------------------------------------------------------ driver
 def _boxes(faces: Sequence[FaceOperand]) -> NDArray:
     return np.stack([np.asarray(f.surface.bounding_box(), dtype=float) for f in faces]) \
@@ -658,45 +578,6 @@ def _along_a_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand
     return False
 
 
-def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None
-                 ) -> list[IntersectionCurve]:
-    try:
-        return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                  stray=StrayCurves.DROP)
-    except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
-            FloatingPointError) as exc:
-        warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
-                      stacklevel=3)
-        return []
-
-
-def _pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                 method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
-                                          CharacteristicRecord | None]:
-    """Untrimmed curves of one face pair by ``method``, how each was found, the record."""
-    if method is Method.MESH:
-        curves = _mesh_curves(fa, fb, tol, mesh_tol)
-        return curves, [FoundBy.MESH] * len(curves), None
-    a, b = fa.surface, fb.surface
-    try:
-        if method is Method.CHARACTERISTIC:
-            record = characteristic_intersection(a, b, tol=tol)
-        else:
-            analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False,
-                                               borders=False)
-            whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
-            mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol)
-            record = certify(a, b, mesh, tol=tol, analysis=analysis)
-    except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
-        warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
-                      stacklevel=3)
-        if method is Method.CHARACTERISTIC:
-            return [], [], None
-        curves = _mesh_curves(fa, fb, tol, mesh_tol)
-        return curves, [FoundBy.MESH] * len(curves), None
-    return list(record.curves), list(record.found_by), record
-
-
 def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOperand,
               tol: float, within: bool) -> list[ContactPoint]:
     """The record's isolated points inside both faces (not on a shared edge within a shape)."""
@@ -713,10 +594,6 @@ def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOper
                 continue
         out.append(ContactPoint(p.point, p.uv_a, p.uv_b, fa, fb))
     return out
-
-
-#: a coincident region with this share of the grid: the triangle method is not run
-FULL_COINCIDENCE = 0.95
 
 
 def intersect(a: Any, b: Any = None, *, tol: float | None = None,
@@ -790,7 +667,7 @@ def intersect(a: Any, b: Any = None, *, tol: float | None = None,
     for done, (i, j) in enumerate(pairs, start=1):
         fa, fb = faces_a[i], faces_b[j]
         start = time.perf_counter()
-        curves, found_by, record = _pair_curves(fa, fb, tol, mesh_tol, method)
+        curves, found_by, record = pair_curves(fa, fb, tol, mesh_tol, method)
         for curve, how in zip(curves, found_by):
             for piece in clip_curve(curve, fa, fb, tol):
                 if b is None and _along_a_boundary(piece, fa, fb, tol):
