@@ -24,18 +24,25 @@ import time
 from pathlib import Path
 
 import numpy as np
-from OCP.Geom import (Geom_CylindricalSurface, Geom_Plane, Geom_SphericalSurface,
-                      Geom_ToroidalSurface)
+from OCP.Geom import (
+    Geom_CylindricalSurface,
+    Geom_Plane,
+    Geom_SphericalSurface,
+    Geom_ToroidalSurface,
+)
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
-
-import surfprep
 from surfprep.algorithms import NurbsSurface
-from surfprep.algorithms.intersection import (connected_branches, curve_set_distance,
-                                              intersect_surfaces)
+from surfprep.algorithms.intersection import (
+    connected_branches,
+    curve_set_distance,
+    intersect_surfaces,
+)
 from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.geom import surface_from_occ
 from surfprep.plugin.intersect import intersect
 from surfprep.plugin.occ_reference import intersect_surfaces_occ, section_faces_occ
+
+import surfprep
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"
