@@ -11,6 +11,7 @@ public too, module by module:
 * :mod:`.segments`: :func:`mesh_segments`, steps 1-4 to a :class:`SegmentSoup`;
 * :mod:`.topology`: Point / PointUse / Segment topology, traced chains;
 * :mod:`.refine`: auxiliary-plane refinement (eqs. 29.18-29.26);
+* :mod:`.sampling`: the samples the cubic interpolants need (:func:`cubic_samples`);
 * :mod:`.result`: :class:`IntersectionCurve` and its interpolants;
 * :mod:`.compare`: distances between two answers (Hausdorff, per-branch).
 """
@@ -26,6 +27,7 @@ from .pipeline import (StrayCurves, StrayCurveWarning, closed_in_space, default_
 from .refine import (RefinedCurve, RefinedPoints, project_points, refine_curves, refine_points,
                      segment_distance)
 from .result import CurveDeviation, IntersectionCurve, interpolate_samples, intersection_curves
+from .sampling import SampledCurve, cubic_samples
 from .segments import SegmentSoup, SoupStats, mesh_segments
 from .tessellation import Tessellation, tessellate
 from .topology import Chain, EndKind, SegmentTopology, build_topology, topology_from_soup
@@ -34,6 +36,7 @@ from .triangles import TriangleHits, intersect_triangles
 __all__ = [
     "intersect_surfaces", "StrayCurves", "StrayCurveWarning", "closed_in_space", "default_mesh_tolerance", "operand_size",
     "IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
+    "cubic_samples", "SampledCurve",
     "EndKind", "Chain", "SegmentTopology", "build_topology", "topology_from_soup",
     "RefinedPoints", "RefinedCurve", "refine_points", "refine_curves", "project_points",
     "segment_distance",
