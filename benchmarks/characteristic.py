@@ -140,7 +140,7 @@ def table(rows) -> str:
         auto = f"{r['auto']} ({r['auto_added']})" + \
             (f" + {r['auto_contacts']} pt" if r["auto_contacts"] else "")
         stage = (f"{100 * r['t_char_stage'] / r['t_curve_stage']:.0f} %"
-                 if r["t_curve_stage"] > 1e-3 else "- (no curve)")
+                 if r["char"] not in (0, "0") and r["t_curve_stage"] > 0 else "- (no curve)")
         lines.append(
             f"| {r['case']} | {truth} | {r['mesh']} | {char} | {auto} | {r['occ']} | {stage} "
             f"| {r['t_mesh']:.3f} | {r['t_auto']:.3f} ({r['t_auto'] / max(r['t_mesh'], 1e-9):.1f}x) "

@@ -58,8 +58,7 @@ from .points import (
 )
 from .projection import ProjectionStatus, Projector
 from .trace import (
-    dense_polyline,
-    polyline_gap,
+    curve_gap,
     to_intersection_curve,
     trace_intersections,
 )
@@ -621,23 +620,22 @@ def _points_3d(field: DistanceField, uv: NDArray) -> NDArray:
     return field.r.evaluate(uv[:, 0], uv[:, 1])
 
 
-def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
-                     known_closed: list[bool], tol: float, size: float
-                     ) -> list[IntersectionCurve]:
-    """Trace the starts that lie on none of the ``known`` polylines (3D), in rounds."""
+def _trace_uncovered(field: DistanceField, starts: Start, known: list[IntersectionCurve],
+                     tol: float, size: float) -> list[IntersectionCurve]:
+    """Trace the starts that lie on none of the ``known`` curves (3D), in rounds."""
     settled, ok = _settle(field, starts)
     uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
     pts = _points_3d(field, uv)
     # a curve within tol of both surfaces may sit tol / sin(angle) off the exact point
     # along the surfaces where they meet at a small angle
     cover = 10 * tol / np.maximum(_sine(field, uv, st), 1e-6) + 1e-9 * size
-    polylines, closed = list(known), list(known_closed)
+    curves = list(known)
     out: list[IntersectionCurve] = []
     todo = np.arange(uv.shape[0])
     for _ in range(MAX_TRACE_ROUNDS):
         if todo.size == 0:
             break
-        gap = polyline_gap(pts[todo], polylines, closed)
+        gap = curve_gap(pts[todo], curves)
         todo = todo[gap > cover[todo]]
         if todo.size == 0:
             break
@@ -654,8 +652,7 @@ def _trace_uncovered(field: DistanceField, starts: Start, known: list[NDArray],
                 continue
             kept_traces.append(t)
             out.append(curve)
-            polylines.append(dense_polyline(curve, 64))
-            closed.append(curve.closed)
+            curves.append(curve)
         todo = np.setdiff1d(todo, batch)
     return out
 
@@ -754,8 +751,7 @@ def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], to
         loop = starts.group >= 0
         starts = Start(starts.uv[loop], starts.st[loop], starts.scale[loop], starts.group[loop])
     if not analysis.coincident:
-        added = _trace_uncovered(fld, starts, [dense_polyline(c, 64) for c in kept],
-                                 [c.closed for c in kept], tol, size)
+        added = _trace_uncovered(fld, starts, kept, tol, size)
         added = [c for c in added if c.max_deviation(a, b).max <= tol]
     curves = tuple(kept) + tuple(added)
     found = (FoundBy.MESH,) * len(kept) + (FoundBy.CHARACTERISTIC,) * len(added)

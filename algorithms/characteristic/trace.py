@@ -105,6 +105,51 @@ def dense_polyline(curve: IntersectionCurve, per_span: int = 32) -> NDArray:
     return curve.curve3d.evaluate(dense)
 
 
+def curve_gap(points: NDArray, curves: list[IntersectionCurve], per_span: int = 64,
+              k: int = 3) -> NDArray:
+    """Distance ``(n,)`` from each of ``points (n, 3)`` to the nearest of ``curves``,
+    measured on their 3D interpolants: the spans next to the ``k`` nearest samples
+    (a k-d tree over all samples) are evaluated at ``per_span`` points each."""
+    if not curves or points.shape[0] == 0:
+        return np.full(points.shape[0], np.inf)
+    from scipy.spatial import cKDTree
+    owner = np.concatenate([np.full(c.points.shape[0], i) for i, c in enumerate(curves)])
+    local = np.concatenate([np.arange(c.points.shape[0]) for c in curves])
+    k = min(k, owner.size)
+    _, idx = cKDTree(np.concatenate([c.points for c in curves])).query(points, k=k)
+    idx = idx.reshape(points.shape[0], k)
+    best = np.full(points.shape[0], np.inf)
+    s = np.linspace(0.0, 1.0, per_span + 1)
+    for i, curve in enumerate(curves):
+        rows, cols = np.nonzero(owner[idx] == i)
+        if rows.size == 0:
+            continue
+        n = curve.points.shape[0]
+        spans = curve.parameters.size - 1
+        sample = local[idx[rows, cols]]
+        span = np.concatenate([sample - 1, sample])               # both spans at the sample
+        who = np.concatenate([rows, rows])
+        if curve.closed:
+            span %= spans
+        keep = (span >= 0) & (span < spans)
+        span, who = span[keep], who[keep]
+        if curve.curve3d is None:
+            nxt = (span + 1) % n
+            chain = curve.points[span][:, None] + s[None, :, None] * (
+                curve.points[nxt] - curve.points[span])[:, None]
+        else:
+            t = curve.parameters
+            tt = t[span][:, None] + s[None, :] * (t[span + 1] - t[span])[:, None]
+            chain = curve.curve3d.evaluate(tt.ravel()).reshape(tt.shape + (3,))
+        a, d = chain[:, :-1], np.diff(chain, axis=1)
+        x = points[who][:, None]
+        dd = np.einsum("mjc,mjc->mj", d, d)
+        w = np.clip(np.einsum("mjc,mjc->mj", x - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        gap = np.linalg.norm(a + w[..., None] * d - x, axis=-1).min(axis=1)
+        np.minimum.at(best, who, gap)
+    return best
+
+
 def polyline_gap(points: NDArray, polylines: list[NDArray], closed: list[bool],
                  k: int = 8) -> NDArray:
     """Distance ``(n,)`` from each of ``points (n, d)`` to the nearest segment of the
