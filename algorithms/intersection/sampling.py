@@ -84,6 +84,9 @@ _STALL_ROUNDS = 3
 _DUPLICATE = 1e-3
 #: spans within this many of a new sample are checked again (0.27^8 = 3e-5)
 _LOCALITY = 8
+#: a new sample is taken when its two images are this close (times tol), even if the
+#: refinement stopped short of tol / 16 (low-angle cuts near 1e-10 converge slowly)
+_ACCEPT = 0.25
 
 
 # ------------------------------------------------------------------ interpolants
@@ -298,7 +301,7 @@ class _Work:
     done: bool = False
     error: float = float("inf")    # largest check-point error in the last round
     result: object = None          # the passing _Check (interpolants) once done
-    history: list = field(default_factory=list)     # error of every round
+    history: list = field(default_factory=list)     # (error, failing spans) per round
     degenerate: bool = False       # all samples on one point (left out of the result)
     fresh: NDArray | None = None   # (m,) bool: kept since the last check
     span_error: NDArray | None = None   # (m,) float: last checked error of the span from here
@@ -493,13 +496,16 @@ def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
     return inside, after, frac
 
 
-def _stalled(history: list[float], target: float) -> bool:
-    """True when a curve still fails and its largest error has not halved over the last
-    ``_STALL_ROUNDS`` rounds (near-tangential surfaces, where the samples themselves are
-    only as good as the refinement's convergence): it is given up, measured as it is."""
-    if len(history) <= _STALL_ROUNDS or history[-1] <= target:
+def _stalled(history: list[tuple[float, int]], target: float) -> bool:
+    """True when a curve still fails and over the last ``_STALL_ROUNDS`` rounds neither
+    its largest error has halved nor its number of failing spans gone down
+    (near-tangential surfaces, where the samples themselves are only as good as the
+    refinement's convergence): it is given up and measured as it is. ``history``
+    holds ``(largest error, failing spans)`` of every round."""
+    if len(history) <= _STALL_ROUNDS or history[-1][0] <= target:
         return False
-    return history[-1] > 0.5 * history[-1 - _STALL_ROUNDS]
+    (error, failing), (before, failing_before) = history[-1], history[-1 - _STALL_ROUNDS]
+    return error > 0.5 * before and failing >= failing_before
 
 
 def _pieces(error: NDArray, target: float) -> NDArray:
@@ -528,11 +534,13 @@ def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
     for w, check, error in zip(todo, checks, errors):
         error = _span_errors_now(w, check, error)
         w.error = float(np.nanmax(error)) if error.size else 0.0
-        w.history.append(w.error)
+        bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
+        w.history.append((w.error, bad.size + off.size))
         if _stalled(w.history, target):         # near-tangential: splitting does not help
             w.done = True
+            if w.error <= tol:                  # within the contract all the same
+                w.result = check
             continue
-        bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
         if bad.size == 0 and off.size == 0:
             w.done = True
             w.result = check
@@ -570,7 +578,7 @@ def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
         sl = slice(offset, offset + start.size)
         offset += start.size
         inside, after, frac = _place(w, start, stop, new.points[sl])
-        ok = new.converged[sl] & inside
+        ok = (new.gap[sl] <= _ACCEPT * tol) & inside   # refined to tol / 16, or nearly
         # two pieces of one span that slid onto each other: the first only
         order = np.lexsort((frac, start))
         same = np.zeros(start.size, dtype=bool)
