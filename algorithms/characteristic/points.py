@@ -249,7 +249,7 @@ def _edge_count(surface: NurbsSurface) -> int:
     return max(EDGE_SAMPLES, 4 * spans + 1)
 
 
-def edge_roots(field: DistanceField, component: int, iterations: int = 12, noise: float = 0.0
+def edge_roots(field: DistanceField, component: int, iterations: int = 6, noise: float = 0.0
                ) -> tuple[NDArray, NDArray, NDArray]:
     """Roots of ``phi_u`` (``component`` 0) or ``phi_v`` (1) on the sides of ``r``'s domain.
 
