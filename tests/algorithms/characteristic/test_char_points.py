@@ -123,3 +123,25 @@ def test_intersection_loop_closes_and_step_cap_is_a_cap(bumps_field):
     (capped,) = trace_curves(bumps_field, CurveKind.INTERSECTION, uv0, ray.st[k:k + 1],
                              np.array([[0.0, 1.0]]), h0=1e-3, h_max=0.03, max_steps=5)
     assert capped.end_reason is EndReason.STEP_LIMIT and capped.uv.shape[0] == 6
+
+
+def test_saddle_on_the_intersection_is_a_double_point():
+    """z = g(x) - g(y) against z = 0: the diagonals x = y and x = 1 - y cross at the
+    centre, a saddle of phi with phi = 0 (eq. 8, det H < 0); both lines are traced
+    from side to side, exactly."""
+    from char_surfaces import clamped, height_field
+    from surfprep.algorithms.basis import greville_abscissae
+    from surfprep.algorithms.characteristic import characteristic_intersection
+    x = greville_abscissae(clamped(6, 3), 3)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    a = height_field(0.3 * (X - 0.5) ** 2 - 0.3 * (Y - 0.5) ** 2)
+    b = horizontal_plane(0.0)
+    rec = characteristic_intersection(a, b, tol=1e-9)
+    (double,) = rec.of_kind(PointKind.DOUBLE_POINT)
+    np.testing.assert_allclose(double.uv_a, [0.5, 0.5], atol=1e-9)
+    assert len(rec.curves) == 2 and not any(c.closed for c in rec.curves)
+    for c in rec.curves:
+        p = c.curve3d.evaluate(np.linspace(0, c.parameters[-1], 101))
+        np.testing.assert_allclose(p[:, 2], 0.0, atol=1e-9)
+        np.testing.assert_allclose(np.abs(p[:, 0] - 0.5), np.abs(p[:, 1] - 0.5), atol=1e-9)
+        assert c.parameters[-1] == pytest.approx(np.sqrt(2), rel=1e-9)
