@@ -21,6 +21,8 @@ __all__ = [
     "plot_curves",
 ]
 
+#: values of --method (plugin.intersect_methods.Method; not imported to build the parser)
+METHODS = ("auto", "mesh", "characteristic")
 #: samples per OpenCascade section edge (chord sag about 3e-7 of a unit circle)
 OCC_SAMPLES = 4001
 
@@ -230,18 +232,15 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG",
-                        help="draw the curves in 3D and in the parameter domains")
+                        help="draw the curves in 3D and in the parameter domains, and for "
+                             "up to 4 face pairs the characteristic curves and points by "
+                             "kind in both domains (paper 002, Fig. 3)")
     parser.add_argument("--compare-occ", action="store_true",
                         help="also run OpenCascade's BRepAlgoAPI_Section and report both")
-    parser.add_argument("--method", choices=[m.value for m in _methods()], default="auto",
+    parser.add_argument("--method", choices=METHODS, default="auto",
                         help="auto (default): triangles, then characteristic points as a "
                              "certificate (missed loops traced and added); mesh: triangles "
                              "only; characteristic: the characteristic-curve method only")
-
-
-def _methods():
-    from ..intersect import Method
-    return list(Method)
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
