@@ -8,6 +8,7 @@ distance function, characteristic points and characteristic curves
 * :mod:`.curves`: u-/v-characteristic curves and intersection curves traced as
   ODEs with a corrector (eqs. 15-21, 33);
 * :mod:`.trace`: intersection curves from start points, refined to ``tol``;
+* :mod:`.starts`: starts on loops (rays from extrema) and their check against known curves;
 * :mod:`.algorithm`: the algorithm of §6.3 (:func:`characteristic_intersection`)
   and the certificate for the triangle method (:func:`certify`);
 * :mod:`.evaluator`: fast power-basis evaluation for the tracers.
