@@ -134,7 +134,7 @@ def classify_critical(phi: NDArray, hess: NDArray, tol: float) -> list[PointKind
 
 # ------------------------------------------------------------------ critical points
 def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = None, *,
-                    max_iter: int = 30, dedupe: float = 1e-7) -> DistanceJet | None:
+                    max_iter: int = 16, dedupe: float = 1e-7) -> DistanceJet | None:
     """Newton on ``grad phi = 0`` (eq. 9) from ``seeds (k, 2)``, batched.
 
     Steps are limited to a tenth of the domain diagonal; a seed whose iterate
