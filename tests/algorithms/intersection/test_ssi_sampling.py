@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_ssi_refine import R_SPHERE, plane_z, sphere_patch, sphere_plane_start
-
 from surfprep.algorithms.intersection.refine import RefinedCurve, refine_curves
 from surfprep.algorithms.intersection.result import checked_curves
-from surfprep.algorithms.intersection.sampling import (cubic_samples, interpolate_samples,
-                                                       interpolate_stacked, sample_parameters)
+from surfprep.algorithms.intersection.sampling import (
+    cubic_samples,
+    interpolate_samples,
+    interpolate_stacked,
+    sample_parameters,
+)
 from surfprep.algorithms.intersection.topology import EndKind
+from test_ssi_refine import R_SPHERE, plane_z, sphere_patch, sphere_plane_start
 
 
 def dense_arc(c: float, n: int, tol: float):
