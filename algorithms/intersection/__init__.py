@@ -11,6 +11,7 @@ public too, module by module:
 * :mod:`.segments`: :func:`mesh_segments`, steps 1-4 to a :class:`SegmentSoup`;
 * :mod:`.topology`: Point / PointUse / Segment topology, traced chains;
 * :mod:`.refine`: auxiliary-plane refinement (eqs. 29.18-29.26);
+* :mod:`.interpolants`: the cubic interpolants of samples and their deviation;
 * :mod:`.sampling`: the samples the cubic interpolants need (:func:`cubic_samples`);
 * :mod:`.result`: :class:`IntersectionCurve` and its interpolants;
 * :mod:`.compare`: distances between two answers (Hausdorff, per-branch).

@@ -28,14 +28,14 @@ from ..curve import NurbsCurve
 from ..measure import arc_length
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .refine import RefinedCurve, project_points, refine_curves
-from .sampling import (
-    cubic_samples,
+from .interpolants import (
     interpolate_samples,
     interpolate_stacked,
     sample_parameters,
     span_errors,
 )
+from .refine import RefinedCurve, project_points, refine_curves
+from .sampling import cubic_samples
 from .topology import Chain, EndKind, SegmentTopology
 
 __all__ = ["IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
