@@ -222,11 +222,15 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
     held_a = np.zeros(n, dtype=bool)        # the last step was clamped on A's / B's boundary
     held_b = np.zeros(n, dtype=bool)
     active = np.arange(n)
+    # images and normals at every point's final parameters: each point leaves the loop
+    # right after an evaluation at its current (u, v), so none is evaluated again
+    img_a, img_b, nrm_a, nrm_b = (np.zeros((n, 3)) for _ in range(4))
     for _ in range(max_iter + 1):
         if active.size == 0:
             break
         p, su, sv, n_p = _frame(surface_a, ua[active])
         q, rw, rt, n_q = _frame(surface_b, ub[active])
+        img_a[active], img_b[active], nrm_a[active], nrm_b[active] = p, q, n_p, n_q
         done = np.linalg.norm(p - q, axis=1) <= tol
         keep = ~done & (iterations[active] < max_iter)
         active, p, q, su, sv, rw, rt, n_p, n_q = (
@@ -253,8 +257,10 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
         held_b[active] = np.any(ub[active] != step_b, axis=1)
         singular[active] = near
         iterations[active] += 1
-    pa, _, _, n_a = _frame(surface_a, ua)
-    pb, _, _, n_b = _frame(surface_b, ub)
+    if active.size:                         # the loop ran out with points still moving
+        img_a[active], _, _, nrm_a[active] = _frame(surface_a, ua[active])
+        img_b[active], _, _, nrm_b[active] = _frame(surface_b, ub[active])
+    pa, pb, n_a, n_b = img_a, img_b, nrm_a, nrm_b
     gap = np.linalg.norm(pa - pb, axis=1)
     converged = gap <= tol
     singular = (singular & ~converged) | (np.linalg.norm(np.cross(n_a, n_b), axis=1) < tangent_sin)
