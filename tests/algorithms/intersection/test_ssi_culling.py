@@ -177,8 +177,11 @@ def random_bspline(rng, n_u: int, n_v: int, rational: bool) -> NurbsSurface:
 
 @pytest.mark.parametrize("seed, rational", [(0, False), (1, True), (2, True)])
 def test_span_hulls_exact_boxes_and_grid_tree(seed, rational):
-    from surfprep.algorithms.intersection.culling import (exact_patch_boxes, grid_tree,
-                                                          span_hull_boxes)
+    from surfprep.algorithms.intersection.culling import (
+        exact_patch_boxes,
+        grid_tree,
+        span_hull_boxes,
+    )
     s = random_bspline(np.random.default_rng(seed), 9, 7, rational)
     exact, _ = surface_patch_boxes(s)                        # whole Bezier decomposition
     np.testing.assert_allclose(exact_patch_boxes(s, np.arange(exact.shape[0])), exact,
