@@ -264,9 +264,9 @@ def _approximate(jobs: list[_Job], sources, tol, gap_tol, skipped: list[str]
     for job in jobs:
         try:
             la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol)
-        except SurfprepError as exc:
-            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant ({exc}); "
-                           "left as it was")
+        except (SurfprepError, np.linalg.LinAlgError) as exc:
+            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
+                           f"({type(exc).__name__}: {exc}); left as it was")
             continue
         if job.origin.kind == "face" and not la.converged:
             skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
