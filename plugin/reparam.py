@@ -302,8 +302,8 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
 
     The shape is copied, the chosen faces are rebuilt on their new surfaces
     with the copy's edges (so shells stay connected) and substituted
-    (``BRepTools_ReShape``). A face that fails keeps its old surface and its
-    entry carries the error.
+    (``BRepTools_ReShape``). A face that fails, or whose chord-length mismatch
+    would get worse, keeps its old surface and its entry carries the reason.
 
     Parameters
     ----------
@@ -345,6 +345,12 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
         start = time.perf_counter()
         try:
             done = reparametrize_face(copied[k], tol=tol, copy=False, **options)
+            r = done.result
+            if r.mismatch_after > r.mismatch_before:
+                raise InvalidGeometryError(
+                    f"the new surface is within tol but not better parametrized (mismatch "
+                    f"{r.mismatch_before:.3g} -> {r.mismatch_after:.3g}; the relocation did "
+                    f"not settle: {r.relocation_sweeps} sweeps); the face is kept")
             reshape.Replace(copied[k], done.face)
             entries.append(ModelFace(k, model.face_names[k], done, None,
                                      time.perf_counter() - start))

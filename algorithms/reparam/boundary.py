@@ -88,8 +88,9 @@ class ArcLengthTable:
         if self.length <= 0.0:
             lo, hi = self.t[0], self.t[-1]
             return lo + f * (hi - lo)
-        arc, keep = np.unique(self.arc, return_index=True)
-        t = PchipInterpolator(arc / self.length, self.t[keep])(f)
+        x = self.arc / self.length
+        keep = np.concatenate([[True], np.diff(x) > 1e-13])
+        t = PchipInterpolator(x[keep], self.t[keep])(f)
         t[f <= 0.0], t[f >= 1.0] = self.t[0], self.t[-1]
         return np.clip(t, self.t[0], self.t[-1])
 
@@ -140,6 +141,7 @@ def arc_length_table(curve: NurbsCurve, collapsed: float = 0.0) -> ArcLengthTabl
     arc, keep = np.unique(s0, return_index=True)
     t_uniform = np.interp(s_uniform, arc, t0[keep])
     t0 = np.unique(np.concatenate([t0, t_uniform]))
+    t0 = t0[np.concatenate([np.diff(t0) > 1e-12 * (t0[-1] - t0[0]), [True]])]
     s0 = cumulative_arc_length(curve, t0, tol=ARC_TOL)
     kappa = _menger_curvature(curve.evaluate(t_uniform))
     return ArcLengthTable(curve, t0, s0, np.interp(s0, s_uniform, kappa))

@@ -210,7 +210,8 @@ def _spread(moved: NDArray) -> NDArray:
 
 
 def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions_v: NDArray,
-             *, max_sweeps: int = 2000, penalty_tol: float = PENALTY_TOL) -> RelocationResult:
+             *, max_sweeps: int = 2000, penalty_tol: float = PENALTY_TOL,
+             fixed: NDArray | None = None) -> RelocationResult:
     """Move the interior nodes until no node with a penalty above ``penalty_tol`` moves.
 
     Parameters
@@ -223,12 +224,17 @@ def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions
         The reconciled parameters of the nodes (any scale).
     max_sweeps : int
     penalty_tol : float
+    fixed : (n_u, n_v) bool, optional
+        Nodes that never move besides the boundary (crease lines).
 
     Returns
     -------
     RelocationResult
+        When the sweeps ran out with a worse largest penalty than at the
+        start, the start grid (``converged`` False).
     """
-    uv = np.array(uv, dtype=float)
+    uv0 = np.array(uv, dtype=float)
+    uv = uv0.copy()
     points = surface.evaluate(uv[..., 0], uv[..., 1])
     targets = (_targets(fractions_u), _targets(fractions_v))
     size = float(np.ptp(points.reshape(-1, points.shape[-1]), axis=0).max(initial=0.0))
@@ -239,7 +245,8 @@ def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions
     colour = (np.add.outer(np.arange(inner[0]), np.arange(inner[1])) % 2).astype(bool)
     pen = penalties(points, fractions_u, fractions_v, floor)
     before = float(pen.max())
-    candidates = np.ones(inner, bool)
+    movable = np.ones(inner, bool) if fixed is None else ~np.asarray(fixed)[1:-1, 1:-1]
+    candidates = movable.copy()
     sweeps, converged = 0, False
     while sweeps < max_sweeps:
         sweeps += 1
@@ -258,6 +265,10 @@ def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions
         if not np.any(moved):
             converged = True
             break
-        candidates = _spread(moved)
+        candidates = _spread(moved) & movable
     after = float(penalties(points, fractions_u, fractions_v, floor).max())
+    if not converged and after > before:         # wandered off: keep the start
+        start = np.array(uv0)
+        return RelocationResult(start, surface.evaluate(start[..., 0], start[..., 1]), sweeps,
+                                False, before, before)
     return RelocationResult(uv, points, sweeps, converged, before, after)

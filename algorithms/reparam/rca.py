@@ -17,7 +17,16 @@ parameters follow arc length (eqs. 29.1/29.2):
 4. the C2 cubic (not-a-knot) interpolant of the grid is measured densely
    (:mod:`.deviation`, eq. 29.3); where it is off by more than ``tol`` the
    intervals get their midpoints as new knots (a grid line of new points) and
-   steps 3-4 repeat, up to ``max_iterations`` times.
+   steps 3-4 repeat, up to ``max_iterations`` times (or until the deviation
+   grows to twice the best so far: then the relocation does not settle and
+   more points do not help).
+
+Creases (knot lines of multiplicity >= degree across which the surface turns,
+:func:`crease_knots`) become fixed grid lines: the lines along the other
+direction are split there into pieces parametrized each by its own arc
+length, the crease curves join the boundaries in the reconciliation, their
+nodes do not move in the relocation, and the interpolant has a triple knot
+(C0) there.
 
 A collapsed boundary (a pole: its length is below ``tol / 10``) takes the
 fractions of the opposite one and gives a collapsed boundary of ``r`` again;
@@ -27,6 +36,7 @@ curve gives the fractions.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -41,7 +51,7 @@ from ..knots import Direction
 from ..parametrization import parametrization_quality
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .boundary import ArcLengthTable, arc_length_table, boundary_fractions
+from .boundary import arc_length_table, boundary_fractions
 from .deviation import deviation_map, original_on_new
 from .interior import PENALTY_TOL, initial_guess, relocate
 from .reconcile import insert_midpoints, reconcile_fractions
@@ -62,6 +72,8 @@ MIN_RELATIVE_TOL, MAX_RELATIVE_TOL = 1e-9, 0.1
 BOUNDARY_SHARE = 0.8
 #: Turn of the cross derivative (radians) across a knot line that makes it a crease.
 CREASE_ANGLE = 1e-4
+#: Stop refining when the deviation grows beyond this factor of the best so far.
+DIVERGING = 2.0
 #: Fewest interpolation points per direction (a cubic not-a-knot spline).
 MIN_POINTS = 4
 
@@ -132,61 +144,194 @@ def _size(surface: NurbsSurface) -> float:
 
 @dataclass(frozen=True)
 class _Direction:
-    """The two boundaries of one direction: tables (None if collapsed) and fractions."""
+    """The lines running along one direction and the creases that split them.
 
-    first: ArcLengthTable | None
-    second: ArcLengthTable | None
+    ``held`` are the values of the other parameter on which the lines lie: the
+    two boundaries, then the creases of the other direction. ``tables[k]`` is
+    line k's arc-length table (None when collapsed: it takes a live line's
+    parameters). ``breaks`` are this direction's own crease parameters; the
+    common coordinate ``F`` in [0, 1] runs through the pieces between them in
+    proportion to their mean length, and each line maps ``F`` piecewise
+    linearly to its own arc-length fraction (identity without creases).
+    """
+
+    held: NDArray
+    tables: tuple
+    breaks: NDArray
+    f_breaks: NDArray
+    arc_breaks: tuple
     length: float
 
-    def parameters(self, fractions: NDArray) -> tuple[NDArray, NDArray]:
-        a = self.first.parameters_at(fractions) if self.first is not None else None
-        b = self.second.parameters_at(fractions) if self.second is not None else None
-        return (a if a is not None else b), (b if b is not None else a)
+    def parameters(self, fractions: NDArray) -> list[NDArray]:
+        """Original parameters along every line at the common fractions ``(n,)``."""
+        out = []
+        for table, arcs in zip(self.tables, self.arc_breaks):
+            out.append(None if table is None else
+                       table.parameters_at(np.interp(fractions, self.f_breaks, arcs)))
+        live = next(p for p in out if p is not None)
+        out = [live if p is None else p for p in out]
+        for k, c in enumerate(self.breaks, start=1):      # crease nodes exactly on the crease
+            at = np.isclose(fractions, self.f_breaks[k], rtol=0.0, atol=1e-14)
+            for p in out:
+                p[at] = c
+        return out
+
+    def to_common(self, line: int, arc_fractions: NDArray) -> NDArray:
+        return np.interp(arc_fractions, self.arc_breaks[line], self.f_breaks)
 
 
-def _boundaries(surface: NurbsSurface, along: Direction, tol: float
-                ) -> tuple[_Direction, NDArray]:
-    """Tables and reconciled fractions of the two boundaries running along ``along``."""
-    held = Direction.V if along is Direction.U else Direction.U
+def _direction(surface: NurbsSurface, along: Direction, breaks: NDArray, other_breaks: NDArray,
+               tol: float) -> tuple[_Direction, NDArray]:
+    """Lines along ``along`` (boundaries + the other direction's creases), their pieces
+    between ``breaks`` and the reconciled common fractions."""
+    held_dir = Direction.V if along is Direction.U else Direction.U
     u0, u1, v0, v1 = surface.domain
-    lo, hi = (v0, v1) if held is Direction.V else (u0, u1)
-    tables = [arc_length_table(isocurve(surface, value, held), 0.1 * tol) for value in (lo, hi)]
+    lo, hi = (v0, v1) if held_dir is Direction.V else (u0, u1)
+    held = np.concatenate([[lo, hi], other_breaks])
+    tables = [arc_length_table(isocurve(surface, value, held_dir), 0.1 * tol) for value in held]
     alive = [t if t.length > 0.1 * tol else None for t in tables]
     if all(t is None for t in alive):
-        middle = arc_length_table(isocurve(surface, 0.5 * (lo + hi), held), 0.1 * tol)
+        middle = arc_length_table(isocurve(surface, 0.5 * (lo + hi), held_dir), 0.1 * tol)
         if middle.length <= 0.1 * tol:
             raise DegenerateGeometryError(
                 f"the surface is collapsed along {along.name}: its boundaries and middle "
                 f"isoparametric curve are shorter than tol/10 = {0.1 * tol:.3g}")
-        sets = [boundary_fractions(middle, BOUNDARY_SHARE * tol)[0]]
-        # both boundaries are poles: they take the middle curve's parameters
-        pole = _Direction(middle, middle, middle.length)
-        return pole, _at_least(reconcile_fractions(*sets))
-    sets = [None if t is None else boundary_fractions(t, BOUNDARY_SHARE * tol)[0] for t in alive]
-    length = float(np.mean([t.length for t in alive if t is not None]))
-    return _Direction(alive[0], alive[1], length), _at_least(reconcile_fractions(*sets))
+        alive = [middle] * len(held)             # all lines are poles: the middle one leads
+    breaks = np.asarray(breaks, float)
+    while True:                          # creases closer than tol to another crease or an end go
+        arcs = [None if t is None else np.concatenate([[0.0], t.fractions_at(breaks), [1.0]])
+                for t in alive]
+        pieces = np.mean([np.diff(a) * t.length for a, t in zip(arcs, alive) if t is not None],
+                         axis=0)
+        short = np.nonzero(pieces <= tol)[0]
+        if not breaks.size or not short.size:
+            break
+        breaks = np.delete(breaks, min(short[0], breaks.size - 1))
+    f_breaks = np.concatenate([[0.0], np.cumsum(pieces) / np.sum(pieces)])
+    f_breaks[-1] = 1.0
+    lengths = [t.length for t in alive if t is not None]
+    line = _Direction(held, tuple(alive), breaks, f_breaks,
+                      tuple(a if a is not None else f_breaks for a in arcs),
+                      float(np.mean(lengths)))
+    sets = [None if t is None else line.to_common(k, _piecewise_fractions(t, breaks, arcs[k], tol))
+            for k, t in enumerate(alive)]
+    if len({id(t) for t in alive if t is not None}) == 1:
+        sets = [next(s for s in sets if s is not None)]
+    fractions = _pin(reconcile_fractions(*sets), f_breaks)
+    return line, _at_least(fractions, f_breaks)
 
 
-def _at_least(fractions: NDArray, count: int = MIN_POINTS) -> NDArray:
-    while len(fractions) < count:
-        widest = np.zeros(len(fractions) - 1, bool)
-        widest[np.argmax(np.diff(fractions))] = True
-        fractions = insert_midpoints(fractions, widest)
+def _piecewise_fractions(table, breaks: NDArray, arcs: NDArray, tol: float) -> NDArray:
+    """Boundary fractions (section 29.2.4) of a line, piece by piece between creases,
+    as arc-length fractions of the whole line (a C2 fit across a crease never converges)."""
+    if not len(breaks):
+        return boundary_fractions(table, BOUNDARY_SHARE * tol)[0]
+    ends = np.concatenate([[table.t[0]], breaks, [table.t[-1]]])
+    out = []
+    for k, (a, b) in enumerate(itertools.pairwise(ends)):
+        piece = arc_length_table(table.curve.restrict(a, b), 0.1 * tol)
+        local = (boundary_fractions(piece, BOUNDARY_SHARE * tol)[0] if piece.length > 0.1 * tol
+                 else np.array([0.0, 1.0]))
+        out.append(arcs[k] + local * (arcs[k + 1] - arcs[k]))
+    return np.unique(np.concatenate(out))
+
+
+def _pin(fractions: NDArray, f_breaks: NDArray) -> NDArray:
+    """``fractions`` with every crease fraction present exactly (a nearby value moves there)."""
+    out = fractions.copy()
+    for f in f_breaks[1:-1]:
+        k = int(np.argmin(np.abs(out - f)))
+        step = np.min(np.diff(out)) if len(out) > 1 else 1.0
+        if abs(out[k] - f) <= 0.25 * step and 0 < k < len(out) - 1:
+            out[k] = f
+        else:
+            out = np.sort(np.append(out, f))
+    return out
+
+
+def _at_least(fractions: NDArray, f_breaks: NDArray, count: int = MIN_POINTS) -> NDArray:
+    """At least ``count`` points in every piece between crease fractions."""
+    for a, b in itertools.pairwise(f_breaks):
+        while True:
+            inside = (fractions >= a - 1e-15) & (fractions <= b + 1e-15)
+            if inside.sum() >= count:
+                break
+            idx = np.nonzero(inside)[0]
+            if idx.size < 2:
+                break
+            widths = np.diff(fractions[idx])
+            k = idx[int(np.argmax(widths))]
+            fractions = np.sort(np.append(fractions, 0.5 * (fractions[k] + fractions[k + 1])))
     return fractions
 
 
+def _line_indices(fractions: NDArray, f_breaks: NDArray) -> NDArray:
+    """Grid indices of the nodes on crease lines (interior f_breaks)."""
+    return np.array([int(np.argmin(np.abs(fractions - f))) for f in f_breaks[1:-1]], dtype=int)
+
+
+def _coons_blocks(uv: NDArray, fu: NDArray, fv: NDArray, iu: NDArray, jv: NDArray) -> NDArray:
+    """Interior nodes of each block between fixed lines by bilinear Coons blending."""
+    rows = np.concatenate([[0], iu, [len(fu) - 1]])
+    cols = np.concatenate([[0], jv, [len(fv) - 1]])
+    for i0, i1 in itertools.pairwise(rows):
+        for j0, j1 in itertools.pairwise(cols):
+            if i1 - i0 < 2 or j1 - j0 < 2:
+                continue
+            s = ((fu[i0 + 1:i1] - fu[i0]) / (fu[i1] - fu[i0]))[:, None, None]
+            t = ((fv[j0 + 1:j1] - fv[j0]) / (fv[j1] - fv[j0]))[None, :, None]
+            a, b = uv[i0, j0 + 1:j1][None], uv[i1, j0 + 1:j1][None]
+            c, d = uv[i0 + 1:i1, j0][:, None], uv[i0 + 1:i1, j1][:, None]
+            corners = ((1 - s) * (1 - t) * uv[i0, j0] + s * (1 - t) * uv[i1, j0]
+                       + (1 - s) * t * uv[i0, j1] + s * t * uv[i1, j1])
+            uv[i0 + 1:i1, j0 + 1:j1] = (1 - s) * a + s * b + (1 - t) * c + t * d - corners
+    return uv
+
+
 def _start_grid(surface: NurbsSurface, du: _Direction, dv: _Direction, fu: NDArray,
-                fv: NDArray, previous: tuple[NDArray, NDArray, NDArray] | None) -> NDArray:
-    """Initial guess (straight lines), or the previous grid interpolated at the new fractions."""
-    bottom, top = du.parameters(fu)
-    left, right = dv.parameters(fv)
-    uv = initial_guess(bottom, top, left, right, surface.domain)
+                fv: NDArray, previous: tuple[NDArray, NDArray, NDArray] | None
+                ) -> tuple[NDArray, NDArray]:
+    """Initial guess and the mask of fixed nodes (boundaries and crease lines).
+
+    Without creases the interior comes from straight lines joining opposite
+    boundary nodes (:func:`initial_guess`); with creases from Coons blending
+    inside each block between crease lines; on refinement from the previous
+    grid interpolated at the new fractions.
+    """
+    u_lines, v_lines = du.parameters(fu), dv.parameters(fv)
+    uv = initial_guess(u_lines[0], u_lines[1], v_lines[0], v_lines[1], surface.domain)
+    iu, jv = _line_indices(fu, du.f_breaks), _line_indices(fv, dv.f_breaks)
+    for k, j in enumerate(jv):                   # v = crease lines (run along u)
+        uv[:, j] = np.stack([u_lines[2 + k], np.full(len(fu), dv.breaks[k])], -1)
+    for k, i in enumerate(iu):                   # u = crease lines (run along v)
+        uv[i, :] = np.stack([np.full(len(fv), du.breaks[k]), v_lines[2 + k]], -1)
+    for k, i in enumerate(iu):
+        uv[i, jv] = np.stack([np.full(len(jv), du.breaks[k]), dv.breaks], -1)
+    fixed = np.zeros(uv.shape[:2], bool)
+    fixed[[0, -1], :] = fixed[:, [0, -1]] = True
+    fixed[iu, :] = fixed[:, jv] = True
     if previous is not None:
         old_fu, old_fv, old_uv = previous
         lookup = RegularGridInterpolator((old_fu, old_fv), old_uv)
         mesh = np.stack(np.meshgrid(fu, fv, indexing="ij"), axis=-1)
-        uv[1:-1, 1:-1] = lookup(mesh[1:-1, 1:-1].reshape(-1, 2)).reshape(mesh[1:-1, 1:-1].shape)
-    return uv
+        free = ~fixed
+        uv[free] = lookup(mesh[free])
+    elif iu.size or jv.size:
+        uv = _coons_blocks(uv, fu, fv, iu, jv)
+    return uv, fixed
+
+
+def _joined_knots(params: NDArray, joints: NDArray) -> NDArray:
+    """Not-a-knot cubic knots per piece, joined with multiplicity 3 (C0) at ``joints``."""
+    cuts = np.concatenate([[0], joints, [len(params) - 1]])
+    parts = [knots_from_breakpoints(params[a:b + 1], 3) for a, b in itertools.pairwise(cuts)]
+    out = [parts[0][:-4]]
+    for k, part in enumerate(parts[1:]):
+        out.append(np.full(3, params[joints[k]]))
+        out.append(part[4:-4] if k < len(parts) - 2 else part[4:])
+    if len(parts) == 1:
+        return parts[0]
+    return np.concatenate(out)
 
 
 def _refinement(dev, reverse, params_u: NDArray, params_v: NDArray, tol: float
@@ -242,8 +387,7 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
     Raises
     ------
     InvalidGeometryError
-        Not a 3D NurbsSurface, or it has creases (:func:`crease_knots`),
-        which a C2 surface cannot follow.
+        Not a 3D NurbsSurface.
     DegenerateGeometryError
         The surface is a point, or collapsed along a whole direction.
     InvalidToleranceError
@@ -256,30 +400,35 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         raise DegenerateGeometryError("the surface is a single point")
     tol = default_tolerance(surface) if tol is None else tol
     tol = check_tolerance(tol, "tol", low=MIN_RELATIVE_TOL * size, high=MAX_RELATIVE_TOL * size)
-    _refuse_creases(surface)
     if per_span < 10:
         raise InvalidGeometryError(f"per_span must be >= 10, got {per_span}")
-    du, fu = _boundaries(surface, Direction.U, tol)
-    dv, fv = _boundaries(surface, Direction.V, tol)
-    previous, sweeps, inserted = None, 0, 0
+    creases_u, creases_v = crease_knots(surface)
+    du, fu = _direction(surface, Direction.U, creases_u, creases_v, tol)
+    dv, fv = _direction(surface, Direction.V, creases_v, du.breaks, tol)
+    if dv.breaks.size != creases_v.size:         # a v crease was dropped as too short
+        du, fu = _direction(surface, Direction.U, du.breaks, dv.breaks, tol)
+    previous, sweeps, inserted, best = None, 0, 0, np.inf
     for iteration in range(1, max_iterations + 1):
-        uv = _start_grid(surface, du, dv, fu, fv, previous)
+        uv, fixed = _start_grid(surface, du, dv, fu, fv, previous)
         if relocation:
-            moved = relocate(surface, uv, fu, fv, max_sweeps=max_sweeps, penalty_tol=PENALTY_TOL)
+            moved = relocate(surface, uv, fu, fv, max_sweeps=max_sweeps, penalty_tol=PENALTY_TOL,
+                             fixed=fixed)
             uv, points, settled = moved.uv, moved.points, moved.converged
             sweeps += moved.sweeps
         else:
             points, settled = surface.evaluate(uv[..., 0], uv[..., 1]), True
         pu, pv = fu * du.length, fv * dv.length
-        new = interpolate_surface(points, params_u=pu, params_v=pv,
-                                  knots_u=knots_from_breakpoints(pu, 3),
-                                  knots_v=knots_from_breakpoints(pv, 3))
+        new = interpolate_surface(
+            points, params_u=pu, params_v=pv,
+            knots_u=_joined_knots(pu, _line_indices(fu, du.f_breaks)),
+            knots_v=_joined_knots(pv, _line_indices(fv, dv.f_breaks)))
         dev = deviation_map(surface, new, pu, pv, uv, per_span)
         reverse = original_on_new(surface, new, pu, pv, uv, per_span)
         worst = max(dev.max, float(reverse[0].max()))
         done = worst <= tol
-        if done or iteration == max_iterations:
+        if done or iteration == max_iterations or worst > DIVERGING * best:
             break
+        best = min(best, worst)
         bad_u, bad_v = _refinement(dev, reverse, pu, pv, tol)
         if len(fu) + bad_u.sum() > max_points or len(fv) + bad_v.sum() > max_points:
             break
@@ -323,15 +472,6 @@ def crease_knots(surface: NurbsSurface, angle: float = CREASE_ANGLE) -> tuple[ND
                 found.append(value)
         out.append(np.array(found))
     return out[0], out[1]
-
-
-def _refuse_creases(surface: NurbsSurface) -> None:
-    cu, cv = crease_knots(surface)
-    if cu.size or cv.size:
-        raise InvalidGeometryError(
-            f"the surface has creases (tangent-discontinuous knot lines u = "
-            f"{[round(float(x), 9) for x in cu]}, v = {[round(float(x), 9) for x in cv]}): a C2 "
-            "reparametrization cannot follow them; split the surface there first")
 
 
 def _mismatch(surface: NurbsSurface) -> float:

@@ -165,3 +165,38 @@ def test_bad_input():
     cp[1, 1, 2] = np.nan
     with pytest.raises(InvalidGeometryError, match="NaN"):
         NurbsSurface(cp, [0] * 4 + [1] * 4, [0] * 4 + [1] * 4, 3, 3)
+
+
+def _roof() -> NurbsSurface:
+    """Degree 1 x 3 roof: two planar slopes meeting in a crease at the knot u = 0.2
+    (equal slope lengths: the u parameter runs 4x faster on the second slope),
+    v distorted as v^3."""
+    t = np.linspace(0.0, 1.0, 8)
+    x = np.array([0.0, 1.0, 2.0])
+    z = np.array([0.0, 0.6, 0.0])
+    cp = np.zeros((3, 8, 3))
+    column = interpolate_surface(np.stack([np.zeros((4, 8)), 1.5 * (np.linspace(0, 1, 4)[:, None]
+                                                                   * 0 + t[None, :] ** 3),
+                                           np.zeros((4, 8))], -1), params_u=np.linspace(0, 1, 4),
+                                 params_v=t)
+    vy = column.control_points[0, :, 1]                       # y control values of v^3
+    cp[:, :, 0], cp[:, :, 1], cp[:, :, 2] = x[:, None], vy[None, :], z[:, None]
+    return NurbsSurface(cp, [0, 0, 0.2, 1, 1], column.knots_v, 1, 3)
+
+
+def test_crease_becomes_a_fixed_c0_line():
+    from surfprep.algorithms.reparam.rca import crease_knots
+    original = _roof()
+    assert list(crease_knots(original)[0]) == [0.2]
+    result = reparametrize_surface(original)
+    assert result.within_tolerance
+    assert dense_deviation(original, result) <= result.tol
+    assert excess(result.mismatch_after) * 10 <= excess(result.mismatch_before)
+    # the crease is a triple knot of the new surface, halfway (equal slope lengths)
+    ku = result.surface.knots_u
+    values, counts = np.unique(ku[4:-4], return_counts=True)
+    (crease,) = values[counts == 3]
+    u0, u1 = result.surface.domain[:2]
+    assert (crease - u0) / (u1 - u0) == pytest.approx(0.5, abs=1e-6)
+    ridge = result.surface.evaluate(np.full(5, crease), np.linspace(*result.surface.domain[2:], 5))
+    assert np.allclose(ridge[:, [0, 2]], [1.0, 0.6], atol=result.tol)
