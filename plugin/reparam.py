@@ -252,7 +252,7 @@ def reparametrize_face(face: TopoDS_Face, *, tol: float | None = None, copy: boo
     ConversionError
         Not a B-spline face, or a face with a location.
     InvalidGeometryError
-        The tolerance was not reached within the limits; creases.
+        The tolerance was not reached within the limits.
     OpenCascadeError
         The new face is not valid.
     """
@@ -390,7 +390,7 @@ def reparametrize(face_or_surface: Any, *, tol: float | None = None, **options) 
     ------
     InvalidGeometryError
         The tolerance could not be reached (the message gives the deviation
-        reached), or the surface has creases.
+        reached).
     DegenerateGeometryError, InvalidToleranceError, ConversionError, OpenCascadeError
     """
     if isinstance(face_or_surface, NurbsSurface):

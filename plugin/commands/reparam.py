@@ -161,9 +161,10 @@ COMMAND = Command(
         "points per knot span, closest-point projection). The faces keep their edges, "
         "with new pcurves, so shells stay connected. Per face the report gives the "
         "chord-length mismatch (eqs. 29.1/29.2, 1 = perfect) before and after, the "
-        "max deviation, the pole counts and the areas. A face that cannot be done "
-        "(creases, tolerance not reached) keeps its surface and is reported as "
-        "skipped; the exit code is then 1."),
+        "max deviation, the pole counts and the areas. Creases (knot lines where the "
+        "surface turns) stay creases (C0 knot lines of the new surface). A face that "
+        "cannot be done (not a B-spline, tolerance not reached, mismatch would get "
+        "worse) keeps its surface and is reported as skipped; the exit code is then 1."),
     epilog=(
         "examples:\n"
         "  surfprep reparam fuselage.stp -o fuselage_rca.stp\n"
