@@ -8,10 +8,10 @@ import sys
 import pytest
 from OCP.BRep import BRep_Tool
 from OCP.BRepCheck import BRepCheck_Analyzer
-from surfprep.plugin.cli import main
-from surfprep.plugin.geom import surface_from_occ
 
 import surfprep
+from surfprep.plugin.cli import main
+from surfprep.plugin.geom import surface_from_occ
 
 
 @pytest.fixture(scope="module")

@@ -17,16 +17,16 @@ from OCP.gp import gp_Ax2d, gp_Dir2d, gp_Pnt2d
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS, TopoDS_Face
+
+import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.reparam.deviation import subdivide
+from surfprep.errors import ConversionError, InvalidGeometryError
 from surfprep.plugin.edges import edge_to_nurbs
 from surfprep.plugin.faces import TrimmedFace
 from surfprep.plugin.geom import surface_from_occ, surface_to_occ
 from surfprep.plugin.reparam import face_area, reparametrize_face
-
-import surfprep
-from surfprep.errors import ConversionError, InvalidGeometryError
 
 
 def _u_cubed_sheet() -> surfprep.NurbsSurface:
@@ -146,19 +146,23 @@ def test_non_bspline_face_is_refused():
 
 @pytest.mark.slow
 def test_real_files_sweep(data_dir):
-    """Every face of the fuselage (4 of them with creases: knot lines where the surface
-    turns by 3-5 degrees, which become C0 grid lines): within tol, mismatch not worse,
-    shape valid. (occt_catia4_face_L1.igs: done too, 2893 -> 1.18, but takes 80 s.)"""
+    """Every face of the fuselage: the four smooth ones done within tol with the mismatch
+    excess 10x smaller; the four with creases (knot lines where the surface turns by
+    3-5 degrees, which become C0 grid lines) done within tol with a mismatch not worse,
+    or kept with the reason (the relocation does not settle on the tapering tail);
+    shape valid. (occt_catia4_face_L1.igs: done, 2893 -> 1.18, but takes 80 s.)"""
     from surfprep.plugin.reparam import reparametrize_model
     for name in ("occt_fuselage.stp",):
         model = surfprep.read(data_dir / name)
         shape, entries = reparametrize_model(model, max_iterations=6)
         assert BRepCheck_Analyzer(shape).IsValid()
         done = [e for e in entries if e.done is not None]
-        assert len(done) == 8
+        assert {e.index for e in done} >= {0, 1, 2, 3}
         for e in done:
             r = e.done.result
             assert r.max_deviation <= r.tol
             assert r.mismatch_after <= r.mismatch_before
+            if e.index < 4:
+                assert r.mismatch_after - 1 <= 0.1 * (r.mismatch_before - 1)
         for e in entries:
             assert e.done is not None or e.error

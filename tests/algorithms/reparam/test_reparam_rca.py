@@ -14,12 +14,12 @@ import math
 
 import numpy as np
 import pytest
+
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.reparam import reparametrize_surface
 from surfprep.algorithms.reparam.deviation import subdivide
 from surfprep.algorithms.surface import NurbsSurface
-
 from surfprep.errors import (
     DegenerateGeometryError,
     InvalidGeometryError,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from surfprep.algorithms.curve import NurbsCurve
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import distance_to_curve
