@@ -38,8 +38,18 @@ from .refine import RefinedCurve, project_points, refine_curves
 from .sampling import cubic_samples
 from .topology import Chain, EndKind, SegmentTopology
 
-__all__ = ["IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
-           "refine_chains", "sampled_curves", "checked_curves"]
+__all__ = [
+    "CurveDeviation",
+    "IntersectionCurve",
+    "checked_curves",
+    "interpolate_samples",
+    "intersection_curves",
+    "refine_chains",
+    "sampled_curves",
+]
+
+#: relative accuracy of :attr:`IntersectionCurve.length` (far below any tol / length)
+LENGTH_REL_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -145,13 +155,15 @@ class IntersectionCurve:
     def length(self) -> float:
         """Length of the curve: of ``curve3d`` (:func:`measure.arc_length`), or of the
         polyline of the samples (closing chord included) without interpolants.
+        The interpolant's length is integrated to ``LENGTH_REL_TOL`` relative to
+        itself (bounded work and memory whatever the curve's size).
 
         The samples are only as dense as the cubic interpolants need, so their
         polyline is shorter than the curve by about ``kappa^2 h^2 / 24`` relative.
         """
         if self.curve3d is None:
             return float(self.parameters[-1])
-        return arc_length(self.curve3d, tol=1e-12)
+        return arc_length(self.curve3d, tol=LENGTH_REL_TOL)
 
     def span_parameters(self, samples_per_span: int = 3) -> NDArray:
         """``(spans, samples_per_span) float``: interior parameters of every span,

@@ -5,12 +5,25 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_ssi_refine import (R_SPHERE, cylinder_x, cylinder_z, invert_1d, paraboloid,
-                             paraboloid_uv, plane_uv, plane_z, sphere_patch, sphere_uv)
+from test_ssi_refine import (
+    R_SPHERE,
+    cylinder_x,
+    cylinder_z,
+    invert_1d,
+    paraboloid,
+    paraboloid_uv,
+    plane_uv,
+    plane_z,
+    sphere_patch,
+    sphere_uv,
+)
 
 from surfprep.algorithms.intersection.refine import refine_points
-from surfprep.algorithms.intersection.result import (IntersectionCurve, intersection_curves,
-                                                     interpolate_samples)
+from surfprep.algorithms.intersection.result import (
+    IntersectionCurve,
+    interpolate_samples,
+    intersection_curves,
+)
 from surfprep.algorithms.intersection.topology import EndKind, build_topology
 from surfprep.errors import InvalidGeometryError
 
@@ -40,7 +53,7 @@ def sphere_plane_samples(c, n, rng, noise=1e-3):
 
 def exact_samples(c, n):
     """Refined samples (to 1e-13) of the latitude circle z = c on the sphere patch."""
-    pts, uv_a, uv_b = sphere_plane_samples(c, n, np.random.default_rng(0), noise=0)
+    _pts, uv_a, uv_b = sphere_plane_samples(c, n, np.random.default_rng(0), noise=0)
     r = refine_points(plane_z(c), sphere_patch(), uv_a, uv_b, tol=1e-13)
     assert r.converged.all()
     return r
@@ -231,3 +244,29 @@ def test_pipeline_needs_uv_for_refinement():
         intersection_curves(topo, plane_z(0), sphere_patch())
     with pytest.raises(InvalidGeometryError, match="exact side"):
         intersection_curves(topo, None, sphere_patch())
+
+
+def test_length_bounded_where_rounding_stalls_the_quadrature():
+    """A unit-radius arc far from the origin (coordinates 1e8): rounding in the
+    derivative (relative 1e-8) keeps the adaptive quadrature's estimates from ever
+    agreeing to a relative 1e-12, and the bisection used to double its pending
+    intervals every pass (about 1 GB asked for here). Now bounded: the length is
+    right to the rounding level, fast and in little memory."""
+    import tracemalloc
+
+    from surfprep.algorithms.fitting import interpolate_curve
+    from surfprep.algorithms.measure import arc_length
+
+    t = np.linspace(0, 1, 200)
+    far = 1e8 + np.stack([np.cos(3 * t), np.sin(3 * t), np.zeros_like(t)], axis=1)
+    curve = interpolate_curve(far, degree=3)
+    tracemalloc.start()
+    try:
+        length = arc_length(curve, tol=1e-12)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert length == pytest.approx(3.0, rel=1e-6)
+    assert peak < 200e6, peak
+    c = IntersectionCurve.from_samples(far, None, None, False, EndKind.OPEN, EndKind.OPEN)
+    assert c.length == pytest.approx(3.0, rel=1e-6)
