@@ -19,13 +19,13 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InvalidGeometryError
 
 __all__ = [
-    "validate_knots",
-    "find_span",
-    "basis_functions",
     "basis_derivatives",
+    "basis_functions",
     "collocation_matrix",
-    "greville_abscissae",
     "distinct_knots",
+    "find_span",
+    "greville_abscissae",
+    "validate_knots",
 ]
 
 
@@ -155,15 +155,16 @@ def _basis_triangle(knots: NDArray, p: int, t: NDArray, span: NDArray) -> NDArra
     right = knots[span[None, :] + j] - t[None, :]             # (p, m): right[j-1] = t_{span+j} - t
     ndu = np.empty((p + 1, p + 1, t.size))
     ndu[0, 0] = 1.0
-    for jj in range(1, p + 1):
-        saved = np.zeros(t.size)
-        for r in range(jj):
-            ndu[jj, r] = right[r] + left[jj - r - 1]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                temp = np.where(ndu[jj, r] != 0.0, ndu[r, jj - 1] / ndu[jj, r], 0.0)
-            ndu[r, jj] = saved + right[r] * temp
-            saved = left[jj - r - 1] * temp
-        ndu[jj, jj] = saved
+    with np.errstate(divide="ignore", invalid="ignore"):     # entered once, not per term
+        for jj in range(1, p + 1):                           # the r loop of A2.2 at once
+            r = np.arange(jj)
+            ndu[jj, :jj] = right[:jj] + left[jj - 1 - r]
+            den = ndu[jj, :jj]
+            temp = np.where(den != 0.0, ndu[:jj, jj - 1] / den, 0.0)   # (jj, m)
+            saved = left[jj - 1 - r] * temp                  # saved after step r
+            ndu[0, jj] = right[0] * temp[0]
+            ndu[1:jj, jj] = saved[:-1] + right[1:jj] * temp[1:]
+            ndu[jj, jj] = saved[-1]
     return ndu
 
 

@@ -12,9 +12,10 @@ References
 
 from __future__ import annotations
 
+from math import comb
+
 import numpy as np
 from numpy.typing import NDArray
-from scipy.special import comb
 
 __all__ = ["curve_derivatives_from_homogeneous", "surface_derivatives_from_homogeneous"]
 
@@ -41,7 +42,7 @@ def curve_derivatives_from_homogeneous(a_ders: NDArray, w_ders: NDArray) -> NDAr
     for k in range(order + 1):
         v = a_ders[:, k, :].copy()
         for i in range(1, k + 1):
-            v -= comb(k, i, exact=True) * w_ders[:, i, None] * out[:, k - i, :]
+            v -= comb(k, i) * w_ders[:, i, None] * out[:, k - i, :]
         out[:, k, :] = v / w0
     return out
 
@@ -76,7 +77,7 @@ def surface_derivatives_from_homogeneous(a_ders: NDArray, w_ders: NDArray) -> ND
             for i in range(k + 1):
                 for j in range(l + 1):
                     if i or j:
-                        coef = comb(k, i, exact=True) * comb(l, j, exact=True)
+                        coef = comb(k, i) * comb(l, j)
                         v -= (coef * w[i, j]) * out[k - i, l - j]
             out[k, l] = v * inv_w
     return np.moveaxis(out, -1, 0)

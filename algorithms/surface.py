@@ -15,6 +15,7 @@ which evaluates each direction's basis once and contracts with BLAS.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,6 +98,11 @@ class NurbsSurface:
         w = np.ones(self.n_control) if self.weights is None else self.weights
         return np.concatenate([self.control_points * w[..., None], w[..., None]], axis=2)
 
+    @functools.cached_property
+    def _homogeneous_net(self) -> NDArray:
+        """:meth:`homogeneous_points`, computed once per surface (read-only)."""
+        return _frozen(self.homogeneous_points())
+
     @classmethod
     def from_homogeneous(cls, points_w: ArrayLike, knots_u: ArrayLike, knots_v: ArrayLike,
                          degree_u: int, degree_v: int, rational: bool = True) -> NurbsSurface:
@@ -143,10 +149,14 @@ class NurbsSurface:
         dv, _ = basis_derivatives(self.knots_v, q, v, order, sv)    # (m, o+1, q+1)
         iu = su[:, None] - p + np.arange(p + 1)
         iv = sv[:, None] - q + np.arange(q + 1)
-        net = self.homogeneous_points()
+        net = self._homogeneous_net
         flat = iu[:, :, None] * net.shape[1] + iv[:, None, :]             # (m, p+1, q+1)
         pw = np.take(net.reshape(-1, net.shape[2]), flat, axis=0)        # (m, p+1, q+1, d+1)
-        hom = np.einsum("mki,mlj,mijc->mklc", du, dv, pw, optimize=True)
+        # hom[m, k, l, c] = sum_ij du[m, k, i] dv[m, l, j] pw[m, i, j, c] as two batched
+        # matmuls (no einsum path search per call; same sums in the same order)
+        m, c = u.size, pw.shape[3]
+        tmp = np.matmul(du, pw.reshape(m, p + 1, (q + 1) * c)).reshape(m, -1, q + 1, c)
+        hom = np.matmul(dv[:, None], tmp)                                 # (m, o+1, o+1, d+1)
         out = self._project(hom)
         return out.reshape(shape + out.shape[1:])
 
@@ -184,7 +194,7 @@ class NurbsSurface:
         du, su = basis_derivatives(self.knots_u, p, u, order)      # (a, o+1, p+1)
         dv, sv = basis_derivatives(self.knots_v, q, v, order)      # (b, o+1, q+1)
         iu = su[:, None] - p + np.arange(p + 1)                    # (a, p+1)
-        pw = self.homogeneous_points()
+        pw = self._homogeneous_net
         # contract u first: (a, o+1, n_v, d+1)
         tmp = np.einsum("aki,aijc->akjc", du, pw[iu], optimize=True)
         iv = sv[:, None] - q + np.arange(q + 1)                    # (b, q+1)
