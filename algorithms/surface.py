@@ -155,7 +155,7 @@ class NurbsSurface:
         # hom[m, k, l, c] = sum_ij du[m, k, i] dv[m, l, j] pw[m, i, j, c] as two batched
         # matmuls (no einsum path search per call; same sums in the same order)
         m, c = u.size, pw.shape[3]
-        tmp = np.matmul(du, pw.reshape(m, p + 1, (q + 1) * c)).reshape(m, -1, q + 1, c)
+        tmp = np.matmul(du, pw.reshape(m, p + 1, (q + 1) * c)).reshape(m, du.shape[1], q + 1, c)
         hom = np.matmul(dv[:, None], tmp)                                 # (m, o+1, o+1, d+1)
         out = self._project(hom)
         return out.reshape(shape + out.shape[1:])

@@ -73,7 +73,6 @@ from ..algorithms.intersection import (
     EndKind,
     IntersectionCurve,
     closed_in_space,
-    polyline_distance,
 )
 from ..errors import InvalidGeometryError, InvalidToleranceError, OpenCascadeError
 from .convert import to_nurbs
@@ -189,6 +188,26 @@ class FaceOperand:
     def edge_tolerance(self) -> float:
         return max((e.tolerance for e in self.trimmed.edges), default=0.0)
 
+    def loop_index(self) -> _LoopIndex | None:
+        """The trimming loops prepared for :func:`inside_face` (cached; None: a rectangle)."""
+        if "loop_index" not in self._cache:
+            seg = self.boundary_segments()
+            u0, u1, v0, v1 = self.surface.domain
+            eps = ON_BOUNDARY * np.hypot(u1 - u0, v1 - v0)
+            rect = seg.shape[0] == 0 or _is_rectangle(seg, self.surface.domain, 1e3 * eps)
+            self._cache["loop_index"] = None if rect else _LoopIndex.build(seg)
+        return self._cache["loop_index"]
+
+    def edge_distance(self, points: NDArray) -> NDArray:
+        """Distance ``(n,)`` of ``points (n, 3)`` to the sampled trimming edges in space
+        (:meth:`boundary_polylines`; k-d tree built once per face)."""
+        if "edge_tree" not in self._cache:
+            lines = self.boundary_polylines()
+            self._cache["edge_tree"] = _SegmentTree.from_polylines(lines) if lines else None
+        tree = self._cache["edge_tree"]
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        return np.full(points.shape[0], np.inf) if tree is None else tree.distance(points)
+
 
 def _as_faces(x: Any) -> list[tuple[TrimmedFace, TopoDS_Face | None]]:
     if isinstance(x, NurbsSurface):
@@ -262,47 +281,91 @@ def _is_rectangle(seg: NDArray, domain, eps: float) -> bool:
     return bool(np.all(same_u | same_v) and pts.size)
 
 
-def _crossings(uv: NDArray, seg: NDArray, bins: int) -> NDArray:
-    """Crossings ``(n,) int`` of a ray in +u from each point with the segments, only
-    testing the segments whose v-range holds the point (bucketed by v)."""
-    a, b = seg[:, 0], seg[:, 1]
-    vlo, vhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
-    lo, hi = vlo.min(), vhi.max()
-    width = (hi - lo) / bins if hi > lo else 1.0
-    first = np.clip(((vlo - lo) / width).astype(np.int64), 0, bins - 1)
-    last = np.clip(((vhi - lo) / width).astype(np.int64), 0, bins - 1)
-    count = last - first + 1
-    seg_of = np.repeat(np.arange(seg.shape[0]), count)
-    bin_of = np.repeat(first, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count,
-                                                                           count))
-    order = np.argsort(bin_of, kind="stable")
-    seg_sorted = seg_of[order]
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(bin_of, minlength=bins))])
-    pbin = np.clip(((uv[:, 1] - lo) / width).astype(np.int64), 0, bins - 1)
-    inside_range = (uv[:, 1] >= lo) & (uv[:, 1] <= hi)
-    per_point = np.where(inside_range, indptr[pbin + 1] - indptr[pbin], 0)
-    point_of = np.repeat(np.arange(uv.shape[0]), per_point)
-    offs = np.arange(per_point.sum()) - np.repeat(np.cumsum(per_point) - per_point, per_point)
-    cand = seg_sorted[indptr[pbin[point_of]] + offs]
-    pa, pb, p = a[cand], b[cand], uv[point_of]
-    straddle = (pa[:, 1] > p[:, 1]) != (pb[:, 1] > p[:, 1])
-    dv = np.where(pb[:, 1] != pa[:, 1], pb[:, 1] - pa[:, 1], 1.0)
-    u_cross = pa[:, 0] + (p[:, 1] - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dv
-    hit = straddle & (u_cross > p[:, 0])
-    return np.bincount(point_of[hit], minlength=uv.shape[0])
+@dataclass(frozen=True, eq=False)
+class _SegmentTree:
+    """Segments ``start + s vec`` (``s`` in [0, 1]) with a k-d tree of their midpoints,
+    built once, for nearest-segment distances of many point batches."""
+
+    start: NDArray
+    vec: NDArray
+    tree: Any
+
+    @classmethod
+    def from_segments(cls, start: NDArray, vec: NDArray) -> _SegmentTree:
+        from scipy.spatial import cKDTree
+        return cls(start, vec, cKDTree(start + 0.5 * vec))
+
+    @classmethod
+    def from_polylines(cls, lines: Sequence[NDArray]) -> _SegmentTree:
+        lines = [np.vstack([q, q]) if q.shape[0] == 1 else q for q in lines]
+        return cls.from_segments(np.concatenate([q[:-1] for q in lines]),
+                                 np.concatenate([np.diff(q, axis=0) for q in lines]))
+
+    def distance(self, x: NDArray, k: int = 8) -> NDArray:
+        """Distance ``(n,)`` from each point ``x (n, dim)`` to the nearest of the ``k``
+        segments whose midpoints are nearest (the segments are short and even)."""
+        if x.shape[0] == 0:
+            return np.zeros(0)
+        k = min(k, self.start.shape[0])
+        _, idx = self.tree.query(x, k=k)
+        idx = idx.reshape(x.shape[0], k)
+        pa, pd = self.start[idx], self.vec[idx]
+        dd = np.einsum("nkc,nkc->nk", pd, pd)
+        t = np.clip(np.einsum("nkc,nkc->nk", x[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0),
+                    0, 1)
+        return np.linalg.norm(pa + t[..., None] * pd - x[:, None], axis=-1).min(axis=1)
 
 
-def _segment_distance_uv(uv: NDArray, seg: NDArray, k: int = 8) -> NDArray:
-    """Distance ``(n,)`` from each point to the nearest of the segments (k-d tree on midpoints)."""
-    from scipy.spatial import cKDTree
-    a, d = seg[:, 0], seg[:, 1] - seg[:, 0]
-    k = min(k, seg.shape[0])
-    _, idx = cKDTree(a + 0.5 * d).query(uv, k=k)
-    idx = idx.reshape(uv.shape[0], k)
-    pa, pd = a[idx], d[idx]
-    dd = np.einsum("nkc,nkc->nk", pd, pd)
-    t = np.clip(np.einsum("nkc,nkc->nk", uv[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0), 0, 1)
-    return np.linalg.norm(pa + t[..., None] * pd - uv[:, None], axis=-1).min(axis=1)
+@dataclass(frozen=True, eq=False)
+class _LoopIndex:
+    """A face's loop segments bucketed by v (for the even-odd ray test) and a
+    segment tree in ``(u, v)``, built once per face."""
+
+    a: NDArray                 # (m, 2) segment starts
+    b: NDArray                 # (m, 2) segment ends
+    lo: float                  # v of the first bucket
+    width: float               # bucket height
+    bins: int
+    seg_sorted: NDArray        # segment indices grouped by bucket
+    indptr: NDArray            # (bins + 1,) bucket starts in seg_sorted
+    hi: float
+    uv_tree: _SegmentTree
+
+    @classmethod
+    def build(cls, seg: NDArray) -> _LoopIndex:
+        a, b = seg[:, 0], seg[:, 1]
+        bins = int(max(1, min(4096, 2 * np.sqrt(seg.shape[0]))))
+        vlo, vhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+        lo, hi = float(vlo.min()), float(vhi.max())
+        width = (hi - lo) / bins if hi > lo else 1.0
+        first = np.clip(((vlo - lo) / width).astype(np.int64), 0, bins - 1)
+        last = np.clip(((vhi - lo) / width).astype(np.int64), 0, bins - 1)
+        count = last - first + 1
+        seg_of = np.repeat(np.arange(seg.shape[0]), count)
+        bin_of = np.repeat(first, count) + (np.arange(count.sum())
+                                            - np.repeat(np.cumsum(count) - count, count))
+        order = np.argsort(bin_of, kind="stable")
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(bin_of, minlength=bins))])
+        return cls(a, b, lo, width, bins, seg_of[order], indptr, hi,
+                   _SegmentTree.from_segments(a, b - a))
+
+    def crossings(self, uv: NDArray) -> NDArray:
+        """Crossings ``(n,) int`` of a ray in +u from each point with the segments,
+        testing only the segments of the point's v-bucket."""
+        a, b = self.a, self.b
+        pbin = np.clip(((uv[:, 1] - self.lo) / self.width).astype(np.int64), 0, self.bins - 1)
+        inside_range = (uv[:, 1] >= self.lo) & (uv[:, 1] <= self.hi)
+        per_point = np.where(inside_range, self.indptr[pbin + 1] - self.indptr[pbin], 0)
+        point_of = np.repeat(np.arange(uv.shape[0]), per_point)
+        offs = np.arange(per_point.sum()) - np.repeat(np.cumsum(per_point) - per_point,
+                                                      per_point)
+        cand = self.seg_sorted[self.indptr[pbin[point_of]] + offs]
+        pa, pb, p = a[cand], b[cand], uv[point_of]
+        straddle = (pa[:, 1] > p[:, 1]) != (pb[:, 1] > p[:, 1])
+        dv = np.where(pb[:, 1] != pa[:, 1], pb[:, 1] - pa[:, 1], 1.0)
+        u_cross = pa[:, 0] + (p[:, 1] - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dv
+        hit = straddle & (u_cross > p[:, 0])
+        return np.bincount(point_of[hit], minlength=uv.shape[0])
 
 
 def inside_face(operand: FaceOperand, uv: NDArray, tol: float = 0.0) -> NDArray:
@@ -321,22 +384,23 @@ def inside_face(operand: FaceOperand, uv: NDArray, tol: float = 0.0) -> NDArray:
     eps = ON_BOUNDARY * np.hypot(u1 - u0, v1 - v0)
     in_box = ((uv[:, 0] >= u0 - eps) & (uv[:, 0] <= u1 + eps) & (uv[:, 1] >= v0 - eps)
               & (uv[:, 1] <= v1 + eps))
-    seg = operand.boundary_segments()
-    if seg.shape[0] == 0 or operand._cache.setdefault(
-            "rectangle", _is_rectangle(seg, operand.surface.domain, 1e3 * eps)):
+    index = operand.loop_index()
+    if index is None:
         return in_box
-    bins = int(max(1, min(4096, 2 * np.sqrt(seg.shape[0]))))
-    odd = _crossings(uv, seg, bins) % 2 == 1
-    near = _segment_distance_uv(uv, seg)
-    inside = in_box & (odd | (near <= eps))
-    if tol > 0:
-        # close to a loop in (u, v): measure in space against the trimming edges
-        cand = np.flatnonzero(in_box & ~inside & (near <= NEAR_BOUNDARY * np.hypot(u1 - u0,
-                                                                                  v1 - v0)))
-        if cand.size:
-            p = operand.surface.evaluate(uv[cand, 0], uv[cand, 1])
-            limit = tol + 2.0 * operand.edge_tolerance()
-            inside[cand] = polyline_distance(p, operand.boundary_polylines()) <= limit
+    odd = index.crossings(uv) % 2 == 1
+    inside = in_box & odd
+    # the distance to the loops is needed only for the points outside by the ray test
+    test = np.flatnonzero(in_box & ~odd)
+    if test.size:
+        near = index.uv_tree.distance(uv[test])
+        inside[test] = near <= eps
+        if tol > 0:
+            # close to a loop in (u, v): measure in space against the trimming edges
+            band = test[(near > eps) & (near <= NEAR_BOUNDARY * np.hypot(u1 - u0, v1 - v0))]
+            if band.size:
+                p = operand.surface.evaluate(uv[band, 0], uv[band, 1])
+                limit = tol + 2.0 * operand.edge_tolerance()
+                inside[band] = operand.edge_distance(p) <= limit
     return inside
 
 
@@ -572,8 +636,11 @@ def _along_a_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand
         lines = face.boundary_polylines()
         if not lines:
             continue
-        sag = 0.01 * max(float(np.linalg.norm(np.diff(p, axis=0), axis=1).max()) for p in lines)
-        if polyline_distance(curve.points, lines).max() <= near + sag:
+        if "sag" not in face._cache:
+            face._cache["sag"] = 0.01 * max(
+                float(np.linalg.norm(np.diff(p, axis=0), axis=1).max(initial=0.0))
+                for p in lines)
+        if face.edge_distance(curve.points).max() <= near + face._cache["sag"]:
             return True
     return False
 
@@ -589,8 +656,8 @@ def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOper
             continue
         if within:
             near = max(10 * tol, 2 * max(fa.edge_tolerance(), fb.edge_tolerance()))
-            lines = fa.boundary_polylines() + fb.boundary_polylines()
-            if lines and polyline_distance(p.point[None], lines)[0] <= near:
+            if min(fa.edge_distance(p.point[None])[0], fb.edge_distance(p.point[None])[0]) \
+                    <= near:
                 continue
         out.append(ContactPoint(p.point, p.uv_a, p.uv_b, fa, fb))
     return out

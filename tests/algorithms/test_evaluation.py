@@ -107,6 +107,15 @@ def test_grid_equals_scattered(surface):
                                atol=1e-12 * (np.abs(scattered).max() + 1))
 
 
+def test_empty_parameter_arrays():
+    net = np.random.default_rng(0).random((5, 4, 3))
+    knots_u, knots_v = [0, 0, 0, 0, 0.5, 1, 1, 1, 1], [0, 0, 0, 0, 1, 1, 1, 1]
+    for weights in (None, np.full((5, 4), 2.0)):
+        s = NurbsSurface(net, knots_u, knots_v, 3, 3, weights)
+        assert s.derivatives(np.zeros(0), np.zeros(0), 2).shape == (0, 3, 3, 3)
+        assert s.evaluate(np.zeros((0, 4)), 0.5).shape == (0, 4, 3)
+
+
 def test_find_span_at_domain_ends_and_outside():
     knots = np.array([0, 0, 0, 1, 2, 2, 3, 3, 3], dtype=float)
     span = find_span(knots, 2, np.array([-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 4.0]))

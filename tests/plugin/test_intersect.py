@@ -131,6 +131,27 @@ def test_inside_face_even_odd_with_hole():
     assert inside_face(face, uv).tolist() == [False, True, True, False, True]
 
 
+def test_inside_face_dense_against_the_exact_plate():
+    """20000 random points at once (the cached loop index, the uv tree, the band
+    measured in space) agree with the exact square-with-hole away from its edges."""
+    plate = (cq.Workplane("XY").rect(2, 2).extrude(0.1).faces("<Z").workplane()
+             .hole(1.0).faces("<Z").val())
+    (face,) = face_operands(plate)
+    s = face.surface
+    u0, u1, v0, v1 = s.domain
+    rng = np.random.default_rng(3)
+    uv = np.c_[rng.uniform(u0, u1, 20000), rng.uniform(v0, v1, 20000)]
+    xyz = s.evaluate(uv[:, 0], uv[:, 1])
+    r = np.hypot(xyz[:, 0], xyz[:, 1])
+    exact = (np.abs(xyz[:, 0]) <= 1) & (np.abs(xyz[:, 1]) <= 1) & (r >= 0.5)
+    margin = np.minimum(np.minimum(1 - np.abs(xyz[:, 0]), 1 - np.abs(xyz[:, 1])), r - 0.5)
+    clear = np.abs(margin) > 1e-3                       # beyond the loop polygon's sag
+    for tol in (0.0, 1e-7):
+        got = inside_face(face, uv, tol)
+        assert np.array_equal(got[clear], exact[clear])
+        assert np.array_equal(inside_face(face, uv[::-1], tol), got[::-1])   # cache reused
+
+
 @pytest.fixture(scope="module")
 def debis():
     path = DATA / "occt_k1_catia_debis.stp"
