@@ -430,6 +430,8 @@ class _Pieces:
         new_lo, new_hi = self.bounds(moved)
         start = np.where(up, new_lo, np.where(down, new_hi, x))
         candidates = np.flatnonzero((up | down).any(axis=1))
+        if candidates.size == 0:          # surfaces cannot evaluate 0 points
+            return np.zeros(x.shape[0], dtype=bool), piece, x
         f, jac, _ = local(start[candidates])
         gradient = np.einsum("md,mdk->mk", f - targets[candidates], jac)
         descend = (up[candidates] & (gradient < 0)) | (down[candidates] & (gradient > 0))

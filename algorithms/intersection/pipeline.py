@@ -57,6 +57,7 @@ from .result import (
     refine_chains,
 )
 from .segments import mesh_segments
+from .sides import DomainSide, box_sides, covered_by_sides, side_curves
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
 __all__ = [
@@ -394,6 +395,54 @@ def _close_boundary_gaps(curves: list[RefinedCurve], chains: list[Chain], ends_u
     return out
 
 
+def _traced_sides(chains: list[Chain], ends_uv: list, surface_a: NurbsSurface,
+                  surface_b: NurbsSurface) -> list[DomainSide]:
+    """Domain sides the traced chains end on (both surfaces)."""
+    sides = []
+    for chain, ends in zip(chains, ends_uv):
+        if chain.closed:
+            continue
+        for (traced_a, traced_b), kind in zip(ends, (chain.start_kind, chain.end_kind)):
+            if kind is not EndKind.BOUNDARY:
+                continue
+            for owner, (traced, surface) in enumerate(((traced_a, surface_a),
+                                                        (traced_b, surface_b))):
+                held = _side_constraint(traced, surface.domain)
+                if held is not None:
+                    sides.append(DomainSide(owner, held[0], float(held[1])))
+    return list(dict.fromkeys(sides))
+
+
+def _along_sides(dense: list[RefinedCurve], kinds: list, chains: list[Chain], ends_uv: list,
+                 surface_a: NurbsSurface, surface_b: NurbsSurface, tol: float):
+    """Curves running along a domain side (:mod:`.sides`) replace the traced pieces
+    lying on them (the tessellations only touch there, so those come in pieces)."""
+    sides = _traced_sides(chains, ends_uv, surface_a, surface_b)
+    if not sides:
+        return dense, kinds
+    extra, runs = side_curves(surface_a, surface_b, sides, tol=tol)
+    if not extra:
+        return dense, kinds
+    keep = [not covered_by_sides(c, runs, surface_a, surface_b, tol) for c in dense]
+    dense = [c for c, k in zip(dense, keep) if k] + extra
+    kinds = [c for c, k in zip(kinds, keep) if k] + [
+        (EndKind.BOUNDARY, EndKind.BOUNDARY)] * len(extra)
+    return dense, kinds
+
+
+def _only_along_sides(a: NurbsSurface, b: NurbsSurface, tol: float, stray) -> list:
+    """No crossing at all in the tessellations: the surfaces may still meet along a
+    domain side (touching chords); the sides whose hulls reach the other box are
+    examined."""
+    sides = box_sides(a, b, tol)
+    extra = side_curves(a, b, sides, tol=tol)[0] if sides else []
+    if not extra:
+        return []
+    curves, worst = checked_curves(extra, [(EndKind.BOUNDARY, EndKind.BOUNDARY)] * len(extra),
+                                   a, b, tol=tol)
+    return _stray_policy(curves, worst, tol, stray)
+
+
 # ------------------------------------------------------------------ driver
 class StrayCurveWarning(UserWarning):
     """Curves were left out because they stray from the surfaces by more than tol."""
@@ -406,6 +455,23 @@ class StrayCurves(enum.Enum):
     RAISE = "raise"
     #: leave them out and return the others
     DROP = "drop"
+
+
+def _stray_policy(curves: list, worst: NDArray, tol: float, stray: StrayCurves) -> list:
+    """Curves straying beyond ``tol`` dropped with a warning or raised (``stray``)."""
+    if stray is StrayCurves.DROP:
+        if np.any(worst > tol):
+            warnings.warn(
+                f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves left out: "
+                f"they stray from the surfaces by up to {worst.max():.3g} > tol={tol:g} "
+                "(near-tangential or overlapping surfaces)", StrayCurveWarning, stacklevel=3)
+        return [c for c, w in zip(curves, worst) if w <= tol]
+    if np.any(worst > tol):
+        raise InvalidGeometryError(
+            f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves stray from "
+            f"the surfaces by up to {worst.max():.3g} > tol={tol:g}: the surfaces are "
+            "near-tangential or overlap there")
+    return curves
 
 
 def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
@@ -465,6 +531,8 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
                                high=max(MAX_MESH_TOL_FACTOR * size, tol))
     soup = mesh_segments(a, b, tol=mesh_tol, max_depth=max_depth)
     if soup.n_segments == 0:
+        if isinstance(a, NurbsSurface) and isinstance(b, NurbsSurface):
+            return _only_along_sides(a, b, tol, stray)
         return []
     domain_a = a.domain if isinstance(a, NurbsSurface) else None
     domain_b = b.domain if isinstance(b, NurbsSurface) else None
@@ -481,18 +549,7 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
              (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in chains]
     dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
                                  reach=_JOIN_FACTOR * mesh_tol)
-    curves, worst = checked_curves(dense, [(c.start_kind, c.end_kind) for c in chains],
-                                   surface_a, surface_b, tol=tol)
-    if stray is StrayCurves.DROP:
-        if np.any(worst > tol):
-            warnings.warn(
-                f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves left out: "
-                f"they stray from the surfaces by up to {worst.max():.3g} > tol={tol:g} "
-                "(near-tangential or overlapping surfaces)", StrayCurveWarning, stacklevel=2)
-        return [c for c, w in zip(curves, worst) if w <= tol]
-    if np.any(worst > tol):
-        raise InvalidGeometryError(
-            f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves stray from "
-            f"the surfaces by up to {worst.max():.3g} > tol={tol:g}: the surfaces are "
-            "near-tangential or overlap there")
-    return curves
+    kinds = [(c.start_kind, c.end_kind) for c in chains]
+    dense, kinds = _along_sides(dense, kinds, chains, ends, surface_a, surface_b, tol)
+    curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
+    return _stray_policy(curves, worst, tol, stray)

@@ -22,10 +22,10 @@ ends exactly on) a surface's boundary, the hardest case for any SSI.
 
 Findings (strict xfails; reported to the SSI owner):
 
-* BUG: an intersection running along the domain side of one surface (e.g. a
-  plane cap x a surface of revolution ending on it, s1_ideas faces 42 x 43)
-  comes out in many pieces with gaps (8 curves, 5.4 mm of the edge uncovered);
-  IntSS returns one curve on the edge to 2e-5 mm.
+* (fixed by algorithms.intersection.sides) an intersection running along the
+  domain side of one surface (e.g. a plane cap x a surface of revolution ending
+  on it, s1_ideas faces 42 x 43) came out in many pieces with gaps (8 curves,
+  5.4 mm of the edge uncovered); now one curve along the side, as IntSS (2e-5 mm).
 * (fixed by bc6c808) s1_ideas faces 121 x 128 and 130 x 133 raised
   DegenerateGeometryError (coincident consecutive samples interpolated).
 * BUG: s1_ideas faces 61 x 65 (a plane and a rational surface crossing at 90
@@ -50,17 +50,17 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from ssi_measure import distance_to_curves
+
+import surfprep
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import (
     StrayCurves,
     intersect_surfaces,
     polyline_distance,
 )
+from surfprep.errors import SurfprepError
 from surfprep.plugin.intersect import face_operands
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
-
-import surfprep
-from surfprep.errors import SurfprepError
 
 #: an edge is sharp when its faces' normals differ by more than this (degrees) all along it
 MIN_ANGLE = 10.0
@@ -241,10 +241,11 @@ def test_edge_inside_both_surfaces_is_covered(s1_ideas, faces):
     assert m.occ_matches, (m.occ, m.limit)
 
 
-@pytest.mark.xfail(strict=True, reason="BUG (reported): an intersection running along a domain "
-                   "side of one surface comes out in pieces with gaps (s1_ideas faces 42 x 43: "
-                   "8 curves, 5.4 mm of the edge uncovered); IntSS covers it to 2e-5 mm")
 def test_edge_along_a_surface_boundary_is_covered(s1_ideas):
+    """s1_ideas faces 42 x 43: a plane cap and a surface of revolution whose domain
+    side v = 0 is a full circle lying on the plane. The tessellations only touch
+    there; this came out in 8 pieces with gaps (5.4 mm of the edge uncovered) until
+    the side was intersected directly (algorithms.intersection.sides)."""
     (edge,) = s1_ideas.edges_between(42, 43)
     assert edge.on_sides == 1
     m = s1_ideas.match(edge)

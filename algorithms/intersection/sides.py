@@ -1,0 +1,260 @@
+"""Intersections that run along a side of a surface's parameter domain.
+
+CAD systems that write every face as a surface ending exactly at the face's
+edges (I-DEAS, for instance) make the intersection of two neighbouring faces'
+surfaces run *along* a domain side of one of them: the side curve
+``S(u, v_0)`` lies on the other surface. The tessellations then touch along
+the boundary chords instead of crossing them (often exactly: the chords of a
+planar side lie in the plane they touch), so the triangle-triangle step finds
+only scattered pieces with gaps (000 §29.4.3 handles crossings, not contact).
+
+Such a stretch is found here directly on the side: the side curve is sampled
+densely (``SIDE_SAMPLES_PER_SPAN`` per knot span), every sample projected onto
+the other surface, and runs of consecutive samples within ``tol / 16`` of it
+become curves. Each run's ends are located by bisection along the side
+(where the side leaves the other surface), and every sample keeps its side
+parameter exactly: the side curve is the intersection there, so no refinement
+is needed (nor possible: the auxiliary-plane step would slide the points into
+the domain; the constrained solve of a point on a side has a one-parameter
+family of solutions along a side that lies on the other surface).
+
+Only sides on which the traced soup has an end are examined, so pairs that
+cross transversally pay nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..projection import project_to_surface
+from ..surface import NurbsSurface
+from .refine import RefinedCurve
+
+__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "side_curves"]
+
+#: samples of a side curve per knot span (at least ``_MIN_SAMPLES`` in all)
+SIDE_SAMPLES_PER_SPAN = 16
+_MIN_SAMPLES = 64
+#: a run must hold this many consecutive samples on the other surface
+_MIN_RUN = 3
+#: bisection steps locating a run's ends along the side
+_BISECTIONS = 40
+#: share of tol within which side samples lie on the other surface (as dense samples)
+_SHARE = 1.0 / 16
+
+
+@dataclass(frozen=True)
+class DomainSide:
+    """A side of a surface's domain: ``owner`` 0 (surface a) or 1 (b), the held
+    ``coord`` (0: u, 1: v) and its ``value``."""
+
+    owner: int
+    coord: int
+    value: float
+
+
+@dataclass(frozen=True)
+class SideRun:
+    """A stretch of a side lying on the other surface: free parameter range ``[t0, t1]``."""
+
+    side: DomainSide
+    t0: float
+    t1: float
+
+
+def _uv_on_side(side: DomainSide, t: NDArray) -> NDArray:
+    uv = np.empty((t.size, 2))
+    uv[:, side.coord] = side.value
+    uv[:, 1 - side.coord] = t
+    return uv
+
+
+def _free_range(surface: NurbsSurface, coord: int) -> tuple[float, float, NDArray]:
+    """Free parameter range of a side holding ``coord``, and the distinct knots inside."""
+    d = surface.domain
+    lo, hi = (d[2], d[3]) if coord == 0 else (d[0], d[1])
+    knots = surface.knots_v if coord == 0 else surface.knots_u
+    return lo, hi, np.unique(knots[(knots >= lo) & (knots <= hi)])
+
+
+def _side_samples(surface: NurbsSurface, coord: int) -> NDArray:
+    """``(m,)`` free parameters: ``SIDE_SAMPLES_PER_SPAN`` per knot span, ends included."""
+    lo, hi, breaks = _free_range(surface, coord)
+    breaks = np.unique(np.concatenate([[lo, hi], breaks]))
+    per = max(SIDE_SAMPLES_PER_SPAN, int(np.ceil(_MIN_SAMPLES / (breaks.size - 1))))
+    s = np.arange(per) / per
+    inner = (breaks[:-1, None] + s * np.diff(breaks)[:, None]).ravel()
+    return np.append(inner, hi)
+
+
+def _gap(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDArray, tol: float,
+         guess: NDArray | None = None):
+    """Points of the side at ``t``, their projections onto ``other`` and the distances."""
+    uv = _uv_on_side(side, t)
+    p = own.evaluate(uv[:, 0], uv[:, 1])
+    kw = {"guess": guess} if guess is not None else {"n_seeds": 2}
+    found = project_to_surface(other, p, tol=1e-3 * tol, **kw)
+    return uv, p, found
+
+
+def _runs(near: NDArray) -> list[tuple[int, int]]:
+    """``[(first, last)]`` index ranges of consecutive True entries, ``_MIN_RUN`` long at least."""
+    edges = np.diff(np.concatenate([[0], near.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return [(int(a), int(b)) for a, b in zip(starts, stops) if b - a + 1 >= _MIN_RUN]
+
+
+def _bisect_ends(own, other, side, inside: NDArray, outside: NDArray, guess: NDArray,
+                 limit: float, tol: float) -> NDArray:
+    """Free parameters ``(k,)`` where the side leaves ``other``: bisection between
+    samples ``inside`` (within ``limit``) and ``outside`` (not)."""
+    a, b = inside.astype(float), outside.astype(float)
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (a + b)
+        _, _, found = _gap(own, other, side, mid, tol, guess)
+        ok = found.distance <= limit
+        a, b = np.where(ok, mid, a), np.where(ok, b, mid)
+    return a
+
+
+def _side_runs(own: NurbsSurface, other: NurbsSurface, side: DomainSide, tol: float
+               ) -> list[SideRun]:
+    t = _side_samples(own, side.coord)
+    found = _gap(own, other, side, t, tol)[2]
+    limit = _SHARE * tol
+    near = found.distance <= limit
+    runs = _runs(near)
+    if not runs:
+        return []
+    lo_i = np.array([r[0] for r in runs])
+    hi_i = np.array([r[1] for r in runs])
+    t0, t1 = t[lo_i], t[hi_i]
+    # extend each end that is not the side's end up to where the side leaves the surface
+    low = lo_i > 0
+    if low.any():
+        t0[low] = _bisect_ends(own, other, side, t[lo_i[low]], t[lo_i[low] - 1],
+                               found.uv[lo_i[low]], limit, tol)
+    high = hi_i < t.size - 1
+    if high.any():
+        t1[high] = _bisect_ends(own, other, side, t[hi_i[high]], t[hi_i[high] + 1],
+                                found.uv[hi_i[high]], limit, tol)
+    return [SideRun(side, float(a), float(b)) for a, b in zip(t0, t1) if b > a]
+
+
+def _run_curve(own: NurbsSurface, other: NurbsSurface, run: SideRun, tol: float
+               ) -> RefinedCurve | None:
+    """Dense samples of a run: side points, their feet on ``other``. A whole side
+    that closes in space stays an open curve whose ends coincide (the convention
+    of a loop through a seam, :func:`.pipeline.closed_in_space`): its own
+    parameter jumps there."""
+    t_all = _side_samples(own, run.side.coord)
+    inner = t_all[(t_all > run.t0) & (t_all < run.t1)]
+    t = np.concatenate([[run.t0], inner, [run.t1]])
+    uv, p, found = _gap(own, other, run.side, t, tol)
+    if np.any(found.distance > _SHARE * tol):
+        return None
+    points = 0.5 * (p + found.points)
+    found_uv = found.uv
+    keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 0])
+    uv, points, found_uv = uv[keep], points[keep], found_uv[keep]
+    if points.shape[0] < 2:
+        return None
+    uv_a, uv_b = (uv, found_uv) if run.side.owner == 0 else (found_uv, uv)
+    n = points.shape[0]
+    return RefinedCurve(points, uv_a, uv_b, False, np.ones(n, bool), np.zeros(n, bool))
+
+
+def _side_rows(surface: NurbsSurface, coord: int, high: bool) -> NDArray:
+    """``(m, 3)`` control points whose hull holds the side (its row when clamped,
+    else the ``degree + 1`` rows next to it)."""
+    knots = surface.knots_u if coord == 0 else surface.knots_v
+    degree = surface.degree_u if coord == 0 else surface.degree_v
+    net = surface.control_points if coord == 0 else np.swapaxes(surface.control_points, 0, 1)
+    ends = knots[-degree - 1:] if high else knots[:degree + 1]
+    rows = 1 if np.all(ends == ends[0]) else degree + 1
+    picked = net[-rows:] if high else net[:rows]
+    return picked.reshape(-1, net.shape[-1])
+
+
+def box_sides(surface_a: NurbsSurface, surface_b: NurbsSurface, tol: float
+              ) -> list[DomainSide]:
+    """Sides of either surface whose control hull meets the other's box (widened by
+    ``tol``): the candidates when the tessellations found nothing at all (touching
+    along a side only)."""
+    out = []
+    surfaces = (surface_a, surface_b)
+    for owner, own in enumerate(surfaces):
+        box = np.asarray(surfaces[1 - owner].bounding_box(), dtype=float)
+        lo, hi = box[0] - tol, box[1] + tol
+        d = own.domain
+        for coord, high, value in ((0, False, d[0]), (0, True, d[1]), (1, False, d[2]),
+                                   (1, True, d[3])):
+            rows = _side_rows(own, coord, high)
+            if np.all(rows.max(axis=0) >= lo) and np.all(rows.min(axis=0) <= hi):
+                out.append(DomainSide(owner, coord, float(value)))
+    return out
+
+
+def _all_on_a_side(surface: NurbsSurface, uv: NDArray, rel: float = 1e-9) -> bool:
+    u0, u1, v0, v1 = surface.domain
+    eu, ev = rel * (u1 - u0), rel * (v1 - v0)
+    for coord, value, eps in ((0, u0, eu), (0, u1, eu), (1, v0, ev), (1, v1, ev)):
+        if np.all(np.abs(uv[:, coord] - value) <= eps):
+            return True
+    return False
+
+
+def side_curves(surface_a: NurbsSurface, surface_b: NurbsSurface, sides: list[DomainSide],
+                *, tol: float) -> tuple[list[RefinedCurve], list[SideRun]]:
+    """Dense curves along the given domain sides where they lie on the other surface.
+
+    Parameters
+    ----------
+    surface_a, surface_b : NurbsSurface
+    sides : list of DomainSide
+        Sides to examine (those the traced soup has ends on).
+    tol : float
+        Model units; samples lie within ``tol / 16`` of both surfaces.
+
+    Returns
+    -------
+    (curves, runs)
+        ``RefinedCurve`` per stretch (as :func:`.refine.refine_curves` gives them),
+        and the runs they came from. A stretch along a side of both surfaces is
+        returned once (from surface a's side).
+    """
+    surfaces = (surface_a, surface_b)
+    curves, runs = [], []
+    for side in dict.fromkeys(sides):
+        own, other = surfaces[side.owner], surfaces[1 - side.owner]
+        for run in _side_runs(own, other, side, tol):
+            curve = _run_curve(own, other, run, tol)
+            if curve is None:
+                continue
+            if side.owner == 1 and _all_on_a_side(surface_a, curve.uv_a):
+                continue                  # a's side too: found (or to be found) from a
+            curves.append(curve)
+            runs.append(run)
+    return curves, runs
+
+
+def covered_by_sides(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsSurface,
+                     surface_b: NurbsSurface, tol: float) -> bool:
+    """True when every sample of ``curve`` lies on one run (within ``tol`` of the
+    side point at its own free parameter, inside the run's range)."""
+    surfaces = (surface_a, surface_b)
+    for run in runs:
+        side = run.side
+        uv = curve.uv_a if side.owner == 0 else curve.uv_b
+        t = uv[:, 1 - side.coord]
+        span = 1e-9 * max(abs(run.t1 - run.t0), 1.0)
+        if np.any(t < run.t0 - span) or np.any(t > run.t1 + span):
+            continue
+        on = _uv_on_side(side, t)
+        q = surfaces[side.owner].evaluate(on[:, 0], on[:, 1])
+        if np.all(np.linalg.norm(q - curve.points, axis=1) <= tol):
+            return True
+    return False

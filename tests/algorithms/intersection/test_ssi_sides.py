@@ -1,0 +1,82 @@
+"""SSI along a domain side (algorithms.intersection.sides): a wall standing on a plane.
+
+The wall's side v = 0 is the parabola ``y = 1 - x^2`` in the plane ``z = 0``; the
+tessellations only touch there (its chords lie in the plane exactly), which gave
+scattered pieces before the side was intersected directly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms.intersection import intersect_surfaces
+from surfprep.algorithms.intersection.sides import DomainSide, side_curves
+from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
+
+TOL = 1e-7
+
+
+def plane(half: float = 2.0) -> NurbsSurface:
+    cp = np.array([[[-half, -half, 0], [-half, half, 0]], [[half, -half, 0], [half, half, 0]]],
+                  float)
+    return NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+
+def wall() -> NurbsSurface:
+    """Quadratic in u (the parabola y = 1 - x^2, x in [-1, 1]), linear in v (z = 0..1)."""
+    base = np.array([[-1, 0], [0, 2], [1, 0]], float)
+    cp = np.empty((3, 2, 3))
+    for j, z in enumerate((0.0, 1.0)):
+        cp[:, j, :2] = base
+        cp[:, j, 2] = z
+    return NurbsSurface(cp, [0, 0, 0, 1, 1, 1], [0, 0, 1, 1], 2, 1)
+
+
+def parabola(x0: float = -1.0, x1: float = 1.0, n: int = 20001) -> np.ndarray:
+    x = np.linspace(x0, x1, n)
+    return np.stack([x, 1 - x * x, np.zeros_like(x)], axis=1)
+
+
+def check_on_both(curves, a, b, per_span: int = 7) -> None:
+    for c in curves:
+        t = c.span_parameters(per_span).ravel()
+        p = np.concatenate([c.points, c.curve3d.evaluate(t)])
+        assert distance_to_surface(a, p).max() <= TOL
+        assert distance_to_surface(b, p).max() <= TOL
+
+
+def covers(curves, exact: np.ndarray) -> float:
+    return float(np.min([distance_to_curve(c.curve3d, exact[::50]) for c in curves], axis=0).max())
+
+
+@pytest.mark.parametrize("order", ["plane_first", "wall_first"])
+def test_wall_on_plane_one_curve_along_the_side(order):
+    a, b = (plane(), wall()) if order == "plane_first" else (wall(), plane())
+    curves = intersect_surfaces(a, b, tol=TOL)
+    assert len(curves) == 1
+    check_on_both(curves, a, b)
+    exact = parabola()
+    assert covers(curves, exact) <= TOL
+    length = np.linalg.norm(np.diff(exact, axis=0), axis=1).sum()
+    assert curves[0].length == pytest.approx(length, rel=1e-6)
+    ends = curves[0].points[[0, -1]]
+    assert np.sort(ends[:, 0]) == pytest.approx([-1, 1], abs=TOL)
+
+
+def test_side_leaving_the_other_surface_ends_at_its_edge():
+    """The plane only reaches x = 0.5: the run along the side stops there (bisection)."""
+    a = NurbsSurface(np.array([[[-2, -2, 0], [-2, 2, 0]], [[0.5, -2, 0], [0.5, 2, 0]]], float),
+                     [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    curves, runs = side_curves(a, wall(), [DomainSide(1, 1, 0.0)], tol=TOL)
+    assert len(curves) == len(runs) == 1
+    p = curves[0].points
+    assert p[:, 0].min() == pytest.approx(-1, abs=TOL)
+    assert p[:, 0].max() == pytest.approx(0.5, abs=1e-6)
+    assert distance_to_surface(a, p).max() <= TOL / 16
+
+
+def test_sides_not_on_the_other_surface_give_nothing():
+    lifted = NurbsSurface(plane().control_points + [0, 0, 1e-3], [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    assert side_curves(lifted, wall(), [DomainSide(1, 1, 0.0)], tol=TOL) == ([], [])
