@@ -211,6 +211,9 @@ def _cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
         else:
             order = np.arange(n)
         pieces: list[list[int]] = [[int(order[0])]]
+        # the jump step each piece starts / ends at (None: a chain end)
+        starts: list[int | None] = [None]
+        stops: list[int | None] = []
         for k in range(1, n):
             step = int(order[k - 1])              # the step from order[k-1] to order[k]
             if jump[step]:
@@ -220,8 +223,11 @@ def _cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
                 else:
                     pieces[-1].append(int(order[k]))
                     pieces.append([int(order[k])])
+                stops.append(step)
+                starts.append(step)
             else:
                 pieces[-1].append(int(order[k]))
+        stops.append(None)
         if chain.closed:          # the closing step is the first jump
             step = int(order[-1])
             seam = _seam_point(step, ca, cb, domain_a, domain_b, jump_a, jump_b)
@@ -229,19 +235,22 @@ def _cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
                 pieces[0].insert(0, step)
             else:
                 pieces[-1].append(int(order[0]))
+            starts[0], stops[-1] = step, step
         for k, local in enumerate(pieces):
             if len(local) < 2:
                 continue
             local = np.asarray(local)
             piece_uv = []
-            for cuv, domain in ((ca, domain_a), (cb, domain_b)):
+            for cuv, domain, jumps in ((ca, domain_a, jump_a), (cb, domain_b, jump_b)):
                 if cuv is None:
                     piece_uv.append(None)
                     continue
                 part = cuv[local].copy()
-                if domain is not None and (k > 0 or chain.closed):      # starts at a seam
+                # only the surface that jumps there is moved to its seam's other side
+                # (the other's (u, v) may change by much between two sparse samples)
+                if domain is not None and starts[k] is not None and jumps[starts[k]]:
                     part[0] = _other_side(part[0], part[1], domain)
-                if domain is not None and (k < len(pieces) - 1 or chain.closed):   # ends at one
+                if domain is not None and stops[k] is not None and jumps[stops[k]]:
                     part[-1] = _other_side(part[-1], part[-2], domain)
                 piece_uv.append(part)
             fresh = np.arange(count, count + local.size)
