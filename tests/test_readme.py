@@ -19,3 +19,6 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert (tmp_path / "halves.step").stat().st_size > 0
     assert namespace["grid"].shape == (100, 50, 3)
     assert namespace["q"].worst > 10          # the fuselage is far from chord-length
+    assert namespace["touch"] == [] and len(namespace["touch"].isolated_points) == 1
+    assert abs(namespace["contact"][1] - 10) < 1e-6
+    assert namespace["network"].joins_before[0].max_gap > 1e-3 > 1e3 * namespace["join"].max_gap
