@@ -20,9 +20,12 @@ from ..algorithms.characteristic import (
     CharacteristicRecord,
     CoincidentRegion,
     FoundBy,
+    NoLoopReason,
     certify,
     characteristic_analysis,
     characteristic_intersection,
+    no_loop_reason,
+    uncertified_record,
 )
 from ..algorithms.intersection import IntersectionCurve, StrayCurves, intersect_surfaces
 from ..errors import InvalidGeometryError, InvalidToleranceError
@@ -139,11 +142,22 @@ def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float |
 def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
                  method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
                                           CharacteristicRecord | None]:
-    """Untrimmed curves of one face pair by ``method``, how each was found, the record."""
+    """Untrimmed curves of one face pair by ``method``, how each was found, the record.
+
+    With ``"auto"``, a pair the prefilter clears
+    (:func:`surfprep.algorithms.characteristic.no_loop_reason`: boxes apart, or a
+    plane against a plane or a surface with a straight parameter direction) gets the
+    triangle method alone (nothing at all when apart) and a record saying so
+    (``record.extra["skipped"]``).
+    """
     if method is Method.MESH:
         curves = _mesh_curves(fa, fb, tol, mesh_tol)
         return curves, [FoundBy.MESH] * len(curves), None
     a, b = fa.surface, fb.surface
+    reason = no_loop_reason(a, b, tol=tol) if method is Method.AUTO else None
+    if reason is not None:              # nothing for the certificate to find (prefilter)
+        curves = [] if reason is NoLoopReason.APART else _mesh_curves(fa, fb, tol, mesh_tol)
+        return curves, [FoundBy.MESH] * len(curves), uncertified_record(curves, reason)
     try:
         if method is Method.CHARACTERISTIC:
             record = characteristic_intersection(a, b, tol=tol)

@@ -11,7 +11,8 @@ distance function, characteristic points and characteristic curves
 * :mod:`.starts`: starts on loops (rays from extrema) and their check against known curves;
 * :mod:`.algorithm`: the algorithm of §6.3 (:func:`characteristic_intersection`)
   and the certificate for the triangle method (:func:`certify`);
-* :mod:`.evaluator`: fast power-basis evaluation for the tracers.
+* :mod:`.evaluator`: fast power-basis evaluation for the tracers;
+* :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them).
 """
 
 from .algorithm import (
@@ -28,6 +29,7 @@ from .curves import CurveKind, EndReason, TracedCurve, trace_curves
 from .distance import DistanceField, DistanceJet, distance_jet
 from .evaluator import PatchEvaluator
 from .points import CharacteristicPoint, PointKind, classify_critical, critical_points
+from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
 from .projection import Projection, ProjectionStatus, Projector
 from .trace import to_intersection_curve, trace_intersections
 
@@ -41,6 +43,7 @@ __all__ = [
                         "DistanceJet",
                         "EndReason",
                         "FoundBy",
+                        "NoLoopReason",
                         "PatchEvaluator",
                         "PointKind",
                         "Projection",
@@ -54,7 +57,9 @@ __all__ = [
                         "classify_critical",
                         "critical_points",
                         "distance_jet",
+                        "no_loop_reason",
                         "to_intersection_curve",
                         "trace_curves",
                         "trace_intersections",
+                        "uncertified_record",
 ]

@@ -49,11 +49,18 @@ def _monomial_table(degree: int, order: int) -> tuple[NDArray, NDArray]:
     return coef, index
 
 
+@lru_cache(maxsize=64)
+def _exponents(n: int) -> NDArray:
+    return np.arange(n)
+
+
 def _monomials(x: NDArray, degree: int, order: int, scale: NDArray) -> NDArray:
     """``(m, order + 1, degree + 1)``: ``d^o/du^o x^k`` with ``x = (u - a) * scale``."""
     coef, index = _monomial_table(degree, order)
-    powers = x[:, None] ** np.arange(degree + 1)                          # (m, p+1)
-    chain = scale[:, None] ** np.arange(order + 1)                        # (m, o+1)
+    powers = x[:, None] ** _exponents(degree + 1)                         # (m, p+1)
+    if order == 0:
+        return powers[:, None, :]
+    chain = scale[:, None] ** _exponents(order + 1)                       # (m, o+1)
     return powers[:, index] * coef * chain[:, :, None]
 
 
@@ -109,12 +116,14 @@ class PatchEvaluator:
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         coef, iu, iv = self._data["coef"], self._data["iu"], self._data["iv"]
-        su = np.clip(np.searchsorted(iu[:, 0], u, side="right") - 1, 0, iu.shape[0] - 1)
-        sv = np.clip(np.searchsorted(iv[:, 0], v, side="right") - 1, 0, iv.shape[0] - 1)
-        scale_u = 1.0 / (iu[su, 1] - iu[su, 0])
-        scale_v = 1.0 / (iv[sv, 1] - iv[sv, 0])
-        pu = _monomials((u - iu[su, 0]) * scale_u, self.surface.degree_u, order, scale_u)
-        pv = _monomials((v - iv[sv, 0]) * scale_v, self.surface.degree_v, order, scale_v)
+        # interior breakpoints only: a parameter beyond either end stays in the end patch
+        su = np.searchsorted(iu[1:, 0], u, side="right")
+        sv = np.searchsorted(iv[1:, 0], v, side="right")
+        a_u, a_v = iu[su, 0], iv[sv, 0]
+        scale_u = 1.0 / (iu[su, 1] - a_u)
+        scale_v = 1.0 / (iv[sv, 1] - a_v)
+        pu = _monomials((u - a_u) * scale_u, self.surface.degree_u, order, scale_u)
+        pv = _monomials((v - a_v) * scale_v, self.surface.degree_v, order, scale_v)
         c = coef[su, sv]                                            # (m, p+1, q+1, 4)
         m, p1, q1, d1 = c.shape
         tmp = np.matmul(pu, c.reshape(m, p1, q1 * d1)).reshape(m, order + 1, q1, d1)

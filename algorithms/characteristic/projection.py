@@ -197,33 +197,38 @@ class Projector:
         moved = np.full(x.shape[0], np.inf)
         before = np.full(x.shape[0], np.inf)
         active = np.arange(x.shape[0])
+        quarter = 0.25 * span
         for _ in range(self.max_iter):
             if active.size == 0:
                 break
-            qd = ev.derivatives(st[active, 0], st[active, 1], 2)
+            # one Newton step per active point, written on components (few small
+            # array operations: this loop runs for every jet of the tracers)
+            sa = st[active]
+            qd = ev.derivatives(sa[:, 0], sa[:, 1], 2)
             off = x[active] - qd[:, 0, 0]
             qs, qt = qd[:, 1, 0], qd[:, 0, 1]
-            f = np.stack([_dot(off, qs), _dot(off, qt)], -1)
-            k = projection_matrix(off, qd)
-            det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
-            jtj = np.stack([np.stack([_dot(qs, qs), _dot(qs, qt)], -1),
-                            np.stack([_dot(qs, qt), _dot(qt, qt)], -1)], -2)
-            good = (det > 0) & (k[:, 0, 0] > 0)
-            mat = np.where(good[:, None, None], k, jtj)
-            mdet = mat[:, 0, 0] * mat[:, 1, 1] - mat[:, 0, 1] ** 2
+            f0, f1 = _dot(off, qs), _dot(off, qt)
+            ss, st_, tt = _dot(qs, qs), _dot(qs, qt), _dot(qt, qt)
+            k00 = ss - _dot(off, qd[:, 2, 0])                               # eq. (22)
+            k01 = st_ - _dot(off, qd[:, 1, 1])
+            k11 = tt - _dot(off, qd[:, 0, 2])
+            good = (k00 * k11 - k01 ** 2 > 0) & (k00 > 0)
+            m00, m01, m11 = np.where(good, k00, ss), np.where(good, k01, st_), \
+                np.where(good, k11, tt)
+            mdet = m00 * m11 - m01 ** 2
             mdet = np.where(np.abs(mdet) > 1e-300, mdet, 1e-300)
-            step = np.stack([mat[:, 1, 1] * f[:, 0] - mat[:, 0, 1] * f[:, 1],
-                             mat[:, 0, 0] * f[:, 1] - mat[:, 0, 1] * f[:, 0]], -1) / mdet[:, None]
+            step = np.stack([m11 * f0 - m01 * f1, m00 * f1 - m01 * f0], -1) / mdet[:, None]
             # limit a step to a quarter of the domain (far seeds must not jump around)
-            scale = np.max(np.abs(step) / (0.25 * span), axis=1)
+            scale = np.max(np.abs(step) / quarter, axis=1)
             step /= np.maximum(scale, 1.0)[:, None]
-            new = np.clip(st[active] + step, lo, hi)
-            d = new - st[active]
+            new = np.clip(sa + step, lo, hi)
+            d = new - sa
             before[active] = moved[active]
-            moved[active] = np.linalg.norm(qs * d[:, :1] + qt * d[:, 1:], axis=1)
+            m = np.linalg.norm(qs * d[:, :1] + qt * d[:, 1:], axis=1)
+            moved[active] = m
             st[active] = new
             # quadratic convergence: the next step would move about moved^3 / before^2
-            m, b = moved[active], before[active]
+            b = before[active]
             nxt = np.where((m < b) & np.isfinite(b), m ** 3 / np.maximum(b, 1e-300) ** 2, np.inf)
             active = active[(m > self.tol) & (nxt > self.tol)]
         qd = ev.derivatives(st[:, 0], st[:, 1], 2)

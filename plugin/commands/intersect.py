@@ -71,6 +71,8 @@ def characteristic_report(results) -> dict:
                 "characteristic_time_s": r.characteristic_time_s,
                 "intersection_time_s": r.intersection_time_s,
             })
+            if "skipped" in r.extra:
+                entry["certificate_skipped"] = r.extra["skipped"]
         pairs.append(entry)
     return {
         "method": method.value,

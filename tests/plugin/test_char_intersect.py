@@ -9,10 +9,10 @@ import json
 import numpy as np
 import pytest
 from OCP.BRepCheck import BRepCheck_Analyzer
-from surfprep.plugin import cli
-from surfprep.plugin.intersect import FoundBy, IntersectionResult, Method, intersect
 
 import surfprep
+from surfprep.plugin import cli
+from surfprep.plugin.intersect import FoundBy, IntersectionResult, Method, intersect
 
 cq = pytest.importorskip("cadquery")
 R2 = np.sqrt(0.5)
@@ -121,3 +121,17 @@ def test_cli_reports_the_contact_point(sphere, tmp_path, capsys):
     r = json.loads(stdout)
     assert r["n_curves"] == 0 and len(r["isolated_points"]) == 1
     np.testing.assert_allclose(r["isolated_points"][0]["point"], [R2, R2, 0], atol=1e-6)
+
+
+def test_certificate_skips_plane_and_ruled_pairs():
+    """Box faces (planes) x a cylinder's side (straight along its axis): ``auto`` skips
+    the certificate there (prefilter) and answers exactly what ``mesh`` does."""
+    box = cq.Solid.makeBox(2, 2, 2, pnt=cq.Vector(-1, -1, -1))
+    cylinder = cq.Solid.makeCylinder(0.5, 3, pnt=cq.Vector(0.3, 0, -1.5))
+    side = [f for f in cylinder.Faces() if f.geomType() == "CYLINDER"]
+    auto = intersect(box, side, tol=1e-7)
+    mesh = intersect(box, side, tol=1e-7, method="mesh")
+    assert auto.records and all(r.record is not None and r.record.extra.get("skipped")
+                                for r in auto.records)
+    assert sorted(round(c.length, 6) for c in auto) == sorted(round(c.length, 6) for c in mesh)
+    assert len(auto) >= 2 and all(c.found_by is FoundBy.MESH for c in auto)

@@ -1,0 +1,84 @@
+"""The certificate's prefilter: pairs with no possible loop nor contact point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from char_surfaces import horizontal_plane, plane_patch, several_bumps, sphere_and_plane
+
+from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms.characteristic import (
+    FoundBy,
+    NoLoopReason,
+    characteristic_intersection,
+    no_loop_reason,
+    uncertified_record,
+)
+
+TOL = 1e-7
+
+
+def wavy_ruled(amplitude: float = 0.3) -> NurbsSurface:
+    """Cubic in u, straight in v (two control rows): a wavy wall, rational weights."""
+    u = np.linspace(0, 1, 7)
+    bottom = np.c_[u, 0.2 * np.sin(6 * u), np.full(7, -0.5)]
+    top = np.c_[u, 0.2 * np.cos(5 * u) + 0.1, np.full(7, 0.5 + amplitude * u)]
+    knots_u = [0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1]
+    w = np.c_[np.linspace(1, 2, 7), np.linspace(2, 1, 7)]
+    return NurbsSurface(np.stack([bottom, top], 1), knots_u, [0, 0, 1, 1], 3, 1, w)
+
+
+def test_plane_and_ruled_and_two_planes():
+    wall = wavy_ruled()
+    for z in (0.0, 0.3):
+        plane = horizontal_plane(z)
+        assert no_loop_reason(plane, wall, tol=TOL) is NoLoopReason.PLANE_AND_RULED
+        assert no_loop_reason(wall, plane, tol=TOL) is NoLoopReason.PLANE_AND_RULED
+    tilted = plane_patch([0.5, 0.5, 0.0], [0.3, 0.1, 1.0], half=2.0)
+    assert no_loop_reason(horizontal_plane(0.0), tilted, tol=TOL) is NoLoopReason.PLANE_AND_RULED
+
+
+def test_cases_the_certificate_must_see():
+    a, b, _, _ = sphere_and_plane(2e-2)                     # a loop
+    assert no_loop_reason(a, b, tol=TOL) is None
+    bumps = several_bumps()                                 # bicubic x plane: loops
+    assert no_loop_reason(bumps, horizontal_plane(0.3), tol=TOL) is None
+    plane = horizontal_plane(0.0)                           # coplanar planes: coincidence
+    assert no_loop_reason(plane, horizontal_plane(0.5 * TOL), tol=TOL) is None
+    near_plane = NurbsSurface(plane.control_points + [0, 0, 1e-3 * TOL], plane.knots_u,
+                              plane.knots_v, 1, 1)
+    assert no_loop_reason(near_plane, plane, tol=TOL) is None
+    # a plane bent by more than the planarity share is not a plane
+    net = several_bumps().control_points.copy()
+    net[..., 2] = 1e-6 * np.sin(net[..., 0] * 7)
+    bent = NurbsSurface(net, several_bumps().knots_u, several_bumps().knots_v, 3, 3)
+    assert no_loop_reason(bent, wavy_ruled(), tol=TOL) is None
+
+
+def test_apart():
+    a, b, _, _ = sphere_and_plane(2e-2)
+    far = NurbsSurface(b.control_points + [0, 0, 50.0], b.knots_u, b.knots_v, b.degree_u,
+                       b.degree_v, b.weights)
+    assert no_loop_reason(a, far, tol=TOL) is NoLoopReason.APART
+
+
+@pytest.mark.parametrize("z", [-0.45, 0.0, 0.4, 0.75])
+def test_skipped_pairs_have_no_loop_and_no_contact(z):
+    """The full characteristic method on plane x ruled pairs finds no closed loop
+    inside the domain and no isolated point: the skip loses nothing."""
+    wall, plane = wavy_ruled(), horizontal_plane(z)
+    assert no_loop_reason(plane, wall, tol=TOL) is NoLoopReason.PLANE_AND_RULED
+    record = characteristic_intersection(plane, wall, tol=TOL)
+    assert not record.isolated_points and record.curves
+    lo, hi = np.array([0.0, 0.0]), np.array([1.0, 1.0])
+    for c in record.curves:
+        uv = c.uv_b
+        # every curve reaches the wall's domain boundary (no interior loop)
+        edge = np.minimum(np.abs(uv - lo), np.abs(uv - hi)).min(axis=1)
+        assert edge.min() <= 1e-6
+
+
+def test_uncertified_record():
+    rec = uncertified_record([], NoLoopReason.APART)
+    assert rec.curves == () and rec.extra["skipped"] == "apart" and rec.counts() == {}
+    assert rec.found_by == () and FoundBy.MESH.value == "mesh"
