@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
+
 from surfprep.algorithms.projection import project_to_curve
 
 #: interpolant points per span that seed the projection
@@ -46,6 +47,14 @@ def distance_to_curves(curves, points: np.ndarray, tol: float) -> np.ndarray:
         nearest = cKDTree(seeds).query(points)[1]
         found = project_to_curve(c.curve3d, points, tol=tol, guess=params[nearest])
         best = np.minimum(best, found.distance)
+        if c.closed:
+            # first and last seed are one point at the two domain ends: a projection
+            # from the wrong end stops there, so points near the closure try both ends
+            end = (nearest == 0) | (nearest == params.size - 1)
+            if end.any():
+                other = np.where(nearest[end] == 0, params[-1], params[0])
+                again = project_to_curve(c.curve3d, points[end], tol=tol, guess=other)
+                best[end] = np.minimum(best[end], again.distance)
     return best
 
 

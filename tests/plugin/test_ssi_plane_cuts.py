@@ -44,14 +44,14 @@ import warnings
 import numpy as np
 import pytest
 from ssi_measure import dense, dense_length, distance_to_curves
+
+import surfprep
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import (
     connected_branches,
     curve_set_distance,
 )
 from surfprep.plugin.occ_reference import section_faces_occ
-
-import surfprep
 
 cq = pytest.importorskip("cadquery")
 
