@@ -38,7 +38,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 from numpy.typing import NDArray
+from scipy.sparse.linalg import spsolve
 
 from ..surface import NurbsSurface
 
@@ -54,6 +56,9 @@ __all__ = [
 PENALTY_TOL = 1e-3
 #: Step scales tried for every moved node.
 _SCALES = np.array([1.0, 0.5, 0.25, 0.125, 0.0625])
+#: Levenberg-Marquardt steps of the global solve at most, and its damping range.
+GLOBAL_STEPS = 40
+_DAMPING = (1e-6, 1e6)
 
 
 @dataclass(frozen=True)
@@ -72,6 +77,8 @@ class RelocationResult:
         No node moved in the last sweep (within ``max_sweeps``).
     penalty_before, penalty_after : float
         Largest penalty of an interior node before and after.
+    newton_steps : int
+        Accepted steps of the global solve that precedes the sweeps.
     """
 
     uv: NDArray
@@ -80,6 +87,7 @@ class RelocationResult:
     converged: bool
     penalty_before: float
     penalty_after: float
+    newton_steps: int = 0
 
 
 def initial_guess(bottom: NDArray, top: NDArray, left: NDArray, right: NDArray,
@@ -199,6 +207,115 @@ def _move(surface: NurbsSurface, uv: NDArray, points: NDArray, selected: NDArray
     return moved
 
 
+def _sum_squares(points, targets, floor, rows) -> float:
+    ru, rv = _residuals(points, *targets, floor)
+    return float(np.sum(ru[rows] ** 2) + np.sum(rv[rows] ** 2))
+
+
+def _global_jacobian(surface, uv, points, movable):
+    """Sparse Jacobian of ``(R^u, R^v)`` at the movable nodes with respect to their
+    original parameters ``(2m, 2m)`` (each residual involves a node and its two
+    neighbours along one direction; fixed neighbours contribute nothing)."""
+    inner = movable.shape
+    index = -np.ones(inner, int)
+    ii, jj = np.nonzero(movable)
+    index[ii, jj] = np.arange(ii.size)
+    i, j = ii + 1, jj + 1
+    d = surface.derivatives(uv[i, j, 0], uv[i, j, 1], 1)
+    tangents = np.stack([d[:, 1, 0], d[:, 0, 1]], axis=1)            # (m, 2, 3)
+    padded = -np.ones((inner[0] + 2, inner[1] + 2), int)
+    padded[1:-1, 1:-1] = index
+    rows, cols, vals = [], [], []
+    x = points[i, j]
+    for eq, (before, after) in enumerate((((i - 1, j), (i + 1, j)), ((i, j - 1), (i, j + 1)))):
+        a, b = x - points[before], points[after] - x
+        ga = a / np.maximum(np.sum(a * a, -1), 1e-300)[:, None]     # d log|a| / d x
+        gb = b / np.maximum(np.sum(b * b, -1), 1e-300)[:, None]     # -d log|b| / d x
+        row = 2 * np.arange(ii.size) + eq
+        for node, grad in (((i, j), ga + gb), (before, -ga), (after, -gb)):
+            col = padded[node]
+            ok = col >= 0
+            if not np.any(ok):
+                continue
+            k = np.nonzero(ok)[0]
+            t = tangents[col[ok]]                                    # (k, 2, 3)
+            g = np.einsum("kc,kdc->kd", grad[ok], t)                 # (k, 2)
+            for c in range(2):
+                rows.append(row[k])
+                cols.append(2 * col[ok] + c)
+                vals.append(g[:, c])
+    n = 2 * ii.size
+    jac = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                        shape=(n, n))
+    return jac, ii, jj
+
+
+def solve_globally(surface: NurbsSurface, uv: NDArray, points: NDArray,
+                   targets: tuple[NDArray, NDArray], floor: float, movable: NDArray,
+                   steps: int = GLOBAL_STEPS) -> tuple[NDArray, NDArray, int]:
+    """All movable nodes at once: Levenberg-Marquardt on the residuals ``(R^u, R^v)``.
+
+    The penalty conditions of all interior nodes form a square nonlinear system
+    in the nodes' original parameters; a node-by-node relocation (Gauss-Seidel)
+    needs O(n^2) sweeps to carry a correction across an ``n x n`` grid, a
+    global Newton step does it at once. Each step solves the damped normal
+    equations ``(J^T J + lambda D) delta = -J^T r`` (sparse; ``D`` the diagonal
+    of ``J^T J``), is cut to the box of each node's neighbours (no fold-over) and
+    is accepted only if the sum of squared residuals drops (else ``lambda`` x 10).
+
+    Parameters
+    ----------
+    uv, points : (n_u, n_v, 2), (n_u, n_v, 3) float
+        Start grid (not modified).
+    movable : (n_u - 2, n_v - 2) bool
+
+    Returns
+    -------
+    uv, points : the improved grid; steps : Newton steps accepted.
+    """
+    uv, points = uv.copy(), points.copy()
+    rows = movable
+    if not np.any(rows):
+        return uv, points, 0
+    cost = _sum_squares(points, targets, floor, rows)
+    damping, accepted = 1e-3, 0
+    for _ in range(steps):
+        jac, ii, jj = _global_jacobian(surface, uv, points, movable)
+        ru, rv = _residuals(points, *targets, floor)
+        r = np.stack([ru[ii, jj], rv[ii, jj]], -1).ravel()
+        jtj = (jac.T @ jac).tocsc()
+        diag = jtj.diagonal()
+        scale = np.where(diag > 0, diag, max(float(diag.max(initial=0.0)), 1e-300))
+        grad = jac.T @ r
+        improved = False
+        while damping <= _DAMPING[1]:
+            delta = spsolve(jtj + sp.diags(damping * scale, format="csc"), -grad)
+            if not np.all(np.isfinite(delta)):
+                damping *= 10.0
+                continue
+            trial_uv = uv.copy()
+            lo, hi = _neighbour_box(uv)
+            moved = uv[ii + 1, jj + 1] + delta.reshape(-1, 2)
+            trial_uv[ii + 1, jj + 1] = np.clip(moved, lo[ii, jj], hi[ii, jj])
+            trial_points = points.copy()
+            trial_points[ii + 1, jj + 1] = surface.evaluate(trial_uv[ii + 1, jj + 1, 0],
+                                                            trial_uv[ii + 1, jj + 1, 1])
+            trial = _sum_squares(trial_points, targets, floor, rows)
+            if trial < cost:
+                uv, points, improved = trial_uv, trial_points, True
+                damping = max(damping / 10.0, _DAMPING[0])
+                break
+            damping *= 10.0
+        if not improved:
+            break
+        accepted += 1
+        done = cost - trial <= 1e-12 * cost
+        cost = trial
+        if done or np.sqrt(cost / r.size) < 1e-2 * PENALTY_TOL:
+            break
+    return uv, points, accepted
+
+
 def _spread(moved: NDArray) -> NDArray:
     """Nodes that moved or have a moved 4-neighbour."""
     out = moved.copy()
@@ -246,6 +363,7 @@ def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions
     pen = penalties(points, fractions_u, fractions_v, floor)
     before = float(pen.max())
     movable = np.ones(inner, bool) if fixed is None else ~np.asarray(fixed)[1:-1, 1:-1]
+    uv, points, newton = solve_globally(surface, uv, points, targets, floor, movable)
     candidates = movable.copy()
     sweeps, converged = 0, False
     while sweeps < max_sweeps:
@@ -271,4 +389,4 @@ def relocate(surface: NurbsSurface, uv: NDArray, fractions_u: NDArray, fractions
         start = np.array(uv0)
         return RelocationResult(start, surface.evaluate(start[..., 0], start[..., 1]), sweeps,
                                 False, before, before)
-    return RelocationResult(uv, points, sweeps, converged, before, after)
+    return RelocationResult(uv, points, sweeps, converged, before, after, newton)

@@ -33,35 +33,43 @@ def reconcile_fractions(*sets: NDArray | None) -> NDArray:
     Returns
     -------
     (m,) float
-        The union in which values of different sets closer than
-        :data:`MATCH_FRACTION` of the smaller adjacent step are merged into
-        their mean (a matched point); every other value is an auxiliary point
-        for the sets that lack it.
+        The union in which a cluster of values of different sets (at most one
+        per set) spanning less than :data:`MATCH_FRACTION` of the smallest own
+        step of its members is merged into its mean (a matched point: with
+        three or more lines - boundaries and creases - a pairwise match left
+        clusters of nearly equal fractions, tiny knot intervals that fold the
+        relocation); every other value is an auxiliary point for the sets that
+        lack it.
     """
     given = [np.asarray(s, dtype=float) for s in sets if s is not None]
     if not given:
         raise ValueError("need at least one fraction set")
     values = np.concatenate(given)
     owner = np.concatenate([np.full(len(s), k) for k, s in enumerate(given)])
+    own_step = np.concatenate([_own_steps(s) for s in given])
     order = np.argsort(values, kind="stable")
-    values, owner = values[order], owner[order]
-    gaps = np.diff(values)
-    padded = np.concatenate([[np.inf], gaps, [np.inf]])
-    neighbour = np.minimum(padded[:-2], padded[2:])               # (n-1,) steps beside
-    candidate = ((owner[1:] != owner[:-1]) & (gaps <= MATCH_FRACTION * neighbour)) | (gaps == 0)
-    keep = np.ones(values.size, bool)
-    out = values.copy()
-    k = 0
-    while k < gaps.size:                 # greedy left to right: a point matches once
-        if candidate[k]:
-            out[k] = 0.5 * (values[k] + values[k + 1])
-            keep[k + 1] = False
-            k += 2
+    values, owner, own_step = values[order], owner[order], own_step[order]
+    out, cluster = [], [0]
+    for k in range(1, values.size):      # greedy left to right: clusters of matched points
+        members = owner[cluster]
+        reach = MATCH_FRACTION * min(own_step[cluster].min(), own_step[k])
+        if (values[k] - values[cluster[0]] <= reach and owner[k] not in members) \
+                or values[k] == values[cluster[-1]]:
+            cluster.append(k)
         else:
-            k += 1
-    out = np.unique(np.clip(out[keep], 0.0, 1.0))
+            out.append(values[cluster].mean())
+            cluster = [k]
+    out.append(values[cluster].mean())
+    out = np.unique(np.clip(out, 0.0, 1.0))
     out[0], out[-1] = 0.0, 1.0
     return out
+
+
+def _own_steps(fractions: NDArray) -> NDArray:
+    """Smaller neighbouring step of every value within its own set ``(n,)``."""
+    gaps = np.diff(fractions)
+    padded = np.concatenate([[np.inf], gaps, [np.inf]])
+    return np.minimum(padded[:-1], padded[1:])
 
 
 def insert_midpoints(fractions: NDArray, intervals: NDArray) -> NDArray:
