@@ -5,7 +5,8 @@
    patch missing. Filled by
 
    * surfprep: ``surfprep.heal(grid, continuity=G0 / G1)`` (hole detected from
-     the free edges; approximant with Hardy's multiquadric over the hole; network
+     the free edges; approximant over the hole filled by the thin-plate spline of
+     the positions found on its rim and on a ring of projections beyond it; network
      joined G0 / G1; sewn and checked);
    * ``BRepOffsetAPI_MakeFilling`` with the four neighbour edges as C0, and as G1
      constraints on their faces (``IsDone`` checked);

@@ -49,6 +49,7 @@ from .error import ErrorSample, measure_error
 from .interpolant import Interpolant, interpolate_grid
 from .multiquadric import HardyMode, fill_positions
 from .offsets import offsets
+from .ring import ring_segments
 from .segments import project_grid
 
 __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_approximant"]
@@ -57,6 +58,11 @@ __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_
 DEFAULT_RELATIVE_TOL = 1e-3
 #: default chord tolerance of the triangulation of surfaces: this fraction of ``d``
 MESH_FRACTION = 0.02
+#: rows of projections beyond the boundary feeding Hardy's fill (:mod:`.ring`)
+RING_ROWS = 4
+#: a grid with artificial projections is refined at least to this resolution (the
+#: fill over a hole is not measured by the error of §7; finer rims carry its shape)
+FILL_RESOLUTION = (16, 16)
 _BOX_PAD = 0.05             # clipping box margin reused by later passes, fraction of its size
 _NEWTON_FRACTION = 1e-9      # residual of the Newton polish, fraction of the size
 _INVERSION_FRACTION = 1e-10  # convergence of point inversion, fraction of the size
@@ -171,22 +177,52 @@ def _sides(found: NDArray, t: NDArray, y: NDArray, x: NDArray, keep_boundary: bo
     return rim, found & ~off_surface, np.where(rim, 0.5, t)
 
 
+def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache):
+    """Segments of the grid (and of the ring around it, :mod:`.ring`) projected."""
+    ring = ring_segments(coons, off.distance, ring_rows) if ring_rows > 0 else None
+    a, b = off.upper.reshape(-1, 3), off.lower.reshape(-1, 3)
+    box = off.box
+    if ring is not None:
+        a, b = np.concatenate([a, ring.upper]), np.concatenate([b, ring.lower])
+        both = np.concatenate([ring.upper, ring.lower])
+        box = np.stack([np.minimum(box[0], both.min(axis=0)),
+                        np.maximum(box[1], both.max(axis=0))])
+    if cache.get("clipped") is None or not cache["clipped"].covers(box):
+        # triangulate a box a little larger than needed: later passes (finer grids,
+        # slightly different normals) reuse the triangles
+        pad = _BOX_PAD * np.ptp(box, axis=0).max()
+        cache["clipped"] = clip_sources(
+            sources, box + np.array([[-pad], [pad]]),
+            mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    y, t, found, src = project_grid(a, b, cache["clipped"].restrict(box),
+                                    tol=_NEWTON_FRACTION * size)
+    return ring, y, t, found, src
+
+
+def _fill(coons, ring, t, known, t_ring, found_ring, hardy, neighbours) -> NDArray:
+    """Positions everywhere on the grid (Hardy's fill, with the ring's data if any)."""
+    if ring is None or np.all(known):
+        return fill_positions(coons.u, coons.v, t, known, mode=hardy, neighbours=neighbours)
+    t_ext = np.zeros(ring.outer.shape)
+    known_ext = np.zeros(ring.outer.shape, bool)
+    t_ext[ring.outer], known_ext[ring.outer] = t_ring, found_ring
+    r = ring.rows
+    t_ext[r:-r, r:-r], known_ext[r:-r, r:-r] = t, known
+    return ring.inner(fill_positions(ring.u, ring.v, t_ext, known_ext, mode=hardy,
+                                     neighbours=neighbours))
+
+
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
-              cache: dict) -> _Pass:
+              ring_rows: int, cache: dict) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
-    if cache.get("clipped") is None or not cache["clipped"].covers(off.box):
-        # triangulate a box a little larger than needed: later passes (finer grids,
-        # slightly different normals) reuse the triangles
-        pad = _BOX_PAD * np.ptp(off.box, axis=0).max()
-        cache["clipped"] = clip_sources(
-            sources, off.box + np.array([[-pad], [pad]]),
-            mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    ring, y, t, found, src = _project(off, coons, ring_rows, sources, mesh_tol, size, cache)
+    inner = (m + 1) * (n + 1)
+    t_ring, found_ring = t[inner:], found[inner:]
+    y, t, found, src = y[:inner], t[:inner], found[:inner], src[:inner]
     clipped = cache["clipped"].restrict(off.box)
-    a, b = off.upper.reshape(-1, 3), off.lower.reshape(-1, 3)
-    y, t, found, src = project_grid(a, b, clipped, tol=_NEWTON_FRACTION * size)
     shape = (m + 1, n + 1)
     found, t = found.reshape(shape), t.reshape(shape)
     if not np.any(found):
@@ -195,7 +231,7 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
             f"lie over them (or the offset distance {off.distance:.3g} is too small)")
     y = y.reshape(shape + (3,))
     rim, found, t = _sides(found, t, y, coons.points, keep_boundary, tol)
-    t_all = fill_positions(coons.u, coons.v, t, found | rim, mode=hardy, neighbours=neighbours)
+    t_all = _fill(coons, ring, t, found | rim, t_ring, found_ring, hardy, neighbours)
     z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
     grid = np.where(found[..., None], y, z)
     grid[rim] = coons.points[rim]
@@ -210,9 +246,11 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       max_resolution: tuple[int, int] = (64, 64),
                       interpolant: Interpolant = Interpolant.C1_BICUBIC,
                       offset: float | None = None, neighbours: int = 8,
-                      hardy: HardyMode = HardyMode.LOCAL, growth: float = 1.5,
+                      hardy: HardyMode = HardyMode.THIN_PLATE, growth: float = 1.5,
                       gap_tol: float | None = None, mesh_tol: float | None = None,
-                      keep_boundary: bool = True, strict: bool = False) -> LocalApproximant:
+                      keep_boundary: bool = True, ring_rows: int | None = None,
+                      fill_resolution: tuple[int, int] = FILL_RESOLUTION,
+                      strict: bool = False) -> LocalApproximant:
     """A bicubic B-spline surface over four boundary curves that follows the sources.
 
     Parameters
@@ -237,8 +275,16 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     neighbours : int
         ``K`` of the localized Hardy method (5-10).
     hardy : HardyMode
-        Localized (default) or global Hardy interpolation (one dense system
-        over all found points: ``O(n^3)``, for small grids).
+        Thin-plate fill (default), localized or global Hardy interpolation
+        (one dense system over all found points: ``O(n^3)``, for small grids).
+    ring_rows : int >= 0
+        Rows of projections beyond the boundary that feed the fill (:mod:`.ring`;
+        0: only the grid's own, as in 001). Default :data:`RING_ROWS` for the
+        thin-plate fill, 0 for Hardy's (his kernel with ``γ = 0.001`` bends the
+        ring's data into the hole: worse than the grid alone).
+    fill_resolution : (int, int)
+        A grid with artificial projections is refined at least to this (capped
+        by ``max_resolution``), even when ``tol`` is met earlier.
     growth : float > 1
         Resolution factor between passes (at least +2 each).
     gap_tol : float, optional
@@ -290,19 +336,26 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         raise InvalidGeometryError(f"neighbours must be an integer >= 1, got {neighbours!r}")
     if offset is not None:
         offset = check_tolerance(offset, "offset", low=1e-12 * size)
+    fill_min = tuple(min(f, lim) for f, lim in zip(
+        _check_resolution(fill_resolution, "fill_resolution", minimum), limit, strict=True))
+    if ring_rows is None:
+        ring_rows = RING_ROWS if hardy is HardyMode.THIN_PLATE else 0
     history, passes, cache = [], [], {}
     while True:
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
                       hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
-                      keep_boundary=keep_boundary, tol=tol, size=size, cache=cache)
+                      keep_boundary=keep_boundary, tol=tol, size=size,
+                      ring_rows=ring_rows, cache=cache)
         share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)
-        if p.error.max_error <= tol or current == limit:
+        filled = (not p.artificial.any()
+                  or all(c >= f for c, f in zip(current, fill_min, strict=True)))
+        if (p.error.max_error <= tol and filled) or current == limit:
             break
         current = _next_resolution(current, limit, growth)
     errors = np.array([s.max_error for s in history])
-    converged = bool(errors[-1] <= tol)
+    converged = bool(errors[-1] <= tol)   # a filled hole refined beyond tol: the last pass
     best = len(passes) - 1 if converged or np.all(np.isnan(errors)) else int(np.nanargmin(errors))
     p, step = passes[best], history[best]
     if strict and not converged:

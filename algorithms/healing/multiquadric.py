@@ -22,6 +22,7 @@ import enum
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.interpolate import RBFInterpolator
 
 from ...errors import DegenerateGeometryError
 
@@ -29,6 +30,10 @@ __all__ = ["HARDY_GAMMA", "HardyMode", "fill_positions", "hardy_parameters"]
 
 #: the exponent of 001 §5
 HARDY_GAMMA = 0.001
+#: thin-plate fill: one global system up to this many found positions
+THIN_PLATE_GLOBAL = 1500
+#: ... else each missing position from this many nearest found ones
+THIN_PLATE_NEIGHBOURS = 64
 
 
 class HardyMode(enum.Enum):
@@ -38,6 +43,12 @@ class HardyMode(enum.Enum):
     LOCAL = "local"
     #: all found positions, one system (eq. 12)
     GLOBAL = "global"
+    #: not Hardy's kernel: the thin-plate spline ``r^2 log r`` plus a linear
+    #: polynomial (the smoothest interpolant of the found positions: no ``R`` or
+    #: ``γ`` to tune; with the ring of :mod:`.ring` it continues the surroundings'
+    #: slope and bending into a hole); over all found positions up to
+    #: :data:`THIN_PLATE_GLOBAL`, else the :data:`THIN_PLATE_NEIGHBOURS` nearest
+    THIN_PLATE = "thin_plate"
 
 
 def hardy_parameters(u: NDArray, v: NDArray) -> float:
@@ -99,6 +110,18 @@ def _local(u: NDArray, v: NDArray, t: NDArray, found: NDArray, radius: float,
     return out
 
 
+def _thin_plate(u: NDArray, v: NDArray, t: NDArray, found: NDArray) -> NDArray:
+    data = np.stack([u[found], v[found]], axis=1)
+    near = None if data.shape[0] <= THIN_PLATE_GLOBAL else THIN_PLATE_NEIGHBOURS
+    degree = 1 if data.shape[0] >= 3 else 0
+    try:
+        rbf = RBFInterpolator(data, t[found], kernel="thin_plate_spline", degree=degree,
+                              neighbors=near)
+        return rbf(np.stack([u[~found], v[~found]], axis=1))
+    except (np.linalg.LinAlgError, ValueError):   # collinear data: Hardy's global form
+        return _global(u, v, t, found, hardy_parameters(u, v), HARDY_GAMMA)
+
+
 def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
                    mode: HardyMode = HardyMode.LOCAL, neighbours: int = 8,
                    radius: float | None = None, gamma: float = HARDY_GAMMA) -> NDArray:
@@ -135,7 +158,9 @@ def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
     if np.all(found):
         return out
     r = hardy_parameters(u, v) if radius is None else float(radius)
-    if mode is HardyMode.GLOBAL:
+    if mode is HardyMode.THIN_PLATE:
+        out[~found] = _thin_plate(u, v, out, found)
+    elif mode is HardyMode.GLOBAL:
         out[~found] = _global(u, v, out, found, r, gamma)
     else:
         out[~found] = _local(u, v, out, found, r, gamma, max(1, int(neighbours)))

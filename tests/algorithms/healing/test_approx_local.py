@@ -288,3 +288,25 @@ def test_trimmed_face_with_a_round_hole(smooth):
     assert distance_to_surface(smooth, pts.reshape(-1, 3)).max() < 1e-3
     with pytest.raises(InvalidGeometryError, match="inside the trimming loops"):
         trimmed_source(smooth, [outer + 5.0])
+
+
+def test_ring_carries_the_surroundings_into_a_rim_bounded_hole(smooth):
+    # 16 x 16 over the hole's own edges: the thin-plate fill with the ring of projections
+    # beyond the rim follows the cut-away surface several times closer than the Coons
+    # interior (Hardy's fill from the rim alone), checked densely against the true surface
+    boundary, sources = iso_boundary(smooth, *HOLE), surrounding_patches(smooth, HOLE)
+    ring = _fixed(boundary, sources, 16)
+    rim_only = _fixed(boundary, sources, 16, hardy=HardyMode.LOCAL)
+    assert ring.artificial_share == pytest.approx(15 ** 2 / 17 ** 2)
+    dev_ring = distance_to_surface(smooth, _dense(ring)[1].reshape(-1, 3)).max()
+    dev_rim = distance_to_surface(smooth, _dense(rim_only)[1].reshape(-1, 3)).max()
+    assert dev_ring < 0.5 * dev_rim
+    assert dev_ring < 2e-5
+
+
+def test_hole_refined_to_the_fill_resolution(smooth):
+    # the error of §7 skips the hole, so tol is met at 8 x 8; the fill still gets 16 x 16
+    r = local_approximant(iso_boundary(smooth, *HOLE), surrounding_patches(smooth, HOLE))
+    assert r.converged and min(r.resolution) >= 16
+    full = local_approximant(iso_boundary(smooth, *PATCH), [smooth])
+    assert full.resolution == (8, 8)                   # nothing missing: no refinement
