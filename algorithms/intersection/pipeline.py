@@ -86,6 +86,13 @@ MAX_MESH_TOL_FACTOR = 0.1
 _MERGE_SHARE = 1e-6
 #: hanging ends closer than this times ``mesh_tol`` are joined (004 §5)
 _JOIN_FACTOR = 4.0
+#: a folded or straying result is computed again this many times at most, each time
+#: with ``mesh_tol`` divided by ``_RETRY_FACTOR``, never below ``_RETRY_FLOOR tol``
+_RETRIES = 2
+_RETRY_FACTOR = 8.0
+_RETRY_FLOOR = 16.0
+#: consecutive chords of refined samples turning by more than this: a fold
+_FOLD_ANGLE = np.radians(120.0)
 
 
 def _operand_box(operand: Operand) -> NDArray:
@@ -501,7 +508,10 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         Chord tolerance of the tessellations (model units); default
         ``MESH_TOL_FACTOR`` (1e-3) times the diagonal of the operands' box.
         Loops smaller than a few ``mesh_tol`` may be missed: lower it to find
-        them (the work grows about as ``1 / mesh_tol`` along the curves).
+        them (the work grows about as ``1 / mesh_tol`` along the curves). A
+        NURBS x NURBS result with a folded or straying curve (near-tangential
+        surfaces, too coarse a tessellation) is computed again with ``mesh_tol``
+        divided by 8, twice at most and not below ``16 tol``.
     max_depth : int
         Tessellation refinement levels at most.
     stray : StrayCurves
@@ -538,6 +548,35 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         mesh_tol = max(MESH_TOL_FACTOR * size, tol)
     mesh_tol = check_tolerance(mesh_tol, "mesh_tol", low=tol,
                                high=max(MAX_MESH_TOL_FACTOR * size, tol))
+    return _intersect(a, b, tol, mesh_tol, max_depth, stray, scale, _RETRIES)
+
+
+def _folded(curve: RefinedCurve) -> bool:
+    """True when the refined samples turn back on themselves (consecutive chords
+    more than ``_FOLD_ANGLE`` apart at a regular sample): a traced loop whose
+    refined points landed on one part of the true curve twice, as where the
+    tessellations are too coarse for surfaces meeting at a small angle."""
+    p = curve.points
+    if p.shape[0] < 3:
+        return False
+    if curve.closed:
+        p = np.concatenate([p, p[:2]])
+    d = np.diff(p, axis=0)
+    norm = np.linalg.norm(d, axis=1)
+    cos = np.einsum("ij,ij->i", d[:-1], d[1:]) / np.maximum(norm[:-1] * norm[1:],
+                                                             np.finfo(float).tiny)
+    middle = np.roll(curve.singular, -1)[: cos.size] if curve.closed else curve.singular[1:-1]
+    return bool(np.any((cos < np.cos(_FOLD_ANGLE)) & ~middle))
+
+
+def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: int,
+               stray: StrayCurves, scale: float, retries: int) -> list[IntersectionCurve]:
+    """:func:`intersect_surfaces` at one ``mesh_tol``; a NURBS x NURBS result with a
+    folded or straying curve is computed again at ``mesh_tol / _RETRY_FACTOR``
+    (``retries`` more times at most, not below ``_RETRY_FLOOR tol``): the
+    tessellations were too coarse for a near-tangential stretch."""
+    finer = mesh_tol / _RETRY_FACTOR
+    can_retry = retries > 0 and finer >= _RETRY_FLOOR * tol
     soup = mesh_segments(a, b, tol=mesh_tol, max_depth=max_depth)
     if soup.n_segments == 0:
         if isinstance(a, NurbsSurface) and isinstance(b, NurbsSurface):
@@ -554,6 +593,8 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     if surface_a is None or surface_b is None:
         return intersection_curves(topology, surface_a, surface_b, tol=tol)
     chains, dense = refine_chains(topology, surface_a, surface_b, tol=tol)
+    if can_retry and any(_folded(c) for c in dense):
+        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1)
     ends = [((topology.uv_a[c.point_ids[0]], topology.uv_b[c.point_ids[0]]),
              (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in chains]
     dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
@@ -561,4 +602,6 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
     kinds = [(c.start_kind, c.end_kind) for c in chains]
     dense, kinds = _along_sides(dense, kinds, chains, ends, surface_a, surface_b, tol)
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
+    if can_retry and np.any(worst > tol):
+        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1)
     return _stray_policy(curves, worst, tol, stray)
