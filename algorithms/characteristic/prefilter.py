@@ -16,7 +16,17 @@ both out from the control nets alone (the net's convex hull holds the surface):
   tangential contact the segment through the point lies in the tangent plane,
   i.e. in the plane, so the contact is a segment, not an isolated point. The
   rule is not applied when the other surface lies within ``tol`` of the plane
-  (coincidence is the full analysis's answer to give).
+  (coincidence is the full analysis's answer to give);
+* **plane x monotone height**: one surface is planar (normal ``n``) and the
+  other, non-rational, has a height ``h = n . S - c`` over it that is strictly
+  monotone in ``u`` across each row of Bézier patches between the first and the
+  last patch that comes within ``tol`` of the plane (every u-difference of the
+  patches' control heights of one sign, each larger than ``tol``), or the same
+  in ``v`` across the columns. A closed loop ``h = 0`` inside the domain is cut
+  twice by some line ``v = const`` inside one row, at two points of patches
+  near the plane, and ``h`` would have to turn between them (Rolle); a contact
+  point needs ``grad h = 0`` in a patch near the plane. The whole-model cut of
+  a ship hull by a waterline plane is of this kind on every face.
 """
 
 from __future__ import annotations
@@ -26,6 +36,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..bezier import bezier_patches
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
 from .algorithm import CharacteristicRecord, FoundBy
@@ -41,6 +52,7 @@ class NoLoopReason(str, enum.Enum):
 
     APART = "apart"
     PLANE_AND_RULED = "plane and ruled"
+    MONOTONE_HEIGHT = "monotone height over a plane"
 
 
 def _patch_boxes(s: NurbsSurface) -> np.ndarray:
@@ -76,6 +88,40 @@ def _straight_direction(s: NurbsSurface) -> bool:
     return (s.degree_u == 1 and nu == 2) or (s.degree_v == 1 and nv == 2)
 
 
+def _monotone_rows(near: np.ndarray, step_sign: np.ndarray) -> bool:
+    """Every row ``j`` of ``near (ku, kv)`` has, from its first to its last near
+    patch, the same nonzero ``step_sign[i, j]``."""
+    for j in range(near.shape[1]):
+        idx = np.flatnonzero(near[:, j])
+        if idx.size == 0:
+            continue
+        signs = step_sign[idx[0]:idx[-1] + 1, j]
+        if not (np.all(signs == 1) or np.all(signs == -1)):
+            return False
+    return True
+
+
+def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
+                     tol: float) -> bool:
+    """The plane x monotone height rule of the module docstring."""
+    if s.is_rational or s.dimension != 3:
+        return False
+    patches, _, _ = bezier_patches(s)                      # (ku, kv, p+1, q+1, 4)
+    h = (patches[..., :3] / patches[..., 3:]) @ normal - float(centre @ normal)
+    near = (h.min(axis=(2, 3)) <= tol) & (h.max(axis=(2, 3)) >= -tol)
+    if not near.any():
+        return True
+    out = False
+    for axis, rows in ((2, lambda x: x), (3, lambda x: x.T)):
+        d = np.diff(h, axis=axis)
+        if d.shape[axis] == 0:
+            continue
+        sign = np.where((d > tol).all(axis=(2, 3)), 1,
+                        np.where((d < -tol).all(axis=(2, 3)), -1, 0))
+        out = out or _monotone_rows(rows(near), rows(sign))
+    return out
+
+
 def no_loop_reason(a: NurbsSurface, b: NurbsSurface, *, tol: float) -> NoLoopReason | None:
     """Why ``a`` and ``b`` can have no closed loop nor isolated contact point (module
     docstring), or None when the certificate must look.
@@ -91,12 +137,15 @@ def no_loop_reason(a: NurbsSurface, b: NurbsSurface, *, tol: float) -> NoLoopRea
         return NoLoopReason.APART
     for flat, other in ((a, b), (b, a)):
         plane = _plane(flat, tol)
-        if plane is None or not (_straight_direction(other) or _plane(other, tol) is not None):
+        if plane is None:
             continue
         centre, normal = plane
         if np.abs((other.control_points.reshape(-1, 3) - centre) @ normal).max() <= tol:
             continue                                     # may coincide: full analysis
-        return NoLoopReason.PLANE_AND_RULED
+        if _straight_direction(other) or _plane(other, tol) is not None:
+            return NoLoopReason.PLANE_AND_RULED
+        if _monotone_height(other, centre, normal, tol):
+            return NoLoopReason.MONOTONE_HEIGHT
     return None
 
 

@@ -82,3 +82,32 @@ def test_uncertified_record():
     rec = uncertified_record([], NoLoopReason.APART)
     assert rec.curves == () and rec.extra["skipped"] == "apart" and rec.counts() == {}
     assert rec.found_by == () and FoundBy.MESH.value == "mesh"
+
+
+def sloped_sheet() -> NurbsSurface:
+    """Bicubic height field rising in u (z = 0.6 u + small waves), 9 x 8 poles."""
+    u, v = np.meshgrid(np.linspace(0, 1, 9), np.linspace(0, 1, 8), indexing="ij")
+    z = 0.6 * u + 0.02 * np.sin(9 * v) + 0.01 * np.cos(5 * u)
+    knots_u = [0, 0, 0, 0, 0.2, 0.4, 0.6, 0.8, 0.9, 1, 1, 1, 1]
+    knots_v = [0, 0, 0, 0, 0.25, 0.5, 0.75, 0.9, 1, 1, 1, 1]
+    return NurbsSurface(np.stack([u, v, z], -1), knots_u, knots_v, 3, 3)
+
+
+@pytest.mark.parametrize("z", [0.05, 0.3, 0.55])
+def test_monotone_height_over_a_plane(z):
+    """Sloped sheet x horizontal plane: the height rises in u across the rows near the
+    plane, so no loop and no contact; the full method agrees (one open curve)."""
+    sheet, plane = sloped_sheet(), horizontal_plane(z)
+    assert no_loop_reason(sheet, plane, tol=TOL) is NoLoopReason.MONOTONE_HEIGHT
+    record = characteristic_intersection(sheet, plane, tol=TOL)
+    assert not record.isolated_points and len(record.curves) == 1
+    uv = record.curves[0].uv_a
+    assert min(uv[:, 1].min(), 1 - uv[:, 1].max()) <= 1e-6      # crosses the v-range
+
+
+def test_a_bump_near_the_plane_is_not_monotone():
+    net = sloped_sheet().control_points.copy()
+    net[4, 4, 2] += 0.4                                  # a bump in the middle
+    s = sloped_sheet()
+    bumped = NurbsSurface(net, s.knots_u, s.knots_v, 3, 3)
+    assert no_loop_reason(bumped, horizontal_plane(0.4), tol=TOL) is None
