@@ -25,8 +25,10 @@ both out from the control nets alone (the net's convex hull holds the surface):
   in ``v`` across the columns. A closed loop ``h = 0`` inside the domain is cut
   twice by some line ``v = const`` inside one row, at two points of patches
   near the plane, and ``h`` would have to turn between them (Rolle); a contact
-  point needs ``grad h = 0`` in a patch near the plane. The whole-model cut of
-  a ship hull by a waterline plane is of this kind on every face.
+  point needs ``grad h = 0`` in a patch near the plane. Where the net is too
+  coarse for the test, every span is halved (knot insertion, same surface) a few
+  times. The whole-model cut of a ship hull by a waterline plane is of this
+  kind on every face.
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ __all__ = ["PLANAR_SHARE", "NoLoopReason", "no_loop_reason", "uncertified_record
 
 #: a control net within this share of ``tol`` of a plane is planar
 PLANAR_SHARE = 1e-3
+#: span halvings at most for the monotone-height rule, and the largest net it may reach
+REFINEMENTS, MAX_REFINED_POLES = 3, 40_000
 
 
 class NoLoopReason(str, enum.Enum):
@@ -101,11 +105,32 @@ def _monotone_rows(near: np.ndarray, step_sign: np.ndarray) -> bool:
     return True
 
 
+def _halved(s: NurbsSurface) -> NurbsSurface:
+    """``s`` with a knot inserted in the middle of every span, both directions."""
+    for direction, knots, degree in (("u", s.knots_u, s.degree_u), ("v", s.knots_v, s.degree_v)):
+        k = np.unique(knots[degree:knots.size - degree])
+        s = s.refine(0.5 * (k[:-1] + k[1:]), direction)
+    return s
+
+
 def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
                      tol: float) -> bool:
-    """The plane x monotone height rule of the module docstring."""
+    """The plane x monotone height rule of the module docstring, on ``s`` and, while
+    it fails and the net stays under ``MAX_REFINED_POLES``, on ``s`` with every span
+    halved (up to ``REFINEMENTS`` times: the control net closes in on the surface)."""
     if s.is_rational or s.dimension != 3:
         return False
+    for level in range(REFINEMENTS + 1):
+        if _monotone_patches(s, centre, normal, tol):
+            return True
+        if level == REFINEMENTS or 4 * np.prod(s.n_control) > MAX_REFINED_POLES:
+            return False
+        s = _halved(s)
+    return False
+
+
+def _monotone_patches(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
+                      tol: float) -> bool:
     patches, _, _ = bezier_patches(s)                      # (ku, kv, p+1, q+1, 4)
     h = (patches[..., :3] / patches[..., 3:]) @ normal - float(centre @ normal)
     near = (h.min(axis=(2, 3)) <= tol) & (h.max(axis=(2, 3)) >= -tol)

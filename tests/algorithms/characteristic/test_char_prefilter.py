@@ -111,3 +111,17 @@ def test_a_bump_near_the_plane_is_not_monotone():
     s = sloped_sheet()
     bumped = NurbsSurface(net, s.knots_u, s.knots_v, 3, 3)
     assert no_loop_reason(bumped, horizontal_plane(0.4), tol=TOL) is None
+
+
+def test_monotone_height_after_halving_the_spans():
+    """Control heights 0, 0.5, 0.4, 1 along u: the net turns, the cubic does not
+    (its derivative's Bernstein coefficients 1.5, -0.3, 1.8 stay positive in
+    between): the rule holds once the spans are halved."""
+    heights = np.array([0.0, 0.5, 0.4, 1.0])
+    u, v = np.meshgrid(np.linspace(0, 1, 4), np.linspace(0, 1, 4), indexing="ij")
+    z = heights[:, None] + 0.05 * v
+    sheet = NurbsSurface(np.stack([u, v, z], -1), [0] * 4 + [1] * 4, [0] * 4 + [1] * 4, 3, 3)
+    plane = horizontal_plane(0.45)
+    assert no_loop_reason(sheet, plane, tol=TOL) is NoLoopReason.MONOTONE_HEIGHT
+    record = characteristic_intersection(sheet, plane, tol=TOL)
+    assert not record.isolated_points and len(record.curves) == 1
