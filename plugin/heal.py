@@ -51,6 +51,7 @@ from ..algorithms.healing import (
     local_approximant,
 )
 from ..algorithms.healing.connectivity import Side, _corner_number, side_points
+from ..algorithms.healing.clipping import trimmed_source
 from ..algorithms.healing.continuity import fit_side_to_curve
 from ..algorithms.healing.measure_joins import measure_join
 from ..algorithms.tolerance import check_tolerance
@@ -90,6 +91,8 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: a side fitted to an untouched face's edge gets at most this many knot spans
 MAX_SNAP_SPANS = 64
+#: pcurve samples per edge of a trimming loop (:func:`face_source`)
+LOOP_SAMPLES_PER_EDGE = 33
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
 
@@ -226,6 +229,41 @@ def _read_faces(model: CadModel) -> tuple[list[TrimmedFace | None], list[str]]:
             faces.append(None)
             skipped.append(f"face {i}: not readable as NURBS ({exc}); kept as it is")
     return faces, skipped
+
+
+def _loop_uv(loop) -> NDArray:
+    """(n, 2) float: one trimming loop sampled along its pcurves, in loop order."""
+    parts = []
+    for e in loop.edges:
+        t = np.linspace(e.t0, e.t1, LOOP_SAMPLES_PER_EDGE)
+        uv = e.pcurve.evaluate(t[::-1] if e.reversed else t)
+        parts.append(uv[:-1])
+    return np.concatenate(parts)
+
+
+def _is_natural(face: TrimmedFace, loops: list[NDArray]) -> bool:
+    """One loop running along the domain's rectangle: the whole surface is the face."""
+    if len(loops) != 1:
+        return False
+    u0, u1, v0, v1 = face.surface.domain
+    eps = 1e-7 * max(u1 - u0, v1 - v0)
+    uv = loops[0]
+    on_side = ((np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps)
+               | (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps))
+    return bool(np.all(on_side))
+
+
+def face_source(face: TrimmedFace):
+    """A face as a source of :func:`local_approximant`: its surface where the face is
+    the whole surface, else :func:`trimmed_source` (only the part inside its loops is
+    projected onto, so a hole in the face or a part trimmed away gets the fill)."""
+    loops = [_loop_uv(lp) for lp in face.loops]
+    if not loops or _is_natural(face, loops):
+        return face.surface
+    try:
+        return trimmed_source(face.surface, loops, name=face.name or "")
+    except SurfprepError:
+        return face.surface
 
 
 def _default_gap_tol(model: CadModel, edges) -> float:
@@ -387,7 +425,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     overlaps = find_overlaps(faces, four, gap_tol)
     trimmed = {o.trimmed: trimmed_back_boundary(faces, o) for o in overlaps}
     directed = read_patch_spec(patches, faces) if patches is not None else []
-    sources = [faces[i].surface for i in kept]
+    sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
     done = _approximate(_jobs(faces, kept, holes, directed, trimmed), sources, tol, gap_tol,
