@@ -45,16 +45,16 @@ from numpy.typing import NDArray
 from scipy.interpolate import RegularGridInterpolator
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
-from ..fitting import interpolate_surface, knots_from_breakpoints
 from ..isocurve import isocurve
 from ..knots import Direction
 from ..parametrization import parametrization_quality
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .boundary import arc_length_table, boundary_fractions
-from .deviation import deviation_map, original_on_new
+from .coarsen import RESPACE_TARGET, Fit, coarsen, respaced_fractions
 from .interior import PENALTY_TOL, initial_guess, relocate
 from .reconcile import insert_midpoints, reconcile_fractions
+from .spline_grid import cell_errors, fit_and_measure, line_indices, subgrid_fit
 
 __all__ = [
     "DEFAULT_RELATIVE_TOL",
@@ -74,6 +74,8 @@ BOUNDARY_SHARE = 0.8
 CREASE_ANGLE = 1e-4
 #: Stop refining when the deviation grows beyond this factor of the best so far.
 DIVERGING = 2.0
+#: Respacings tried after the fit is within tol (each one relocation + fit + dense check).
+RESPACE_TRIES = 3
 #: Fewest interpolation points per direction (a cubic not-a-knot spline).
 MIN_POINTS = 4
 
@@ -111,6 +113,8 @@ class ReparametrizationResult:
         New parameters of the interpolation points.
     uv : (n_u, n_v, 2) float
         Their parameters on the original surface (the reparametrization map).
+    lines_removed : int
+        Grid lines dropped again by the coarsening (u and v together).
     """
 
     surface: NurbsSurface
@@ -126,6 +130,7 @@ class ReparametrizationResult:
     params_u: NDArray
     params_v: NDArray
     uv: NDArray
+    lines_removed: int = 0
 
     @property
     def grid_shape(self) -> tuple[int, int]:
@@ -265,11 +270,6 @@ def _at_least(fractions: NDArray, f_breaks: NDArray, count: int = MIN_POINTS) ->
     return fractions
 
 
-def _line_indices(fractions: NDArray, f_breaks: NDArray) -> NDArray:
-    """Grid indices of the nodes on crease lines (interior f_breaks)."""
-    return np.array([int(np.argmin(np.abs(fractions - f))) for f in f_breaks[1:-1]], dtype=int)
-
-
 def _coons_blocks(uv: NDArray, fu: NDArray, fv: NDArray, iu: NDArray, jv: NDArray) -> NDArray:
     """Interior nodes of each block between fixed lines by bilinear Coons blending."""
     rows = np.concatenate([[0], iu, [len(fu) - 1]])
@@ -300,7 +300,7 @@ def _start_grid(surface: NurbsSurface, du: _Direction, dv: _Direction, fu: NDArr
     """
     u_lines, v_lines = du.parameters(fu), dv.parameters(fv)
     uv = initial_guess(u_lines[0], u_lines[1], v_lines[0], v_lines[1], surface.domain)
-    iu, jv = _line_indices(fu, du.f_breaks), _line_indices(fv, dv.f_breaks)
+    iu, jv = line_indices(fu, du.f_breaks), line_indices(fv, dv.f_breaks)
     for k, j in enumerate(jv):                   # v = crease lines (run along u)
         uv[:, j] = np.stack([u_lines[2 + k], np.full(len(fu), dv.breaks[k])], -1)
     for k, i in enumerate(iu):                   # u = crease lines (run along v)
@@ -319,19 +319,6 @@ def _start_grid(surface: NurbsSurface, du: _Direction, dv: _Direction, fu: NDArr
     elif iu.size or jv.size:
         uv = _coons_blocks(uv, fu, fv, iu, jv)
     return uv, fixed
-
-
-def _joined_knots(params: NDArray, joints: NDArray) -> NDArray:
-    """Not-a-knot cubic knots per piece, joined with multiplicity 3 (C0) at ``joints``."""
-    cuts = np.concatenate([[0], joints, [len(params) - 1]])
-    parts = [knots_from_breakpoints(params[a:b + 1], 3) for a, b in itertools.pairwise(cuts)]
-    out = [parts[0][:-4]]
-    for k, part in enumerate(parts[1:]):
-        out.append(np.full(3, params[joints[k]]))
-        out.append(part[4:-4] if k < len(parts) - 2 else part[4:])
-    if len(parts) == 1:
-        return parts[0]
-    return np.concatenate(out)
 
 
 def _refinement(dev, reverse, params_u: NDArray, params_v: NDArray, tol: float
@@ -355,7 +342,8 @@ def _refinement(dev, reverse, params_u: NDArray, params_v: NDArray, tol: float
 def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
                           per_span: int = 10, max_iterations: int = 12,
                           max_points: int = 400, relocation: bool = True,
-                          max_sweeps: int = 2000) -> ReparametrizationResult:
+                          max_sweeps: int = 2000, coarsening: bool = True
+                          ) -> ReparametrizationResult:
     """Chord-length (RCA) reparametrization within ``tol`` (section 29.2, module docstring).
 
     Parameters
@@ -378,6 +366,10 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         guess; for comparison only).
     max_sweeps : int
         Sweeps of each relocation at most.
+    coarsening : bool
+        Once within ``tol``, respace the points where the dense error leaves
+        headroom and drop grid lines (:mod:`.coarsen`; fewer poles, every
+        step measured densely and kept only within ``tol``).
 
     Returns
     -------
@@ -413,18 +405,14 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         if relocation:
             moved = relocate(surface, uv, fu, fv, max_sweeps=max_sweeps, penalty_tol=PENALTY_TOL,
                              fixed=fixed)
-            uv, points, settled = moved.uv, moved.points, moved.converged
+            uv, settled = moved.uv, moved.converged
             sweeps += moved.sweeps
         else:
-            points, settled = surface.evaluate(uv[..., 0], uv[..., 1]), True
+            settled = True
         pu, pv = fu * du.length, fv * dv.length
-        new = interpolate_surface(
-            points, params_u=pu, params_v=pv,
-            knots_u=_joined_knots(pu, _line_indices(fu, du.f_breaks)),
-            knots_v=_joined_knots(pv, _line_indices(fv, dv.f_breaks)))
-        dev = deviation_map(surface, new, pu, pv, uv, per_span)
-        reverse = original_on_new(surface, new, pu, pv, uv, per_span)
-        worst = max(dev.max, float(reverse[0].max()))
+        new, dev, reverse, worst = fit_and_measure(
+            surface, uv, pu, pv, (line_indices(fu, du.f_breaks), line_indices(fv, dv.f_breaks)),
+            per_span)
         done = worst <= tol
         if done or iteration == max_iterations or worst > DIVERGING * best:
             break
@@ -435,11 +423,46 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         previous = (fu, fv, uv)
         fu, fv = insert_midpoints(fu, bad_u), insert_midpoints(fv, bad_v)
         inserted += int(bad_u.sum() + bad_v.sum())
+    removed = 0
+    if done and coarsening:
+        target = RESPACE_TARGET
+        for _ in range(RESPACE_TRIES):          # a coarser point set where errors leave room
+            cells = cell_errors(dev, reverse, pu, pv)
+            su = respaced_fractions(fu, cells.max(axis=1), tol, du.f_breaks, target, MIN_POINTS)
+            sv = respaced_fractions(fv, cells.max(axis=0), tol, dv.f_breaks, target, MIN_POINTS)
+            if len(su) * len(sv) >= len(fu) * len(fv):
+                break
+            trial_uv, fixed = _start_grid(surface, du, dv, su, sv, (fu, fv, uv))
+            if relocation:
+                trial_uv = relocate(surface, trial_uv, su, sv, max_sweeps=max_sweeps,
+                                    penalty_tol=PENALTY_TOL, fixed=fixed).uv
+            tu, tv = su * du.length, sv * dv.length
+            trial = fit_and_measure(surface, trial_uv, tu, tv, (line_indices(su, du.f_breaks),
+                                                                line_indices(sv, dv.f_breaks)),
+                                    per_span)
+            if trial[3] <= tol:
+                fu, fv, uv, pu, pv = su, sv, trial_uv, tu, tv
+                new, dev, reverse, worst = trial
+            else:
+                target *= 0.6
+        fit = subgrid_fit(surface, uv, pu, pv,
+                          (line_indices(fu, du.f_breaks), line_indices(fv, dv.f_breaks)), per_span)
+        full_u, full_v = np.ones(len(fu), bool), np.ones(len(fv), bool)
+        start = Fit(full_u, full_v, worst, cell_errors(dev, reverse, pu, pv), (new, pu, pv, uv))
+        fixed_u, fixed_v = ~full_u, ~full_v
+        fixed_u[[0, -1]] = fixed_v[[0, -1]] = True
+        fixed_u[line_indices(fu, du.f_breaks)] = True
+        fixed_v[line_indices(fv, dv.f_breaks)] = True
+        best = coarsen(fit, start, fixed_u, fixed_v, tol, MIN_POINTS)
+        new, pu, pv, uv = best.payload
+        worst = best.worst
+        removed = int((~best.keep_u).sum() + (~best.keep_v).sum())
     return ReparametrizationResult(
         surface=new, tol=tol, max_deviation=worst, within_tolerance=bool(done),
         mismatch_before=_mismatch(surface), mismatch_after=_mismatch(new),
         iterations=iteration, knots_inserted=inserted, relocation_sweeps=sweeps,
-        relocation_converged=bool(settled), params_u=pu, params_v=pv, uv=uv)
+        relocation_converged=bool(settled), params_u=pu, params_v=pv, uv=uv,
+        lines_removed=removed)
 
 
 def crease_knots(surface: NurbsSurface, angle: float = CREASE_ANGLE) -> tuple[NDArray, NDArray]:
