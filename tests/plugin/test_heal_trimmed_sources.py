@@ -52,7 +52,7 @@ def test_face_source_trimmed_or_whole():
     part = face_source(face_to_nurbs(_grid_faces(bumped)[0]))        # x, y in [0, 1/3]
     assert isinstance(part, SurfaceSource) and part.mesh is not None
     centroids = part.mesh.triangle_uv().mean(axis=1)
-    assert centroids.max(axis=0) == pytest.approx([1 / 3, 1 / 3], abs=0.02)
+    assert centroids.max(axis=0) == pytest.approx([1 / 3, 1 / 3], abs=0.06)
     assert np.all(centroids <= 1 / 3 + 1e-9)
 
 
