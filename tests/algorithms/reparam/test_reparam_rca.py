@@ -200,3 +200,52 @@ def test_crease_becomes_a_fixed_c0_line():
     assert (crease - u0) / (u1 - u0) == pytest.approx(0.5, abs=1e-6)
     ridge = result.surface.evaluate(np.full(5, crease), np.linspace(*result.surface.domain[2:], 5))
     assert np.allclose(ridge[:, [0, 2]], [1.0, 0.6], atol=result.tol)
+
+
+def _tapering_tail() -> NurbsSurface:
+    """A tapering quarter tube in three cubic Bezier pieces along u joined C0 (the axis
+    bends at u = 1 and 2: creases), its rows crowded at every piece start (u
+    distorted), the cross-section poles uneven (v distorted); the radius shrinks
+    from 1 to 0.16 (like the fuselage tail, occt_fuselage faces 4-7)."""
+    ends, slopes = np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.0, 0.25, 0.7])
+    rows = np.concatenate([ends[k] + np.array(s) for k, s in
+                           enumerate([(0, 0.04, 0.25), (0, 0.04, 0.25), (0, 0.04, 0.25, 1)])])
+    piece = np.minimum(rows.astype(int), 2)
+    z = np.concatenate([[0], np.cumsum(slopes)])[piece] + slopes[piece] * (rows - ends[piece])
+    radius = 1.0 - 0.28 * rows
+    section = np.array([[1, 0], [1, 0.15], [0.35, 1.0], [0, 1]], float)
+    cp = np.stack([np.broadcast_to(3 * rows[:, None], (len(rows), 4)),
+                   radius[:, None] * section[None, :, 0],
+                   z[:, None] + radius[:, None] * section[None, :, 1]], -1)
+    return NurbsSurface(cp, [0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 3], [0] * 4 + [1] * 4, 3, 3)
+
+
+def _no_near_duplicates(params) -> bool:
+    """Neighbouring interpolation intervals differ by less than 8x."""
+    h = np.diff(params)
+    return bool(np.all(np.maximum(h[1:] / h[:-1], h[:-1] / h[1:]) < 8.0))
+
+
+def test_creased_tapering_tail():
+    from surfprep.algorithms.reparam.rca import crease_knots
+    original = _tapering_tail()
+    assert list(crease_knots(original)[0]) == [1.0, 2.0]
+    result = reparametrize_surface(original)
+    assert result.within_tolerance and result.relocation_converged
+    assert dense_deviation(original, result) <= result.tol
+    assert excess(result.mismatch_before) > 3.0
+    assert excess(result.mismatch_after) * 10 <= excess(result.mismatch_before)
+    # the v points of four lines (two boundaries, two creases) reconcile to one set,
+    # without clusters of nearly equal fractions
+    assert _no_near_duplicates(result.params_v) and _no_near_duplicates(result.params_u)
+    assert result.surface.n_control[1] <= 12
+
+
+@pytest.mark.parametrize("warp", [u_cubed, sheared])
+def test_coarsening_saves_poles_within_tol(warp):
+    original, coarse = reparametrized(warp)
+    _, dense = reparametrized(warp, coarsening=False)
+    assert dense.within_tolerance and coarse.within_tolerance
+    assert dense_deviation(original, coarse) <= coarse.tol
+    assert np.prod(coarse.surface.n_control) < np.prod(dense.surface.n_control)
+    assert excess(coarse.mismatch_after) * 10 <= excess(coarse.mismatch_before)

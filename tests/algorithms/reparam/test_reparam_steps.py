@@ -71,6 +71,19 @@ def test_reconcile_matches_and_inserts():
     assert np.array_equal(reconcile_fractions(a, a), a)
 
 
+def test_reconcile_merges_a_cluster_from_many_lines():
+    """Four lines (two boundaries, two crease lines) nearly agreeing: one point each,
+    not pairs plus leftovers (near-equal fractions are tiny knot intervals)."""
+    base = np.array([0.0, 0.14, 0.28, 0.43, 0.57, 0.71, 0.86, 1.0])
+    sets = [base + d * np.r_[0, np.ones(6), 0] for d in (0.0, 0.001, -0.0015, 0.002)]
+    out = reconcile_fractions(*sets)
+    assert len(out) == len(base)
+    assert np.allclose(out, base, atol=0.002)
+    # two points of the same line are never merged, however close
+    tight = np.array([0.0, 0.5, 0.501, 1.0])
+    assert len(reconcile_fractions(tight, tight + np.r_[0, 1e-4, 1e-4, 0])) == 4
+
+
 def test_initial_guess_is_the_line_intersection():
     bottom, top = np.array([0.0, 0.3, 1.0]), np.array([0.0, 0.5, 1.0])
     left, right = np.array([0.0, 0.2, 1.0]), np.array([0.0, 0.6, 1.0])
@@ -95,6 +108,8 @@ def test_relocation_recovers_the_cartesian_grid_of_a_sheared_plane():
     result = relocate(plane, uv, fu, fv)
     assert before > 0.3
     assert result.converged and result.penalty_after <= 1e-3
+    # the global Newton solve does the work, the node-by-node sweeps only confirm it
+    assert result.newton_steps >= 1 and result.sweeps <= 3
     x = result.points
     assert np.allclose(x[..., 0], fu[:, None], atol=2e-3)
     assert np.allclose(x[..., 1], fv[None, :], atol=2e-3)
