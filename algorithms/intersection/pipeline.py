@@ -48,6 +48,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from .extend import extend_open_ends
 from .mesh import TriangleMesh
 from .refine import RefinedCurve
 from .result import (
@@ -91,6 +92,8 @@ _JOIN_FACTOR = 4.0
 _RETRIES = 2
 _RETRY_FACTOR = 8.0
 _RETRY_FLOOR = 16.0
+#: first marching step from a hanging end, times ``mesh_tol``
+_MARCH_STEP = 0.25
 #: consecutive chords of refined samples turning by more than this: a fold
 _FOLD_ANGLE = np.radians(120.0)
 
@@ -411,6 +414,20 @@ def _close_boundary_gaps(curves: list[RefinedCurve], chains: list[Chain], ends_u
     return out
 
 
+def _extend(dense: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
+            surface_b: NurbsSurface, tol: float, mesh_tol: float):
+    """OPEN (hanging) ends continued on the exact surfaces (:mod:`.extend`); an end
+    that reaches a domain side becomes BOUNDARY."""
+    open_ends = [(s is EndKind.OPEN, e is EndKind.OPEN) for s, e in kinds]
+    if not any(a or b for a, b in open_ends):
+        return dense, kinds
+    dense, reached = extend_open_ends(dense, open_ends, surface_a, surface_b, tol=tol,
+                                      step=_MARCH_STEP * mesh_tol)
+    kinds = [tuple(EndKind.BOUNDARY if r else k for k, r in zip(kind, hit))
+             for kind, hit in zip(kinds, reached)]
+    return dense, kinds
+
+
 def _traced_sides(chains: list[Chain], ends_uv: list, surface_a: NurbsSurface,
                   surface_b: NurbsSurface) -> list[DomainSide]:
     """Domain sides the traced chains end on (both surfaces)."""
@@ -600,6 +617,7 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
     dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
                                  reach=_JOIN_FACTOR * mesh_tol)
     kinds = [(c.start_kind, c.end_kind) for c in chains]
+    dense, kinds = _extend(dense, kinds, surface_a, surface_b, tol, mesh_tol)
     dense, kinds = _along_sides(dense, kinds, chains, ends, surface_a, surface_b, tol)
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
     if can_retry and np.any(worst > tol):
