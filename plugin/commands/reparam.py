@@ -29,7 +29,8 @@ def face_entry(entry) -> dict:
             "mismatch_before": r.mismatch_before, "mismatch_after": r.mismatch_after,
             "poles_before": d.poles_before, "poles_after": d.poles_after,
             "grid": list(r.grid_shape), "iterations": r.iterations,
-            "knots_inserted": r.knots_inserted, "relocation_sweeps": r.relocation_sweeps,
+            "knots_inserted": r.knots_inserted, "lines_removed": r.lines_removed,
+            "relocation_sweeps": r.relocation_sweeps,
             "area_before": d.area_before, "area_after": d.area_after,
             "pcurve_deviation": d.pcurve_deviation,
         })
