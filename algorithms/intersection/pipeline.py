@@ -92,6 +92,10 @@ _JOIN_FACTOR = 4.0
 _RETRIES = 2
 _RETRY_FACTOR = 8.0
 _RETRY_FLOOR = 16.0
+#: a surface is closed across a seam when its opposite sides meet within this
+#: times ``tol`` (not ``mesh_tol``: a face narrower than a few ``mesh_tol``, like
+#: the KCS hull's 20 mm transom at mesh_tol 9 mm, is not closed)
+_SEAM_CLOSURE = 64.0
 #: first marching step from a hanging end, times ``mesh_tol``
 _MARCH_STEP = 0.25
 #: consecutive chords of refined samples turning by more than this: a fold
@@ -606,7 +610,8 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
                                   domain_a=domain_a, domain_b=domain_b)
     surface_a = a if isinstance(a, NurbsSurface) else None
     surface_b = b if isinstance(b, NurbsSurface) else None
-    topology = _cut_at_seams(topology, surface_a, surface_b, _JOIN_FACTOR * mesh_tol)
+    closure = min(_JOIN_FACTOR * mesh_tol, max(_SEAM_CLOSURE * tol, merge))
+    topology = _cut_at_seams(topology, surface_a, surface_b, closure)
     if surface_a is None or surface_b is None:
         return intersection_curves(topology, surface_a, surface_b, tol=tol)
     chains, dense = refine_chains(topology, surface_a, surface_b, tol=tol)

@@ -29,10 +29,11 @@ Findings (strict xfails, reported; at commits ca89398 / bc6c808):
   missing); 5.7-9.3 s against the Section's 0.3-0.4 s (now about 2 s). (The Section there is
   itself up to 0.22 mm off the surfaces near the nose and 0.25 mm mid-body,
   ours within 0.014 mm; tol 0.064 mm.)
-* KCS waterline at 30 % height: on hull face 1 (the transom, a plane
-  x = 170.89 mm) our piece runs out about 10 mm and back (20.6 mm long)
-  instead of the 16.2 mm segment, so 2.9 mm of the waterline are missing
-  (at bc6c808: 16 mm missing, Hausdorff 16 mm).
+* (fixed: seam closure measured to 64 tol, not 4 mesh_tol) KCS waterline at
+  30 % height: on hull face 1 (the transom, a plane x = 170.89 mm, 20.57 mm
+  wide) our piece ran out about 10 mm and back instead of across: the face is
+  narrower than 4 mesh_tol (37 mm), so its opposite sides "met" and the chain
+  was cut as if at a seam of a closed surface (at bc6c808: 16 mm missing).
   (Before 1e917ff the 60 % waterline also lost 3.26 m on face 16: its curve
   strayed beyond tol and was dropped; it passes now.)
 """
@@ -216,13 +217,7 @@ HULL_GAP = 1.0
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("fraction", [
-    pytest.param(0.3, marks=pytest.mark.xfail(strict=True, reason="BUG (reported): part of the "
-                                              "waterline on hull face 1 (the plane transom "
-                                              "x = 170.89) is missing: 2.9 mm at ca89398 (a piece "
-                                              "running out 10 mm and back), 16 mm at bc6c808")),
-    0.6,
-])
+@pytest.mark.parametrize("fraction", [0.3, 0.6])
 def test_hull_waterlines(hull, fraction):
     """Waterlines of the KCS hull (z at 30 % and 60 % of its height): the Section's
     curves covered by ours to 2 tol; ours may end up to the patch gap away from

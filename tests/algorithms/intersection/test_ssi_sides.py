@@ -80,3 +80,17 @@ def test_side_leaving_the_other_surface_ends_at_its_edge():
 def test_sides_not_on_the_other_surface_give_nothing():
     lifted = NurbsSurface(plane().control_points + [0, 0, 1e-3], [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
     assert side_curves(lifted, wall(), [DomainSide(1, 1, 0.0)], tol=TOL) == ([], [])
+
+
+def test_narrow_face_is_not_taken_for_a_closed_surface():
+    """A 0.02 wide strip (x = 0, y in [0, 0.02], z in [-1, 1]) cut by the plane z = 0
+    with mesh_tol 0.01: its opposite sides are nearer than 4 mesh_tol, which made
+    the seam cut treat the strip as closed and the curve ran half-way out and back
+    (KCS hull transom). Now one straight curve across the strip."""
+    strip = NurbsSurface(np.array([[[0, 0, -1], [0, 0, 1]], [[0, 0.02, -1], [0, 0.02, 1]]],
+                                  float), [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    curves = intersect_surfaces(strip, plane(), tol=TOL, mesh_tol=0.01)
+    assert len(curves) == 1
+    p = curves[0].points
+    assert np.sort(p[[0, -1], 1]) == pytest.approx([0, 0.02], abs=TOL)
+    assert curves[0].length == pytest.approx(0.02, rel=1e-9)
