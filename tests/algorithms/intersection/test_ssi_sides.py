@@ -83,11 +83,11 @@ def test_sides_not_on_the_other_surface_give_nothing():
 
 
 def test_narrow_face_is_not_taken_for_a_closed_surface():
-    """A 0.02 wide strip (x = 0, y in [0, 0.02], z in [-1, 1]) cut by the plane z = 0
+    """A 0.02 wide strip (x = 0, y in [0, 0.02], z in [-0.4, 1.6]) cut by the plane z = 0
     with mesh_tol 0.01: its opposite sides are nearer than 4 mesh_tol, which made
     the seam cut treat the strip as closed and the curve ran half-way out and back
     (KCS hull transom). Now one straight curve across the strip."""
-    strip = NurbsSurface(np.array([[[0, 0, -1], [0, 0, 1]], [[0, 0.02, -1], [0, 0.02, 1]]],
+    strip = NurbsSurface(np.array([[[0, 0, -0.4], [0, 0, 1.6]], [[0, 0.02, -0.4], [0, 0.02, 1.6]]],
                                   float), [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
     curves = intersect_surfaces(strip, plane(), tol=TOL, mesh_tol=0.01)
     assert len(curves) == 1
