@@ -34,8 +34,9 @@ __all__ = ["HEADROOM", "RESPACE_TARGET", "Fit", "coarsen", "respaced_fractions"]
 HEADROOM = 0.25
 #: Headroom of the single retry after a rejected batch.
 STRICT_HEADROOM = 1.0 / 16.0
-#: Error aimed at (share of ``tol``) when a whole direction is respaced.
-RESPACE_TARGET = 0.6
+#: Error aimed at per direction (share of ``tol``) when the point sets are respaced
+#: (a cell's error is about the sum of its u and v parts, hence below one half).
+RESPACE_TARGET = 0.45
 #: Largest factor by which one interval may grow or shrink in a respacing.
 RESPACE_LIMITS = (0.5, 2.0)
 #: Batches tried at most (each costs one fit and one dense measurement).

@@ -427,9 +427,9 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
     if done and coarsening:
         target = RESPACE_TARGET
         for _ in range(RESPACE_TRIES):          # a coarser point set where errors leave room
-            cells = cell_errors(dev, reverse, pu, pv)
-            su = respaced_fractions(fu, cells.max(axis=1), tol, du.f_breaks, target, MIN_POINTS)
-            sv = respaced_fractions(fv, cells.max(axis=0), tol, dv.f_breaks, target, MIN_POINTS)
+            eu, ev = _direction_errors(dev, reverse, pu, pv)
+            su = respaced_fractions(fu, eu, tol, du.f_breaks, target, MIN_POINTS)
+            sv = respaced_fractions(fv, ev, tol, dv.f_breaks, target, MIN_POINTS)
             if len(su) * len(sv) >= len(fu) * len(fv):
                 break
             trial_uv, fixed = _start_grid(surface, du, dv, su, sv, (fu, fv, uv))
@@ -463,6 +463,21 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         iterations=iteration, knots_inserted=inserted, relocation_sweeps=sweeps,
         relocation_converged=bool(settled), params_u=pu, params_v=pv, uv=uv,
         lines_removed=removed)
+
+
+def _direction_errors(dev, reverse, params_u: NDArray, params_v: NDArray
+                      ) -> tuple[NDArray, NDArray]:
+    """Error per u and per v interval that its own spacing causes ``(n_u-1,), (n_v-1,)``.
+
+    Along the grid lines the interpolant is a pure u (or v) interpolation, so
+    the line errors belong to one direction; what a cell adds beyond the sum of
+    its two line errors is shared by both in proportion to them.
+    """
+    cells = cell_errors(dev, reverse, params_u, params_v)
+    lu, lv = dev.u_errors[:, None], dev.v_errors[None, :]
+    total = np.maximum(lu + lv, 1e-300)
+    extra = np.maximum(cells - (lu + lv), 0.0)
+    return ((lu + extra * lu / total).max(axis=1), (lv + extra * lv / total).max(axis=0))
 
 
 def crease_knots(surface: NurbsSurface, angle: float = CREASE_ANGLE) -> tuple[NDArray, NDArray]:
