@@ -20,6 +20,13 @@ interior nodes are the intersections (:func:`initial_guess`).
 and the penalty is ``|R^u| + |R^v|`` (0: the node is where the new
 parametrization wants it).
 
+**Global solve first.** All movable nodes are first moved together by a
+damped Newton (Levenberg-Marquardt) solve of the square system
+``R^u = R^v = 0`` (:func:`solve_globally`, sparse): node-by-node moves need
+O(n^2) sweeps to carry a correction across an ``n x n`` grid, a global step
+does it at once (3-5 steps on smooth surfaces). The sweeps below then only
+finish what it left (nodes it could not move without fold-over).
+
 **Relocation.** A node is moved *in the original domain* by a damped Newton
 step on ``(R^u, R^v)`` with its neighbours held (the 2 x 2 Jacobian comes from
 ``s_u``, ``s_v`` and the chord directions); the step is accepted only if it

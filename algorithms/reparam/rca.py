@@ -19,7 +19,11 @@ parameters follow arc length (eqs. 29.1/29.2):
    intervals get their midpoints as new knots (a grid line of new points) and
    steps 3-4 repeat, up to ``max_iterations`` times (or until the deviation
    grows to twice the best so far: then the relocation does not settle and
-   more points do not help).
+   more points do not help);
+5. once within ``tol``, fewer points where the error leaves room
+   (:mod:`.coarsen`): each direction is respaced by the h^4 law from the error
+   its own spacing causes, relocated, fitted and measured again (kept only
+   within ``tol``), then single grid lines far below ``tol`` are dropped.
 
 Creases (knot lines of multiplicity >= degree across which the surface turns,
 :func:`crease_knots`) become fixed grid lines: the lines along the other
