@@ -177,7 +177,7 @@ def _sides(found: NDArray, t: NDArray, y: NDArray, x: NDArray, keep_boundary: bo
     return rim, found & ~off_surface, np.where(rim, 0.5, t)
 
 
-def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache):
+def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache, preferred):
     """Segments of the grid (and of the ring around it, :mod:`.ring`) projected."""
     ring = ring_segments(coons, off.distance, ring_rows) if ring_rows > 0 else None
     a, b = off.upper.reshape(-1, 3), off.lower.reshape(-1, 3)
@@ -195,7 +195,7 @@ def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache):
             sources, box + np.array([[-pad], [pad]]),
             mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
     y, t, found, src = project_grid(a, b, cache["clipped"].restrict(box),
-                                    tol=_NEWTON_FRACTION * size)
+                                    tol=_NEWTON_FRACTION * size, preferred=preferred)
     return ring, y, t, found, src
 
 
@@ -215,10 +215,11 @@ def _fill(coons, ring, t, known, t_ring, found_ring, hardy, neighbours) -> NDArr
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
-              ring_rows: int, cache: dict) -> _Pass:
+              ring_rows: int, preferred: int | None, cache: dict) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
-    ring, y, t, found, src = _project(off, coons, ring_rows, sources, mesh_tol, size, cache)
+    ring, y, t, found, src = _project(off, coons, ring_rows, sources, mesh_tol, size, cache,
+                                      preferred)
     inner = (m + 1) * (n + 1)
     t_ring, found_ring = t[inner:], found[inner:]
     y, t, found, src = y[:inner], t[:inner], found[:inner], src[:inner]
@@ -250,6 +251,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       gap_tol: float | None = None, mesh_tol: float | None = None,
                       keep_boundary: bool = True, ring_rows: int | None = None,
                       fill_resolution: tuple[int, int] = FILL_RESOLUTION,
+                      preferred_source: int | None = None,
                       strict: bool = False) -> LocalApproximant:
     """A bicubic B-spline surface over four boundary curves that follows the sources.
 
@@ -285,6 +287,12 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     fill_resolution : (int, int)
         A grid with artificial projections is refined at least to this (capped
         by ``max_resolution``), even when ``tol`` is met earlier.
+    preferred_source : int, optional
+        Index into ``sources`` of the surface the approximant replaces: a
+        segment that hits it takes that hit, other sources only serve where
+        it is missed (gaps at its rim). Without it the hit nearest the Coons
+        point wins (001), which with the long segments of eq. (8) can be a
+        far-away face crossing the segment.
     growth : float > 1
         Resolution factor between passes (at least +2 each).
     gap_tol : float, optional
@@ -332,6 +340,10 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
             f"max_resolution {limit} must be at least resolution {current}")
     if not (np.isfinite(growth) and growth > 1):
         raise InvalidGeometryError(f"growth must be > 1, got {growth!r}")
+    if preferred_source is not None and not (
+            isinstance(preferred_source, (int, np.integer)) and 0 <= preferred_source < len(srcs)):
+        raise InvalidGeometryError(
+            f"preferred_source must index the {len(srcs)} sources, got {preferred_source!r}")
     if not (isinstance(neighbours, (int, np.integer)) and neighbours >= 1):
         raise InvalidGeometryError(f"neighbours must be an integer >= 1, got {neighbours!r}")
     if offset is not None:
@@ -345,7 +357,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
                       hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
                       keep_boundary=keep_boundary, tol=tol, size=size,
-                      ring_rows=ring_rows, cache=cache)
+                      ring_rows=ring_rows, preferred=preferred_source, cache=cache)
         share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)

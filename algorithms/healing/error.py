@@ -187,9 +187,11 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
                           ) -> NDArray:
     """Shortest distance of each point to the clipped sources, through their triangles.
 
-    The nearest triangles (by centroid) give, per point and source, the closest
-    point of the triangulation; on a parametric source its barycentric
-    ``(u, v)`` (eq. 10) starts Newton point inversion on the exact surface.
+    Per source, its triangles nearest each point (by centroid, searched among
+    that source's triangles only: a plane cut into a few large triangles is not
+    crowded out by a finely triangulated neighbour) give the closest point of
+    the triangulation; on a parametric source its barycentric ``(u, v)``
+    (eq. 10) starts Newton point inversion on the exact surface.
 
     Parameters
     ----------
@@ -202,33 +204,37 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
     -------
     (k,) float, ``inf`` where there is no triangle.
     """
-    k_pts, n_tri = points.shape[0], clipped.n_triangles
-    best = np.full(k_pts, np.inf)
-    if k_pts == 0 or n_tri == 0:
+    best = np.full(points.shape[0], np.inf)
+    if points.shape[0] == 0 or clipped.n_triangles == 0:
         return best
-    k = min(_CANDIDATE_TRIANGLES, n_tri)
-    _, cand = cKDTree(clipped.points.mean(axis=1)).query(points, k=k)
-    cand = cand.reshape(k_pts, k).ravel()
+    for s_id in np.unique(clipped.source):
+        ids = np.flatnonzero(clipped.source == s_id)
+        np.minimum(best, _source_triangles_distance(points, clipped, s_id, ids, tol), out=best)
+    return best
+
+
+def _source_triangles_distance(points: NDArray, clipped: ClippedTriangles, s_id: int,
+                               ids: NDArray, tol: float) -> NDArray:
+    """Distance of each point to one source through its clipped triangles ``ids``."""
+    k_pts = points.shape[0]
+    k = min(_CANDIDATE_TRIANGLES, ids.size)
+    _, cand = cKDTree(clipped.points[ids].mean(axis=1)).query(points, k=k)
+    cand = ids[cand.reshape(k_pts, k)].ravel()
     rows = np.repeat(np.arange(k_pts), k)
     foot, bary = closest_on_triangles(points[rows], clipped.points[cand])
-    dist = np.linalg.norm(points[rows] - foot, axis=1)
-    src = clipped.source[cand]
-    order = np.lexsort((dist, rows * len(clipped.sources) + src))   # best per (point, source)
-    key = (rows * len(clipped.sources) + src)[order]
-    first = order[np.r_[True, key[1:] != key[:-1]]]
-    uv = np.einsum("pk,pkc->pc", bary[first], clipped.uv[cand[first]])
+    dist = np.linalg.norm(points[rows] - foot, axis=1).reshape(k_pts, k)
+    pick = np.argmin(dist, axis=1)
+    flat = np.arange(k_pts) * k + pick
+    out = dist[np.arange(k_pts), pick]
+    uv = np.einsum("pk,pkc->pc", bary[flat], clipped.uv[cand[flat]])
+    surface = clipped.sources[s_id].surface
     exact_uv = np.all(np.isfinite(uv), axis=1)
-    mesh_only = ~exact_uv          # chords, not the surface, where the surface is known
-    np.minimum.at(best, rows[first][mesh_only], dist[first][mesh_only])
-    for s_id in np.unique(src[first]):
-        surface = clipped.sources[s_id].surface
-        sel = np.flatnonzero((src[first] == s_id) & exact_uv)
-        if surface is None or sel.size == 0:
-            continue
-        exact = project_to_surface(surface, points[rows[first][sel]], tol=tol,
-                                   guess=uv[sel]).distance
-        np.minimum.at(best, rows[first][sel], exact)
-    return best
+    if surface is None or not np.any(exact_uv):
+        return out
+    # chords, not the surface, where the surface is known
+    out[exact_uv] = project_to_surface(surface, points[exact_uv], tol=tol,
+                                       guess=uv[exact_uv]).distance
+    return out
 
 
 def measure_error(surface: NurbsSurface, found: NDArray, clipped: ClippedTriangles,

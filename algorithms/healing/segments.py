@@ -173,8 +173,8 @@ def pierce_surface(surface: NurbsSurface, origin: NDArray, direction: NDArray, u
     return uv, t, ok
 
 
-def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: float
-                 ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: float,
+                 preferred: int | None = None) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Projections ``y`` of the grid onto the sources (eqs. 9-11 and the Newton polish).
 
     The hit nearest the midpoint is chosen after the polish, among the nearest
@@ -188,6 +188,11 @@ def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: floa
     clipped : ClippedTriangles
     tol : float
         Residual accepted by the Newton polish, model units.
+    preferred : int, optional
+        Index of a source whose hit wins over hits on the others, nearer the
+        midpoint or not (the face an approximant replaces: other faces are
+        only for where the segment misses it; with a long ``d`` a segment may
+        otherwise pick a far-away face that crosses it nearer ``x``).
 
     Returns
     -------
@@ -217,7 +222,8 @@ def project_grid(a: NDArray, b: NDArray, clipped: ClippedTriangles, *, tol: floa
         final_uv = np.where(ok[:, None], new_uv, uv[sel])
         points[sel] = surface.evaluate(final_uv[:, 0], final_uv[:, 1])
         t[sel] = np.where(ok, new_t, t[sel])
-    best = _nearest_midpoint(seg, t)
+    rank = t if preferred is None else np.where(src == preferred, t, t + 2.0)
+    best = _nearest_midpoint(seg, rank)     # |rank - 1/2| > 1 off the preferred source
     out_points = np.full(a.shape, np.nan)
     out_t = np.full(n, np.nan)
     out_src = np.full(n, -1, np.int64)

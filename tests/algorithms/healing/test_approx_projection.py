@@ -12,7 +12,12 @@ from surfprep.algorithms.healing.error import (
     distance_to_triangles,
     error_parameters,
 )
-from surfprep.algorithms.healing.segments import intersect_segments, pierce_surface
+from surfprep.algorithms.healing.segments import (
+    intersect_segments,
+    pierce_surface,
+    project_grid,
+)
+from surfprep.algorithms.surface import NurbsSurface
 
 RNG = np.random.default_rng(11)
 
@@ -90,3 +95,38 @@ def test_distance_through_triangles_matches_global_inversion():
     local = distance_to_triangles(pts, clipped, tol=1e-12)
     glob = distance_to_sources(pts, sources, tol=1e-12)
     np.testing.assert_allclose(local, glob, atol=1e-10)       # exact, not the chords
+
+
+def _plane(z: float, lo: float = -1.0, hi: float = 2.0) -> NurbsSurface:
+    c = np.array([[[lo, lo, z], [lo, hi, z]], [[hi, lo, z], [hi, hi, z]]], float)
+    return NurbsSurface(c, np.array([0, 0, 1, 1.0]), np.array([0, 0, 1, 1.0]), 1, 1)
+
+
+def test_preferred_source_wins_over_a_hit_nearer_the_midpoint():
+    # planes z = 0.7 (nearer the segments' midpoints) and z = 0.1 (the preferred one)
+    sources = as_sources([_plane(0.7), _plane(0.1)])
+    clipped = clip_sources(sources, np.array([[-1, -1, -1], [2, 2, 2.0]]), mesh_tol=1e-3)
+    s = np.linspace(0.0, 1.0, 5)
+    a = np.stack([s, s, np.ones_like(s)], axis=1)
+    b = a - [0, 0, 1.0]
+    y, t, found, src = project_grid(a, b, clipped, tol=1e-12)
+    assert found.all() and np.all(src == 0)
+    np.testing.assert_allclose(y[:, 2], 0.7)
+    y, t, found, src = project_grid(a, b, clipped, tol=1e-12, preferred=1)
+    assert found.all() and np.all(src == 1)
+    np.testing.assert_allclose(y[:, 2], 0.1)
+    np.testing.assert_allclose(t, 0.9)
+
+
+def test_coarse_plane_not_crowded_out_by_a_fine_neighbour():
+    # a plane in two big triangles next to a finely triangulated curved patch: the error
+    # of points on the plane is ~0 even where the patch's centroids are all nearer
+    plane = _plane(0.0, 0.0, 100.0)
+    fine = smooth_surface()                        # ~unit size, near the plane's corner
+    sources = as_sources([plane, fine])
+    clipped = clip_sources(sources, np.array([[-1, -1, -1], [101, 101, 1.0]]), mesh_tol=1e-4)
+    assert np.sum(clipped.source == 0) <= 8 < np.sum(clipped.source == 1)
+    pts = np.stack([RNG.uniform(0.5, 3.0, 200), RNG.uniform(0.5, 3.0, 200),
+                    np.zeros(200)], axis=1)
+    d = distance_to_triangles(pts, clipped, tol=1e-12)
+    assert d.max() < 1e-9
