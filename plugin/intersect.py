@@ -10,7 +10,11 @@ is clipped to both faces' trimmed domains:
   that are long in the parameter plane) into one set of polygon segments; a
   (u, v) point is inside when a ray in +u crosses them an odd number of times
   (even-odd rule: outer loop and holes at once), vectorized over points x
-  segments. A face without loops is its whole parameter rectangle.
+  segments. A face without loops is its whole parameter rectangle. Everything
+  the test needs is built once per face and cached (:class:`_LoopIndex`: the
+  segments bucketed by v, a k-d tree of them in (u, v); a k-d tree of the
+  trimming edges in space for the tolerance band), so the 30 bisection rounds
+  of the splitting cost little.
 * **Splitting**: a curve is cut into the runs of samples inside both faces.
   Where a run leaves a face, the crossing is located on the interpolants
   (``curve3d``, ``pcurve_a``, ``pcurve_b`` share one parameter) by 30
