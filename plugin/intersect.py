@@ -11,7 +11,7 @@ is clipped to both faces' trimmed domains:
   (u, v) point is inside when a ray in +u crosses them an odd number of times
   (even-odd rule: outer loop and holes at once), vectorized over points x
   segments. A face without loops is its whole parameter rectangle. Everything
-  the test needs is built once per face and cached (:class:`_LoopIndex`: the
+  the test needs is built once per face and cached (:class:`surfprep.plugin.trim_loops.LoopIndex`: the
   segments bucketed by v, a k-d tree of them in (u, v); a k-d tree of the
   trimming edges in space for the tolerance band), so the 30 bisection rounds
   of the splitting cost little.
@@ -92,6 +92,7 @@ from .intersect_methods import (
     pair_curves,
 )
 from .io import CadModel
+from .trim_loops import EDGE_SAMPLES, LoopIndex, SegmentTree, is_rectangle, loop_segments
 
 __all__ = [
     "DEFAULT_TOL_FACTOR",
@@ -114,8 +115,6 @@ __all__ = [
 DEFAULT_TOL_FACTOR = 1e-6
 #: smallest accepted ``tol``: this times that diagonal
 MIN_TOL_FACTOR = 1e-9
-#: samples per trimming edge for the point-in-face test
-EDGE_SAMPLES = 64
 _BISECTIONS = 30
 #: a (u, v) this close to a trimming loop (relative to the domain diagonal) is inside
 ON_BOUNDARY = 1e-9
@@ -171,7 +170,7 @@ class FaceOperand:
         """``(m, 2, 2)`` segments of the sampled trimming loops in ``(u, v)`` (cached)."""
         if "segments" not in self._cache:
             (self._cache["segments"], self._cache["segment_edges"],
-             self._cache["segment_params"]) = _loop_segments(self.trimmed)
+             self._cache["segment_params"]) = loop_segments(self.trimmed)
         return self._cache["segments"]
 
     def segment_edges(self) -> tuple[NDArray, NDArray]:
@@ -192,14 +191,14 @@ class FaceOperand:
     def edge_tolerance(self) -> float:
         return max((e.tolerance for e in self.trimmed.edges), default=0.0)
 
-    def loop_index(self) -> _LoopIndex | None:
+    def loop_index(self) -> LoopIndex | None:
         """The trimming loops prepared for :func:`inside_face` (cached; None: a rectangle)."""
         if "loop_index" not in self._cache:
             seg = self.boundary_segments()
             u0, u1, v0, v1 = self.surface.domain
             eps = ON_BOUNDARY * np.hypot(u1 - u0, v1 - v0)
-            rect = seg.shape[0] == 0 or _is_rectangle(seg, self.surface.domain, 1e3 * eps)
-            self._cache["loop_index"] = None if rect else _LoopIndex.build(seg)
+            rect = seg.shape[0] == 0 or is_rectangle(seg, self.surface.domain, 1e3 * eps)
+            self._cache["loop_index"] = None if rect else LoopIndex.build(seg)
         return self._cache["loop_index"]
 
     def edge_distance(self, points: NDArray) -> NDArray:
@@ -207,7 +206,7 @@ class FaceOperand:
         (:meth:`boundary_polylines`; k-d tree built once per face)."""
         if "edge_tree" not in self._cache:
             lines = self.boundary_polylines()
-            self._cache["edge_tree"] = _SegmentTree.from_polylines(lines) if lines else None
+            self._cache["edge_tree"] = SegmentTree.from_polylines(lines) if lines else None
         tree = self._cache["edge_tree"]
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         return np.full(points.shape[0], np.inf) if tree is None else tree.distance(points)
@@ -249,129 +248,6 @@ def face_operands(x: Any) -> list[FaceOperand]:
 
 
 # ------------------------------------------------------------------ classification
-def _loop_segments(face: TrimmedFace) -> tuple[NDArray, NDArray, NDArray]:
-    """Polygon segments of all trimming loops (pcurves sampled densely).
-
-    Returns ``segments (m, 2, 2)`` in ``(u, v)``, the edge (index into
-    ``face.edges``) of each ``(m,) int`` and its pcurve parameters at both ends
-    ``(m, 2) float``.
-    """
-    segments, owners, params = [], [], []
-    u0, u1, v0, v1 = face.surface.domain
-    diagonal = max(np.hypot(u1 - u0, v1 - v0), 1e-300)
-    for k, edge in enumerate(face.edges):
-        t = np.linspace(edge.t0, edge.t1, EDGE_SAMPLES)
-        uv = edge.pcurve.evaluate(t)
-        # edges long in the parameter plane get more samples
-        rel = np.linalg.norm(np.diff(uv, axis=0), axis=1).sum() / diagonal
-        if rel > 0.25:
-            t = np.linspace(edge.t0, edge.t1, int(EDGE_SAMPLES * min(16, 4 * rel)))
-            uv = edge.pcurve.evaluate(t)
-        segments.append(np.stack([uv[:-1], uv[1:]], axis=1))
-        owners.append(np.full(t.size - 1, k))
-        params.append(np.stack([t[:-1], t[1:]], axis=1))
-    if not segments:
-        return np.zeros((0, 2, 2)), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
-    return np.concatenate(segments), np.concatenate(owners), np.concatenate(params)
-
-
-def _is_rectangle(seg: NDArray, domain, eps: float) -> bool:
-    """True when every loop segment lies on a side of the parameter rectangle."""
-    u0, u1, v0, v1 = domain
-    on = lambda x, lo, hi: (np.abs(x - lo) <= eps) | (np.abs(x - hi) <= eps)
-    pts = seg.reshape(-1, 2)
-    same_u = on(seg[:, 0, 0], u0, u1) & (np.abs(seg[:, 0, 0] - seg[:, 1, 0]) <= eps)
-    same_v = on(seg[:, 0, 1], v0, v1) & (np.abs(seg[:, 0, 1] - seg[:, 1, 1]) <= eps)
-    return bool(np.all(same_u | same_v) and pts.size)
-
-
-@dataclass(frozen=True, eq=False)
-class _SegmentTree:
-    """Segments ``start + s vec`` (``s`` in [0, 1]) with a k-d tree of their midpoints,
-    built once, for nearest-segment distances of many point batches."""
-
-    start: NDArray
-    vec: NDArray
-    tree: Any
-
-    @classmethod
-    def from_segments(cls, start: NDArray, vec: NDArray) -> _SegmentTree:
-        from scipy.spatial import cKDTree
-        return cls(start, vec, cKDTree(start + 0.5 * vec))
-
-    @classmethod
-    def from_polylines(cls, lines: Sequence[NDArray]) -> _SegmentTree:
-        lines = [np.vstack([q, q]) if q.shape[0] == 1 else q for q in lines]
-        return cls.from_segments(np.concatenate([q[:-1] for q in lines]),
-                                 np.concatenate([np.diff(q, axis=0) for q in lines]))
-
-    def distance(self, x: NDArray, k: int = 8) -> NDArray:
-        """Distance ``(n,)`` from each point ``x (n, dim)`` to the nearest of the ``k``
-        segments whose midpoints are nearest (the segments are short and even)."""
-        if x.shape[0] == 0:
-            return np.zeros(0)
-        k = min(k, self.start.shape[0])
-        _, idx = self.tree.query(x, k=k)
-        idx = idx.reshape(x.shape[0], k)
-        pa, pd = self.start[idx], self.vec[idx]
-        dd = np.einsum("nkc,nkc->nk", pd, pd)
-        t = np.clip(np.einsum("nkc,nkc->nk", x[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0),
-                    0, 1)
-        return np.linalg.norm(pa + t[..., None] * pd - x[:, None], axis=-1).min(axis=1)
-
-
-@dataclass(frozen=True, eq=False)
-class _LoopIndex:
-    """A face's loop segments bucketed by v (for the even-odd ray test) and a
-    segment tree in ``(u, v)``, built once per face."""
-
-    a: NDArray                 # (m, 2) segment starts
-    b: NDArray                 # (m, 2) segment ends
-    lo: float                  # v of the first bucket
-    width: float               # bucket height
-    bins: int
-    seg_sorted: NDArray        # segment indices grouped by bucket
-    indptr: NDArray            # (bins + 1,) bucket starts in seg_sorted
-    hi: float
-    uv_tree: _SegmentTree
-
-    @classmethod
-    def build(cls, seg: NDArray) -> _LoopIndex:
-        a, b = seg[:, 0], seg[:, 1]
-        bins = int(max(1, min(4096, 2 * np.sqrt(seg.shape[0]))))
-        vlo, vhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
-        lo, hi = float(vlo.min()), float(vhi.max())
-        width = (hi - lo) / bins if hi > lo else 1.0
-        first = np.clip(((vlo - lo) / width).astype(np.int64), 0, bins - 1)
-        last = np.clip(((vhi - lo) / width).astype(np.int64), 0, bins - 1)
-        count = last - first + 1
-        seg_of = np.repeat(np.arange(seg.shape[0]), count)
-        bin_of = np.repeat(first, count) + (np.arange(count.sum())
-                                            - np.repeat(np.cumsum(count) - count, count))
-        order = np.argsort(bin_of, kind="stable")
-        indptr = np.concatenate([[0], np.cumsum(np.bincount(bin_of, minlength=bins))])
-        return cls(a, b, lo, width, bins, seg_of[order], indptr, hi,
-                   _SegmentTree.from_segments(a, b - a))
-
-    def crossings(self, uv: NDArray) -> NDArray:
-        """Crossings ``(n,) int`` of a ray in +u from each point with the segments,
-        testing only the segments of the point's v-bucket."""
-        a, b = self.a, self.b
-        pbin = np.clip(((uv[:, 1] - self.lo) / self.width).astype(np.int64), 0, self.bins - 1)
-        inside_range = (uv[:, 1] >= self.lo) & (uv[:, 1] <= self.hi)
-        per_point = np.where(inside_range, self.indptr[pbin + 1] - self.indptr[pbin], 0)
-        point_of = np.repeat(np.arange(uv.shape[0]), per_point)
-        offs = np.arange(per_point.sum()) - np.repeat(np.cumsum(per_point) - per_point,
-                                                      per_point)
-        cand = self.seg_sorted[self.indptr[pbin[point_of]] + offs]
-        pa, pb, p = a[cand], b[cand], uv[point_of]
-        straddle = (pa[:, 1] > p[:, 1]) != (pb[:, 1] > p[:, 1])
-        dv = np.where(pb[:, 1] != pa[:, 1], pb[:, 1] - pa[:, 1], 1.0)
-        u_cross = pa[:, 0] + (p[:, 1] - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dv
-        hit = straddle & (u_cross > p[:, 0])
-        return np.bincount(point_of[hit], minlength=uv.shape[0])
-
-
 def inside_face(operand: FaceOperand, uv: NDArray, tol: float = 0.0) -> NDArray:
     """``(n,) bool``: which ``uv (n, 2)`` lie inside the face.
 
