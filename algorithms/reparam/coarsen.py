@@ -141,14 +141,15 @@ def coarsen(fit: Callable[[NDArray, NDArray], Fit], start: Fit, fixed_u: NDArray
 
 def respaced_fractions(fractions: NDArray, interval_errors: NDArray, tol: float,
                        f_breaks: NDArray, target: float = RESPACE_TARGET,
-                       min_points: int = 4) -> NDArray:
+                       min_points: int = 4, grow: bool = True) -> NDArray:
     """A new point set whose intervals aim at ``target * tol`` (the h^4 law).
 
     An interval of width ``h`` with error ``e`` wants width
     ``h (target tol / e)^(1/4)`` (within :data:`RESPACE_LIMITS`); the wanted
     density ``1 / width`` is integrated over each piece between crease
     fractions ``f_breaks`` and the piece gets ``ceil`` of it intervals (at least
-    ``min_points - 1``) at equal steps of the integral.
+    ``min_points - 1``) at equal steps of the integral. With ``grow`` False no
+    interval may grow (refining a point set that missed ``tol``).
 
     Parameters
     ----------
@@ -162,8 +163,8 @@ def respaced_fractions(fractions: NDArray, interval_errors: NDArray, tol: float,
     (m,) float
     """
     h = np.diff(fractions)
-    grow = (target * tol / np.maximum(interval_errors, 1e-300 * tol)) ** 0.25
-    density = 1.0 / (h * np.clip(grow, *RESPACE_LIMITS))
+    factor = (target * tol / np.maximum(interval_errors, 1e-300 * tol)) ** 0.25
+    density = 1.0 / (h * np.clip(factor, RESPACE_LIMITS[0], RESPACE_LIMITS[1] if grow else 1.0))
     effort = np.concatenate([[0.0], np.cumsum(density * h)])
     out = [np.array([0.0])]
     for a, b in itertools.pairwise(f_breaks):

@@ -66,6 +66,9 @@ _SCALES = np.array([1.0, 0.5, 0.25, 0.125, 0.0625])
 #: Levenberg-Marquardt steps of the global solve at most, and its damping range.
 GLOBAL_STEPS = 40
 _DAMPING = (1e-6, 1e6)
+#: Relative drop of the squared residuals below which a global step counts as stalled
+#: (three in a row end the solve; the sweeps take over).
+_STALL = 0.01
 
 
 @dataclass(frozen=True)
@@ -268,7 +271,8 @@ def solve_globally(surface: NurbsSurface, uv: NDArray, points: NDArray,
     global Newton step does it at once. Each step solves the damped normal
     equations ``(J^T J + lambda D) delta = -J^T r`` (sparse; ``D`` the diagonal
     of ``J^T J``), is cut to the box of each node's neighbours (no fold-over) and
-    is accepted only if the sum of squared residuals drops (else ``lambda`` x 10).
+    is accepted only if the sum of squared residuals drops (else ``lambda`` x 10);
+    three steps in a row that gain less than 1 % end it.
 
     Parameters
     ----------
@@ -285,7 +289,7 @@ def solve_globally(surface: NurbsSurface, uv: NDArray, points: NDArray,
     if not np.any(rows):
         return uv, points, 0
     cost = _sum_squares(points, targets, floor, rows)
-    damping, accepted = 1e-3, 0
+    damping, accepted, stalled = 1e-3, 0, 0
     for _ in range(steps):
         jac, ii, jj = _global_jacobian(surface, uv, points, movable)
         ru, rv = _residuals(points, *targets, floor)
@@ -316,9 +320,9 @@ def solve_globally(surface: NurbsSurface, uv: NDArray, points: NDArray,
         if not improved:
             break
         accepted += 1
-        done = cost - trial <= 1e-12 * cost
+        stalled = stalled + 1 if trial > (1.0 - _STALL) * cost else 0
         cost = trial
-        if done or np.sqrt(cost / r.size) < 1e-2 * PENALTY_TOL:
+        if stalled >= 3 or np.sqrt(cost / r.size) < 1e-2 * PENALTY_TOL:
             break
     return uv, points, accepted
 

@@ -78,8 +78,12 @@ BOUNDARY_SHARE = 0.8
 CREASE_ANGLE = 1e-4
 #: Stop refining when the deviation grows beyond this factor of the best so far.
 DIVERGING = 2.0
-#: Respacings tried after the fit is within tol (each one relocation + fit + dense check).
-RESPACE_TRIES = 3
+#: A coarser fit is kept only within this share of ``tol`` (a margin for what lies
+#: between the 10 x 10 check points per cell).
+COARSE_SHARE = 0.9
+#: Respacings tried after the fit is within tol (each one relocation + fit + dense
+#: check); each starts from the errors of the previous one, kept or not.
+RESPACE_TRIES = 4
 #: Fewest interpolation points per direction (a cubic not-a-knot spline).
 MIN_POINTS = 4
 
@@ -429,14 +433,16 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         inserted += int(bad_u.sum() + bad_v.sum())
     removed = 0
     if done and coarsening:
-        target = RESPACE_TARGET
+        best_state = current = (fu, fv, uv, pu, pv, new, dev, reverse, worst)
         for _ in range(RESPACE_TRIES):          # a coarser point set where errors leave room
-            eu, ev = _direction_errors(dev, reverse, pu, pv)
-            su = respaced_fractions(fu, eu, tol, du.f_breaks, target, MIN_POINTS)
-            sv = respaced_fractions(fv, ev, tol, dv.f_breaks, target, MIN_POINTS)
-            if len(su) * len(sv) >= len(fu) * len(fv):
+            cfu, cfv, cuv, cpu, cpv, _, cdev, creverse, _ = current
+            eu, ev = _direction_errors(cdev, creverse, cpu, cpv)
+            grow = current is best_state          # after a miss: refine only
+            su = respaced_fractions(cfu, eu, tol, du.f_breaks, RESPACE_TARGET, MIN_POINTS, grow)
+            sv = respaced_fractions(cfv, ev, tol, dv.f_breaks, RESPACE_TARGET, MIN_POINTS, grow)
+            if len(su) * len(sv) >= len(best_state[0]) * len(best_state[1]):
                 break
-            trial_uv, fixed = _start_grid(surface, du, dv, su, sv, (fu, fv, uv))
+            trial_uv, fixed = _start_grid(surface, du, dv, su, sv, (cfu, cfv, cuv))
             if relocation:
                 trial_uv = relocate(surface, trial_uv, su, sv, max_sweeps=max_sweeps,
                                     penalty_tol=PENALTY_TOL, fixed=fixed).uv
@@ -444,11 +450,10 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
             trial = fit_and_measure(surface, trial_uv, tu, tv, (line_indices(su, du.f_breaks),
                                                                 line_indices(sv, dv.f_breaks)),
                                     per_span)
-            if trial[3] <= tol:
-                fu, fv, uv, pu, pv = su, sv, trial_uv, tu, tv
-                new, dev, reverse, worst = trial
-            else:
-                target *= 0.6
+            current = (su, sv, trial_uv, tu, tv, *trial)   # a miss still tells where to refine
+            if trial[3] <= COARSE_SHARE * tol:
+                best_state = current
+        fu, fv, uv, pu, pv, new, dev, reverse, worst = best_state
         fit = subgrid_fit(surface, uv, pu, pv,
                           (line_indices(fu, du.f_breaks), line_indices(fv, dv.f_breaks)), per_span)
         full_u, full_v = np.ones(len(fu), bool), np.ones(len(fv), bool)
@@ -457,7 +462,7 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         fixed_u[[0, -1]] = fixed_v[[0, -1]] = True
         fixed_u[line_indices(fu, du.f_breaks)] = True
         fixed_v[line_indices(fv, dv.f_breaks)] = True
-        best = coarsen(fit, start, fixed_u, fixed_v, tol, MIN_POINTS)
+        best = coarsen(fit, start, fixed_u, fixed_v, COARSE_SHARE * tol, MIN_POINTS)
         new, pu, pv, uv = best.payload
         worst = best.worst
         removed = int((~best.keep_u).sum() + (~best.keep_v).sum())
