@@ -54,6 +54,7 @@ from ..algorithms.healing.connectivity import Side, _corner_number, side_points
 from ..algorithms.healing.clipping import trimmed_source
 from ..algorithms.healing.continuity import fit_side_to_curve
 from ..algorithms.healing.measure_joins import measure_join
+from ..algorithms.projection import project_to_curve
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
@@ -91,6 +92,8 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: a side fitted to an untouched face's edge gets at most this many knot spans
 MAX_SNAP_SPANS = 64
+#: samples of a fitted side checked against the edge
+SNAP_CHECK_SAMPLES = 257
 #: pcurve samples per edge of a trimming loop (:func:`face_source`)
 LOOP_SAMPLES_PER_EDGE = 33
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
@@ -296,12 +299,16 @@ def _jobs(faces, kept, holes, directed: list[DirectedPatch], trimmed: dict) -> l
     return jobs
 
 
-def _approximate(jobs: list[_Job], sources, tol, gap_tol, skipped: list[str]
-                 ) -> list[tuple[_Job, LocalApproximant]]:
+def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_tol,
+                 skipped: list[str]) -> list[tuple[_Job, LocalApproximant]]:
+    """One approximant per job; a face's own surface is its preferred source (other
+    faces only where it is missed), so long segments do not pick far-away faces."""
     out = []
     for job in jobs:
+        own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
         try:
-            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol)
+            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
+                                   preferred_source=own)
         except (SurfprepError, np.linalg.LinAlgError) as exc:
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
                            f"({type(exc).__name__}: {exc}); left as it was")
@@ -310,6 +317,15 @@ def _approximate(jobs: list[_Job], sources, tol, gap_tol, skipped: list[str]
             skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
                            f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
                            "kept as it was")
+            continue
+        if job.origin.kind == "hole" and not la.converged:
+            # the error is measured only where segments land on the originals: over a real
+            # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
+            # of a slot, an open end) is no hole, and a patch over it would not fit them
+            skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
+                           f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
+                           f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
+                           "left open")
             continue
         out.append((job, la))
     return out
@@ -350,8 +366,20 @@ def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
     return any(_corner_number(s, e) == number for p, s, e in members if p == patch)
 
 
-def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float
-                       ) -> tuple[Network, int]:
+def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float):
+    """``surface`` with ``side`` fitted to ``target``: knot spans along the side doubled
+    (up to :data:`MAX_SNAP_SPANS`) until the side lies within ``tight`` of the edge."""
+    spans = min(MAX_SNAP_SPANS, 2 * (np.unique(target.knots).size - 1) + 8)
+    while True:
+        fitted = fit_side_to_curve(surface, side, target, min_spans=spans, free_corners=free)
+        pts = side_points(fitted, side, SNAP_CHECK_SAMPLES)
+        if spans >= MAX_SNAP_SPANS or project_to_curve(target, pts).distance.max() <= tight:
+            return fitted
+        spans = min(MAX_SNAP_SPANS, 2 * spans)
+
+
+def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
+                       tight: float) -> tuple[Network, int]:
     """Sides of approximants that meet a face kept as it was (not another approximant)
     fitted to that face's edge (:func:`fit_side_to_curve`), joins measured again."""
     if not edges:
@@ -366,10 +394,8 @@ def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float
             target = _matching_edge(side_points(patches[p], side, 17),
                                     side_points(patches[p], side, 129), edges, gap_tol)
             if target is not None:
-                spans = min(MAX_SNAP_SPANS, 2 * (np.unique(target.knots).size - 1) + 8)
                 free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
-                patches[p] = fit_side_to_curve(patches[p], side, target, min_spans=spans,
-                                               free_corners=free)
+                patches[p] = _snapped(patches[p], side, target, free, tight)
                 snapped += 1
     if not snapped:
         return network, 0
@@ -428,15 +454,16 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    done = _approximate(_jobs(faces, kept, holes, directed, trimmed), sources, tol, gap_tol,
-                        skipped)
+    done = _approximate(_jobs(faces, kept, holes, directed, trimmed), sources,
+                        {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
     network = None
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
         replaced = {job.origin.index for job, _ in done if job.origin.kind == "face"}
         network, snapped = _snap_to_originals(
-            network, [e for e in edges if e.face not in replaced], gap_tol)
+            network, [e for e in edges if e.face not in replaced], gap_tol,
+            TIGHT_FACTOR * model.size)
     result = _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start)
     result.extra["snapped_sides"] = snapped if network is not None else 0

@@ -14,6 +14,7 @@ import pytest
 from OCP.BRep import BRep_Builder
 from OCP.TopoDS import TopoDS_Compound
 from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.algorithms.surface import NurbsSurface
 from surfprep.plugin.convert import to_nurbs
 from surfprep.plugin.faces import make_face
 from surfprep.plugin.heal import heal
@@ -176,3 +177,24 @@ def test_overlapping_faces_trimmed_back():
     assert deviation_from_graph(r) < 1.5e-3
     if continuity == "G1":
         assert r.joins[0].max_angle < 1e-2
+
+
+def _quad(p00, p10, p01, p11):
+    c = np.array([[p00, p01], [p10, p11]], float)
+    return NurbsSurface(c, np.array([0, 0, 1, 1.0]), np.array([0, 0, 1, 1.0]), 1, 1)
+
+
+@pytest.mark.slow
+def test_mouth_of_a_shallow_pocket_is_not_a_hole():
+    # floor and four walls 0.1 high: the walls' top edges chain into a loop of four free
+    # edges, but a patch over it lands on the floor (segments of length 2 d = 1 > 0.1):
+    # no hole, left open; the walls and floor stay closed to each other
+    z0, z1 = 0.0, 0.1
+    c = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    walls = [_quad((*c[k], z0), (*c[(k + 1) % 4], z0), (*c[k], z1), (*c[(k + 1) % 4], z1))
+             for k in range(4)]
+    floor = _quad((0, 0, z0), (1, 0, z0), (0, 1, z0), (1, 1, z0))
+    r = heal(compound([make_face(s) for s in walls + [floor]]))
+    assert not any(p.origin.kind == "hole" for p in r.patches)
+    assert any("not a hole" in s for s in r.skipped)
+    assert r.free_edges_after == 4 and r.valid_after

@@ -27,12 +27,15 @@ def test_marscapsule_duplicates_dropped(data_dir):
 def test_microstation_gaps_fewer_geometric_free_edges(data_dir):
     """occt_k1geo_microstation.stp: a face soup with real gaps of 0.01-0.1 mm. Free edges
     when the faces are sewn at 1e-7 x size (i.e. not closed in the geometry) drop
-    (measured 70 -> 48), the shape stays valid and joins between approximants are closed."""
+    (measured 70 -> 32), free edges at gap_tol do not grow (5 -> 5: the loop of free edges
+    around the mouth of a slot is no hole and stays open), the shape stays valid and joins
+    between approximants are closed."""
     path = data_dir / "occt_k1geo_microstation.stp"
     if not path.exists():
         pytest.skip("shared data not available")
     r = surfprep.heal(path)
     assert r.tight_free_edges_after < r.tight_free_edges_before
+    assert r.free_edges_after <= r.free_edges_before
     assert r.valid_after
     assert len(r.joins) > 10 and all(j.max_gap < 1e-9 for j in r.joins)
-    assert sum(p.origin.kind == "hole" for p in r.patches) >= 1
+    assert any("not a hole" in s for s in r.skipped)
