@@ -15,7 +15,12 @@ measured densely with ``surfprep.algorithms.projection.distance_to_surface``:
 for ours at the samples and at three interpolant points per span, for
 OpenCascade at 4001 points per curve, uniform in its parameter.
 
-Run:  python benchmarks/intersect.py        (prints a markdown table)
+Whole models cut by a plane (:data:`MODEL_CUTS`: fuselage waterline and frame,
+KCS hull waterlines) are timed too: ``surfprep.intersect(model, plane)`` with
+``auto`` and ``mesh`` against ``BRepAlgoAPI_Section`` (second table; with
+``--cuts-only`` only that one).
+
+Run:  python benchmarks/intersect.py [--cuts-only]        (prints markdown tables)
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ from OCP.Geom import (
     Geom_ToroidalSurface,
 )
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
+
+import surfprep
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import (
     connected_branches,
@@ -41,8 +48,6 @@ from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.geom import surface_from_occ
 from surfprep.plugin.intersect import intersect
 from surfprep.plugin.occ_reference import intersect_surfaces_occ, section_faces_occ
-
-import surfprep
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"
@@ -180,6 +185,55 @@ def run() -> list[dict]:
     return rows
 
 
+#: whole models cut by a plane face: (file, axis, fraction of the model's extent)
+MODEL_CUTS = [("occt_fuselage.stp", 2, 0.4), ("occt_fuselage.stp", 0, 0.3),
+              ("overture_kcs_hull_ideas.igs", 2, 0.3), ("overture_kcs_hull_ideas.igs", 2, 0.6)]
+
+
+def model_cuts() -> list[dict]:
+    """``surfprep.intersect(model, plane)`` (``auto`` and ``mesh``) against
+    ``BRepAlgoAPI_Section(shape, plane)`` on whole models: times (best of three) and
+    total lengths."""
+    import cadquery as cq
+    rows = []
+    for file, axis, fraction in MODEL_CUTS:
+        path = DATA / file
+        if not path.exists():
+            continue
+        model = surfprep.read(path)
+        x0, y0, z0, x1, y1, z1 = model.bounding_box
+        lo, hi = np.array([x0, y0, z0]), np.array([x1, y1, z1])
+        origin, normal = 0.5 * (lo + hi), np.zeros(3)
+        origin[axis] = lo[axis] + fraction * (hi[axis] - lo[axis])
+        normal[axis] = 1.0
+        side = 1.5 * float(np.max(hi - lo))
+        plane = cq.Face.makePlane(side, side, basePnt=cq.Vector(*origin), dir=cq.Vector(*normal))
+        tol = 1e-6 * model.size
+        auto, t_auto = timed(intersect, model, plane, tol=tol)
+        _, t_mesh = timed(intersect, model, plane, tol=tol, method="mesh")
+        occ, t_occ = timed(section_faces_occ, model.shape, plane.wrapped, tol,
+                           samples=OCC_SAMPLES)
+        rows.append({"case": f"{file} {'xyz'[axis]} at {fraction:.0%}", "t_auto": t_auto,
+                     "t_mesh": t_mesh, "t_occ": t_occ,
+                     "length": sum(p.length for p in auto),
+                     "occ_length": sum(c.length for c in occ),
+                     "skipped": sum(1 for r in auto.records
+                                    if r.record is not None and "skipped" in r.record.extra),
+                     "pairs": len(auto.records)})
+    return rows
+
+
+def markdown_cuts(rows: list[dict]) -> str:
+    head = ("| whole-model cut | ours auto s | ours mesh s | Section s | auto/Section "
+            "| certificate skipped | length ours / Section |")
+    lines = [head, "|" + "---|" * 7]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['t_auto']:.2f} | {r['t_mesh']:.2f} | {r['t_occ']:.2f} "
+                     f"| {r['t_auto'] / max(r['t_occ'], 1e-9):.1f} | {r['skipped']}/{r['pairs']} "
+                     f"| {r['length']:.6g} / {r['occ_length']:.6g} |")
+    return "\n".join(lines)
+
+
 def markdown(rows: list[dict]) -> str:
     head = ("| case | OCC method | tol | ours s | OCC s | ours/OCC | branches ours / OCC "
             "| curves ours / OCC | max dev ours | max dev OCC | Hausdorff |")
@@ -196,4 +250,8 @@ def markdown(rows: list[dict]) -> str:
 
 
 if __name__ == "__main__":
-    print(markdown(run()))
+    import sys
+    if "--cuts-only" not in sys.argv:
+        print(markdown(run()))
+        print()
+    print(markdown_cuts(model_cuts()))
