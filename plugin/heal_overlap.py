@@ -52,8 +52,11 @@ def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float) -> list[int]:
     """Sides of ``a`` lying on ``b``'s surface and away from ``b``'s edges."""
     sides_a, sides_b = four_sided_boundary(a), four_sided_boundary(b)
     out = []
+    box = b.surface.bounding_box()           # control net: holds the surface
     for k, curve in enumerate(sides_a):
         pts = _interior_samples(curve)
+        if np.any((pts < box[0] - gap_tol) | (pts > box[1] + gap_tol)):
+            continue                          # a sample off b's box is off b's surface
         if distance_to_surface(b.surface, pts).max() > gap_tol:
             continue
         if _distance_to_curves(pts, sides_b).min() > gap_tol:
