@@ -18,14 +18,18 @@ both out from the control nets alone (the net's convex hull holds the surface):
   rule is not applied when the other surface lies within ``tol`` of the plane
   (coincidence is the full analysis's answer to give);
 * **plane x monotone height**: one surface is planar (normal ``n``) and the
-  other, non-rational, has a height ``h = n . S - c`` over it that is strictly
+  other, non-rational or with separable weights ``w_ij = a_i b_j`` (surfaces of
+  revolution and extrusions from OpenCascade are), has a height ``h = n . S - c`` over it that is strictly
   monotone in ``u`` across each row of Bézier patches between the first and the
   last patch that comes within ``tol`` of the plane (every u-difference of the
   patches' control heights of one sign, each larger than ``tol``), or the same
   in ``v`` across the columns. A closed loop ``h = 0`` inside the domain is cut
   twice by some line ``v = const`` inside one row, at two points of patches
-  near the plane, and ``h`` would have to turn between them (Rolle); a contact
-  point needs ``grad h = 0`` in a patch near the plane. Where the net is too
+  near the plane, and ``h`` would have to turn between them (Rolle; for the
+  rational case: the variation-diminishing property of a rational curve with
+  positive weights, whose control heights all rise, makes it strictly
+  monotone); an isolated contact point needs a local extremum of ``h``, which a
+  function strictly monotone along every line ``v = const`` has not. Where the net is too
   coarse for the test, every span is halved (knot insertion, same surface) a few
   times. The whole-model cut of a ship hull by a waterline plane is of this
   kind on every face.
@@ -105,6 +109,14 @@ def _monotone_rows(near: np.ndarray, step_sign: np.ndarray) -> bool:
     return True
 
 
+def _separable_weights(w: np.ndarray) -> bool:
+    """True when ``w[i, j] = a[i] b[j]`` (to rounding): then along a line ``v = const`` the
+    control heights of the u-curve are the same convex combination of the rows'
+    heights for every ``i``, so their differences are combinations of the net's."""
+    outer = np.outer(w[:, 0], w[0, :]) / w[0, 0]
+    return bool(np.abs(outer - w).max() <= 1e-12 * np.abs(w).max())
+
+
 def _halved(s: NurbsSurface) -> NurbsSurface:
     """``s`` with a knot inserted in the middle of every span, both directions."""
     for direction, knots, degree in (("u", s.knots_u, s.degree_u), ("v", s.knots_v, s.degree_v)):
@@ -118,7 +130,7 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     """The plane x monotone height rule of the module docstring, on ``s`` and, while
     it fails and the net stays under ``MAX_REFINED_POLES``, on ``s`` with every span
     halved (up to ``REFINEMENTS`` times: the control net closes in on the surface)."""
-    if s.is_rational or s.dimension != 3:
+    if s.dimension != 3 or (s.is_rational and not _separable_weights(s.weights)):
         return False
     for level in range(REFINEMENTS + 1):
         if _monotone_patches(s, centre, normal, tol):
