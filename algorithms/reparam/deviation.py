@@ -11,8 +11,11 @@ by closest-point projection (:func:`~surfprep.algorithms.projection.project_to_s
   original parameters interpolated from the relocation grid. A local
   projection can only overestimate the distance, so the figure is safe.
 * **original on new** (eq. 29.3 as written): ``s`` at ``per_span x per_span``
-  points per knot span of ``s`` (at least :data:`MIN_ORIGINAL_SAMPLES` per
-  direction), projected onto ``r`` with seeds.
+  points per knot span of ``s``, and per direction at least
+  :data:`MIN_ORIGINAL_SAMPLES` and ``per_span`` per interval of ``r`` (an
+  original with one span and a finer ``r`` was sampled too coarsely: 30 %
+  of the deviation could lie between the samples), projected onto ``r``
+  with seeds.
 
 The first also gives the error along the grid lines ``U = U_i`` (a pure v
 interpolation) and ``V = V_j`` (pure u), which tells in which direction a cell
@@ -130,10 +133,13 @@ def original_on_new(original: NurbsSurface, new: NurbsSurface, params_u: NDArray
         Foot points in ``new``'s domain (where it needs another knot).
     """
     grids = []
-    for knots, degree, n in ((original.knots_u, original.degree_u, original.n_control[0]),
-                             (original.knots_v, original.degree_v, original.n_control[1])):
+    for knots, degree, n, params in ((original.knots_u, original.degree_u, original.n_control[0],
+                                      params_u),
+                                     (original.knots_v, original.degree_v, original.n_control[1],
+                                      params_v)):
         breaks = np.unique(knots[degree:n + 1])
-        parts = max(per_span, -(-MIN_ORIGINAL_SAMPLES // (len(breaks) - 1)))
+        least = max(MIN_ORIGINAL_SAMPLES, per_span * (len(params) - 1))   # and per new cell
+        parts = max(per_span, -(-least // (len(breaks) - 1)))
         grids.append(subdivide(breaks, parts))
     points = original.evaluate_grid(*grids).reshape(-1, original.dimension)
     queries = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, 2)
