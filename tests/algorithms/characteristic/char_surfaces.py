@@ -9,6 +9,7 @@ numpy only (no OCP).
 from __future__ import annotations
 
 import numpy as np
+
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.basis import greville_abscissae
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from char_surfaces import DIAGONAL, height_field, plane_patch, sphere_band
+
 from surfprep.algorithms.characteristic import (
     DistanceField,
     PatchEvaluator,

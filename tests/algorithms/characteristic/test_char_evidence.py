@@ -22,6 +22,7 @@ from char_surfaces import (
     sphere_and_plane,
     touching_bumps,
 )
+
 from surfprep.algorithms.characteristic import (
     FoundBy,
     PointKind,

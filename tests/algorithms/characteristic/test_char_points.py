@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from char_surfaces import horizontal_plane, plane_patch, several_bumps, touching_bumps
+
 from surfprep.algorithms.characteristic import (
     CurveKind,
     DistanceField,
@@ -130,6 +131,7 @@ def test_saddle_on_the_intersection_is_a_double_point():
     centre, a saddle of phi with phi = 0 (eq. 8, det H < 0); both lines are traced
     from side to side, exactly."""
     from char_surfaces import clamped, height_field
+
     from surfprep.algorithms.basis import greville_abscissae
     from surfprep.algorithms.characteristic import characteristic_intersection
     x = greville_abscissae(clamped(6, 3), 3)
