@@ -381,12 +381,16 @@ def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float)
 def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
                        tight: float) -> tuple[Network, int]:
     """Sides of approximants that meet a face kept as it was (not another approximant)
-    fitted to that face's edge (:func:`fit_side_to_curve`), joins measured again."""
+    fitted to that face's edge (:func:`fit_side_to_curve`), joins measured again.
+
+    A corner shared with other approximants is first moved, in every patch that
+    shares it, onto the nearer end of the edge (:func:`_pin_corners`), so the side
+    can follow the edge to its end instead of stopping at the averaged corner."""
     if not edges:
         return network, 0
     shared = {(e.a, e.side_a) for e in network.edges} | {(e.b, e.side_b) for e in network.edges}
-    patches, snapped = list(network.patches), 0
-    in_clusters = {(m[0], m[1], m[2]) for c in network.connectivity.corners for m in c.members}
+    patches = list(network.patches)
+    targets = []
     for p in range(len(patches)):
         for side in Side:
             if (p, side) in shared:
@@ -394,13 +398,47 @@ def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
             target = _matching_edge(side_points(patches[p], side, 17),
                                     side_points(patches[p], side, 129), edges, gap_tol)
             if target is not None:
-                free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
-                patches[p] = _snapped(patches[p], side, target, free, tight)
-                snapped += 1
-    if not snapped:
+                targets.append((p, side, target))
+    if not targets:
         return network, 0
+    clusters = network.connectivity.corners
+    _pin_corners(patches, targets, clusters, tight)
+    in_clusters = {(m[0], m[1], m[2]) for c in clusters for m in c.members}
+    for p, side, target in targets:
+        free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
+        patches[p] = _snapped(patches[p], side, target, free, tight)
     joins = tuple(measure_join(patches, e) for e in network.edges)
-    return replace(network, patches=tuple(patches), joins=joins), snapped
+    return replace(network, patches=tuple(patches), joins=joins), len(targets)
+
+
+def _corner_index(surface, number: int) -> tuple[int, int]:
+    nu, nv = surface.n_control
+    return (0 if number % 2 == 0 else nu - 1), (0 if number // 2 == 0 else nv - 1)
+
+
+def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
+    """Corners of approximant clusters moved (in place, in every member patch: their
+    shared boundary rows stay identical) onto the end of a kept face's edge a member
+    side is snapped to, where they are farther from it than ``tight``."""
+    for p, side, target in targets:
+        ends = target.evaluate(np.array(target.domain))
+        for end in (0, 1):
+            number = _corner_number(side, end)
+            cluster = next((c for c in clusters if any(
+                m[0] == p and _corner_number(m[1], m[2]) == number for m in c.members)), None)
+            if cluster is None:
+                continue
+            i, j = _corner_index(patches[p], number)
+            corner = patches[p].control_points[i, j]
+            goal = ends[int(np.argmin(np.linalg.norm(ends - corner, axis=1)))]
+            if np.linalg.norm(goal - corner) <= tight:
+                continue
+            for q in {m[0] for m in cluster.members}:
+                numbers = {_corner_number(m[1], m[2]) for m in cluster.members if m[0] == q}
+                net = patches[q].control_points.copy()
+                for n in numbers:
+                    net[_corner_index(patches[q], n)] = goal
+                patches[q] = replace(patches[q], control_points=net)
 
 
 # ---------------------------------------------------------------------- heal
