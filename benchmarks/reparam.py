@@ -13,7 +13,7 @@ faces 0, 2 and 4 of occt_fuselage.stp, 4 with creases) at the same tolerance
 
 Every result is measured the same way, by OUR closest-point projection (seeded,
 not the method's own map): the result sampled 10 x 10 per knot span projected
-onto the original, and the original sampled 10 x 10 per knot span (>= 60 per
+onto the original, and the original sampled 10 x 10 per knot span (>= 200 per
 direction) projected onto the result; the larger distance is reported
 ("max dev", OpenCascade's tolerance holds only at its sample points). Also the
 worst chord-length mismatch (eqs. 29.1/29.2, 1 = perfect), the pole count and
@@ -90,7 +90,7 @@ def max_deviation(original, result) -> float:
     """Both ways, our seeded projection, 10 x 10 per knot span (see module docstring)."""
     forward = project_to_surface(original, result.evaluate_grid(*dense_grid(result)),
                                  n_seeds=1).distance.max()
-    backward = project_to_surface(result, original.evaluate_grid(*dense_grid(original, least=60)),
+    backward = project_to_surface(result, original.evaluate_grid(*dense_grid(original, least=200)),
                                   n_seeds=1).distance.max()
     return float(max(forward, backward))
 
