@@ -31,8 +31,14 @@ from scipy.spatial import cKDTree
 
 from ...errors import InvalidGeometryError
 
-__all__ = ["hausdorff", "polyline_distance", "curve_set_distance", "CurveSetDistance",
-           "connected_branches", "DENSE_PER_SPAN"]
+__all__ = [
+    "DENSE_PER_SPAN",
+    "CurveSetDistance",
+    "connected_branches",
+    "curve_set_distance",
+    "hausdorff",
+    "polyline_distance",
+]
 
 #: points per span of a curve with an interpolant, as queries and as polyline
 DENSE_PER_SPAN = 8
@@ -113,21 +119,14 @@ def _newton_distance(curve3d, x: NDArray, t: NDArray, lo: float, hi: float) -> N
     return np.linalg.norm(curve3d.evaluate(t) - x, axis=1)
 
 
-def polyline_distance(points: ArrayLike, curves: Sequence, k: int = 8) -> NDArray:
-    """Distance ``(n,)`` of each point ``(n, 3)`` to the nearest segment of the polylines.
-
-    The ``k`` segments whose midpoints are nearest are tested exactly (segments
-    of sampled curves are short and even, so the nearest one is among them).
-    Curves with an interpolant are densified and the distance finished on the
-    interpolant itself (module docstring).
-    """
-    x = _points(np.reshape(points, (-1, 3)))
-    if len(curves) == 0:
-        return np.full(x.shape[0], np.inf)
-    start, vec, owner, t0, t1 = _segments(curves)
-    k = min(k, start.shape[0])
-    _, idx = cKDTree(start + 0.5 * vec).query(x, k=k)
-    idx = idx.reshape(x.shape[0], k)
+def _nearest_segments(x: NDArray, start: NDArray, vec: NDArray, among: NDArray, k: int
+                      ) -> tuple[NDArray, NDArray, NDArray]:
+    """Per point of ``x (n, 3)``: distance to the nearest of the segments ``among``
+    (the ``k`` with the nearest midpoints tested exactly), that segment and the
+    fraction along it."""
+    n = x.shape[0]
+    _, idx = cKDTree(start[among] + 0.5 * vec[among]).query(x, k=k)
+    idx = among[idx.reshape(n, k)]
     a, d = start[idx], vec[idx]                                 # (n, k, 3)
     dd = np.einsum("nkc,nkc->nk", d, d)
     t = np.where(dd > 0, np.einsum("nkc,nkc->nk", x[:, None] - a, d) / np.where(dd > 0, dd, 1),
@@ -135,15 +134,41 @@ def polyline_distance(points: ArrayLike, curves: Sequence, k: int = 8) -> NDArra
     t = np.clip(t, 0.0, 1.0)
     dist = np.linalg.norm(a + t[..., None] * d - x[:, None], axis=-1)
     best = np.argmin(dist, axis=1)
-    out = dist[np.arange(x.shape[0]), best]
-    seg = idx[np.arange(x.shape[0]), best]
-    frac = t[np.arange(x.shape[0]), best]
-    for i in np.unique(owner[seg[~np.isnan(t0[seg])]]):        # finish on the interpolants
-        rows = np.flatnonzero((owner[seg] == i) & ~np.isnan(t0[seg]))
+    rows = np.arange(n)
+    return dist[rows, best], idx[rows, best], t[rows, best]
+
+
+def polyline_distance(points: ArrayLike, curves: Sequence, k: int = 8) -> NDArray:
+    """Distance ``(n,)`` of each point ``(n, 3)`` to the nearest segment of the polylines.
+
+    Per curve, the ``k`` segments whose midpoints are nearest are tested exactly
+    (segments of sampled curves are short and even, so the nearest one is among
+    them). Curves with an interpolant are densified and the distance finished on
+    the interpolant itself (module docstring).
+    """
+    x = _points(np.reshape(points, (-1, 3)))
+    if len(curves) == 0:
+        return np.full(x.shape[0], np.inf)
+    start, vec, owner, t0, t1 = _segments(curves)
+    k = min(k, start.shape[0])
+    out = _nearest_segments(x, start, vec, np.arange(start.shape[0]), k)[0]
+    # finish on the interpolants, curve by curve: where curves cross or pass close,
+    # the k nearest segments of all curves together may all belong to other curves
+    # than the nearest interpolant point (sparse samples sag), so each curve's own
+    # nearest segments are looked up for the points its box may hold nearer
+    for i in np.unique(owner[~np.isnan(t0)]):
+        mine = np.flatnonzero(owner == i)
+        ends = np.concatenate([start[mine], start[mine] + vec[mine]])
+        lo, hi = ends.min(axis=0), ends.max(axis=0)
+        box = np.linalg.norm(np.maximum(np.maximum(lo - x, x - hi), 0.0), axis=1)
+        rows = np.flatnonzero(box <= out)
+        if rows.size == 0:
+            continue
+        near, sg, fr = _nearest_segments(x[rows], start, vec, mine, min(k, mine.size))
         curve3d, params = _interpolant(curves[i])
-        guess = t0[seg[rows]] + frac[rows] * (t1[seg[rows]] - t0[seg[rows]])
+        guess = t0[sg] + fr * (t1[sg] - t0[sg])
         exact = _newton_distance(curve3d, x[rows], guess, params[0], params[-1])
-        out[rows] = np.minimum(out[rows], exact)
+        out[rows] = np.minimum(out[rows], np.minimum(near, exact))
     return out
 
 

@@ -432,29 +432,40 @@ def _extend(dense: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
     return dense, kinds
 
 
-def _traced_sides(chains: list[Chain], ends_uv: list, surface_a: NurbsSurface,
+def _domain_sides(domain) -> list[tuple[int, float, float]]:
+    """``(coord, value, slack)`` of the four sides of a domain (slack 1e-9 of its extent)."""
+    extent = (domain[1] - domain[0], domain[3] - domain[2])
+    return [(0, domain[0], 1e-9 * extent[0]), (0, domain[1], 1e-9 * extent[0]),
+            (1, domain[2], 1e-9 * extent[1]), (1, domain[3], 1e-9 * extent[1])]
+
+
+def _traced_sides(topology: SegmentTopology, chains: list[Chain], surface_a: NurbsSurface,
                   surface_b: NurbsSurface) -> list[DomainSide]:
-    """Domain sides the traced chains end on (both surfaces)."""
+    """Domain sides the traced chains may run along: a chain has two consecutive
+    points on the side, or two chain ends lie on it (scattered pieces along it).
+    A curve merely crossing a side has one end there and costs nothing."""
     sides = []
-    for chain, ends in zip(chains, ends_uv):
-        if chain.closed:
-            continue
-        for (traced_a, traced_b), kind in zip(ends, (chain.start_kind, chain.end_kind)):
-            if kind is not EndKind.BOUNDARY:
-                continue
-            for owner, (traced, surface) in enumerate(((traced_a, surface_a),
-                                                        (traced_b, surface_b))):
-                held = _side_constraint(traced, surface.domain)
-                if held is not None:
-                    sides.append(DomainSide(owner, held[0], float(held[1])))
-    return list(dict.fromkeys(sides))
+    for owner, (uv_all, surface) in enumerate(((topology.uv_a, surface_a),
+                                               (topology.uv_b, surface_b))):
+        for coord, value, slack in _domain_sides(surface.domain):
+            ends = 0
+            for chain in chains:
+                on = np.abs(uv_all[chain.point_ids, coord] - value) <= slack
+                if np.any(on[:-1] & on[1:]):
+                    ends = 2
+                    break
+                ends += 0 if chain.closed else int(on[0]) + int(on[-1])
+            if ends >= 2:
+                sides.append(DomainSide(owner, coord, float(value)))
+    return sides
 
 
-def _along_sides(dense: list[RefinedCurve], kinds: list, chains: list[Chain], ends_uv: list,
-                 surface_a: NurbsSurface, surface_b: NurbsSurface, tol: float):
+def _along_sides(dense: list[RefinedCurve], kinds: list, topology: SegmentTopology,
+                 chains: list[Chain], surface_a: NurbsSurface, surface_b: NurbsSurface,
+                 tol: float):
     """Curves running along a domain side (:mod:`.sides`) replace the traced pieces
     lying on them (the tessellations only touch there, so those come in pieces)."""
-    sides = _traced_sides(chains, ends_uv, surface_a, surface_b)
+    sides = _traced_sides(topology, chains, surface_a, surface_b)
     if not sides:
         return dense, kinds
     extra, runs = side_curves(surface_a, surface_b, sides, tol=tol)
@@ -623,7 +634,7 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
                                  reach=_JOIN_FACTOR * mesh_tol)
     kinds = [(c.start_kind, c.end_kind) for c in chains]
     dense, kinds = _extend(dense, kinds, surface_a, surface_b, tol, mesh_tol)
-    dense, kinds = _along_sides(dense, kinds, chains, ends, surface_a, surface_b, tol)
+    dense, kinds = _along_sides(dense, kinds, topology, chains, surface_a, surface_b, tol)
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
     if can_retry and np.any(worst > tol):
         return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1)
