@@ -56,6 +56,7 @@ from .points import (
     grid_seeds,
     make_points,
 )
+from .poles import pole_contacts
 from .projection import ProjectionStatus, Projector
 from .starts import (
     Start,
@@ -414,11 +415,29 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         kinds = classify_critical(crit.phi, crit.hess, tol)
         points += make_points(fld, kinds, crit.uv, crit.st, crit.point, crit.phi)
         starts.append(ray_starts(fld, crit, kinds, tol))
+    points += _pole_points(fld, a, b, tol, points)
     start = Start.concat(starts)
     start = Start.stack([Start(start.uv, start.st, start.scale, loop_keys(fld, grid, shape, start)),
                          border_keys(border_start)])
     return CharacteristicAnalysis(fld, tuple(points), tuple(curves), start, (),
                                   time.perf_counter() - start_time)
+
+
+def _pole_points(fld: DistanceField, a: NurbsSurface, b: NurbsSurface, tol: float,
+                 known: list[CharacteristicPoint]) -> list[CharacteristicPoint]:
+    """Isolated contacts at collapsed sides (:mod:`.poles`) not already among ``known``."""
+    contacts = pole_contacts(a, b, tol=tol)
+    radius = max(1e3 * tol, 1e-6 * _size(a, b))
+    contacts = [c for c in contacts if not any(
+        p.kind is PointKind.ISOLATED and np.linalg.norm(p.point - c.point) <= radius
+        for p in known)]
+    if not contacts:
+        return []
+    ua = np.array([c.uv_a for c in contacts])
+    ub = np.array([c.uv_b for c in contacts])
+    uv_r, st_q = (ub, ua) if fld.swapped else (ua, ub)
+    return make_points(fld, PointKind.ISOLATED, uv_r, st_q, np.array([c.point for c in contacts]),
+                       np.array([c.distance for c in contacts]))
 
 
 def _subset(field: DistanceField, jet: DistanceJet, rows: NDArray) -> DistanceJet:

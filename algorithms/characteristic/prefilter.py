@@ -46,6 +46,7 @@ from ..bezier import bezier_patches
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
 from .algorithm import CharacteristicRecord, FoundBy
+from .poles import collapsed_sides
 
 __all__ = ["PLANAR_SHARE", "NoLoopReason", "no_loop_reason", "uncertified_record"]
 
@@ -159,6 +160,18 @@ def _monotone_patches(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     return out
 
 
+def _pole_near(s: NurbsSurface, other: NurbsSurface, tol: float) -> bool:
+    """A collapsed side of ``s`` (a pole) within ``tol`` of ``other``'s control-net box:
+    a tangential contact there is on the boundary of ``s``'s domain, which the
+    height rules below do not see."""
+    box = other.bounding_box()
+    for uv in collapsed_sides(s):
+        p = s.evaluate(*uv)
+        if np.all(p >= box[0] - tol) and np.all(p <= box[1] + tol):
+            return True
+    return False
+
+
 def no_loop_reason(a: NurbsSurface, b: NurbsSurface, *, tol: float) -> NoLoopReason | None:
     """Why ``a`` and ``b`` can have no closed loop nor isolated contact point (module
     docstring), or None when the certificate must look.
@@ -172,6 +185,8 @@ def no_loop_reason(a: NurbsSurface, b: NurbsSurface, *, tol: float) -> NoLoopRea
     """
     if _apart(a, b, tol):
         return NoLoopReason.APART
+    if _pole_near(a, b, tol) or _pole_near(b, a, tol):
+        return None                                      # a contact may sit on the pole
     for flat, other in ((a, b), (b, a)):
         plane = _plane(flat, tol)
         if plane is None:

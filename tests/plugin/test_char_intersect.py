@@ -135,3 +135,20 @@ def test_certificate_skips_plane_and_ruled_pairs():
                                 for r in auto.records)
     assert sorted(round(c.length, 6) for c in auto) == sorted(round(c.length, 6) for c in mesh)
     assert len(auto) >= 2 and all(c.found_by is FoundBy.MESH for c in auto)
+
+
+@pytest.mark.parametrize("method", ["auto", "characteristic"])
+def test_cadquery_sphere_resting_on_a_plate_touches_at_its_pole(method):
+    """cadquery's sphere has its poles on the z axis: a plate on top touches it at
+    the north pole, a collapsed side of the face's parametrization (no interior
+    critical point of phi there); the contact is one isolated point, no curve.
+    With the plate 1e-3 lower it cuts a small circle instead."""
+    sphere = cq.Workplane().sphere(10)
+    touch = intersect(sphere, cq.Workplane().box(30, 30, 1).translate((0, 0, 10.5)),
+                      tol=1e-6, method=method)
+    assert len(touch) == 0 and len(touch.isolated_points) == 1
+    np.testing.assert_allclose(touch.isolated_points[0].point, [0, 0, 10], atol=1e-9)
+    cut = intersect(sphere, cq.Workplane().box(30, 30, 1).translate((0, 0, 10.499)),
+                    tol=1e-6, method=method)
+    assert cut.isolated_points == [] and len(cut) == 1
+    assert cut[0].curve.length == pytest.approx(2 * np.pi * np.sqrt(100 - 9.999 ** 2), rel=1e-5)
