@@ -347,17 +347,32 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 
 # ------------------------------------------------------- untouched neighbours
 def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], gap_tol: float):
-    """The edge lying closest along the whole side, within ``gap_tol`` both ways, or None."""
+    """The edge lying closest along the whole side, within ``gap_tol`` both ways; else
+    the edges of one face that lie on the side and together cover it (a T-junction:
+    the side meets several edges of a kept face), as a list; else None."""
     lo, hi = side.min(axis=0) - gap_tol, side.max(axis=0) + gap_tol
     best, best_distance = None, gap_tol
+    on_side = []
     for e in edges:
         if np.any(e.samples.min(axis=0) > hi) or np.any(e.samples.max(axis=0) < lo):
             continue
-        distance = max(polyline_distance(e.samples, dense_side).max(),
-                       polyline_distance(side, dense_edge(e)).max())
+        along = polyline_distance(e.samples, dense_side).max()
+        if along > gap_tol:
+            continue
+        on_side.append(e)
+        distance = max(along, polyline_distance(side, dense_edge(e)).max())
         if distance <= best_distance:
             best, best_distance = e.curve, distance
-    return best
+    if best is not None:
+        return best
+    for face in {e.face for e in on_side}:
+        pieces = [e for e in on_side if e.face == face]
+        if len(pieces) < 2:
+            continue
+        cover = np.min([polyline_distance(side, dense_edge(e)) for e in pieces], axis=0)
+        if cover.max() <= gap_tol:
+            return [e.curve for e in pieces]
+    return None
 
 
 def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
@@ -367,15 +382,22 @@ def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
 
 
 def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float):
-    """``surface`` with ``side`` fitted to ``target``: knot spans along the side doubled
-    (up to :data:`MAX_SNAP_SPANS`) until the side lies within ``tight`` of the edge."""
-    spans = min(MAX_SNAP_SPANS, 2 * (np.unique(target.knots).size - 1) + 8)
+    """``surface`` with ``side`` fitted to ``target`` (an edge or a list of edges): knot
+    spans along the side doubled (up to :data:`MAX_SNAP_SPANS`) until the side lies
+    within ``tight`` of the edges."""
+    curves = _curves(target)
+    spans = min(MAX_SNAP_SPANS, sum(2 * (np.unique(c.knots).size - 1) for c in curves) + 8)
     while True:
         fitted = fit_side_to_curve(surface, side, target, min_spans=spans, free_corners=free)
         pts = side_points(fitted, side, SNAP_CHECK_SAMPLES)
-        if spans >= MAX_SNAP_SPANS or project_to_curve(target, pts).distance.max() <= tight:
+        gap = np.min([project_to_curve(c, pts).distance for c in curves], axis=0).max()
+        if spans >= MAX_SNAP_SPANS or gap <= tight:
             return fitted
         spans = min(MAX_SNAP_SPANS, 2 * spans)
+
+
+def _curves(target) -> list:
+    return target if isinstance(target, list) else [target]
 
 
 def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
@@ -421,7 +443,7 @@ def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
     shared boundary rows stay identical) onto the end of a kept face's edge a member
     side is snapped to, where they are farther from it than ``tight``."""
     for p, side, target in targets:
-        ends = target.evaluate(np.array(target.domain))
+        ends = np.concatenate([c.evaluate(np.array(c.domain)) for c in _curves(target)])
         for end in (0, 1):
             number = _corner_number(side, end)
             cluster = next((c for c in clusters if any(

@@ -323,7 +323,7 @@ def _refined_along(surface: NurbsSurface, side, min_spans: int) -> NurbsSurface:
     return refine_surface(surface, np.sort(new), side.along) if new else surface
 
 
-def fit_side_to_curve(surface: NurbsSurface, side, target: NurbsCurve, *,
+def fit_side_to_curve(surface: NurbsSurface, side, target, *,
                       min_spans: int = 0, free_corners: tuple[bool, bool] = (False, False)
                       ) -> NurbsSurface:
     """``surface`` with the boundary row of ``side`` fitted to ``target`` (corners kept).
@@ -339,7 +339,9 @@ def fit_side_to_curve(surface: NurbsSurface, side, target: NurbsCurve, *,
     ----------
     surface : NurbsSurface (non-rational)
     side : connectivity.Side
-    target : NurbsCurve, 3D
+    target : NurbsCurve, 3D, or a sequence of them
+        The edge, or edges end to end along the side (a side meeting several
+        edges of one kept face: each sample goes to the nearest of them).
     min_spans : int
         Knots are first inserted along the side (geometry unchanged) until it has
         this many spans, so the row can follow a target with more detail.
@@ -359,11 +361,15 @@ def fit_side_to_curve(surface: NurbsSurface, side, target: NurbsCurve, *,
     spans = max(1, np.unique(knots).size - 1)
     t = np.linspace(lo, hi, FIT_SAMPLES_PER_SPAN * spans + 1)
     uv = side.uv(surface, t)
-    feet = project_to_curve(target, surface.evaluate(uv[:, 0], uv[:, 1])).points
+    curves = [target] if isinstance(target, NurbsCurve) else list(target)
+    samples = surface.evaluate(uv[:, 0], uv[:, 1])
+    found = [project_to_curve(c, samples) for c in curves]
+    nearest = np.argmin(np.stack([f.distance for f in found]), axis=0)
+    feet = np.stack([f.points for f in found])[nearest, np.arange(samples.shape[0])]
     basis = collocation_matrix(knots, degree, t)                  # (m, n)
     i, j = side_indices(surface.n_control, side)
     row = surface.control_points[i, j].copy()                     # (n, 3)
-    ends = target.evaluate(np.array(target.domain))
+    ends = np.concatenate([c.evaluate(np.array(c.domain)) for c in curves])
     for k, free in zip((0, -1), free_corners):
         if free:
             row[k] = ends[int(np.argmin(np.linalg.norm(ends - row[k], axis=1)))]
