@@ -18,7 +18,7 @@ from surfprep.plugin.intersect import FaceIntersection, face_operands, inside_fa
 from surfprep.plugin.occ_reference import section_faces_occ
 
 cq = pytest.importorskip("cadquery")
-DATA = Path("/work/shared/data")
+DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"   # beside the checkout, as in conftest
 
 
 def unit_sphere():
