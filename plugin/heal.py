@@ -13,14 +13,18 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    edges chained into loops of four from two or more faces are holes;
 3. every four-sided face (one loop of four real edges, trimmed or not) gets a
    :func:`local_approximant` over its own four edges, projected onto all
-   original surfaces (a face whose approximant misses ``tol`` at the largest
+   original faces (trimmed faces as the part inside their loops,
+   :func:`face_source`; the face itself preferred over other faces crossing
+   the segments; a face whose approximant misses ``tol`` at the largest
    resolution is kept as it is, and the report says so); every hole one over
-   its four free edges; every directed patch of ``patches`` (:mod:`.heal_spec`)
-   one over its curves or corners;
+   its four free edges (a loop whose patch lands on faces, e.g. the mouth of
+   a slot, is no hole and stays open); every directed patch of ``patches``
+   (:mod:`.heal_spec`) one over its curves or corners;
 4. the approximants are joined by :func:`connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
-   as it was (not re-approximated) is fitted to that face's edge, so the gap
-   to it closes up to the fit error too;
+   as it was (not re-approximated) is fitted to that face's edge or edges
+   (with the shared corners moved onto the edge's ends), so the gap to it
+   closes up to the fit error too;
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
    shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
    untouched faces keep their names (a replaced face passes its name to its

@@ -11,7 +11,10 @@
    closest to the Coons point, mapped onto the exact surface (eqs. 9-11) and
    polished by Newton (:mod:`.segments`);
 5. artificial projections where a segment hits nothing (Hardy's reciprocal
-   multiquadric, localized or global, eqs. 12-15, :mod:`.multiquadric`);
+   multiquadric, localized or global, eqs. 12-15, :mod:`.multiquadric`; by
+   default a thin-plate spline of the same positions plus those of a ring of
+   projections beyond the boundary, :mod:`.ring`, which carries the
+   surroundings' slope and bending into a hole);
 6. the bicubic interpolant (C1 of eqs. 16-18 or C2 of 003, :mod:`.interpolant`);
 7. the error at the points of eq. (19), cells over holes skipped (:mod:`.error`).
 
