@@ -33,7 +33,8 @@ from ..projection import project_to_surface
 from ..surface import NurbsSurface
 from .refine import RefinedCurve
 
-__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "side_curves"]
+__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "may_run_along",
+           "side_curves"]
 
 #: samples of a side curve per knot span (at least ``_MIN_SAMPLES`` in all)
 SIDE_SAMPLES_PER_SPAN = 16
@@ -102,6 +103,27 @@ def _gap(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDArray, t
                                                      "samples_per_span": _SEED_PER_SPAN}
     found = project_to_surface(other, p, tol=1e-3 * tol, **kw)
     return uv, p, found
+
+
+def may_run_along(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDArray,
+                  guess: NDArray, *, tol: float) -> bool:
+    """Cheap necessary test before a side is scanned: False when none of the side
+    points half a sample spacing either side of the traced points at free
+    parameters ``t (k,)`` lies on ``other`` (within ``tol / 16``, projected from
+    ``guess (k, 2)``, their parameters on ``other``).
+
+    A run of :func:`side_curves` holds ``_MIN_RUN`` consecutive samples, so it is
+    at least two spacings long and a traced point on it has a probe inside it; a
+    curve merely crossing the side (a seam, a trimmed end) is off ``other``
+    there by about the spacing times the crossing angle.
+    """
+    t = np.asarray(t, dtype=float)
+    lo, hi, _ = _free_range(own, side.coord)
+    delta = 0.5 * float(np.min(np.diff(_side_samples(own, side.coord))))
+    probes = np.clip(np.concatenate([t - delta, t + delta]), lo, hi)
+    guess = np.concatenate([guess, guess])
+    found = _gap(own, other, side, probes, tol, np.asarray(guess, dtype=float))[2]
+    return bool(np.any(found.distance <= _SHARE * tol))
 
 
 def _runs(near: NDArray) -> list[tuple[int, int]]:
