@@ -149,3 +149,16 @@ def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:
     for source in inputs:
         if source.exists() and os.path.samefile(source, target):
             raise OutputFileError(f"refusing to overwrite the input file {target}")
+
+
+def check_outputs(inputs: tuple[Path, ...], output: Path, *, plot: Path | None = None,
+                  json_path: str | None = None) -> None:
+    """Fail before the work, not after: no output may be an input file, and ``--plot``
+    needs matplotlib (:class:`OutputFileError` either way)."""
+    from .plotting import require_matplotlib
+    report = None if json_path in (None, STDOUT) else Path(json_path)
+    for target in (output, plot, report):
+        if target is not None:
+            refuse_overwriting_inputs(Path(target), inputs)
+    if plot is not None:
+        require_matplotlib()

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import OutputFileError
 from ..io import read, write
-from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
+from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from .plotting import pyplot, save_figure
 
 __all__ = ["COMMAND", "plot_deviation"]
 
@@ -18,9 +18,7 @@ __all__ = ["COMMAND", "plot_deviation"]
 def plot_deviation(result, path: Path) -> Path:
     """Deviation map: the §7 error points of every approximant coloured by distance to
     the originals, plus each shared edge's measured gap and angle (Agg)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     fig = plt.figure(figsize=(12, 5.5))
     ax = fig.add_subplot(1, 2, 1, projection="3d")
     bars = fig.add_subplot(1, 2, 2)
@@ -44,13 +42,7 @@ def plot_deviation(result, path: Path) -> Path:
         gap_axis.legend(loc="upper right", fontsize="small")
     bars.set_title(f"measured joins ({result.continuity.value})")
     fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise OutputFileError(f"cannot write plot {path}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(fig)
-    return path.resolve()
+    return save_figure(fig, path)
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -95,10 +87,7 @@ def _summary(report: dict) -> list[str]:
 def _run(args: argparse.Namespace, console: Console) -> int:
     from ..heal import heal
     inputs = tuple(p for p in (args.input, args.patches) if p is not None)
-    for target in (args.output, args.plot,
-                   None if args.json_path in (None, STDOUT) else Path(args.json_path)):
-        if target is not None:                       # fail before the work, not after
-            refuse_overwriting_inputs(Path(target), inputs)
+    check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read(args.input)
     result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                   patches=args.patches)

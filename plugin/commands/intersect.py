@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import OutputFileError
 from ..io import read, write
-from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
+from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from .plotting import pyplot, save_figure
 
 __all__ = [
     "COMMAND",
@@ -125,9 +125,7 @@ def compare_with_occ(results, model_a, model_b) -> dict:
 
 def plot_curves(results, path: Path) -> Path:
     """3D view and both parameter domains of every curve, written to ``path`` (Agg)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     pairs = _characteristic_pairs(results)
     rows = 1 + len(pairs)
     fig = plt.figure(figsize=(15, 5 * rows))
@@ -164,13 +162,7 @@ def plot_curves(results, path: Path) -> Path:
     if results and len(results) <= 12:
         axb.legend(fontsize="small")
     fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise OutputFileError(f"cannot write plot {path}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(fig)
-    return path.resolve()
+    return save_figure(fig, path)
 
 
 #: marker and colour of each characteristic point kind in --plot (paper Fig. 3 style)
@@ -248,10 +240,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace, console: Console) -> int:
     from ..intersect import intersect
     inputs = tuple(p for p in (args.file_a, args.file_b) if p is not None)
-    for target in (args.output, args.plot,
-                   None if args.json_path in (None, STDOUT) else Path(args.json_path)):
-        if target is not None:                       # fail before the work, not after
-            refuse_overwriting_inputs(Path(target), inputs)
+    check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model_a = read(args.file_a)
     model_b = read(args.file_b) if args.file_b is not None else None
     start = time.perf_counter()

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ...errors import OutputFileError
 from ..io import read, write
-from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
+from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from .plotting import pyplot, save_figure
 
 __all__ = ["COMMAND", "face_entry", "plot_isolines"]
 
@@ -60,12 +60,7 @@ def plot_isolines(pairs, path: Path) -> Path:
     ``pairs`` is a list of ``(label, old NurbsSurface, new NurbsSurface)``; each
     face is drawn in the plane of its two principal directions.
     """
-    try:
-        import matplotlib
-    except ImportError:
-        raise OutputFileError("--plot needs matplotlib: pip install 'surfprep[plot]'") from None
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     rows = max(1, len(pairs))
     fig, axes = plt.subplots(rows, 2, figsize=(11, 4.2 * rows), squeeze=False)
     for row, (label, old, new) in enumerate(pairs):
@@ -80,13 +75,7 @@ def plot_isolines(pairs, path: Path) -> Path:
             ax.set_title(f"{label}: {title} (u blue, v red, equal parameter steps)",
                          fontsize="small")
     fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise OutputFileError(f"cannot write plot {path}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(fig)
-    return path.resolve()
+    return save_figure(fig, path)
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -107,15 +96,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     from ..geom import surface_from_occ
     from ..reparam import reparametrize_model
     inputs = (args.file,)
-    for target in (args.output, args.plot,
-                   None if args.json_path in (None, STDOUT) else Path(args.json_path)):
-        if target is not None:                       # fail before the work, not after
-            refuse_overwriting_inputs(Path(target), inputs)
-    if args.plot is not None:
-        try:
-            import matplotlib  # noqa: F401
-        except ImportError:
-            raise OutputFileError("--plot needs matplotlib: pip install 'surfprep[plot]'") from None
+    check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read(args.file)
     start = time.perf_counter()
     shape, entries = reparametrize_model(
