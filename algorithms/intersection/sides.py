@@ -115,14 +115,18 @@ def may_run_along(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: N
     A run of :func:`side_curves` holds ``_MIN_RUN`` consecutive samples, so it is
     at least two spacings long and a traced point on it has a probe inside it; a
     curve merely crossing the side (a seam, a trimmed end) is off ``other``
-    there by about the spacing times the crossing angle.
+    there by about the spacing times the crossing angle. Probes beyond the
+    side's ends are left out (a run reaching an end has the inner one inside).
     """
     t = np.asarray(t, dtype=float)
     lo, hi, _ = _free_range(own, side.coord)
     delta = 0.5 * float(np.min(np.diff(_side_samples(own, side.coord))))
-    probes = np.clip(np.concatenate([t - delta, t + delta]), lo, hi)
-    guess = np.concatenate([guess, guess])
-    found = _gap(own, other, side, probes, tol, np.asarray(guess, dtype=float))[2]
+    probes = np.concatenate([t - delta, t + delta])
+    inside = (probes >= lo) & (probes <= hi)      # a run at the side's end: the inner probe
+    if not np.any(inside):
+        return True
+    guess = np.concatenate([guess, guess])[inside]
+    found = _gap(own, other, side, probes[inside], tol, np.asarray(guess, dtype=float))[2]
     return bool(np.any(found.distance <= _SHARE * tol))
 
 

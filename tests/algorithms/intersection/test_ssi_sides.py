@@ -12,7 +12,7 @@ import pytest
 
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import intersect_surfaces
-from surfprep.algorithms.intersection.sides import DomainSide, side_curves
+from surfprep.algorithms.intersection.sides import DomainSide, may_run_along, side_curves
 from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
 
 TOL = 1e-7
@@ -94,3 +94,21 @@ def test_narrow_face_is_not_taken_for_a_closed_surface():
     p = curves[0].points
     assert np.sort(p[[0, -1], 1]) == pytest.approx([0, 0.02], abs=TOL)
     assert curves[0].length == pytest.approx(0.02, rel=1e-9)
+
+
+def test_may_run_along_tells_a_side_on_the_surface_from_a_crossing():
+    """The cheap pre-test of a side scan: the wall's foot (side v = 0) lies on the
+    plane next to a traced point on it; the wall's end u = 0, sunk to cross the
+    plane at its middle, leaves the plane half a sample spacing either side."""
+    flat, standing = plane(), wall()
+    foot = DomainSide(owner=0, coord=1, value=0.0)
+    assert may_run_along(standing, flat, foot, np.array([0.5]), np.array([[0.5, 0.75]]),
+                         tol=TOL)
+    sunk = NurbsSurface(standing.control_points - np.array([0.0, 0.0, 0.5]),
+                        standing.knots_u, standing.knots_v, 2, 1)
+    end = DomainSide(owner=0, coord=0, value=0.0)
+    assert not may_run_along(sunk, flat, end, np.array([0.5]), np.array([[0.25, 0.5]]),
+                             tol=TOL)
+    # a curve through the corner: the probe beyond the side's end is not taken
+    assert not may_run_along(standing, flat, end, np.array([0.0]), np.array([[0.25, 0.5]]),
+                             tol=TOL)
