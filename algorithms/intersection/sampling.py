@@ -75,6 +75,8 @@ _SPACING = 0.8
 _POINT_SHARE = 1.0 / 16.0
 #: Newton steps projecting left-out dense samples onto curve3d
 _PROJECTION_STEPS = 4
+#: a projection onto curve3d stops once its steps move the foot by this share of the target
+_SETTLED = 1e-2
 #: a span longer than this times a neighbour is split (graded sampling)
 _MAX_RATIO = 4.0
 #: a failing span takes a dense sample within this fraction of its middle, else a new one
@@ -239,9 +241,11 @@ class _Work:
 
 
 def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
-                      hi: NDArray) -> NDArray:
+                      hi: NDArray, settled: float = 0.0) -> NDArray:
     """Distances ``(m,)`` of points ``x (m, 3)`` to the first three coordinates of
-    ``curve`` near ``t0`` (Newton within ``[lo, hi]``)."""
+    ``curve`` near ``t0`` (Newton within ``[lo, hi]``, ``_PROJECTION_STEPS`` at most;
+    stopped once every step moves the foot by ``settled`` model units or less: the
+    distance is stationary at the foot, so its error is of second order in that)."""
     t = t0.copy()
     for _ in range(_PROJECTION_STEPS):
         d = curve.derivatives(t, 2)[..., :3]
@@ -250,7 +254,11 @@ def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
         speed = np.einsum("ij,ij->i", d[:, 1], d[:, 1])
         den = speed + np.einsum("ij,ij->i", r, d[:, 2])
         den = np.where(den > 0, den, speed)
-        t = np.clip(t - num / np.where(den > 0, den, 1.0), lo, hi)
+        moved = np.clip(t - num / np.where(den > 0, den, 1.0), lo, hi)
+        step = np.abs(moved - t) * np.sqrt(speed)
+        t = moved
+        if np.all(step <= settled):
+            break
     return np.linalg.norm(curve.evaluate(t)[:, :3] - x, axis=1)
 
 
@@ -368,7 +376,7 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
         a0, a1 = arc[ends[j]], arc[ends[j + 1]]
         frac = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
         dist = _project_on_curve(check.stacked, w.points[idx], t[j] + frac * dt[j], t[j],
-                                 t[j + 1])
+                                 t[j + 1], settled=_SETTLED * target)
         far = dist > target
         if np.any(far):                          # the worst of each span
             order = np.lexsort((-dist[far], j[far]))
