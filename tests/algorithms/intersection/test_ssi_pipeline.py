@@ -37,7 +37,7 @@ TAU = 2 * np.pi
 TOL = 1e-7
 #: OpenCascade's curves sampled this densely (chord sag about 1e-8 on a unit circle)
 OCC_SAMPLES = 20001
-DATA = Path("/work/shared/data")
+DATA = Path(__file__).resolve().parents[3] / ".." / "shared" / "data"   # beside the checkout, as in conftest
 
 
 # ---------------------------------------------------------------- operands
