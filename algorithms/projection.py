@@ -66,7 +66,6 @@ from scipy.spatial import cKDTree
 
 from ..errors import InvalidGeometryError
 from .basis import distinct_knots
-from .curve import NurbsCurve
 from .surface import NurbsSurface
 from .tolerance import check_tolerance
 
@@ -108,17 +107,6 @@ class ProjectionResult:
     """
 
     uv: NDArray
-    points: NDArray
-    distance: NDArray
-    converged: NDArray
-
-
-@dataclass(frozen=True)
-class CurveProjectionResult:
-    """Closest points on a curve: ``t (...)``, ``points (..., d)``, ``distance (...)``,
-    ``converged (...)`` as in :class:`ProjectionResult`."""
-
-    t: NDArray
     points: NDArray
     distance: NDArray
     converged: NDArray
@@ -565,71 +553,7 @@ def distance_to_surface(surface: NurbsSurface, points: ArrayLike, *,
     return project_to_surface(surface, points, tol=tol).distance
 
 
-# -------------------------------------------------------------------- curves
-def _curve_local(curve: NurbsCurve) -> tuple[Callable, Callable]:
-    def local(x):
-        d = curve.derivatives(x[:, 0], 2)
-        return d[:, 0], d[:, 1, :, None], d[:, 2, :, None, None]
-
-    def value(x):
-        return curve.evaluate(x[:, 0])
-
-    return local, value
-
-
-def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None = None,
-                     max_iter: int = 30, n_seeds: int = 3,
-                     samples_per_span: int | None = None,
-                     guess: ArrayLike | None = None) -> CurveProjectionResult:
-    """Closest points of a curve to many points (eqs. 6.3-6.5 of [PT]).
-
-    Parameters
-    ----------
-    curve : NurbsCurve
-    points : (..., d) float, ``d`` the curve's dimension (2 or 3)
-    tol, max_iter, n_seeds : as in :func:`project_to_surface`
-    samples_per_span : int, optional
-        Default: at least ``max(1024, 4 (degree + 1) spans)``, shared as for surfaces.
-    guess : (...) float, optional
-        Start parameters instead of the samples.
-
-    Returns
-    -------
-    CurveProjectionResult
-        ``t (...)``, ``points (..., d)``, ``distance (...)``, ``converged (...)``.
-    """
-    p = _check_points(points, curve.dimension)
-    shape = p.shape[:-1]
-    targets = p.reshape(-1, curve.dimension)
-    tol = _tolerance(tol, curve)
-    max_iter = _check_count(max_iter, "max_iter", 1)
-    n_seeds = _check_count(n_seeds, "n_seeds", 1)
-    lo, hi = (np.array([x]) for x in curve.domain)
-    pieces = _Pieces([curve.knots], [curve.degree])
-    if guess is not None:
-        x0 = np.asarray(guess, dtype=float)
-        if x0.shape != shape or not np.all(np.isfinite(x0)):
-            raise InvalidGeometryError(f"guess must be finite of shape {shape}, got {x0.shape}")
-        rows, x0 = np.arange(targets.shape[0]), np.clip(x0.reshape(-1, 1), lo, hi)
-    else:
-        extents = _span_extents(curve.control_points, curve.knots, curve.degree)
-        (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
-                                   4 * _MIN_SAMPLES, density=4)
-        st = _span_samples(curve.knots, curve.degree, counts)
-        rows, sample = _pick_seeds(curve.evaluate(st), targets, n_seeds,
-                                   [pieces.axis_index(0, st)])
-        x0 = st[sample][:, None]
-    local, value = _curve_local(curve)
-    rows, x0 = pieces.split_seeds(rows, x0)
-    x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
-    best = _best_per_query(rows, distance)
-    return CurveProjectionResult(t=x[best, 0].reshape(shape),
-                                 points=foot[best].reshape(shape + (curve.dimension,)),
-                                 distance=distance[best].reshape(shape),
-                                 converged=converged[best].reshape(shape))
-
-
-def distance_to_curve(curve: NurbsCurve, points: ArrayLike, *,
-                      tol: float | None = None) -> NDArray:
-    """Distances ``(...)`` from ``points (..., d)`` to the curve (:func:`project_to_curve`)."""
-    return project_to_curve(curve, points, tol=tol).distance
+# Curves share the machinery above; their functions live in their own module and
+# are served from here too (imported last: that module uses the names above).
+from .curve_projection import (CurveProjectionResult, distance_to_curve,  # noqa: E402
+                               project_to_curve)
