@@ -14,7 +14,7 @@ import surfprep
 from surfprep.plugin import cli
 from surfprep.plugin.intersect import FoundBy, IntersectionResult, Method, intersect
 
-cq = pytest.importorskip("cadquery")
+import cadquery as cq
 R2 = np.sqrt(0.5)
 
 

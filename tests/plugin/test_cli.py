@@ -17,7 +17,6 @@ from surfprep.plugin.commands import info as info_command
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "step_samples"
-DATA = REPO.parent / "shared" / "data"
 FUSELAGE = SAMPLES / "occt_fuselage.stp"
 SYNTHETIC = SAMPLES / "synthetic_named_faces.step"
 CAPSULE = SAMPLES / "overture_marscapsule_proe.igs"
@@ -273,10 +272,8 @@ def test_console_script_error_exit_code(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["occt_k1_catia_debis.stp", "pyiges_impeller_solidworks.igs",
                                   "occt_cornetta.stp"])
-def test_demo_on_real_files(capsys, tmp_path, name):
-    path = DATA / name
-    if not path.is_file():
-        pytest.skip(f"{path} not available")
+def test_demo_on_real_files(capsys, tmp_path, name, data_dir):
+    path = data_dir / name
     code, _, err = run(capsys, "demo", "--input", str(path), "-o", str(tmp_path))
     assert code == 0, err
     report = json.loads(next(tmp_path.glob("*-report.json")).read_text())

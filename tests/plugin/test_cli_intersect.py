@@ -15,7 +15,7 @@ from OCP.TopExp import TopExp_Explorer
 import surfprep
 from surfprep.plugin import cli
 
-cq = pytest.importorskip("cadquery")
+import cadquery as cq
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:

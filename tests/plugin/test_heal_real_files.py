@@ -12,8 +12,6 @@ import surfprep
 @pytest.mark.slow
 def test_marscapsule_duplicates_dropped(data_dir):
     path = data_dir / "overture_marscapsule_proe.igs"
-    if not path.exists():
-        pytest.skip("shared data not available")
     r = surfprep.heal(path)
     rep = r.report()
     assert rep["faces_in"] == 36
@@ -31,8 +29,6 @@ def test_microstation_gaps_fewer_geometric_free_edges(data_dir):
     around the mouth of a slot is no hole and stays open), the shape stays valid and joins
     between approximants are closed."""
     path = data_dir / "occt_k1geo_microstation.stp"
-    if not path.exists():
-        pytest.skip("shared data not available")
     r = surfprep.heal(path)
     assert r.tight_free_edges_after < r.tight_free_edges_before
     assert r.free_edges_after <= r.free_edges_before
@@ -50,8 +46,6 @@ def test_heartvalve_every_face_approximated(data_dir):
     faces are sewn at 1e-7 x size drop 24 -> 0 (sides snapped onto kept faces' edges, also
     where a side meets two edges of one face, with shared corners moved onto the edge ends)."""
     path = data_dir / "overture_heartvalve_rhino.igs"
-    if not path.exists():
-        pytest.skip("shared data not available")
     r = surfprep.heal(path)
     faces = [p for p in r.patches if p.origin.kind == "face"]
     assert len(faces) == 11 and all(p.converged for p in faces)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,8 +16,7 @@ from surfprep.errors import ConversionError, InvalidToleranceError
 from surfprep.plugin.intersect import FaceIntersection, face_operands, inside_face, intersect
 from surfprep.plugin.occ_reference import section_faces_occ
 
-cq = pytest.importorskip("cadquery")
-DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"   # beside the checkout, as in conftest
+import cadquery as cq
 
 
 def unit_sphere():
@@ -80,7 +78,7 @@ def test_hole_in_a_face_splits_the_curve():
 
 
 def test_build123d_box_and_cylinder():
-    bd = pytest.importorskip("build123d")
+    import build123d as bd
     result = intersect(bd.Box(1, 1, 1), bd.Cylinder(0.3, 2), tol=1e-7)
     check_result(result)
     assert connected_branches([r.curve for r in result], 1e-6) == 2
@@ -153,10 +151,8 @@ def test_inside_face_dense_against_the_exact_plate():
 
 
 @pytest.fixture(scope="module")
-def debis():
-    path = DATA / "occt_k1_catia_debis.stp"
-    if not path.exists():
-        pytest.skip(f"{path} not available")
+def debis(data_dir):
+    path = data_dir / "occt_k1_catia_debis.stp"
     return surfprep.read(path)
 
 

@@ -22,7 +22,6 @@ from surfprep.plugin.step_iges import TranslationError
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "step_samples"
-DATA = REPO.parent / "shared" / "data"
 
 FUSELAGE = SAMPLES / "occt_fuselage.stp"
 CAPSULE = SAMPLES / "overture_marscapsule_proe.igs"
@@ -421,10 +420,8 @@ REAL_FILES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name, n_faces", sorted(REAL_FILES.items()))
-def test_real_files_read_with_catalogue_face_counts(name, n_faces):
-    path = DATA / name
-    if not path.is_file():
-        pytest.skip(f"{path} not available")
+def test_real_files_read_with_catalogue_face_counts(name, n_faces, data_dir):
+    path = data_dir / name
     model = read(path)
     assert model.n_faces == n_faces
     assert model.size > 0
@@ -433,10 +430,8 @@ def test_real_files_read_with_catalogue_face_counts(name, n_faces):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["occt_k1_catia_debis.stp", "occt_s1_ideas.stp",
                                   "pyocc_ventilator_catia5.stp"])
-def test_real_step_face_names_survive_step_round_trip(tmp_path, name):
-    path = DATA / name
-    if not path.is_file():
-        pytest.skip(f"{path} not available")
+def test_real_step_face_names_survive_step_round_trip(tmp_path, name, data_dir):
+    path = data_dir / name
     model = read(path)
     assert all(n is not None for n in model.face_names)
     again = read(write(model, tmp_path / "copy.step"))

@@ -21,7 +21,7 @@ Times of both are printed (``-s``): the whole-model cut runs per face pair in
 Python and is 2-25 x slower than the Section here -- a finding, not an
 assertion (benchmarks/ holds timed comparisons).
 
-Findings (strict xfails, reported; at commits ca89398 / bc6c808):
+Findings that were pinned as strict xfails (at commits ca89398 / bc6c808) and are now fixed:
 
 * (fixed: hanging ends continued by marching, algorithms.intersection.extend)
   fuselage waterline at 40 % height: at the nose, where faces 0 and 1 close
@@ -57,7 +57,7 @@ from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.intersect import face_operands
 from surfprep.plugin.occ_reference import section_faces_occ
 
-cq = pytest.importorskip("cadquery")
+import cadquery as cq
 
 OCC_SAMPLES = 4001
 TOL_FACTOR = 1e-6
@@ -159,8 +159,6 @@ def check_agree(model: Model, f: dict, gap: float = 0.0, occ_off: float = 0.0) -
 @pytest.fixture(scope="module")
 def fuselage(data_dir):
     path = data_dir / "occt_fuselage.stp"
-    if not path.exists():
-        pytest.skip(f"{path} not available")
     return Model(path)
 
 
@@ -207,8 +205,6 @@ def test_fuselage_waterline(fuselage):
 @pytest.fixture(scope="module")
 def hull(data_dir):
     path = data_dir / "overture_kcs_hull_ideas.igs"
-    if not path.exists():
-        pytest.skip(f"{path} not available")
     return Model(path)
 
 

@@ -20,7 +20,7 @@ domain ends at the face's edges, so in ``occt_s1_ideas.stp`` most edges lie on
 the boundary of one or both surfaces -- the intersection then runs along (or
 ends exactly on) a surface's boundary, the hardest case for any SSI.
 
-Findings (strict xfails; reported to the SSI owner):
+Findings that were pinned as strict xfails and are now fixed (kept as the history of each case):
 
 * (fixed by algorithms.intersection.sides) an intersection running along the
   domain side of one surface (e.g. a plane cap x a surface of revolution ending
@@ -216,8 +216,6 @@ class RealFile:
 @pytest.fixture(scope="module")
 def s1_ideas(data_dir):
     path = data_dir / "occt_s1_ideas.stp"
-    if not path.exists():
-        pytest.skip(f"{path} not available")
     return RealFile(path)
 
 

@@ -32,7 +32,7 @@ from surfprep.algorithms.characteristic import (
 from surfprep.algorithms.intersection import connected_branches
 from surfprep.algorithms.projection import distance_to_surface
 
-occ_reference = pytest.importorskip("surfprep.plugin.occ_reference")
+from surfprep.plugin import occ_reference
 TOL = 1e-9
 
 

@@ -15,12 +15,11 @@ differently. Where either side misses a branch, the test says so in a comment
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-OCP = pytest.importorskip("OCP")
+import OCP  # noqa: F401  (the OpenCascade cross-checks below)
 from OCP.Geom import (Geom_CylindricalSurface, Geom_Plane, Geom_SphericalSurface,  # noqa: E402
                       Geom_ToroidalSurface)
 from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt  # noqa: E402
@@ -37,7 +36,6 @@ TAU = 2 * np.pi
 TOL = 1e-7
 #: OpenCascade's curves sampled this densely (chord sag about 1e-8 on a unit circle)
 OCC_SAMPLES = 20001
-DATA = Path(__file__).resolve().parents[3] / ".." / "shared" / "data"   # beside the checkout, as in conftest
 
 
 # ---------------------------------------------------------------- operands
@@ -289,7 +287,7 @@ def test_torus_plane_through_the_axis_two_circles():
 # ---------------------------------------------------------------- free form
 def contour_reference(surface: NurbsSurface, level: float, n: int = 1201):
     """Marching-squares contour of z(u, v) = level on an n x n grid, mapped to 3D."""
-    contourpy = pytest.importorskip("contourpy")
+    import contourpy
     u = np.linspace(0, 1, n)
     z = surface.evaluate(u[:, None], u[None, :])[..., 2]
     lines = contourpy.contour_generator(u, u, z.T).lines(level)
@@ -337,10 +335,8 @@ def test_small_loop_needs_a_finer_mesh_tolerance():
 
 # ---------------------------------------------------------------- real file
 @pytest.fixture(scope="module")
-def debis():
-    path = DATA / "occt_k1_catia_debis.stp"
-    if not path.exists():
-        pytest.skip(f"{path} not available")
+def debis(data_dir):
+    path = data_dir / "occt_k1_catia_debis.stp"
     import surfprep
     from surfprep.plugin.faces import face_to_nurbs
     model = surfprep.read(path)
