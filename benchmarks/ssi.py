@@ -33,14 +33,14 @@ import argparse
 import time
 
 import numpy as np
-from intersect import bumpy, cylinder, flat, plane, sphere, torus
+from intersect import bumpy, cylinder, deviation, flat, plane, sphere, torus
+from intersect import densely as dense_points
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import (
     connected_branches,
     intersect_surfaces,
     polyline_distance,
 )
-from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.geom import surface_to_occ
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
 
@@ -129,21 +129,6 @@ def best_time(fn, repeat: int):
         if best > 5.0:
             break
     return out, best
-
-
-def dense_points(curves) -> np.ndarray:
-    out = [np.zeros((0, 3))]
-    for c in curves:
-        out.append(c.points)
-        if getattr(c, "curve3d", None) is not None:
-            out.append(c.curve3d.evaluate(c.span_parameters(3).ravel()))
-    return np.concatenate(out)
-
-
-def deviation(points: np.ndarray, a: NurbsSurface, b: NurbsSurface) -> float:
-    if points.shape[0] == 0:
-        return float("nan")
-    return float(max(distance_to_surface(a, points).max(), distance_to_surface(b, points).max()))
 
 
 def coverage_gap(exact: list[np.ndarray], curves) -> float:
