@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
+from . import basis_kernels
 
 __all__ = [
     "basis_derivatives",
@@ -135,13 +136,22 @@ def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
     t = np.asarray(t, dtype=float).reshape(-1)
     if span is None:
         span = find_span(knots, p, t)
+    if basis_kernels.AVAILABLE:                               # same recurrences, compiled
+        return basis_kernels.basis_derivatives_compiled(knots, p, t, span,
+                                                        max(int(order), 0)), span
+    return _basis_derivatives_numpy(knots, p, t, order, span), span
+
+
+def _basis_derivatives_numpy(knots: NDArray, p: int, t: NDArray, order: int,
+                             span: NDArray) -> NDArray:
+    """The numpy form of :func:`basis_derivatives`: ``(m, order + 1, p + 1)``."""
     top = min(max(int(order), 0), p)
     ndu = _basis_triangle(knots, p, t, span)                 # (p+1, p+1, m)
     ders = np.zeros((max(int(order), 0) + 1, p + 1, t.size))
     ders[0] = ndu[:, p]
     if top > 0:
         ders[1:top + 1] = _derivative_rows(ndu, p, top)
-    return np.ascontiguousarray(ders.transpose(2, 0, 1)), span
+    return np.ascontiguousarray(ders.transpose(2, 0, 1))
 
 
 def _basis_triangle(knots: NDArray, p: int, t: NDArray, span: NDArray) -> NDArray:
