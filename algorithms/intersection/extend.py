@@ -29,9 +29,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
+from .branches import SingularKind, locate_singular_points, singular_branches
 from .refine import RefinedCurve, refine_points
+from .topology import EndKind
 
-__all__ = ["extend_open_ends"]
+__all__ = ["extend_open_ends", "join_at_singular_points"]
 
 _MAX_STEPS = 400
 #: largest tangent turn of one accepted step (radians)
@@ -188,3 +190,297 @@ def extend_open_ends(curves: list[RefinedCurve], open_ends: list[tuple[bool, boo
         out.append(c)
         reached.append(tuple(flags))
     return out, reached
+
+
+# ------------------------------------------------------------------ singular points
+#: a sample whose normals are within this sine of parallel may be near a singular point
+_SIN_CANDIDATE = 0.1
+#: at most this many such samples per call are tried as starts
+_MAX_SAMPLE_STARTS = 16
+#: the ball cut around a singular point: this times the farthest end that led to it
+_BALL_MARGIN = 1.25
+#: a piece end is joined to the half-branch it points along within this angle
+_JOIN_COS = np.cos(np.radians(35.0))
+
+
+def _normal_sines(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray,
+                  ub: NDArray) -> NDArray:
+    """``|N_a x N_b| (n,)`` at samples ``ua, ub (n, 2)``."""
+    da = surface_a.derivatives(ua[:, 0], ua[:, 1], 1)
+    db = surface_b.derivatives(ub[:, 0], ub[:, 1], 1)
+    na = np.cross(da[:, 1, 0], da[:, 0, 1])
+    nb = np.cross(db[:, 1, 0], db[:, 0, 1])
+    den = np.maximum(np.linalg.norm(na, axis=1) * np.linalg.norm(nb, axis=1),
+                     np.finfo(float).tiny)
+    return np.linalg.norm(np.cross(na, nb), axis=1) / den
+
+
+def _singular_starts(curves: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
+                     surface_b: NurbsSurface) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Starts for :func:`.branches.locate_singular_points`: every BIFURCATION or OPEN
+    end, and the samples where the normals come closest to parallel (local
+    minima of ``|N_a x N_b|`` below ``_SIN_CANDIDATE``, the lowest few).
+    Returns ``points (k, 3)``, ``uv_a, uv_b (k, 2)`` and ``is_end (k,) bool``."""
+    pts, ua, ub, is_end = [], [], [], []
+    for c, kind in zip(curves, kinds):
+        if c.closed or c.points.shape[0] < 2:
+            continue
+        for e, k in ((0, kind[0]), (-1, kind[1])):
+            if k in (EndKind.BIFURCATION, EndKind.OPEN):
+                pts.append(c.points[e])
+                ua.append(c.uv_a[e])
+                ub.append(c.uv_b[e])
+                is_end.append(True)
+    sizes = [c.points.shape[0] for c in curves]
+    if sum(sizes):
+        all_a = np.concatenate([c.uv_a for c in curves])
+        all_b = np.concatenate([c.uv_b for c in curves])
+        sines = _normal_sines(surface_a, surface_b, all_a, all_b)
+        minima = []
+        start = 0
+        for n in sizes:
+            s = sines[start:start + n]
+            if n >= 3:
+                inner = np.flatnonzero((s[1:-1] <= s[:-2]) & (s[1:-1] <= s[2:])
+                                       & (s[1:-1] < _SIN_CANDIDATE)) + 1
+                minima.extend(start + inner)
+            start += n
+        minima = np.array(minima, dtype=int)
+        minima = minima[np.argsort(sines[minima])[:_MAX_SAMPLE_STARTS]]
+        all_p = np.concatenate([c.points for c in curves])
+        pts.extend(all_p[minima])
+        ua.extend(all_a[minima])
+        ub.extend(all_b[minima])
+        is_end.extend([False] * minima.size)
+    if not pts:
+        z = np.zeros((0, 2))
+        return np.zeros((0, 3)), z, z, np.zeros(0, dtype=bool)
+    return np.array(pts), np.array(ua), np.array(ub), np.array(is_end)
+
+
+def _unique_points(points: NDArray, merge: float) -> tuple[NDArray, NDArray]:
+    """Indices of the first of each group of ``points`` within ``merge``, and the
+    group of each point."""
+    first, group = [], np.full(points.shape[0], -1)
+    for i, p in enumerate(points):
+        for g, j in enumerate(first):
+            if np.linalg.norm(points[j] - p) <= merge:
+                group[i] = g
+                break
+        else:
+            group[i] = len(first)
+            first.append(i)
+    return np.array(first, dtype=int), group
+
+
+def _pieces(curve: RefinedCurve, kind: tuple, centre: NDArray, radius: float) -> list:
+    """The runs of ``curve`` outside the ball ``|x - centre| < radius``:
+    ``[(RefinedCurve, (start_kind, end_kind), (start_cut, end_cut))]``; an end
+    made by the cut has kind OPEN and ``*_cut`` True. A curve not entering the
+    ball comes back whole."""
+    inside = np.linalg.norm(curve.points - centre, axis=1) < radius
+    if not inside.any():
+        return [(curve, kind, (False, False))]
+    fields = [curve.points, curve.uv_a, curve.uv_b, curve.converged, curve.singular]
+    if curve.closed:                      # start the open curve inside the ball
+        shift = int(np.argmax(inside))
+        fields = [np.roll(f, -shift, axis=0) for f in fields]
+        inside = np.roll(inside, -shift)
+        kind = (EndKind.OPEN, EndKind.OPEN)
+    out = []
+    edges = np.flatnonzero(np.diff(np.concatenate([[1], inside.astype(int), [1]])))
+    n = inside.size
+    for lo, hi in zip(edges[0::2], edges[1::2]):      # runs of outside samples [lo, hi)
+        if hi - lo < 2:
+            continue
+        cut = (lo > 0 or inside[0], hi < n or inside[-1])
+        if curve.closed:
+            cut = (True, True)
+        k = (EndKind.OPEN if cut[0] else kind[0], EndKind.OPEN if cut[1] else kind[1])
+        part = [f[lo:hi] for f in fields]
+        out.append((RefinedCurve(part[0], part[1], part[2], False, part[3], part[4]), k, cut))
+    return out
+
+
+def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: tuple,
+                direction: NDArray, heights: NDArray, tol: float, iterations: int = 30
+                ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Points of one branch leaving the singular point ``centre = (p, uv_a, uv_b)``
+    along the unit ``direction (3,)``: the intersection with the planes
+    ``direction . (x - p) = heights (m,)``, all at once by Newton on
+    ``[a(u, v) - b(s, t), direction . (a - p) - h]`` (four equations, four
+    unknowns), started from the tangent-plane prediction ``p + h direction``
+    mapped by each surface's Jacobian pseudo-inverse.
+
+    Returns ``points (m, 3)``, ``uv_a, uv_b (m, 2)`` and ``converged (m,) bool``
+    (``|a - b| <= tol / 16`` and within ``tol / 16`` of its plane)."""
+    p, uv_a, uv_b = centre
+    m = heights.size
+    da = surface_a.derivatives(uv_a[:1, 0], uv_a[:1, 1], 1)[0]
+    db = surface_b.derivatives(uv_b[:1, 0], uv_b[:1, 1], 1)[0]
+    ja = np.stack([da[1, 0], da[0, 1]], axis=1)
+    jb = np.stack([db[1, 0], db[0, 1]], axis=1)
+    step = heights[:, None] * direction[None]
+    z = np.concatenate([uv_a + step @ np.linalg.pinv(ja).T, uv_b + step @ np.linalg.pinv(jb).T],
+                       axis=1)
+    lo = np.concatenate([surface_a.domain[0::2], surface_b.domain[0::2]])
+    hi = np.concatenate([surface_a.domain[1::2], surface_b.domain[1::2]])
+    ok = np.zeros(m, dtype=bool)
+    for _ in range(iterations):
+        da = surface_a.derivatives(z[:, 0], z[:, 1], 1)
+        db = surface_b.derivatives(z[:, 2], z[:, 3], 1)
+        gap = da[:, 0, 0] - db[:, 0, 0]
+        off = (da[:, 0, 0] - p) @ direction - heights
+        ok = (np.linalg.norm(gap, axis=1) <= tol / 16) & (np.abs(off) <= tol / 16)
+        if ok.all():
+            break
+        jac = np.zeros((m, 4, 4))
+        jac[:, :3, 0], jac[:, :3, 1] = da[:, 1, 0], da[:, 0, 1]
+        jac[:, :3, 2], jac[:, :3, 3] = -db[:, 1, 0], -db[:, 0, 1]
+        jac[:, 3, 0], jac[:, 3, 1] = da[:, 1, 0] @ direction, da[:, 0, 1] @ direction
+        rhs = -np.concatenate([gap, off[:, None]], axis=1)
+        good = np.abs(np.linalg.det(jac)) > 1e-300
+        dz = np.zeros((m, 4))
+        dz[good] = np.linalg.solve(jac[good], rhs[good][..., None])[..., 0]
+        z = np.where(ok[:, None], z, np.clip(z + dz, lo, hi))
+    pts = 0.5 * (surface_a.evaluate(z[:, 0], z[:, 1]) + surface_b.evaluate(z[:, 2], z[:, 3]))
+    return pts, z[:, :2], z[:, 2:], ok & np.isfinite(z).all(axis=1)
+
+
+def _reversed(c: RefinedCurve) -> RefinedCurve:
+    return RefinedCurve(c.points[::-1], c.uv_a[::-1], c.uv_b[::-1], False, c.converged[::-1],
+                        c.singular[::-1])
+
+
+def _joined(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: tuple,
+            direction: NDArray, piece: RefinedCurve, tol: float) -> RefinedCurve:
+    """``piece`` continued from its first sample along the half-branch ``direction``
+    back to the singular point ``centre``; the result starts there."""
+    p, uv_a, uv_b = centre
+    reach = float((piece.points[0] - p) @ direction)
+    spacing = float(np.linalg.norm(piece.points[1] - piece.points[0]))
+    n = min(max(2, int(np.ceil(reach / max(spacing, 1e-300)))), 4096)
+    heights = reach * np.arange(1, n) / n
+    pts, ua, ub, ok = _arc_points(surface_a, surface_b, centre, direction, heights, tol)
+    pts, ua, ub = pts[ok], ua[ok], ub[ok]
+    k = pts.shape[0]
+    return RefinedCurve(np.concatenate([p[None], pts, piece.points]),
+                        np.concatenate([uv_a, ua, piece.uv_a]),
+                        np.concatenate([uv_b, ub, piece.uv_b]), False,
+                        np.concatenate([np.ones(k + 1, bool), piece.converged]),
+                        np.concatenate([[True], np.zeros(k, bool), piece.singular]))
+
+
+def _resolve_one(curves: list, kinds: list, centre: tuple, directions: NDArray,
+                 radius: float, surface_a: NurbsSurface, surface_b: NurbsSurface,
+                 tol: float) -> tuple[list, list]:
+    """Cut the ball of ``radius`` around one double point out of every curve and
+    join the cut ends to the half-branches ``+-directions (2, 3)`` through it
+    (each half-branch to the cut end pointing most nearly along it)."""
+    p = centre[0]
+    pieces = []
+    for c, k in zip(curves, kinds):
+        pieces.extend(_pieces(c, k, p, radius))
+    halves = np.concatenate([directions, -directions])              # (4, 3)
+    ends = []                     # (cos, piece, end 0 / 1, half)
+    for i, (piece, _, cut) in enumerate(pieces):
+        for end in (0, 1):
+            if cut[end]:
+                x = piece.points[-end] - p
+                cos = halves @ x / max(np.linalg.norm(x), 1e-300)
+                ends.append((float(np.max(cos)), i, end, int(np.argmax(cos))))
+    taken, joins = set(), {}
+    for cos, i, end, j in sorted(ends, reverse=True):
+        if cos >= _JOIN_COS and j not in taken:
+            taken.add(j)
+            joins[(i, end)] = j
+    new_curves, new_kinds = [], []
+    for i, (piece, kind, _) in enumerate(pieces):
+        kind = list(kind)
+        if (i, 0) in joins:
+            piece = _joined(surface_a, surface_b, centre, halves[joins[(i, 0)]], piece, tol)
+            kind[0] = EndKind.BIFURCATION
+        if (i, 1) in joins:
+            piece = _reversed(_joined(surface_a, surface_b, centre, halves[joins[(i, 1)]],
+                                      _reversed(piece), tol))
+            kind[1] = EndKind.BIFURCATION
+        new_curves.append(piece)
+        new_kinds.append(tuple(kind))
+    return new_curves, new_kinds
+
+
+def join_at_singular_points(curves: list[RefinedCurve], kinds: list[tuple[EndKind, EndKind]],
+                            surface_a: NurbsSurface, surface_b: NurbsSurface, *, tol: float,
+                            reach: float) -> tuple[list[RefinedCurve], list[tuple]]:
+    """Curves meeting at singular points of the intersection made to end exactly there.
+
+    Near a point where the surfaces cross with parallel normals (a double point:
+    two branches crossing, as two cylinders of equal radius with perpendicular
+    axes) the tessellations' segments cross over between the branches and the
+    refinement's auxiliary plane degenerates (its normal ``N_a x N_b`` vanishes),
+    so the traced curves end short of the point, switch branches, or cut the
+    corner. Here (000 §29.5.1; 002 §4):
+
+    1. the singular points are located (:func:`.branches.locate_singular_points`)
+       from every BIFURCATION / OPEN end and from the samples where the normals
+       come nearest to parallel, keeping those within ``reach`` of their start;
+    2. the branch directions come from the second-order form ``II_a - II_b``
+       (:func:`.branches.singular_branches`); only double points are resolved;
+    3. every curve is cut out of a ball around the point (``_BALL_MARGIN`` times
+       the farthest end that led to it), and each cut end is joined to the
+       half-branch it points along by points solved on planes across that
+       branch (:func:`_arc_points`), so four curves end at the point, with end
+       kind BIFURCATION and the point itself as their first sample.
+
+    Parameters
+    ----------
+    curves : list of RefinedCurve
+        Dense refined curves.
+    kinds : list of (EndKind, EndKind)
+        Their end kinds.
+    tol : float
+        Model units; new samples lie within ``tol / 16`` of both surfaces.
+    reach : float
+        Model units: how far from a curve end or sample a singular point is looked for.
+
+    Returns
+    -------
+    (curves, kinds)
+        With every double point found resolved; unchanged when there is none.
+    """
+    pts, ua, ub, is_end = _singular_starts(curves, kinds, surface_a, surface_b)
+    if pts.shape[0] == 0:
+        return curves, kinds
+    sa, sb, ok = locate_singular_points(surface_a, surface_b, ua, ub, tol=tol, scale=reach)
+    where = 0.5 * (surface_a.evaluate(sa[:, 0], sa[:, 1]) + surface_b.evaluate(sb[:, 0], sb[:, 1]))
+    dist = np.linalg.norm(where - pts, axis=1)
+    ok &= dist <= reach
+    if not ok.any():
+        return curves, kinds
+    idx = np.flatnonzero(ok)
+    first, group = _unique_points(where[idx], max(64 * tol, 1e-3 * reach))
+    centres, kinds_s, dirs = singular_branches(surface_a, surface_b, sa[idx[first]],
+                                               sb[idx[first]])
+    curves, kinds = list(curves), list(kinds)
+    for g, f in enumerate(first):
+        if kinds_s[g] is not SingularKind.DOUBLE_POINT:
+            continue
+        mine = group == g
+        far = dist[idx[mine]][is_end[idx[mine]]]
+        spacing = _local_spacing(curves, centres[g], reach)
+        radius = min(max(_BALL_MARGIN * (far.max() if far.size else 0.0), 4 * spacing), reach)
+        centre = (centres[g], sa[idx[f]][None], sb[idx[f]][None])
+        curves, kinds = _resolve_one(curves, kinds, centre, dirs[g], radius, surface_a,
+                                     surface_b, tol)
+    return curves, kinds
+
+
+def _local_spacing(curves: list[RefinedCurve], centre: NDArray, reach: float) -> float:
+    """Largest spacing of the samples within ``reach`` of ``centre`` (0 if none)."""
+    best = 0.0
+    for c in curves:
+        near = np.linalg.norm(c.points - centre, axis=1) <= reach
+        if near.sum() >= 2:
+            d = np.linalg.norm(np.diff(c.points, axis=0), axis=1)
+            best = max(best, float(d[near[:-1] & near[1:]].max(initial=0.0)))
+    return best
