@@ -84,6 +84,9 @@ __all__ = [
 GRID_MIN, GRID_MAX = 33, 129
 #: largest turn per step on a characteristic curve (only sign changes are read off it)
 CHARACTERISTIC_TURN = 0.6
+#: corrector tolerance on a characteristic curve: a share of the step and of the
+#: diagonal (its sign changes seed Newton on the exact points afterwards)
+CHARACTERISTIC_CTOL = 5e-2
 #: derivatives of phi below this share of its largest gradient on the grid are rounding
 NOISE_SHARE = 1e-9
 #: rounds of "trace through new critical points" at most
@@ -297,7 +300,8 @@ def _turning_points(field: DistanceField, uv: NDArray, st: NDArray, kind: CurveK
 def _trace_characteristic(field: DistanceField, kind, uv: NDArray, st: NDArray,
                           direction: NDArray, h_max: float) -> list[TracedCurve]:
     return trace_curves(field, kind, uv, st, direction, h0=0.2 * h_max, h_max=h_max,
-                        max_steps=400, max_turn=CHARACTERISTIC_TURN)
+                        max_steps=400, max_turn=CHARACTERISTIC_TURN,
+                        ctol=1e-3 * field.diagonal, relative_ctol=CHARACTERISTIC_CTOL)
 
 
 def _from_critical(field: DistanceField, crit: DistanceJet, h_max: float) -> list[TracedCurve]:

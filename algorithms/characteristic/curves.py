@@ -199,7 +199,8 @@ def _correct(field: DistanceField, kind: NDArray, uv: NDArray, st: NDArray,
 def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: NDArray, st0: NDArray,
                  direction: NDArray, *, h0: float | NDArray, h_max: float,
                  h_min: float | None = None, max_steps: int = 2000,
-                 ctol: float | None = None, max_turn: float = MAX_TURN) -> list[TracedCurve]:
+                 ctol: float | None = None, max_turn: float = MAX_TURN,
+                 relative_ctol: float = RELATIVE_CTOL) -> list[TracedCurve]:
     """Trace ``m`` curves of ``kind`` from ``uv0 (m, 2)`` one way each, all at once.
 
     Parameters
@@ -221,8 +222,12 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         Largest accepted turn of the tangent per step (radians).
     ctol : float
         Corrector convergence in parameter units (default 1e-7 of the diagonal;
-        never more than ``RELATIVE_CTOL`` of the step). The samples are starts
+        never more than ``relative_ctol`` of the step). The samples are starts
         for a later refinement (:mod:`.trace`), not the final answer.
+    relative_ctol : float
+        Share of the step the corrector must reach (default ``RELATIVE_CTOL``);
+        curves read only for sign changes (characteristic curves) take a
+        looser one: their crossings are refined by Newton afterwards.
 
     Returns
     -------
@@ -279,7 +284,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         comp = comp_all[active]
         st_guess = st[active] + np.einsum("mij,mj->mi", jac[active], pred - x0)   # eq. (21)
         x, nj, conv = _correct(field, comp, pred, st_guess, pinned,
-                               np.minimum(ctol, RELATIVE_CTOL * hh))
+                               np.minimum(ctol, relative_ctol * hh))
         _, ndg = curve_value(nj, comp)
         ntan = _tangent(ndg)
         ntan *= np.where(np.einsum("mi,mi->m", ntan, t0) < 0, -1.0, 1.0)[:, None]

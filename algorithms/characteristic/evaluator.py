@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..bezier import bezier_patches
 from ..rational import surface_derivatives_from_homogeneous
 from ..surface import NurbsSurface
+from . import kernels
 
 __all__ = ["PatchEvaluator"]
 
@@ -106,6 +107,13 @@ class PatchEvaluator:
         mv = _bernstein_to_monomial(self.surface.degree_v)
         coef = np.einsum("ik,jl,abijc->abklc", mu, mv, patches)
         self._data.update(coef=coef, iu=iu, iv=iv)
+        self._data["compiled"] = kernels.evaluator_arrays(coef, iu, iv) + (
+            self.surface.weights is not None,)
+
+    @property
+    def compiled(self) -> tuple[NDArray, NDArray, NDArray, bool]:
+        """``(coef, iu, iv, rational)`` for :mod:`.kernels`."""
+        return self._data["compiled"]
 
     @property
     def domain(self) -> tuple[float, float, float, float]:
@@ -115,6 +123,8 @@ class PatchEvaluator:
         """``(m, order + 1, order + 1, 3)``, as :meth:`NurbsSurface.derivatives` on 1-D input."""
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
+        if kernels.AVAILABLE and order <= 2:
+            return kernels.patch_derivatives(*self.compiled, u, v)[:, :order + 1, :order + 1]
         coef, iu, iv = self._data["coef"], self._data["iu"], self._data["iv"]
         # interior breakpoints only: a parameter beyond either end stays in the end patch
         su = np.searchsorted(iu[1:, 0], u, side="right")

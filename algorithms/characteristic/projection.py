@@ -26,7 +26,11 @@ taken instead.
   can record where the boundary was crossed.
 
 Start values come from the caller (continuation along a traced curve) or from
-the nearest sample of a grid over ``q`` (:class:`Projector` caches it).
+the nearest sample of a grid over ``q`` (:class:`Projector` caches it). A
+parallelogram ``q`` (degree 1 x 1, four non-rational control points with
+``p00 + p11 = p01 + p10``: every plane OpenCascade hands over) is affine in
+``(s, t)``: its foot is the solution of one 2 x 2 linear system (eqs. 3-4 are
+linear there), no Newton and no seed grid.
 """
 
 from __future__ import annotations
@@ -41,6 +45,7 @@ from scipy.spatial import cKDTree
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from . import kernels
 from .evaluator import PatchEvaluator
 
 __all__ = [
@@ -113,6 +118,26 @@ def projection_matrix(offset: NDArray, qd: NDArray) -> NDArray:
     return np.stack([np.stack([k00, k01], -1), np.stack([k01, k11], -1)], -2)
 
 
+def _affine_frame(surface: NurbsSurface) -> tuple[NDArray, NDArray, NDArray, NDArray] | None:
+    """``(p0, q_s, q_t, Gram matrix)`` of a parallelogram ``surface``, or None."""
+    if (surface.degree_u, surface.degree_v) != (1, 1) or tuple(surface.n_control) != (2, 2):
+        return None
+    if surface.weights is not None and np.ptp(surface.weights) > 1e-14 * np.abs(
+            surface.weights).max():
+        return None
+    p = surface.control_points
+    size = max(float(np.ptp(p.reshape(-1, 3), axis=0).max()), 1e-300)
+    if np.abs(p[0, 0] + p[1, 1] - p[0, 1] - p[1, 0]).max() > 1e-14 * size:
+        return None
+    d = surface.domain
+    qs = (p[1, 0] - p[0, 0]) / (d[1] - d[0])
+    qt = (p[0, 1] - p[0, 0]) / (d[3] - d[2])
+    gram = np.array([[qs @ qs, qs @ qt], [qs @ qt, qt @ qt]])
+    if np.linalg.det(gram) <= 1e-12 * np.trace(gram) ** 2:
+        return None
+    return p[0, 0].astype(float), qs, qt, gram
+
+
 @dataclass(frozen=True, eq=False)
 class Projector:
     """Orthogonal projection onto one surface, with a cached seed grid.
@@ -137,6 +162,12 @@ class Projector:
             raise InvalidGeometryError("projection needs a NurbsSurface in 3D")
         object.__setattr__(self, "tol", check_tolerance(self.tol))
         self._grid["evaluator"] = PatchEvaluator(self.surface)
+        self._grid["affine"] = _affine_frame(self.surface)
+
+    @property
+    def is_affine(self) -> bool:
+        """True when ``q`` is a parallelogram (projection in closed form)."""
+        return self._grid["affine"] is not None
 
     @property
     def evaluator(self) -> PatchEvaluator:
@@ -179,6 +210,24 @@ class Projector:
         _, idx = tree.query(points)
         return params[idx]
 
+    def _project_affine(self, x: NDArray) -> tuple[Projection, NDArray]:
+        """Feet on a parallelogram ``q``: ``G (s, t) = [q_s . (x - p0), q_t . (x - p0)]``
+        (eqs. 3-4 with ``q_st = 0``; ``K = G`` is the constant Gram matrix)."""
+        origin, qs, qt, gram = self._grid["affine"]
+        off = x - origin
+        rhs = np.stack([off @ qs, off @ qt], -1)
+        st = np.linalg.solve(gram, rhs.T).T + self.lower
+        span = self.upper - self.lower
+        st = np.clip(st, self.lower - EXTENSION * span, self.upper + EXTENSION * span)
+        d = st - self.lower
+        qd = np.zeros((x.shape[0], 3, 3, 3))
+        qd[:, 0, 0] = origin + d[:, :1] * qs + d[:, 1:] * qt
+        qd[:, 1, 0], qd[:, 0, 1] = qs, qt
+        status = np.where(self.inside(st), int(ProjectionStatus.UNIQUE),
+                          int(ProjectionStatus.NONE)).astype(np.int8)
+        det = np.full(x.shape[0], float(np.linalg.det(gram)))
+        return Projection(st, qd[:, 0, 0], status, det), qd
+
     # ------------------------------------------------------------ Newton
     def project(self, points: ArrayLike, st0: ArrayLike | None = None) -> Projection:
         """Feet of ``points (n, 3)`` by Newton on eqs. (3)-(4), from ``st0 (n, 2)``
@@ -190,9 +239,16 @@ class Projector:
         """:meth:`project` and ``q``'s derivatives at the feet ``(n, 3, 3, 3)``."""
         ev = self.evaluator
         x = np.asarray(points, dtype=float).reshape(-1, 3)
+        if self.is_affine:
+            return self._project_affine(x)
         st = self.seeds(x) if st0 is None else np.array(st0, dtype=float).reshape(-1, 2)
         span = self.upper - self.lower
         lo, hi = self.lower - EXTENSION * span, self.upper + EXTENSION * span
+        if kernels.AVAILABLE:
+            st, qd, moved, before = kernels.project_points(
+                *ev.compiled, x, np.ascontiguousarray(st), lo, hi, 0.25 * span,
+                float(self.tol), int(self.max_iter))
+            return self._finish(x, st, qd, moved, before)
         st = np.clip(st, lo, hi)
         moved = np.full(x.shape[0], np.inf)
         before = np.full(x.shape[0], np.inf)
@@ -231,7 +287,11 @@ class Projector:
             b = before[active]
             nxt = np.where((m < b) & np.isfinite(b), m ** 3 / np.maximum(b, 1e-300) ** 2, np.inf)
             active = active[(m > self.tol) & (nxt > self.tol)]
-        qd = ev.derivatives(st[:, 0], st[:, 1], 2)
+        return self._finish(x, st, ev.derivatives(st[:, 0], st[:, 1], 2), moved, before)
+
+    def _finish(self, x: NDArray, st: NDArray, qd: NDArray, moved: NDArray, before: NDArray
+                ) -> tuple[Projection, NDArray]:
+        """The §6.2 case of every foot from the last Newton moves."""
         k = projection_matrix(x - qd[:, 0, 0], qd)
         det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
         status = np.full(x.shape[0], int(ProjectionStatus.UNIQUE), dtype=np.int8)
