@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ...errors import DegenerateGeometryError
 from ..measure import normals
 from ..projection import project_to_curve
 from ..surface import NurbsSurface
@@ -62,6 +63,21 @@ class JoinReport:
                 "samples": self.samples}
 
 
+def _normals(surface: NurbsSurface, uv: NDArray) -> NDArray:
+    """(n, 3) float unit normals, NaN rows where the surface has none (a corner
+    collapsed to a point, a patch degenerated along a side)."""
+    try:
+        return normals(surface, uv[:, 0], uv[:, 1])
+    except DegenerateGeometryError:
+        out = np.full((uv.shape[0], 3), np.nan)
+        for k in range(uv.shape[0]):          # rare: only when some point has no normal
+            try:
+                out[k] = normals(surface, uv[k:k + 1, 0], uv[k:k + 1, 1])[0]
+            except DegenerateGeometryError:
+                pass
+        return out
+
+
 def _one_way(sa: NurbsSurface, side_a: Side, sb: NurbsSurface, side_b: Side, n: int
              ) -> tuple[NDArray, NDArray]:
     """Gaps ``(n,)`` and angles ``(n,)`` (degrees) from side a's samples to side b."""
@@ -71,8 +87,8 @@ def _one_way(sa: NurbsSurface, side_a: Side, sb: NurbsSurface, side_b: Side, n: 
     curve_b = sb.isocurve(side_b.parameter(sb), side_b.fixed)
     foot = project_to_curve(curve_b, points)
     uv_b = side_b.uv(sb, foot.t)
-    na = normals(sa, uv_a[:, 0], uv_a[:, 1])
-    nb = normals(sb, uv_b[:, 0], uv_b[:, 1])
+    na = _normals(sa, uv_a)
+    nb = _normals(sb, uv_b)
     cos = np.abs(np.einsum("nc,nc->n", na, nb))
     sin = np.linalg.norm(np.cross(na, nb), axis=1)
     return foot.distance, np.degrees(np.arctan2(sin, cos))
@@ -86,4 +102,15 @@ def measure_join(patches: list[NurbsSurface], edge: SharedEdge, *,
     gaps, angles = np.concatenate([ga, gb]), np.concatenate([aa, ab])
     return JoinReport(edge.a, edge.side_a, edge.b, edge.side_b, edge.reversed,
                       float(gaps.max()), float(np.sqrt(np.mean(gaps ** 2))),
-                      float(angles.max()), float(np.sqrt(np.mean(angles ** 2))), samples)
+                      _nan_max(angles), _nan_rms(angles), samples)
+
+
+def _nan_max(values: NDArray) -> float:
+    """Largest value where defined (angles where both normals exist); NaN if none."""
+    finite = values[np.isfinite(values)]
+    return float(finite.max()) if finite.size else float("nan")
+
+
+def _nan_rms(values: NDArray) -> float:
+    finite = values[np.isfinite(values)]
+    return float(np.sqrt(np.mean(finite ** 2))) if finite.size else float("nan")

@@ -1,0 +1,378 @@
+"""Four-sided sub-patches of a face that is not four-sided (001 §3 asks for four
+boundary curves; 003 and handbook 000 §29.3 cover other regions by several
+four-sided patches).
+
+The face's outer loop is given as :class:`LoopEdge` objects (3D curve and
+pcurve on the face's surface, both oriented along the loop). Its vertices are
+classed by the *turning angle* on the surface (the angle between the incoming
+and the outgoing tangent): a vertex turning by more than ``smooth_angle`` is a
+corner, the others join their edges into one side. With ``c`` corners:
+
+* ``c = 4``: one four-sided patch whose sides are the edge chains between the
+  corners (a face of more than four edges with smooth vertices);
+* ``c = 3`` or ``c >= 5``: the classic split into ``c`` quads around a centre
+  point: the midpoint (half the arc length) of every side is joined to a centre
+  on the surface by a *spoke*, quad ``k`` is ``V_k, M_k, C, M_{k-1}``;
+* ``c <= 2`` (a disc, a lens, a half disc): split points are added at the
+  middle (in arc length) of the longest sides until there are four, one patch.
+
+Spokes are straight lines in the face's parameter plane from the centre (the
+mean ``(u, v)`` of the side midpoints) mapped onto the surface and interpolated
+(:func:`..fitting.interpolate_curve`), so they lie on the face; two quads
+sharing a spoke get the same curve. A layout is refused
+(:class:`NotDecomposableError`) when a spoke leaves the face's outline or a
+sub-patch's Coons map in ``(u, v)`` folds (a very non-convex outline).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError
+from ..curve import NurbsCurve
+from ..fitting import interpolate_curve
+from .clipping import inside_loops
+
+__all__ = [
+    "DEFAULT_SMOOTH_ANGLE",
+    "Decomposition",
+    "LoopEdge",
+    "NotDecomposableError",
+    "decompose_loop",
+    "join_curves",
+    "reverse_curve",
+    "turning_angles",
+]
+
+#: a vertex turning by less than this (radians) joins its two edges into one side
+DEFAULT_SMOOTH_ANGLE = np.radians(20.0)
+#: most sides handled by the split around a centre
+MAX_SIDES = 16
+#: a vertex turning by more than this (radians) is a cusp: no sub-patch fits in it
+CUSP_ANGLE = np.radians(179.0)
+#: samples of a spoke in (u, v) interpolated in 3D
+SPOKE_SAMPLES = 33
+#: samples per side of the (u, v) Coons check of a sub-patch
+CHECK_SAMPLES = 16
+_DENSE = 65                  # parameter samples per edge for arc lengths
+
+
+class NotDecomposableError(InvalidGeometryError):
+    """The face cannot be split into four-sided sub-patches; ``str()`` is the reason."""
+
+
+@dataclass(frozen=True, eq=False)
+class LoopEdge:
+    """One edge of a face's outer loop, oriented along the loop.
+
+    Attributes
+    ----------
+    curve : NurbsCurve (3D) or None
+        None for a degenerated edge (a surface pole).
+    pcurve : NurbsCurve (2D)
+        Same parameter and direction as ``curve``.
+    """
+
+    curve: NurbsCurve | None
+    pcurve: NurbsCurve
+
+
+@dataclass(frozen=True, eq=False)
+class Decomposition:
+    """Four-sided sub-patches of one face.
+
+    Attributes
+    ----------
+    quads : tuple of tuple of four NurbsCurve
+        Boundaries in loop order (bottom, right, top, left of :mod:`.boundary`).
+    quads_uv : tuple of (4 * CHECK_SAMPLES, 2) float
+        Each sub-patch's outline in the face's ``(u, v)``.
+    corners : (c,) int
+        Indices (into the real edges) of the edges starting at a corner.
+    centre_uv : (2,) float or None
+        The centre of a split (None for one patch).
+    turning : (m,) float
+        Turning angle (radians) at the start of every real edge.
+    """
+
+    quads: tuple
+    quads_uv: tuple
+    corners: NDArray
+    centre_uv: NDArray | None
+    turning: NDArray
+
+
+# ------------------------------------------------------------------ curves
+def reverse_curve(curve: NurbsCurve) -> NurbsCurve:
+    """The same curve run the other way, on the same domain."""
+    a, b = curve.domain
+    knots = a + b - curve.knots[::-1]
+    weights = None if curve.weights is None else curve.weights[::-1]
+    return NurbsCurve(curve.control_points[::-1], knots, curve.degree, weights)
+
+
+def join_curves(curves: Sequence[NurbsCurve]) -> NurbsCurve:
+    """Exact C0 join of curves meeting end to end: degrees raised to the largest,
+    domains laid end to end, each piece's weights scaled to match at the joint
+    (a homogeneous scaling leaves a rational curve unchanged), tiny gaps closed
+    at their midpoint."""
+    if len(curves) == 1:
+        return curves[0]
+    degree = max(c.degree for c in curves)
+    rational = any(c.is_rational for c in curves)
+    pws, knots, scale = [], [], 1.0
+    for n, c in enumerate(curves):
+        c = c.clamp()
+        c = c.elevate_degree(degree - c.degree) if c.degree < degree else c
+        pw = (c.homogeneous_points() if rational
+              else np.column_stack([c.control_points, np.ones(c.n_control)]))
+        k = np.asarray(c.knots, float)
+        if n:
+            pw *= scale / pw[0, -1]
+            pws[-1][-1] = 0.5 * (pws[-1][-1] + pw[0])
+            pw, k = pw[1:], k[degree + 1:] + (knots[-1][-1] - k[0])
+            knots[-1] = knots[-1][:-1]          # the joint stays ``degree`` times
+        scale = pw[-1, -1]
+        pws.append(pw)
+        knots.append(k)
+    pw, kv = np.concatenate(pws), np.concatenate(knots)
+    if rational:
+        return NurbsCurve.from_homogeneous(pw, kv, degree)
+    return NurbsCurve(pw[:, :-1], kv, degree)
+
+
+def _sample(edge: LoopEdge, n: int = _DENSE) -> tuple[NDArray, NDArray, NDArray]:
+    """Parameters (n,), 3D points (n, 3) and uv points (n, 2) of one edge."""
+    t = np.linspace(*edge.pcurve.domain, n)
+    uv = edge.pcurve.evaluate(t)
+    xyz = None if edge.curve is None else edge.curve.evaluate(t)
+    return t, xyz, uv
+
+
+def turning_angles(edges: Sequence[LoopEdge]) -> NDArray:
+    """(m,) float: the angle (radians) between the end tangent of real edge ``k - 1``
+    and the start tangent of real edge ``k`` (cyclic; a degenerated edge between them,
+    a surface pole, is skipped: the 3D tangents meet there as at any vertex)."""
+    real = [e.curve for e in edges if e.curve is not None]
+    t_in = np.array([c.derivatives(c.domain[1], 1)[1] for c in real])
+    t_out = np.array([c.derivatives(c.domain[0], 1)[1] for c in real])
+    t_in = np.roll(t_in, 1, axis=0)
+    denom = np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1)
+    cos = np.einsum("kc,kc->k", t_in, t_out) / np.where(denom > 0, denom, 1.0)
+    return np.where(denom > 0, np.arccos(np.clip(cos, -1.0, 1.0)), np.pi)
+
+
+# ------------------------------------------------------------ loop positions
+@dataclass(frozen=True, eq=False)
+class _Side:
+    """A chain of edge pieces ``(edge, t_start, t_end)`` between two loop positions,
+    its joined 3D curve and dense samples (3D arc length ``(k,)``, uv ``(k, 2)``,
+    piece index and parameter ``(k,)``)."""
+
+    pieces: tuple
+    curve: NurbsCurve
+    length: NDArray
+    uv: NDArray
+    piece: NDArray
+    t: NDArray
+
+    def locate(self, s: float) -> tuple[int, float]:
+        """Loop position ``(edge, t)`` at arc length ``s`` along the side."""
+        j = int(np.clip(np.searchsorted(self.length, s) - 1, 0, self.length.size - 2))
+        if self.piece[j] != self.piece[j + 1]:
+            j += 1 if j + 2 < self.length.size else -1
+        span = self.length[j + 1] - self.length[j]
+        w = 0.0 if span <= 0 else float(np.clip((s - self.length[j]) / span, 0, 1))
+        k = self.pieces[int(self.piece[j])][0]
+        return k, float((1 - w) * self.t[j] + w * self.t[j + 1])
+
+
+def _restricted(curve: NurbsCurve, a: float, b: float) -> NurbsCurve:
+    t0, t1 = curve.domain
+    eps = 1e-12 * (t1 - t0)
+    if a <= t0 + eps and b >= t1 - eps:
+        return curve
+    return curve.restrict(max(a, t0), min(b, t1))
+
+
+def _pieces(real: Sequence[LoopEdge], a: tuple[int, float], b: tuple[int, float]) -> list:
+    """Edge pieces ``(edge, t0, t1)`` along the loop from position ``a`` to ``b``."""
+    (ka, ta), (kb, tb) = a, b
+    if ka == kb and tb > ta:
+        return [(ka, ta, tb)]
+    out = [(ka, ta, real[ka].curve.domain[1])]
+    k = (ka + 1) % len(real)
+    while k != kb:
+        out.append((k, *real[k].curve.domain))
+        k = (k + 1) % len(real)
+    out.append((kb, real[kb].curve.domain[0], tb))
+    return [p for p in out if p[2] - p[1] > 1e-12 * np.ptp(real[p[0]].curve.domain)]
+
+
+def _side(real: Sequence[LoopEdge], pieces: list) -> _Side:
+    curve = join_curves([_restricted(real[k].curve, a, b) for k, a, b in pieces])
+    xyz, uv, piece, ts = [], [], [], []
+    for n, (k, a, b) in enumerate(pieces):
+        t = np.linspace(a, b, _DENSE)
+        xyz.append(real[k].curve.evaluate(t))
+        uv.append(real[k].pcurve.evaluate(t))
+        piece.append(np.full(t.size, n))
+        ts.append(t)
+    xyz = np.concatenate(xyz)
+    length = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))]
+    return _Side(tuple(pieces), curve, length, np.concatenate(uv), np.concatenate(piece),
+                 np.concatenate(ts))
+
+
+def _uniform_uv(side_uv: NDArray, length: NDArray, n: int) -> NDArray:
+    """(n + 1, 2) float: uv points at uniform arc length (eq. 4's sampling)."""
+    s = np.linspace(0.0, length[-1], n + 1)
+    return np.column_stack([np.interp(s, length, side_uv[:, 0]), np.interp(s, length, side_uv[:, 1])])
+
+
+def _extra_cuts(real: Sequence[LoopEdge], cuts: list, count: int) -> list:
+    """``cuts`` completed to ``count`` loop positions, each new one at the middle (in
+    arc length) of the longest stretch between positions."""
+    lengths = np.array([np.sum(np.linalg.norm(np.diff(real[k].curve.evaluate(
+        np.linspace(*real[k].curve.domain, _DENSE)), axis=0), axis=1)) for k in range(len(real))])
+    start = np.r_[0.0, np.cumsum(lengths)]
+    total = start[-1]
+    at = sorted(start[k] for k, _ in cuts) or [0.0]
+    while len(at) < count:
+        gaps = np.diff(np.r_[at, at[0] + total])
+        g = int(np.argmax(gaps))
+        at = sorted(at + [(at[g] + 0.5 * gaps[g]) % total])
+    whole = _side(real, [(k, *real[k].curve.domain) for k in range(len(real))])
+    return [whole.locate(s) for s in at]
+
+
+# ------------------------------------------------------------------ checks
+def _coons_cells(sides_uv: Sequence[NDArray]) -> NDArray:
+    """Signed areas ``(m, m)`` of the cells of the bilinearly blended Coons map (001
+    eq. 4) of four uv sides (bottom, right, top, left, in loop order, ``(m + 1, 2)``)."""
+    bottom, right, top, left = (np.asarray(s, float) for s in sides_uv)
+    top, left = top[::-1], left[::-1]
+    m = bottom.shape[0] - 1
+    u = np.linspace(0, 1, m + 1)[:, None, None]
+    v = np.linspace(0, 1, m + 1)[None, :, None]
+    p00, p10, p11, p01 = bottom[0], bottom[-1], top[-1], top[0]
+    x = ((1 - v) * bottom[:, None] + v * top[:, None] + (1 - u) * left[None] + u * right[None]
+         - ((1 - u) * (1 - v) * p00 + u * (1 - v) * p10 + u * v * p11 + (1 - u) * v * p01))
+    d1 = x[1:, 1:] - x[:-1, :-1]
+    d2 = x[:-1, 1:] - x[1:, :-1]
+    return 0.5 * (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0])
+
+
+def _signed_area(poly: NDArray) -> float:
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _check_quad(sides_uv: Sequence[NDArray], orientation: float, what: str) -> None:
+    cells = _coons_cells(sides_uv) * orientation
+    if cells.min() < -1e-9 * np.abs(cells).sum():
+        raise NotDecomposableError(
+            f"{what}: its Coons map folds in (u, v) (a very non-convex outline)")
+
+
+# -------------------------------------------------------------- the layouts
+def _spoke(surface, centre: NDArray, mid_uv: NDArray, mid_xyz: NDArray
+           ) -> tuple[NurbsCurve, NDArray]:
+    """3D curve from the centre to a side midpoint along the uv line, and its uv
+    samples ``(SPOKE_SAMPLES, 2)``."""
+    s = np.linspace(0.0, 1.0, SPOKE_SAMPLES)[:, None]
+    uv = (1 - s) * centre + s * mid_uv
+    pts = surface.evaluate(uv[:, 0], uv[:, 1])
+    pts[-1] = mid_xyz                      # the edge's point (on the surface within its tolerance)
+    return interpolate_curve(pts), uv
+
+
+def _single(sides: Sequence[_Side], orientation: float) -> list:
+    _check_quad([_uniform_uv(s.uv, s.length, CHECK_SAMPLES) for s in sides], orientation,
+                "the four-sided patch")
+    return [([s.curve for s in sides], np.concatenate([s.uv for s in sides]))]
+
+
+def _star(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArray]:
+    """The split into ``len(sides)`` quads around a centre (module docstring)."""
+    n = len(sides)
+    mids = [s.locate(0.5 * s.length[-1]) for s in sides]
+    mid_uv = np.array([real[k].pcurve.evaluate(t) for k, t in mids]).reshape(n, 2)
+    mid_xyz = np.array([real[k].curve.evaluate(t) for k, t in mids]).reshape(n, 3)
+    centre = mid_uv.mean(axis=0)
+    if not inside_loops(centre[None], [outline])[0]:
+        raise NotDecomposableError("the centre of the split lies outside the face (non-convex "
+                                   "outline)")
+    spokes = [_spoke(surface, centre, mid_uv[i], mid_xyz[i]) for i in range(n)]
+    for curve, uv in spokes:
+        if not np.all(inside_loops(uv[1:-SPOKE_SAMPLES // 8], [outline])):
+            raise NotDecomposableError("a split curve leaves the face (non-convex outline)")
+    first = [_side(real, _pieces(real, cuts[i], mids[i])) for i in range(n)]
+    second = [_side(real, _pieces(real, mids[i], cuts[(i + 1) % n])) for i in range(n)]
+    quads = []
+    for i in range(n):
+        j = i - 1
+        spoke_out, spoke_in = spokes[i], spokes[j]
+        curves = [first[i].curve, reverse_curve(spoke_out[0]), spoke_in[0], second[j].curve]
+        spoke_length = [np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
+                        for uv in (spoke_out[1][::-1], spoke_in[1])]
+        uv_sides = [_uniform_uv(first[i].uv, first[i].length, CHECK_SAMPLES),
+                    _uniform_uv(spoke_out[1][::-1], spoke_length[0], CHECK_SAMPLES),
+                    _uniform_uv(spoke_in[1], spoke_length[1], CHECK_SAMPLES),
+                    _uniform_uv(second[j].uv, second[j].length, CHECK_SAMPLES)]
+        _check_quad(uv_sides, orientation, f"sub-patch {i} of {n}")
+        quads.append((curves, np.concatenate(uv_sides)))
+    return quads, centre
+
+
+def decompose_loop(surface, edges: Sequence[LoopEdge], *,
+                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition:
+    """Four-sided sub-patches covering a face bounded by one loop (module docstring).
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+        The face's surface (spokes are mapped through it).
+    edges : sequence of LoopEdge
+        The outer loop, in loop order, each edge oriented along it.
+    smooth_angle : float
+        Radians; vertices turning less join their edges into one side.
+
+    Returns
+    -------
+    Decomposition
+
+    Raises
+    ------
+    NotDecomposableError
+        With the reason: no real edge, too many corners, a spoke leaving the
+        face, a folding sub-patch.
+    """
+    real = [e for e in edges if e.curve is not None]
+    if not real:
+        raise NotDecomposableError("the loop has no edge with a 3D curve")
+    turning = turning_angles(edges)
+    corners = np.flatnonzero(turning > smooth_angle)
+    if np.any(turning > CUSP_ANGLE):
+        raise NotDecomposableError(
+            f"a cusp: the loop turns back by {np.degrees(turning.max()):.0f} degrees")
+    if corners.size > MAX_SIDES:
+        raise NotDecomposableError(f"{corners.size} corners: more than {MAX_SIDES} sides")
+    cuts = [(int(k), real[k].curve.domain[0]) for k in corners]
+    if len(cuts) <= 2:
+        cuts = _extra_cuts(real, cuts, 4)
+    n = len(cuts)
+    sides = [_side(real, _pieces(real, cuts[i], cuts[(i + 1) % n])) for i in range(n)]
+    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+                              for e in edges])
+    orientation = np.sign(_signed_area(outline)) or 1.0
+    if n == 4:
+        quads, centre = _single(sides, orientation), None
+    else:
+        quads, centre = _star(surface, real, cuts, sides, outline, orientation)
+    return Decomposition(tuple(tuple(q) for q, _ in quads), tuple(uv for _, uv in quads),
+                         corners, centre, turning)
