@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..surface import NurbsSurface
+from . import kernels
 from .evaluator import PatchEvaluator
 from .projection import Projection, Projector, projection_matrix
 
@@ -130,6 +131,8 @@ def distance_jet(r: NurbsSurface | PatchEvaluator, projector: Projector, uv: Arr
         Start feet (continuation); default the projector's seed grid.
     """
     uv = np.asarray(uv, dtype=float).reshape(-1, 2)
+    if kernels.AVAILABLE and isinstance(r, PatchEvaluator):
+        return _compiled_jet(r, projector, uv, st0)
     rd = r.derivatives(uv[:, 0], uv[:, 1], 2)
     point = rd[:, 0, 0]
     proj, qd = projector.project_with_derivatives(point, st0)
@@ -151,6 +154,20 @@ def distance_jet(r: NurbsSurface | PatchEvaluator, projector: Projector, uv: Arr
     mixed = 0.5 * (huv + hvu)
     hess = np.stack([np.stack([huu, mixed], -1), np.stack([mixed, hvv], -1)], -2)
     return DistanceJet(uv, point, proj, n, phi, grad, hess, jac)
+
+
+def _compiled_jet(r: PatchEvaluator, projector: Projector, uv: NDArray,
+                  st0: ArrayLike | None) -> DistanceJet:
+    """:func:`distance_jet` by :func:`.kernels.distance_points` (one compiled pass)."""
+    if st0 is None:
+        st0 = projector.seeds(r.evaluate(uv[:, 0], uv[:, 1]))
+    st0 = np.ascontiguousarray(np.asarray(st0, dtype=float).reshape(-1, 2))
+    lo, hi, quarter = projector.newton_bounds()
+    point, foot, normal, st, phi, grad, hess, jac, k, moved, before = kernels.distance_points(
+        *r.compiled, *projector.evaluator.compiled, np.ascontiguousarray(uv), st0, lo, hi,
+        quarter, float(projector.tol), int(projector.max_iter))
+    status, det = projector.status(st, k, moved, before)
+    return DistanceJet(uv, point, Projection(st, foot, status, det), normal, phi, grad, hess, jac)
 
 
 @dataclass(frozen=True, eq=False)

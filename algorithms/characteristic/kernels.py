@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from ..basis_kernels import AVAILABLE, _jit
 
-__all__ = ["AVAILABLE", "patch_derivatives", "project_points"]
+__all__ = ["AVAILABLE", "distance_points", "patch_derivatives", "project_points"]
 
 
 @_jit
@@ -100,6 +100,50 @@ def patch_derivatives(coef, iu, iv, rational, u, v):
 
 
 @_jit
+def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, tol, max_iter,
+                 du, dv, hom, d, qd):
+    """Newton on eqs. (3)-(4) for one point; ``qd (3, 3, 3)`` filled at the foot.
+    Returns ``(s, t, moved, before)``: the foot and its last two moves."""
+    s0 = min(max(s0, lo[0]), hi[0])
+    t0 = min(max(t0, lo[1]), hi[1])
+    moved, before = np.inf, np.inf
+    for _ in range(max_iter):
+        _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, d)
+        off0, off1, off2 = x0 - d[0, 0, 0], x1 - d[0, 0, 1], x2 - d[0, 0, 2]
+        f0 = off0 * d[1, 0, 0] + off1 * d[1, 0, 1] + off2 * d[1, 0, 2]
+        f1 = off0 * d[0, 1, 0] + off1 * d[0, 1, 1] + off2 * d[0, 1, 2]
+        ss = d[1, 0, 0] ** 2 + d[1, 0, 1] ** 2 + d[1, 0, 2] ** 2
+        sm = d[1, 0, 0] * d[0, 1, 0] + d[1, 0, 1] * d[0, 1, 1] + d[1, 0, 2] * d[0, 1, 2]
+        tt = d[0, 1, 0] ** 2 + d[0, 1, 1] ** 2 + d[0, 1, 2] ** 2
+        k00 = ss - (off0 * d[2, 0, 0] + off1 * d[2, 0, 1] + off2 * d[2, 0, 2])   # eq. (22)
+        k01 = sm - (off0 * d[1, 1, 0] + off1 * d[1, 1, 1] + off2 * d[1, 1, 2])
+        k11 = tt - (off0 * d[0, 2, 0] + off1 * d[0, 2, 1] + off2 * d[0, 2, 2])
+        if not (k00 * k11 - k01 * k01 > 0 and k00 > 0):
+            k00, k01, k11 = ss, sm, tt                # Gauss-Newton off the minimum
+        det = k00 * k11 - k01 * k01
+        if abs(det) <= 1e-300:
+            det = 1e-300
+        step0 = (k11 * f0 - k01 * f1) / det
+        step1 = (k00 * f1 - k01 * f0) / det
+        scale = max(abs(step0) / quarter[0], abs(step1) / quarter[1], 1.0)
+        n0 = min(max(s0 + step0 / scale, lo[0]), hi[0])
+        n1 = min(max(t0 + step1 / scale, lo[1]), hi[1])
+        e0, e1 = n0 - s0, n1 - t0
+        before = moved
+        moved = np.sqrt((d[1, 0, 0] * e0 + d[0, 1, 0] * e1) ** 2
+                        + (d[1, 0, 1] * e0 + d[0, 1, 1] * e1) ** 2
+                        + (d[1, 0, 2] * e0 + d[0, 1, 2] * e1) ** 2)
+        s0, t0 = n0, n1
+        nxt = np.inf
+        if moved < before and np.isfinite(before):
+            nxt = moved ** 3 / max(before, 1e-300) ** 2
+        if moved <= tol or nxt <= tol:
+            break
+    _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, qd)
+    return s0, t0, moved, before
+
+
+@_jit
 def project_points(coef, iu, iv, rational, x, st0, lo, hi, quarter, tol, max_iter):
     """Newton on eqs. (3)-(4) for every row of ``x (n, 3)`` from ``st0 (n, 2)``.
 
@@ -117,56 +161,144 @@ def project_points(coef, iu, iv, rational, x, st0, lo, hi, quarter, tol, max_ite
         The last two foot moves (for the caller's convergence test).
     """
     n = x.shape[0]
-    st = st0.copy()
+    st = np.empty((n, 2))
     qd = np.empty((n, 3, 3, 3))
-    moved = np.full(n, np.inf)
-    before = np.full(n, np.inf)
+    moved = np.empty(n)
+    before = np.empty(n)
     du = np.empty((3, coef.shape[2]))
     dv = np.empty((3, coef.shape[3]))
     hom = np.empty((3, 3, coef.shape[4]))
     d = np.empty((3, 3, 3))
     for i in range(n):
-        s0 = min(max(st[i, 0], lo[0]), hi[0])
-        t0 = min(max(st[i, 1], lo[1]), hi[1])
-        for _ in range(max_iter):
-            _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, d)
-            off0 = x[i, 0] - d[0, 0, 0]
-            off1 = x[i, 1] - d[0, 0, 1]
-            off2 = x[i, 2] - d[0, 0, 2]
-            f0 = off0 * d[1, 0, 0] + off1 * d[1, 0, 1] + off2 * d[1, 0, 2]
-            f1 = off0 * d[0, 1, 0] + off1 * d[0, 1, 1] + off2 * d[0, 1, 2]
-            ss = d[1, 0, 0] ** 2 + d[1, 0, 1] ** 2 + d[1, 0, 2] ** 2
-            sm = d[1, 0, 0] * d[0, 1, 0] + d[1, 0, 1] * d[0, 1, 1] + d[1, 0, 2] * d[0, 1, 2]
-            tt = d[0, 1, 0] ** 2 + d[0, 1, 1] ** 2 + d[0, 1, 2] ** 2
-            k00 = ss - (off0 * d[2, 0, 0] + off1 * d[2, 0, 1] + off2 * d[2, 0, 2])
-            k01 = sm - (off0 * d[1, 1, 0] + off1 * d[1, 1, 1] + off2 * d[1, 1, 2])
-            k11 = tt - (off0 * d[0, 2, 0] + off1 * d[0, 2, 1] + off2 * d[0, 2, 2])
-            if not (k00 * k11 - k01 * k01 > 0 and k00 > 0):
-                k00, k01, k11 = ss, sm, tt            # Gauss-Newton off the minimum
-            det = k00 * k11 - k01 * k01
-            if abs(det) <= 1e-300:
-                det = 1e-300
-            step0 = (k11 * f0 - k01 * f1) / det
-            step1 = (k00 * f1 - k01 * f0) / det
-            scale = max(abs(step0) / quarter[0], abs(step1) / quarter[1], 1.0)
-            step0 /= scale
-            step1 /= scale
-            n0 = min(max(s0 + step0, lo[0]), hi[0])
-            n1 = min(max(t0 + step1, lo[1]), hi[1])
-            e0, e1 = n0 - s0, n1 - t0
-            before[i] = moved[i]
-            m = np.sqrt((d[1, 0, 0] * e0 + d[0, 1, 0] * e1) ** 2
-                        + (d[1, 0, 1] * e0 + d[0, 1, 1] * e1) ** 2
-                        + (d[1, 0, 2] * e0 + d[0, 1, 2] * e1) ** 2)
-            moved[i] = m
-            s0, t0 = n0, n1
-            b = before[i]
-            nxt = m ** 3 / max(b, 1e-300) ** 2 if (m < b and np.isfinite(b)) else np.inf
-            if m <= tol or nxt <= tol:
-                break
-        st[i, 0], st[i, 1] = s0, t0
-        _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, qd[i])
+        st[i, 0], st[i, 1], moved[i], before[i] = _project_one(
+            coef, iu, iv, rational, x[i, 0], x[i, 1], x[i, 2], st0[i, 0], st0[i, 1], lo, hi,
+            quarter, tol, max_iter, du, dv, hom, d, qd[i])
     return st, qd, moved, before
+
+
+@_jit
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@_jit
+def _normal_derivative(c1, c2, n, length, out):
+    """``out = ((c1 + c2) - n (n . (c1 + c2))) / length``: a derivative of the unit normal."""
+    dot = 0.0
+    for c in range(3):
+        out[c] = c1[c] + c2[c]
+        dot += n[c] * out[c]
+    for c in range(3):
+        out[c] = (out[c] - n[c] * dot) / length
+
+
+@_jit
+def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
+                    lo, hi, quarter, tol, max_iter):
+    """``phi``, its gradient and Hessian (002 eqs. 2, 24-31) at ``uv (n, 2)`` of ``r``.
+
+    Per point: ``r``'s derivatives, the foot on ``q`` (:func:`_project_one`), the
+    unit normal ``n_q`` and its derivatives (Weingarten), ``K`` (eq. 22), the map
+    ``K^{-1} G`` (eqs. 21, 23) and the derivatives of eqs. (24)-(31), as
+    :func:`.distance.distance_jet` computes them with numpy.
+
+    Returns
+    -------
+    point, foot, normal : (n, 3) float
+    st : (n, 2) float
+    phi : (n,) float
+    grad : (n, 2) float
+    hess, jac, k : (n, 2, 2) float
+        Hessian of phi, ``K^{-1} G``, ``K``.
+    moved, before : (n,) float
+    """
+    n = uv.shape[0]
+    point = np.empty((n, 3))
+    foot = np.empty((n, 3))
+    normal = np.empty((n, 3))
+    st = np.empty((n, 2))
+    phi = np.empty(n)
+    grad = np.empty((n, 2))
+    hess = np.empty((n, 2, 2))
+    jac = np.empty((n, 2, 2))
+    kmat = np.empty((n, 2, 2))
+    moved = np.empty(n)
+    before = np.empty(n)
+    du = np.empty((3, max(r_coef.shape[2], q_coef.shape[2])))
+    dv = np.empty((3, max(r_coef.shape[3], q_coef.shape[3])))
+    hom = np.empty((3, 3, 4))
+    d = np.empty((3, 3, 3))
+    rd = np.empty((3, 3, 3))
+    qd = np.empty((3, 3, 3))
+    big = np.empty(3)
+    c1 = np.empty(3)
+    c2 = np.empty(3)
+    n_s = np.empty(3)
+    n_t = np.empty(3)
+    for i in range(n):
+        _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
+                           r_rational, uv[i, 0], uv[i, 1], hom[:, :, :r_coef.shape[4]], rd)
+        for c in range(3):
+            point[i, c] = rd[0, 0, c]
+        st[i, 0], st[i, 1], moved[i], before[i] = _project_one(
+            q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
+            st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter,
+            du[:, :q_coef.shape[2]], dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
+        qs, qt = qd[1, 0], qd[0, 1]
+        _cross(qs, qt, big)
+        length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
+        nq = normal[i]
+        for c in range(3):
+            nq[c] = big[c] / length
+            foot[i, c] = qd[0, 0, c]
+        _cross(qd[2, 0], qt, c1)
+        _cross(qs, qd[1, 1], c2)
+        _normal_derivative(c1, c2, nq, length, n_s)
+        _cross(qd[1, 1], qt, c1)
+        _cross(qs, qd[0, 2], c2)
+        _normal_derivative(c1, c2, nq, length, n_t)
+        ru, rv = rd[1, 0], rd[0, 1]
+        p_ = 0.0
+        gu = 0.0
+        gv = 0.0
+        g00 = g01 = g10 = g11 = 0.0
+        k00 = k01 = k11 = 0.0
+        for c in range(3):
+            off = rd[0, 0, c] - qd[0, 0, c]
+            p_ += nq[c] * off
+            gu += nq[c] * ru[c]
+            gv += nq[c] * rv[c]
+            g00 += ru[c] * qs[c]                                           # eq. (23)
+            g01 += rv[c] * qs[c]
+            g10 += ru[c] * qt[c]
+            g11 += rv[c] * qt[c]
+            k00 += qs[c] * qs[c] - off * qd[2, 0, c]                       # eq. (22)
+            k01 += qs[c] * qt[c] - off * qd[1, 1, c]
+            k11 += qt[c] * qt[c] - off * qd[0, 2, c]
+        phi[i] = p_
+        grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
+        kmat[i, 0, 0], kmat[i, 0, 1], kmat[i, 1, 0], kmat[i, 1, 1] = k00, k01, k01, k11
+        det = k00 * k11 - k01 * k01
+        j00 = j01 = j10 = j11 = 0.0
+        if abs(det) > 1e-300:                                              # eq. (21)
+            j00 = (k11 * g00 - k01 * g10) / det
+            j01 = (k11 * g01 - k01 * g11) / det
+            j10 = (k00 * g10 - k01 * g00) / det
+            j11 = (k00 * g11 - k01 * g01) / det
+        jac[i, 0, 0], jac[i, 0, 1], jac[i, 1, 0], jac[i, 1, 1] = j00, j01, j10, j11
+        huu = huv = hvu = hvv = 0.0
+        for c in range(3):
+            nu_c = n_s[c] * j00 + n_t[c] * j10                             # (30)
+            nv_c = n_s[c] * j01 + n_t[c] * j11                             # (31)
+            huu += nu_c * ru[c] + nq[c] * rd[2, 0, c]                      # (26)
+            huv += nv_c * ru[c] + nq[c] * rd[1, 1, c]                      # (27)
+            hvu += nu_c * rv[c] + nq[c] * rd[1, 1, c]                      # (28)
+            hvv += nv_c * rv[c] + nq[c] * rd[0, 2, c]                      # (29)
+        mixed = 0.5 * (huv + hvu)
+        hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
+    return point, foot, normal, st, phi, grad, hess, jac, kmat, moved, before
 
 
 def evaluator_arrays(coef: NDArray, iu: NDArray, iv: NDArray) -> tuple[NDArray, NDArray, NDArray]:

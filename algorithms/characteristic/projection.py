@@ -293,11 +293,23 @@ class Projector:
                 ) -> tuple[Projection, NDArray]:
         """The §6.2 case of every foot from the last Newton moves."""
         k = projection_matrix(x - qd[:, 0, 0], qd)
+        status, det = self.status(st, k, moved, before)
+        return Projection(st, qd[:, 0, 0], status, det), qd
+
+    def status(self, st: NDArray, k: NDArray, moved: NDArray, before: NDArray
+               ) -> tuple[NDArray, NDArray]:
+        """``(status (n,) int8, det K (n,))`` of feet ``st (n, 2)`` with ``K (n, 2, 2)``
+        (eq. 22) and the last two Newton moves of each (§6.2 cases)."""
         det = k[:, 0, 0] * k[:, 1, 1] - k[:, 0, 1] ** 2
-        status = np.full(x.shape[0], int(ProjectionStatus.UNIQUE), dtype=np.int8)
+        status = np.full(st.shape[0], int(ProjectionStatus.UNIQUE), dtype=np.int8)
         scale = (k[:, 0, 0] + k[:, 1, 1]) ** 2
         status[(det <= 1e-12 * scale) | (k[:, 0, 0] <= 0)] = ProjectionStatus.MULTIPLE
         lost = (moved > 10 * self.tol) & ~((moved < before) & np.isfinite(before)
                                             & (moved ** 3 / np.maximum(before, 1e-300) ** 2 <= self.tol))
         status[~self.inside(st) | lost] = ProjectionStatus.NONE
-        return Projection(st, qd[:, 0, 0], status, det), qd
+        return status, det
+
+    def newton_bounds(self) -> tuple[NDArray, NDArray, NDArray]:
+        """``(lo, hi, quarter)``: Newton's clip box (domain and extension) and step limit."""
+        span = self.upper - self.lower
+        return self.lower - EXTENSION * span, self.upper + EXTENSION * span, 0.25 * span
