@@ -111,3 +111,49 @@ def test_distance_jet_function_and_field_agree():
     two = DistanceField(a, projector).jet(uv)
     np.testing.assert_allclose(one.phi, two.phi, atol=1e-14)
     np.testing.assert_allclose(one.hess, two.hess, atol=1e-9)
+
+
+@pytest.mark.parametrize("pair", ["bicubic", "sphere"])
+def test_compiled_jet_matches_the_numpy_jet(pair, monkeypatch):
+    """The numba pass (kernels.distance_points, project_points, patch_derivatives)
+    computes what the numpy forms compute: same feet, cases, phi and derivatives."""
+    from surfprep.algorithms.characteristic import kernels
+    if pair == "bicubic":
+        a, b = random_pair(4)
+    else:
+        a, b = plane_patch(0.99 * DIAGONAL, DIAGONAL, 0.4), sphere_band()
+    uv = np.random.default_rng(5).uniform(-0.02, 1.02, (300, 2))
+    uv = np.clip(uv, 0.0, 1.0)
+    compiled = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
+    monkeypatch.setattr(kernels, "AVAILABLE", False)
+    ref = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
+    assert kernels.AVAILABLE is False
+    np.testing.assert_array_equal(compiled.status, ref.status)
+    ok = ref.status != ProjectionStatus.NONE
+    assert ok.sum() > 100
+    np.testing.assert_allclose(compiled.st[ok], ref.st[ok], atol=1e-10)
+    np.testing.assert_allclose(compiled.phi[ok], ref.phi[ok], atol=1e-12)
+    np.testing.assert_allclose(compiled.grad[ok], ref.grad[ok], atol=1e-10)
+    scale = np.abs(ref.hess[ok]).max()
+    np.testing.assert_allclose(compiled.hess[ok], ref.hess[ok], atol=1e-9 * scale)
+    np.testing.assert_allclose(compiled.st_jacobian[ok], ref.st_jacobian[ok], atol=1e-9 * scale)
+
+
+def test_parallelogram_projection_in_closed_form_matches_newton():
+    """A plane q is projected by one linear solve; Newton (compiled) finds the same feet."""
+    plane = plane_patch([0.1, 0.2, 0.3], [1.0, 2.0, 2.0], 0.5)
+    projector = Projector(plane, tol=1e-13)
+    assert projector.is_affine
+    pts = np.random.default_rng(9).uniform(-0.8, 0.8, (200, 3))
+    closed = projector.project(pts)
+    projector._grid["affine"] = None                  # the same projector, Newton's way
+    newton = projector.project(pts)
+    assert not projector.is_affine
+    np.testing.assert_array_equal(closed.status, newton.status)
+    np.testing.assert_allclose(closed.st, newton.st, atol=1e-12)
+    np.testing.assert_allclose(closed.foot, newton.foot, atol=1e-12)
+    assert (closed.status == ProjectionStatus.NONE).any() and closed.regular.any()
+    # a regular foot is the orthogonal one: r - foot along the plane's normal
+    n = np.array([1.0, 2.0, 2.0]) / 3.0
+    off = (pts - closed.foot)[closed.regular]
+    np.testing.assert_allclose(np.linalg.norm(np.cross(off, n), axis=1), 0.0, atol=1e-12)
