@@ -201,18 +201,24 @@ class DistanceField:
 
     @property
     def lower(self) -> NDArray:
-        d = self.r.domain
-        return np.array([d[0], d[2]])
+        if "lower" not in self._cache:
+            d = self.r.domain
+            self._cache["lower"] = np.array([d[0], d[2]])
+        return self._cache["lower"]
 
     @property
     def upper(self) -> NDArray:
-        d = self.r.domain
-        return np.array([d[1], d[3]])
+        if "upper" not in self._cache:
+            d = self.r.domain
+            self._cache["upper"] = np.array([d[1], d[3]])
+        return self._cache["upper"]
 
     @property
     def diagonal(self) -> float:
         """Diagonal of ``r``'s parameter rectangle."""
-        return float(np.linalg.norm(self.upper - self.lower))
+        if "diagonal" not in self._cache:
+            self._cache["diagonal"] = float(np.linalg.norm(self.upper - self.lower))
+        return self._cache["diagonal"]
 
     @property
     def speed(self) -> float:

@@ -163,6 +163,9 @@ class Projector:
         object.__setattr__(self, "tol", check_tolerance(self.tol))
         self._grid["evaluator"] = PatchEvaluator(self.surface)
         self._grid["affine"] = _affine_frame(self.surface)
+        d = self.surface.domain
+        self._grid["lower"] = np.array([d[0], d[2]])
+        self._grid["upper"] = np.array([d[1], d[3]])
 
     @property
     def is_affine(self) -> bool:
@@ -176,13 +179,11 @@ class Projector:
     # ------------------------------------------------------------ domain
     @property
     def lower(self) -> NDArray:
-        d = self.surface.domain
-        return np.array([d[0], d[2]])
+        return self._grid["lower"]
 
     @property
     def upper(self) -> NDArray:
-        d = self.surface.domain
-        return np.array([d[1], d[3]])
+        return self._grid["upper"]
 
     def inside(self, st: NDArray, rel: float = 1e-9) -> NDArray:
         """``(n,) bool``: ``st (n, 2)`` within the domain (``rel`` of its size)."""
