@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
+from . import vectors
 
 __all__ = ["TriangleMesh", "collinear_mask"]
 
@@ -43,7 +44,7 @@ def collinear_mask(points: NDArray) -> NDArray:
     """
     edges = points[:, [1, 2, 0]] - points
     longest2 = np.max(np.sum(edges * edges, axis=2), axis=1)
-    cross = np.linalg.norm(np.cross(edges[:, 0], -edges[:, 2]), axis=1)
+    cross = np.linalg.norm(vectors.cross(edges[:, 0], -edges[:, 2]), axis=1)
     return cross <= _COLLINEAR * longest2
 
 
@@ -222,7 +223,7 @@ class TriangleMesh:
     def area_vectors(self) -> NDArray:
         """``(p1 - p0) x (p2 - p0)`` of every triangle: (m, 3) float (twice the area)."""
         p = self.triangle_points()
-        return np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        return vectors.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
 
     def areas(self) -> NDArray:
         """Triangle areas: (m,) float."""

@@ -56,9 +56,16 @@ from ...errors import InvalidGeometryError
 from ..measure import normals
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from . import vectors
 
-__all__ = ["RefinedPoints", "RefinedCurve", "refine_points", "refine_curves",
-           "project_points", "segment_distance"]
+__all__ = [
+    "RefinedCurve",
+    "RefinedPoints",
+    "project_points",
+    "refine_curves",
+    "refine_points",
+    "segment_distance",
+]
 
 _DEGENERATE = 1e-10     # |Su x Sv| / (|Su| |Sv|) below this: a pole, use the pseudo-inverse
 #: curve refinement: samples and chord midpoints are refined to tol * _POINT_SHARE, and a
@@ -145,7 +152,7 @@ def _dot(a: NDArray, b: NDArray) -> NDArray:
 
 
 def _unit(a: NDArray) -> tuple[NDArray, NDArray]:
-    norm = np.linalg.norm(a, axis=1)
+    norm = vectors.norm(a)
     return a / np.where(norm > 0, norm, 1.0)[:, None], norm
 
 
@@ -153,8 +160,8 @@ def _frame(surface: NurbsSurface, uv: NDArray) -> tuple[NDArray, NDArray, NDArra
     """Point, S_u, S_v and unit normal: four (m, 3) float (one derivatives call)."""
     d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
     point, su, sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
-    n, size = _unit(np.cross(su, sv))
-    bad = size <= _DEGENERATE * np.linalg.norm(su, axis=1) * np.linalg.norm(sv, axis=1)
+    n, size = _unit(vectors.cross(su, sv))
+    bad = size <= _DEGENERATE * vectors.norm(su) * vectors.norm(sv)
     if np.any(bad):     # a pole: limit normal
         n[bad] = normals(surface, uv[bad, 0], uv[bad, 1])
     return point, su, sv, n
@@ -162,9 +169,9 @@ def _frame(surface: NurbsSurface, uv: NDArray) -> tuple[NDArray, NDArray, NDArra
 
 def _increments(su: NDArray, sv: NDArray, n: NDArray, delta: NDArray) -> NDArray:
     """Parameter step ``(m, 2)`` with ``S_u du + S_v dv ~ delta`` (eqs. 29.22–29.25)."""
-    su_p, sv_p = np.cross(su, n), np.cross(sv, n)          # 29.22 / 29.23
+    su_p, sv_p = vectors.cross(su, n), vectors.cross(sv, n)          # 29.22 / 29.23
     den_u, den_v = _dot(sv_p, su), _dot(su_p, sv)
-    scale = np.linalg.norm(su, axis=1) * np.linalg.norm(sv, axis=1)
+    scale = vectors.norm(su) * vectors.norm(sv)
     bad = ~(np.abs(den_u) > _DEGENERATE * scale)
     step = np.stack([_dot(sv_p, delta) / np.where(bad, 1.0, den_u),    # 29.24 / 29.25
                      _dot(su_p, delta) / np.where(bad, 1.0, den_v)], axis=1)
@@ -180,7 +187,7 @@ def _three_planes(p: NDArray, q: NDArray, n_p: NDArray, n_q: NDArray, anchor: ND
     d_p, d_q = _dot(n_p, p), _dot(n_q, q)                   # 29.18
     n_n = cross / sin[:, None]                              # 29.19
     d_n = _dot(n_n, anchor)                                 # 29.20
-    num = (d_p[:, None] * np.cross(n_q, n_n) + d_q[:, None] * np.cross(n_n, n_p)
+    num = (d_p[:, None] * vectors.cross(n_q, n_n) + d_q[:, None] * vectors.cross(n_n, n_p)
            + d_n[:, None] * cross)
     return num / sin[:, None]                               # [n_p, n_q, n_n] = |n_p x n_q|
 
@@ -231,15 +238,15 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
         p, su, sv, n_p = _frame(surface_a, ua[active])
         q, rw, rt, n_q = _frame(surface_b, ub[active])
         img_a[active], img_b[active], nrm_a[active], nrm_b[active] = p, q, n_p, n_q
-        done = np.linalg.norm(p - q, axis=1) <= tol
+        done = vectors.norm(p - q) <= tol
         keep = ~done & (iterations[active] < max_iter)
         active, p, q, su, sv, rw, rt, n_p, n_q = (
             a[keep] for a in (active, p, q, su, sv, rw, rt, n_p, n_q))
         if active.size == 0:
             break
         mid = 0.5 * (p + q)
-        cross = np.cross(n_p, n_q)
-        sin = np.linalg.norm(cross, axis=1)
+        cross = vectors.cross(n_p, n_q)
+        sin = vectors.norm(cross)
         near = sin < tangent_sin
         x = mid.copy()                                      # fallback: the midpoint
         ok = ~near
@@ -261,9 +268,9 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
         img_a[active], _, _, nrm_a[active] = _frame(surface_a, ua[active])
         img_b[active], _, _, nrm_b[active] = _frame(surface_b, ub[active])
     pa, pb, n_a, n_b = img_a, img_b, nrm_a, nrm_b
-    gap = np.linalg.norm(pa - pb, axis=1)
+    gap = vectors.norm(pa - pb)
     converged = gap <= tol
-    singular = (singular & ~converged) | (np.linalg.norm(np.cross(n_a, n_b), axis=1) < tangent_sin)
+    singular = (singular & ~converged) | (vectors.norm(vectors.cross(n_a, n_b)) < tangent_sin)
     return RefinedPoints(0.5 * (pa + pb), ua, ub, gap, iterations, converged, singular)
 
 

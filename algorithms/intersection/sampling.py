@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
+from . import vectors
 from .interpolants import (
     interpolate_samples,
     interpolate_stacked,
@@ -113,7 +114,7 @@ def _menger(points: NDArray, closed: bool) -> NDArray:
     a, b, c = here - prev, nxt - here, nxt - prev
     la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
     area2 = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]) if points.shape[1] == 2 \
-        else np.linalg.norm(np.cross(a, b), axis=1)
+        else np.linalg.norm(vectors.cross(a, b), axis=1)
     den = la * lb * lc
     kappa[idx] = np.where(den > 0, 2.0 * area2 / np.where(den > 0, den, 1.0), 0.0)
     return kappa

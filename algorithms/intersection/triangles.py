@@ -45,6 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
+from . import vectors
 
 __all__ = ["TriangleHits", "intersect_triangles"]
 
@@ -115,9 +116,9 @@ def _barycentric(tri: NDArray, normal: NDArray, p: NDArray) -> NDArray:
     """Barycentric coordinates (k, c, 3) of points p (k, c, 3) projected into triangles."""
     t = tri[:, None]                                         # (k, 1, 3, 3)
     n = normal[:, None]
-    w = np.stack([_dot(n, np.cross(t[:, :, 1] - p, t[:, :, 2] - p)),
-                  _dot(n, np.cross(t[:, :, 2] - p, t[:, :, 0] - p)),
-                  _dot(n, np.cross(t[:, :, 0] - p, t[:, :, 1] - p))], axis=-1)
+    w = np.stack([_dot(n, vectors.cross(t[:, :, 1] - p, t[:, :, 2] - p)),
+                  _dot(n, vectors.cross(t[:, :, 2] - p, t[:, :, 0] - p)),
+                  _dot(n, vectors.cross(t[:, :, 0] - p, t[:, :, 1] - p))], axis=-1)
     return w / _dot(normal, normal)[:, None, None]
 
 
@@ -176,7 +177,7 @@ def _clip(a: NDArray, b: NDArray, na: NDArray, nb: NDArray, da: NDArray, db: NDA
                              np.all(bb_in_a >= -_INSIDE_SLACK, axis=2)], axis=1)
     source = np.repeat([[0, 0, 1, 1]], a.shape[0], axis=0)
     edge = np.concatenate([ea, eb], axis=1)
-    s = _dot(points, np.cross(na, nb)[:, None])
+    s = _dot(points, vectors.cross(na, nb)[:, None])
     lo = np.argmin(np.where(inside, s, np.inf), axis=1)
     hi = np.argmax(np.where(inside, s, -np.inf), axis=1)
     pick = np.stack([lo, hi], axis=1)
@@ -230,7 +231,7 @@ def _zero_contacts(a: NDArray, b: NDArray, na: NDArray, nb: NDArray, zero_a: NDA
     bary_b = np.concatenate([_barycentric(b, nb, a), eye], axis=1)
     inside = np.concatenate([np.all(bary_b[:, :3] >= -_INSIDE_SLACK, axis=2) & zero_a,
                              np.all(bary_a[:, 3:] >= -_INSIDE_SLACK, axis=2) & zero_b], axis=1)
-    s = _dot(points, np.cross(na, nb)[:, None])
+    s = _dot(points, vectors.cross(na, nb)[:, None])
     lo = np.argmin(np.where(inside, s, np.inf), axis=1)
     hi = np.argmax(np.where(inside, s, -np.inf), axis=1)
     rows = np.arange(k)
@@ -263,8 +264,8 @@ def intersect_triangles(tri_a: ArrayLike, tri_b: ArrayLike) -> TriangleHits:
     a, b = _check(tri_a, "tri_a"), _check(tri_b, "tri_b")
     if a.shape != b.shape:
         raise InvalidGeometryError(f"tri_a and tri_b differ in shape: {a.shape} vs {b.shape}")
-    na = np.cross(a[:, 1] - a[:, 0], a[:, 2] - a[:, 0])
-    nb = np.cross(b[:, 1] - b[:, 0], b[:, 2] - b[:, 0])
+    na = vectors.cross(a[:, 1] - a[:, 0], a[:, 2] - a[:, 0])
+    nb = vectors.cross(b[:, 1] - b[:, 0], b[:, 2] - b[:, 0])
     da = _dot(nb[:, None], a - b[:, :1])                     # (k, 3), scaled by |nb|
     db = _dot(na[:, None], b - a[:, :1])
     size = np.maximum(np.abs(a).max(axis=(1, 2)), np.abs(b).max(axis=(1, 2)))
