@@ -201,7 +201,7 @@ def _normal_spread(surface: NurbsSurface, n: int = 9) -> float:
     return float(np.arccos(np.clip(normal @ mean, -1, 1)).max())
 
 
-def _coverage(r: NurbsSurface, projector: Projector, n: int = 17) -> float:
+def _coverage(r: NurbsSurface, projector: Projector, n: int = 9) -> float:
     d = r.domain
     pts = r.evaluate_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)).reshape(-1, 3)
     return float(np.mean(projector.project(pts).status != ProjectionStatus.NONE))
@@ -216,6 +216,8 @@ def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | 
     of normals: projections onto it are unique farther out). ``phi_on`` forces
     the choice (``"a"`` or ``"b"``).
     """
+    if phi_on not in (None, "a", "b"):
+        raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
     proj_b, proj_a = Projector(b, tol=tol * 1e-3), Projector(a, tol=tol * 1e-3)
     if phi_on is None:
         cover_ab, cover_ba = _coverage(a, proj_b), _coverage(b, proj_a)
@@ -223,11 +225,10 @@ def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | 
             phi_on = "a" if cover_ab > cover_ba else "b"
         else:
             phi_on = "a" if _normal_spread(b) <= _normal_spread(a) else "b"
-    if phi_on == "a":
-        return DistanceField(a, proj_b, False)
-    if phi_on == "b":
-        return DistanceField(b, proj_a, True)
-    raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
+    field = DistanceField(a, proj_b, False) if phi_on == "a" else DistanceField(b, proj_a, True)
+    # the other role (border points) reuses the other projector instead of building it again
+    field._cache["other_projector"] = proj_a if phi_on == "a" else proj_b
+    return field
 
 
 # ------------------------------------------------------------------ stage helpers
@@ -334,7 +335,8 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     start_time = time.perf_counter()
     tol = check_tolerance(tol)
     fld = choose_field(a, b, tol=tol, phi_on=phi_on)
-    other = DistanceField(fld.q, Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
+    other = DistanceField(fld.q, fld._cache.get("other_projector")
+                          or Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
     h_max = 0.15 * fld.diagonal
     grid, shape = _grid(fld)
     coincident = _coincident(fld, grid, shape, tol)
