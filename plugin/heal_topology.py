@@ -48,6 +48,7 @@ __all__ = [
 
 #: samples per edge for the pairing test
 EDGE_SAMPLES = 17
+_PAIR_CHUNK = 128             # edge pairs per batch of the pairing test
 
 
 @dataclass(frozen=True, eq=False)
@@ -104,26 +105,65 @@ def dense_edge(edge: FaceEdge, n: int = 129) -> NDArray:
     return edge.curve.evaluate(np.linspace(t0, t1, n))
 
 
+def _polyline_distances(points: NDArray, lines: NDArray) -> NDArray:
+    """Batched :func:`polyline_distance`: points ``(P, k, 3)`` to polylines ``(P, L, 3)``,
+    pair by pair; returns ``(P, k)``."""
+    a, ab = lines[:, :-1], np.diff(lines, axis=1)                     # (P, L-1, 3)
+    denom = np.maximum(np.einsum("psc,psc->ps", ab, ab), np.finfo(float).tiny)
+    rel = points[:, :, None] - a[:, None]                              # (P, k, L-1, 3)
+    t = np.clip(np.einsum("pksc,psc->pks", rel, ab) / denom[:, None], 0.0, 1.0)
+    off = rel - t[..., None] * ab[:, None]
+    return np.sqrt(np.min(np.einsum("pksc,pksc->pks", off, off), axis=2))
+
+
+def _pairs_within(samples: NDArray, dense: NDArray, i: NDArray, j: NDArray, gap_tol: float
+                  ) -> NDArray:
+    """(len(i),) bool: samples of edge ``i`` all within ``gap_tol`` of edge ``j``'s polyline."""
+    out = np.zeros(i.size, bool)
+    for start in range(0, i.size, _PAIR_CHUNK):
+        sl = slice(start, start + _PAIR_CHUNK)
+        out[sl] = _polyline_distances(samples[i[sl]], dense[j[sl]]).max(axis=1) <= gap_tol
+    return out
+
+
 def pair_edges(edges: list[FaceEdge], gap_tol: float) -> list[tuple[int, int]]:
-    """Index pairs of edges of different faces lying on each other within ``gap_tol``."""
+    """Index pairs of edges of different faces lying on each other within ``gap_tol``.
+
+    Candidates are the pairs of overlapping boxes (grown by ``gap_tol``); each is
+    tested first at the two ends and the middle of both edges, then at all
+    samples of each edge against the other's dense polyline, in batches."""
     if not edges:
         return []
-    lo = np.array([e.samples.min(axis=0) for e in edges]) - gap_tol
-    hi = np.array([e.samples.max(axis=0) for e in edges]) + gap_tol
-    overlap = np.all((lo[:, None] <= hi[None]) & (lo[None] <= hi[:, None]), axis=2)
-    dense = {}
-    out = []
-    for i, j in zip(*np.nonzero(np.triu(overlap, 1))):
-        a, b = edges[i], edges[j]
-        if a.face == b.face:
-            continue
-        da = dense.setdefault(j, dense_edge(b))
-        if polyline_distance(a.samples, da).max() > gap_tol:
-            continue
-        db = dense.setdefault(i, dense_edge(a))
-        if polyline_distance(b.samples, db).max() <= gap_tol:
-            out.append((int(i), int(j)))
-    return out
+    samples = np.stack([e.samples for e in edges])                     # (n, k, 3)
+    lo, hi = samples.min(axis=1) - gap_tol, samples.max(axis=1) + gap_tol
+    face = np.array([e.face for e in edges])
+    i, j = _box_pairs(lo, hi)
+    keep = face[i] != face[j]
+    i, j = i[keep], j[keep]
+    if i.size == 0:
+        return []
+    dense = np.stack([dense_edge(e) for e in edges])                 # (n, 129, 3)
+    probe = samples[:, [0, samples.shape[1] // 2, -1]]
+    keep = _pairs_within(probe, dense, i, j, gap_tol) & _pairs_within(probe, dense, j, i, gap_tol)
+    i, j = i[keep], j[keep]
+    keep = _pairs_within(samples, dense, i, j, gap_tol) & _pairs_within(samples, dense, j, i,
+                                                                         gap_tol)
+    return [(int(a), int(b)) for a, b in zip(i[keep], j[keep])]
+
+
+def _box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
+    """Index pairs ``i < j`` of overlapping boxes ``(n, 3)``, row by row (as
+    ``nonzero(triu(overlap, 1))``), the overlap matrix built in row blocks."""
+    out_i, out_j = [], []
+    for start in range(0, lo.shape[0], _PAIR_CHUNK):
+        rows = slice(start, start + _PAIR_CHUNK)
+        overlap = np.all((lo[rows, None] <= hi[None]) & (lo[None] <= hi[rows, None]), axis=2)
+        r, c = np.nonzero(overlap)
+        r = r + start
+        keep = c > r
+        out_i.append(r[keep])
+        out_j.append(c[keep])
+    return np.concatenate(out_i), np.concatenate(out_j)
 
 
 def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float

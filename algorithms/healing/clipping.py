@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from weakref import WeakKeyDictionary
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,6 +45,12 @@ __all__ = [
 #: default chord tolerance of :func:`trimmed_source`, fraction of the surface's box diagonal
 TRIM_MESH_FRACTION = 1e-3
 _PIP_CHUNK = 4096
+#: a surface at most this many times the clipping box's size is triangulated whole and kept
+CACHE_SIZE_RATIO = 4.0
+#: a kept triangulation serves chord tolerances up to this factor coarser than its own
+CACHE_TOL_RANGE = 4.0
+_SURFACE_MESHES: WeakKeyDictionary = WeakKeyDictionary()
+_MESH_TRIANGLES: WeakKeyDictionary = WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,20 +238,50 @@ def _overlaps(box_a: NDArray, box_b: NDArray) -> NDArray:
     return np.all((box_b[..., 0, :] <= box_a[1]) & (box_b[..., 1, :] >= box_a[0]), axis=-1)
 
 
+def _surface_triangles(surface: NurbsSurface, box: NDArray, mesh_tol: float
+                       ) -> tuple[NDArray, NDArray]:
+    """Triangles ``(t, 3, 3)`` and parameters ``(t, 3, 2)`` of a surface near ``box``.
+
+    A surface not much larger than the box is triangulated whole, once, and
+    kept (per surface, weakly) for every later box whose chord tolerance lies in
+    ``[tol, CACHE_TOL_RANGE * tol]``: heal projects many approximants onto the same
+    neighbours. A large surface is triangulated near the box only, every time.
+    """
+    surface_size = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
+    box_size = float(np.linalg.norm(np.ptp(box, axis=0)))
+    if surface_size > CACHE_SIZE_RATIO * box_size:
+        mesh = tessellate(surface, mesh_tol, keep_boxes=box[None]).mesh
+        return mesh.triangle_points(), mesh.triangle_uv()
+    entries = _SURFACE_MESHES.setdefault(surface, [])
+    for tol, points, uv in entries:
+        if mesh_tol / CACHE_TOL_RANGE <= tol <= mesh_tol:
+            return points, uv
+    tol = mesh_tol / np.sqrt(CACHE_TOL_RANGE)
+    mesh = tessellate(surface, tol).mesh
+    entries.append((tol, mesh.triangle_points(), mesh.triangle_uv()))
+    return entries[-1][1], entries[-1][2]
+
+
+def _mesh_triangles(mesh: TriangleMesh, with_uv: bool) -> tuple[NDArray, NDArray]:
+    """Triangle corners and parameters of a source's own mesh (computed once per mesh)."""
+    cached = _MESH_TRIANGLES.get(mesh)
+    if cached is None:
+        pts = mesh.triangle_points()
+        uv = (mesh.triangle_uv() if with_uv and mesh.uv is not None
+              else np.full(pts.shape[:2] + (2,), np.nan))
+        cached = (pts, uv)
+        _MESH_TRIANGLES[mesh] = cached
+    return cached
+
+
 def _source_mesh(source: SurfaceSource, box: NDArray, mesh_tol: float
                  ) -> tuple[NDArray, NDArray]:
     """Triangle corners (t, 3, 3) and parameters (t, 3, 2) of one source near ``box``."""
     if source.mesh is not None:
-        mesh = source.mesh
+        pts, uv = _mesh_triangles(source.mesh, source.surface is not None)
     else:
-        mesh = tessellate(source.surface, mesh_tol, keep_boxes=box[None]).mesh
-    pts = mesh.triangle_points()
-    if source.surface is not None and mesh.uv is not None:
-        uv = mesh.triangle_uv()
-    else:
-        uv = np.full(pts.shape[:2] + (2,), np.nan)
-    boxes = np.stack([pts.min(axis=1), pts.max(axis=1)], axis=1)
-    keep = _overlaps(box, boxes)
+        pts, uv = _surface_triangles(source.surface, box, mesh_tol)
+    keep = _overlaps(box, np.stack([pts.min(axis=1), pts.max(axis=1)], axis=1))
     return pts[keep], uv[keep]
 
 

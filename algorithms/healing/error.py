@@ -111,21 +111,23 @@ def closest_on_triangles(points: NDArray, tri: NDArray) -> tuple[NDArray, NDArra
     barycentric : (k, 3) float
     """
     p0, e1, e2 = tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    gram = np.stack([np.stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2)], 1),
-                     np.stack([np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e2)], 1)],
-                    1)
-    rhs = np.stack([np.einsum("ij,ij->i", points - p0, e1),
-                    np.einsum("ij,ij->i", points - p0, e2)], 1)
-    st = np.linalg.solve(gram, rhs[..., None])[..., 0]
-    bary = np.stack([1 - st[:, 0] - st[:, 1], st[:, 0], st[:, 1]], axis=1)
-    inside = np.all(bary >= 0, axis=1)
+    g11, g12, g22 = (np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
+                     np.einsum("ij,ij->i", e2, e2))
+    r1, r2 = np.einsum("ij,ij->i", points - p0, e1), np.einsum("ij,ij->i", points - p0, e2)
+    det = g11 * g22 - g12 * g12
+    solid = det > 1e-14 * g11 * g22            # a sliver or point: its edges decide
+    inv = np.where(solid, 1.0 / np.where(solid, det, 1.0), 0.0)
+    s_, t_ = (g22 * r1 - g12 * r2) * inv, (g11 * r2 - g12 * r1) * inv
+    bary = np.stack([1 - s_ - t_, s_, t_], axis=1)
+    inside = solid & np.all(bary >= 0, axis=1)
     best_d = np.where(inside, np.linalg.norm(points - np.einsum("kc,kcd->kd", bary, tri), axis=1),
                       np.inf)
     best_b = bary.copy()
     for i, j in ((0, 1), (1, 2), (2, 0)):
         a, b = tri[:, i], tri[:, j]
         ab = b - a
-        s = np.clip(np.einsum("ij,ij->i", points - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        s = np.clip(np.einsum("ij,ij->i", points - a, ab)
+                    / np.maximum(np.einsum("ij,ij->i", ab, ab), np.finfo(float).tiny), 0, 1)
         d = np.linalg.norm(points - (a + s[:, None] * ab), axis=1)
         better = ~inside & (d < best_d)
         cand = np.zeros_like(bary)

@@ -130,3 +130,15 @@ def test_coarse_plane_not_crowded_out_by_a_fine_neighbour():
                     np.zeros(200)], axis=1)
     d = distance_to_triangles(pts, clipped, tol=1e-12)
     assert d.max() < 1e-9
+
+
+def test_closest_on_degenerate_triangles_uses_their_edges():
+    """Slivers and points (zero-area triangles of a trimmed triangulation) give the
+    closest point of their edges instead of a singular system."""
+    tri = np.array([[[0.0, 0, 0], [1, 0, 0], [2, 0, 0]],          # collinear
+                    [[1.0, 1, 1], [1, 1, 1], [1, 1, 1]],          # a point
+                    [[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]])         # a proper one
+    points = np.array([[1.5, 0.5, 0.0], [0.0, 0, 0], [0.2, 0.2, 0.3]])
+    foot, bary = closest_on_triangles(points, tri)
+    assert np.allclose(foot, [[1.5, 0, 0], [1, 1, 1], [0.2, 0.2, 0]])
+    assert np.allclose(bary.sum(axis=1), 1.0)

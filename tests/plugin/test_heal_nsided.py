@@ -1,0 +1,103 @@
+"""Faces that are not four-sided as four-sided sub-patches (plugin/heal_nsided.py):
+faces built in OpenCascade on a wavy B-spline surface and read back, their
+sub-patches approximated over the face (its trimmed source) and joined."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "algorithms" / "healing"))
+from decompose_cases import (  # noqa: E402
+    disc,
+    line,
+    edge_from_uv,
+    pentagon,
+    polygon_loop,
+    six_edges_two_smooth,
+    triangle,
+    wavy_surface,
+)
+from surfprep.algorithms.healing import connect, local_approximant  # noqa: E402
+from surfprep.algorithms.healing.decompose import reverse_curve  # noqa: E402
+from surfprep.algorithms.projection import distance_to_surface  # noqa: E402
+from surfprep.plugin.edges import TrimEdge  # noqa: E402
+from surfprep.plugin.faces import TrimLoop, face_to_nurbs, make_face  # noqa: E402
+from surfprep.plugin.heal import face_source  # noqa: E402
+from surfprep.plugin.heal_nsided import (  # noqa: E402
+    decompose_face,
+    quad_boundaries,
+    why_not_decomposable,
+)
+from surfprep.plugin.heal_topology import four_sided_boundary  # noqa: E402
+
+SURFACE = wavy_surface()
+GAP = 1e-6
+
+
+def occ_face(loops, reverse_edges=False):
+    """TrimmedFace read back from an OpenCascade face with these loops (LoopEdges);
+    with ``reverse_edges`` every edge is stored the other way and used reversed."""
+    trim = []
+    for loop in loops:
+        edges = []
+        for e in loop:
+            if reverse_edges:
+                edges.append(TrimEdge(reverse_curve(e.curve), reverse_curve(e.pcurve), 0.0, 1.0,
+                                      reversed=True))
+            else:
+                edges.append(TrimEdge(e.curve, e.pcurve, 0.0, 1.0))
+        trim.append(TrimLoop(edges))
+    return face_to_nurbs(make_face(SURFACE, trim))
+
+
+def _ends_meet(boundary):
+    ends = np.array([[c.evaluate(c.domain[0]), c.evaluate(c.domain[1])] for c in boundary])
+    forward = np.linalg.norm(ends[:, 1] - np.roll(ends[:, 0], -1, axis=0), axis=1).max()
+    return forward < 1e-7
+
+
+@pytest.mark.parametrize(("case", "n_quads", "reverse"),
+                         [(triangle, 3, False), (triangle, 3, True), (pentagon, 5, False),
+                          (six_edges_two_smooth, 1, False), (disc, 1, True)])
+def test_quad_boundaries_of_occ_faces(case, n_quads, reverse):
+    face = occ_face([case(SURFACE)], reverse_edges=reverse)
+    quads = quad_boundaries(face, gap_tol=GAP)
+    assert quads is not None and len(quads) == n_quads
+    assert all(len(q) == 4 and _ends_meet(q) for q in quads)
+
+
+def test_four_sided_face_is_its_own_boundary():
+    face = occ_face([polygon_loop(SURFACE, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)])])
+    quads = quad_boundaries(face, gap_tol=GAP)
+    assert len(quads) == 1 and quads[0] == four_sided_boundary(face)
+    assert decompose_face(face, gap_tol=GAP) is None
+
+
+def test_face_with_a_hole_is_not_decomposable_and_says_why():
+    outer = polygon_loop(SURFACE, [(0.05, 0.05), (0.95, 0.05), (0.5, 0.95)])
+    hole = [edge_from_uv(SURFACE, line(a, b)) for a, b in
+            [((0.4, 0.3), (0.5, 0.5)), ((0.5, 0.5), (0.6, 0.3)), ((0.6, 0.3), (0.4, 0.3))]]
+    face = occ_face([outer, hole])
+    assert quad_boundaries(face, gap_tol=GAP) is None
+    assert "inner loop" in why_not_decomposable(face, gap_tol=GAP)
+
+
+def test_triangle_sub_patches_follow_the_trimmed_face_and_join_g1():
+    face = occ_face([triangle(SURFACE)])
+    source = face_source(face)
+    quads = quad_boundaries(face, gap_tol=GAP)
+    las = [local_approximant(q, [source], preferred_source=0) for q in quads]
+    assert all(la.converged for la in las)
+    net = connect(las, continuity="G1")
+    size = float(np.linalg.norm(np.ptp(SURFACE.bounding_box(), axis=0)))
+    assert len(net.joins) == 3
+    assert max(j.max_gap for j in net.joins) <= 1e-9 * size
+    assert max(j.max_angle for j in net.joins) < 0.2
+    t = np.linspace(0, 1, 41)
+    for la, p in zip(las, net.patches):
+        assert distance_to_surface(face.surface, p.evaluate_grid(t, t).reshape(-1, 3)).max() \
+            <= la.tol
