@@ -48,7 +48,7 @@ from surfprep.algorithms.intersection import (
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
 
 TOL = 1e-9
-REPEAT = 2
+REPEAT = 3
 
 
 def bumps_level() -> float:
