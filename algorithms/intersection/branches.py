@@ -110,16 +110,23 @@ def branch_directions(hessian: ArrayLike, *, rel_tol: float = 1e-8
     return kinds, out
 
 
+def _cross(a: NDArray, b: NDArray) -> NDArray:
+    """Row-wise cross product of ``(n, 3)`` arrays (np.cross without its axis moves)."""
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+                     a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+
+
 def _unit_normal(d: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """Unit normal ``(n, 3)`` and its u- and v-derivatives from derivatives
     ``d (n, 3, 3, 3)`` (order 2)."""
     su, sv = d[:, 1, 0], d[:, 0, 1]
-    n = np.cross(su, sv)
+    n = _cross(su, sv)
     length = np.maximum(np.linalg.norm(n, axis=1), np.finfo(float).tiny)[:, None]
     unit = n / length
     out = [unit]
-    for dn in (np.cross(d[:, 2, 0], sv) + np.cross(su, d[:, 1, 1]),
-               np.cross(d[:, 1, 1], sv) + np.cross(su, d[:, 0, 2])):
+    for dn in (_cross(d[:, 2, 0], sv) + _cross(su, d[:, 1, 1]),
+               _cross(d[:, 1, 1], sv) + _cross(su, d[:, 0, 2])):
         out.append((dn - unit * np.einsum("ij,ij->i", unit, dn)[:, None]) / length)
     return out[0], out[1], out[2]
 
@@ -157,7 +164,7 @@ def surface_pair_form(da: NDArray, db: NDArray) -> tuple[NDArray, NDArray]:
     """
     na = _unit_normal(da)[0]
     e1 = da[:, 1, 0] / np.linalg.norm(da[:, 1, 0], axis=1)[:, None]
-    e2 = np.cross(na, e1)
+    e2 = _cross(na, e1)
     frame = np.stack([e1, e2], axis=2)
     return frame, _second_form(da, na, frame) - _second_form(db, na, frame)
 
@@ -223,12 +230,12 @@ def _residual(surface_a: NurbsSurface, surface_b: NurbsSurface, z: NDArray, scal
     db = surface_b.derivatives(z[:, 2], z[:, 3], 2)
     na, na_u, na_v = _unit_normal(da)
     nb, nb_s, nb_t = _unit_normal(db)
-    res = np.concatenate([da[:, 0, 0] - db[:, 0, 0], scale * np.cross(na, nb)], axis=1)
+    res = np.concatenate([da[:, 0, 0] - db[:, 0, 0], scale * _cross(na, nb)], axis=1)
     if not with_jacobian:
         return res, None
     top = np.stack([da[:, 1, 0], da[:, 0, 1], -db[:, 1, 0], -db[:, 0, 1]], axis=2)
-    bottom = scale * np.stack([np.cross(na_u, nb), np.cross(na_v, nb),
-                               np.cross(na, nb_s), np.cross(na, nb_t)], axis=2)
+    bottom = scale * np.stack([_cross(na_u, nb), _cross(na_v, nb),
+                               _cross(na, nb_s), _cross(na, nb_t)], axis=2)
     return res, np.concatenate([top, bottom], axis=1)
 
 

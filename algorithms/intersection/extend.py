@@ -275,9 +275,11 @@ def _unique_points(points: NDArray, merge: float) -> tuple[NDArray, NDArray]:
 
 def _pieces(curve: RefinedCurve, kind: tuple, centre: NDArray, radius: float) -> list:
     """The runs of ``curve`` outside the ball ``|x - centre| < radius``:
-    ``[(RefinedCurve, (start_kind, end_kind), (start_cut, end_cut))]``; an end
-    made by the cut has kind OPEN and ``*_cut`` True. A curve not entering the
-    ball comes back whole."""
+    ``[(RefinedCurve, (start_kind, end_kind), (start_cut, end_cut))]``. An end
+    made by the cut has kind OPEN and ``*_cut`` True; where the cut removed an
+    original BOUNDARY end (a singular point on a seam or side), that end keeps
+    kind BOUNDARY (the join brings it back to the point). A curve not entering
+    the ball comes back whole."""
     inside = np.linalg.norm(curve.points - centre, axis=1) < radius
     if not inside.any():
         return [(curve, kind, (False, False))]
@@ -293,56 +295,71 @@ def _pieces(curve: RefinedCurve, kind: tuple, centre: NDArray, radius: float) ->
     for lo, hi in zip(edges[0::2], edges[1::2]):      # runs of outside samples [lo, hi)
         if hi - lo < 2:
             continue
-        cut = (lo > 0 or inside[0], hi < n or inside[-1])
-        if curve.closed:
-            cut = (True, True)
-        k = (EndKind.OPEN if cut[0] else kind[0], EndKind.OPEN if cut[1] else kind[1])
+        cut = (lo > 0, hi < n)
+        k = [kind[0] if lo == 0 else EndKind.OPEN, kind[1] if hi == n else EndKind.OPEN]
+        if lo == int(np.argmax(~inside)) and lo > 0 and kind[0] is EndKind.BOUNDARY:
+            k[0] = EndKind.BOUNDARY
+        if hi == n - int(np.argmax(~inside[::-1])) and hi < n and kind[1] is EndKind.BOUNDARY:
+            k[1] = EndKind.BOUNDARY
         part = [f[lo:hi] for f in fields]
-        out.append((RefinedCurve(part[0], part[1], part[2], False, part[3], part[4]), k, cut))
+        out.append((RefinedCurve(part[0], part[1], part[2], False, part[3], part[4]),
+                    tuple(k), cut))
     return out
 
 
-def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: tuple,
-                direction: NDArray, heights: NDArray, tol: float, iterations: int = 30
-                ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-    """Points of one branch leaving the singular point ``centre = (p, uv_a, uv_b)``
-    along the unit ``direction (3,)``: the intersection with the planes
-    ``direction . (x - p) = heights (m,)``, all at once by Newton on
-    ``[a(u, v) - b(s, t), direction . (a - p) - h]`` (four equations, four
-    unknowns), started from the tangent-plane prediction ``p + h direction``
-    mapped by each surface's Jacobian pseudo-inverse.
+def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArray,
+                uv_a: NDArray, uv_b: NDArray, direction: NDArray, heights: NDArray, tol: float,
+                iterations: int = 30) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Points of branches leaving singular points along unit directions, all at once.
+
+    Row ``i`` is the intersection of the branch leaving ``centre[i] (3,)`` (at
+    ``uv_a[i], uv_b[i]``) along ``direction[i] (3,)`` with the plane
+    ``direction[i] . (x - centre[i]) = heights[i]``: Newton on
+    ``[a(u, v) - b(s, t), direction . (a - centre) - h]`` (four equations, four
+    unknowns), started from the tangent-plane prediction ``centre + h direction``
+    mapped by each surface's Jacobian pseudo-inverse there. Its Jacobian is
+    regular on the branch away from the centre (the normals differ by about
+    ``h |II_a - II_b|``).
 
     Returns ``points (m, 3)``, ``uv_a, uv_b (m, 2)`` and ``converged (m,) bool``
-    (``|a - b| <= tol / 16`` and within ``tol / 16`` of its plane)."""
-    p, uv_a, uv_b = centre
+    (``|a - b| <= tol / 16`` and within ``tol / 16`` of its plane).
+    """
     m = heights.size
-    da = surface_a.derivatives(uv_a[:1, 0], uv_a[:1, 1], 1)[0]
-    db = surface_b.derivatives(uv_b[:1, 0], uv_b[:1, 1], 1)[0]
-    ja = np.stack([da[1, 0], da[0, 1]], axis=1)
-    jb = np.stack([db[1, 0], db[0, 1]], axis=1)
-    step = heights[:, None] * direction[None]
-    z = np.concatenate([uv_a + step @ np.linalg.pinv(ja).T, uv_b + step @ np.linalg.pinv(jb).T],
-                       axis=1)
+    da = surface_a.derivatives(uv_a[:, 0], uv_a[:, 1], 1)
+    db = surface_b.derivatives(uv_b[:, 0], uv_b[:, 1], 1)
+    step = heights[:, None] * direction
+    pa = np.linalg.pinv(np.stack([da[:, 1, 0], da[:, 0, 1]], axis=2))        # (m, 2, 3)
+    pb = np.linalg.pinv(np.stack([db[:, 1, 0], db[:, 0, 1]], axis=2))
+    z = np.concatenate([uv_a + np.einsum("mij,mj->mi", pa, step),
+                        uv_b + np.einsum("mij,mj->mi", pb, step)], axis=1)
     lo = np.concatenate([surface_a.domain[0::2], surface_b.domain[0::2]])
     hi = np.concatenate([surface_a.domain[1::2], surface_b.domain[1::2]])
     ok = np.zeros(m, dtype=bool)
+    todo = np.arange(m)
     for _ in range(iterations):
-        da = surface_a.derivatives(z[:, 0], z[:, 1], 1)
-        db = surface_b.derivatives(z[:, 2], z[:, 3], 1)
+        zt = z[todo]
+        da = surface_a.derivatives(zt[:, 0], zt[:, 1], 1)
+        db = surface_b.derivatives(zt[:, 2], zt[:, 3], 1)
+        d = direction[todo]
         gap = da[:, 0, 0] - db[:, 0, 0]
-        off = (da[:, 0, 0] - p) @ direction - heights
-        ok = (np.linalg.norm(gap, axis=1) <= tol / 16) & (np.abs(off) <= tol / 16)
-        if ok.all():
+        off = np.einsum("mi,mi->m", da[:, 0, 0] - centre[todo], d) - heights[todo]
+        done = (np.linalg.norm(gap, axis=1) <= tol / 16) & (np.abs(off) <= tol / 16)
+        ok[todo[done]] = True
+        keep = ~done
+        todo, zt, da, db, d = todo[keep], zt[keep], da[keep], db[keep], d[keep]
+        gap, off = gap[keep], off[keep]
+        if todo.size == 0:
             break
-        jac = np.zeros((m, 4, 4))
+        jac = np.zeros((todo.size, 4, 4))
         jac[:, :3, 0], jac[:, :3, 1] = da[:, 1, 0], da[:, 0, 1]
         jac[:, :3, 2], jac[:, :3, 3] = -db[:, 1, 0], -db[:, 0, 1]
-        jac[:, 3, 0], jac[:, 3, 1] = da[:, 1, 0] @ direction, da[:, 0, 1] @ direction
+        jac[:, 3, 0] = np.einsum("mi,mi->m", da[:, 1, 0], d)
+        jac[:, 3, 1] = np.einsum("mi,mi->m", da[:, 0, 1], d)
         rhs = -np.concatenate([gap, off[:, None]], axis=1)
         good = np.abs(np.linalg.det(jac)) > 1e-300
-        dz = np.zeros((m, 4))
+        dz = np.zeros((todo.size, 4))
         dz[good] = np.linalg.solve(jac[good], rhs[good][..., None])[..., 0]
-        z = np.where(ok[:, None], z, np.clip(z + dz, lo, hi))
+        z[todo] = np.clip(zt + dz, lo, hi)
     pts = 0.5 * (surface_a.evaluate(z[:, 0], z[:, 1]) + surface_b.evaluate(z[:, 2], z[:, 3]))
     return pts, z[:, :2], z[:, 2:], ok & np.isfinite(z).all(axis=1)
 
@@ -352,23 +369,44 @@ def _reversed(c: RefinedCurve) -> RefinedCurve:
                         c.singular[::-1])
 
 
-def _joined(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: tuple,
-            direction: NDArray, piece: RefinedCurve, tol: float) -> RefinedCurve:
-    """``piece`` continued from its first sample along the half-branch ``direction``
-    back to the singular point ``centre``; the result starts there."""
-    p, uv_a, uv_b = centre
-    reach = float((piece.points[0] - p) @ direction)
+def _arc_heights(centre: NDArray, direction: NDArray, piece: RefinedCurve) -> NDArray:
+    """Plane heights of the new samples between the point and the piece's first
+    sample, at about the piece's own first spacing."""
+    reach = float((piece.points[0] - centre) @ direction)
     spacing = float(np.linalg.norm(piece.points[1] - piece.points[0]))
     n = min(max(2, int(np.ceil(reach / max(spacing, 1e-300)))), 4096)
-    heights = reach * np.arange(1, n) / n
-    pts, ua, ub, ok = _arc_points(surface_a, surface_b, centre, direction, heights, tol)
-    pts, ua, ub = pts[ok], ua[ok], ub[ok]
+    return reach * np.arange(1, n) / n
+
+
+def _joined(centre: tuple, arc: tuple, piece: RefinedCurve) -> RefinedCurve:
+    """``piece`` preceded by the singular point ``centre = (p, uv_a (1, 2), uv_b (1, 2))``
+    and the converged ``arc = (points, uv_a, uv_b, converged)`` samples between."""
+    p, uv_a, uv_b = centre
+    ok = arc[3]
+    pts, ua, ub = arc[0][ok], arc[1][ok], arc[2][ok]
     k = pts.shape[0]
     return RefinedCurve(np.concatenate([p[None], pts, piece.points]),
                         np.concatenate([uv_a, ua, piece.uv_a]),
                         np.concatenate([uv_b, ub, piece.uv_b]), False,
                         np.concatenate([np.ones(k + 1, bool), piece.converged]),
                         np.concatenate([[True], np.zeros(k, bool), piece.singular]))
+
+
+def _centres_per_end(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: tuple,
+                     ends: list, tol: float, radius: float) -> list[tuple]:
+    """The singular point located again from each cut end ``(piece, end)`` at once,
+    so that its (u, v) lie on that end's side of a seam; the shared ``centre``
+    where that fails."""
+    if not ends:
+        return []
+    ua = np.array([piece.uv_a[-end] for piece, end in ends])
+    ub = np.array([piece.uv_b[-end] for piece, end in ends])
+    ra, rb, ok = locate_singular_points(surface_a, surface_b, ua, ub, tol=tol,
+                                        scale=max(radius, tol))
+    where = surface_a.evaluate(ra[:, 0], ra[:, 1])
+    ok &= np.linalg.norm(where - centre[0], axis=1) <= 16 * tol
+    return [(centre[0], ra[i:i + 1], rb[i:i + 1]) if ok[i] else centre
+            for i in range(len(ends))]
 
 
 def _resolve_one(curves: list, kinds: list, centre: tuple, directions: NDArray,
@@ -394,16 +432,32 @@ def _resolve_one(curves: list, kinds: list, centre: tuple, directions: NDArray,
         if cos >= _JOIN_COS and j not in taken:
             taken.add(j)
             joins[(i, end)] = j
+    keys = sorted(joins)
+    local = dict(zip(keys, _centres_per_end(surface_a, surface_b, centre,
+                                            [(pieces[i][0], e) for i, e in keys], tol, radius)))
+    # every join's arc in one batched solve, each piece seen from its joined end
+    starts = {key: pieces[key[0]][0] if key[1] == 0 else _reversed(pieces[key[0]][0])
+              for key in keys}
+    heights = [_arc_heights(p, halves[joins[key]], starts[key]) for key in keys]
+    rows = np.repeat(np.arange(len(keys)), [h.size for h in heights])
+    arcs = {}
+    if keys:
+        cu = np.concatenate([local[key][1] for key in keys])
+        cv = np.concatenate([local[key][2] for key in keys])
+        dirs = np.stack([halves[joins[key]] for key in keys])
+        solved = _arc_points(surface_a, surface_b, np.broadcast_to(p, (rows.size, 3)),
+                             cu[rows], cv[rows], dirs[rows], np.concatenate(heights), tol)
+        for n, key in enumerate(keys):
+            arcs[key] = tuple(x[rows == n] for x in solved)
     new_curves, new_kinds = [], []
     for i, (piece, kind, _) in enumerate(pieces):
         kind = list(kind)
         if (i, 0) in joins:
-            piece = _joined(surface_a, surface_b, centre, halves[joins[(i, 0)]], piece, tol)
-            kind[0] = EndKind.BIFURCATION
+            piece = _joined(local[(i, 0)], arcs[(i, 0)], piece)
+            kind[0] = kind[0] if kind[0] is EndKind.BOUNDARY else EndKind.BIFURCATION
         if (i, 1) in joins:
-            piece = _reversed(_joined(surface_a, surface_b, centre, halves[joins[(i, 1)]],
-                                      _reversed(piece), tol))
-            kind[1] = EndKind.BIFURCATION
+            piece = _reversed(_joined(local[(i, 1)], arcs[(i, 1)], _reversed(piece)))
+            kind[1] = kind[1] if kind[1] is EndKind.BOUNDARY else EndKind.BIFURCATION
         new_curves.append(piece)
         new_kinds.append(tuple(kind))
     return new_curves, new_kinds
@@ -469,10 +523,26 @@ def join_at_singular_points(curves: list[RefinedCurve], kinds: list[tuple[EndKin
         far = dist[idx[mine]][is_end[idx[mine]]]
         spacing = _local_spacing(curves, centres[g], reach)
         radius = min(max(_BALL_MARGIN * (far.max() if far.size else 0.0), 4 * spacing), reach)
+        radius = _clear_of_sides(curves, kinds, centres[g], radius)
         centre = (centres[g], sa[idx[f]][None], sb[idx[f]][None])
         curves, kinds = _resolve_one(curves, kinds, centre, dirs[g], radius, surface_a,
                                      surface_b, tol)
     return curves, kinds
+
+
+def _clear_of_sides(curves: list[RefinedCurve], kinds: list, centre: NDArray,
+                    radius: float) -> float:
+    """``radius`` shrunk so that no BOUNDARY end lies in the ball unless it lies at
+    ``centre`` (within a quarter of the radius: a singular point on a side or
+    seam, whose end kind the join keeps)."""
+    for c, kind in zip(curves, kinds):
+        if c.closed:
+            continue
+        for e, k in ((0, kind[0]), (-1, kind[1])):
+            d = float(np.linalg.norm(c.points[e] - centre))
+            if k is EndKind.BOUNDARY and 0.25 * radius < d < radius:
+                radius = 0.9 * d
+    return radius
 
 
 def _local_spacing(curves: list[RefinedCurve], centre: NDArray, reach: float) -> float:
