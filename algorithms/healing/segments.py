@@ -152,21 +152,27 @@ def pierce_surface(surface: NurbsSurface, origin: NDArray, direction: NDArray, u
     u0, u1, v0, v1 = surface.domain
     lo, hi = np.array([u0, v0]), np.array([u1, v1])
     uv, t = uv0.copy(), t0.copy()
-    residual = np.full(t.shape, np.inf)
+    active = np.arange(t.size)
     for _ in range(_NEWTON_STEPS):
-        d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
-        f = d[:, 0, 0] - origin - t[:, None] * direction
-        residual = np.linalg.norm(f, axis=1)
-        jac = np.stack([d[:, 1, 0], d[:, 0, 1], -direction], axis=2)
+        if active.size == 0:
+            break
+        d = surface.derivatives(uv[active, 0], uv[active, 1], 1)
+        f = d[:, 0, 0] - origin[active] - t[active, None] * direction[active]
+        # points already within a tenth of tol stop (their next step would be smaller)
+        moving = np.linalg.norm(f, axis=1) > 0.1 * tol
+        active, d, f = active[moving], d[moving], f[moving]
+        if active.size == 0:
+            break
+        jac = np.stack([d[:, 1, 0], d[:, 0, 1], -direction[active]], axis=2)
         det = np.linalg.det(jac)
         good = np.abs(det) > 1e-300
-        step = np.zeros((t.size, 3))
+        step = np.zeros((active.size, 3))
         if np.any(good):
             with np.errstate(all="ignore"):
                 step[good] = np.linalg.solve(jac[good], -f[good][..., None])[..., 0]
         step[~np.all(np.isfinite(step), axis=1)] = 0.0
-        uv = np.clip(uv + step[:, :2], lo, hi)
-        t = t + step[:, 2]
+        uv[active] = np.clip(uv[active] + step[:, :2], lo, hi)
+        t[active] = t[active] + step[:, 2]
     p = surface.evaluate(uv[:, 0], uv[:, 1])
     residual = np.linalg.norm(p - origin - t[:, None] * direction, axis=1)
     ok = (residual <= tol) & (t >= 0) & (t <= 1) & np.all(np.isfinite(uv), axis=1)

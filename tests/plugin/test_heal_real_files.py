@@ -53,3 +53,47 @@ def test_heartvalve_every_face_approximated(data_dir):
     assert r.valid_after and r.free_edges_after <= r.free_edges_before
     assert r.tight_free_edges_before == 24 and r.tight_free_edges_after == 0
     assert all(j.max_gap < 1e-9 for j in r.joins)
+
+
+@pytest.mark.slow
+def test_microstation_faces_not_four_sided_decompose(data_dir):
+    """occt_k1geo_microstation.stp: of the 12 faces that are not four-sided, those of one
+    loop without cusps split into four-sided sub-patches (heal_nsided.quad_boundaries),
+    every sub-patch's approximant over the face (its own source preferred) meets tol,
+    and the sub-patches of a face join closed in the geometry; the others say why
+    (holes in the face, very non-convex outlines, a loop turning back on itself)."""
+    import numpy as np
+
+    from surfprep.algorithms.healing import connect, local_approximant
+    from surfprep.algorithms.projection import distance_to_surface
+    from surfprep.plugin.heal import _default_gap_tol, _read_faces, face_source
+    from surfprep.plugin.heal_nsided import quad_boundaries, why_not_decomposable
+    from surfprep.plugin.heal_topology import face_edges, four_sided_boundary
+    from surfprep.plugin.io import read
+
+    model = read(data_dir / "occt_k1geo_microstation.stp")
+    faces, _ = _read_faces(model)
+    gap_tol = _default_gap_tol(model, face_edges(faces))
+    kept = [i for i, f in enumerate(faces) if f is not None]
+    sources = [face_source(faces[i]) for i in kept]
+    others = [k for k, i in enumerate(kept) if four_sided_boundary(faces[i]) is None]
+    decomposed, reasons = 0, []
+    for k in others:
+        face = faces[kept[k]]
+        quads = quad_boundaries(face, gap_tol=gap_tol)
+        if quads is None:
+            reasons.append(why_not_decomposable(face, gap_tol=gap_tol))
+            continue
+        decomposed += 1
+        las = [local_approximant(q, sources, gap_tol=gap_tol, preferred_source=k)
+               for q in quads]
+        assert all(la.converged for la in las)
+        net = connect(las, continuity="G1", gap_tol=gap_tol, strict=False)
+        assert all(j.max_gap <= 1e-9 * model.size for j in net.joins)
+        t = np.linspace(0, 1, 21)
+        for la, patch in zip(las, net.patches):
+            pts = patch.evaluate_grid(t, t).reshape(-1, 3)
+            assert distance_to_surface(face.surface, pts).max() <= la.tol
+    assert len(others) == 12
+    assert decomposed >= 4                    # measured: 4 (two 6-edge faces, two discs)
+    assert all(reasons) and any("inner loop" in r for r in reasons)
