@@ -56,7 +56,7 @@ from ...errors import InvalidGeometryError
 from ..measure import normals
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from . import vectors
+from . import refine_kernel, vectors
 
 __all__ = [
     "RefinedCurve",
@@ -192,38 +192,11 @@ def _three_planes(p: NDArray, q: NDArray, n_p: NDArray, n_q: NDArray, anchor: ND
     return num / sin[:, None]                               # [n_p, n_q, n_n] = |n_p x n_q|
 
 
-# ------------------------------------------------------------------ points
-def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayLike,
-                  uv_b: ArrayLike, *, tol: float = 1e-7, anchors: ArrayLike | None = None,
-                  max_iter: int = 40, tangent_sin: float = 1e-6) -> RefinedPoints:
-    """Auxiliary-plane refinement (Hosaka; eqs. 29.18–29.26) of ``n`` points at once.
-
-    Parameters
-    ----------
-    surface_a, surface_b : NurbsSurface
-    uv_a, uv_b : (n, 2) float
-        Start parameters (e.g. from the barycentric map of the triangles).
-    tol : float
-        Convergence when ``|S_a(uv_a) - S_b(uv_b)| <= tol``.
-    anchors : (n, 3) float, optional
-        Fixed points for the plane ``F_n``; default the current midpoint of the images.
-    max_iter : int
-    tangent_sin : float
-        ``|n_p x n_q|`` below this: near-tangential, midpoint fallback, flagged.
-
-    Returns
-    -------
-    RefinedPoints
-    """
-    _check_surface(surface_a, "surface_a")
-    _check_surface(surface_b, "surface_b")
-    tol = check_tolerance(tol)
-    ua = _clamp(_check_uv(uv_a, "uv_a"), surface_a)
-    ub = _clamp(_check_uv(uv_b, "uv_b", ua.shape[0]), surface_b)
+def _iterate(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray, ub: NDArray,
+             anchor: NDArray | None, tol: float, max_iter: int, tangent_sin: float) -> tuple:
+    """The numpy form of the iteration of :func:`refine_points` over all points at once:
+    ``ua, ub, img_a, img_b, nrm_a, nrm_b, iterations, singular``."""
     n = ua.shape[0]
-    anchor = None if anchors is None else np.asarray(anchors, dtype=float)
-    if anchor is not None and anchor.shape != (n, 3):
-        raise InvalidGeometryError(f"anchors must have shape ({n}, 3), got {anchor.shape}")
     iterations = np.zeros(n, dtype=np.int64)
     singular = np.zeros(n, dtype=bool)
     held_a = np.zeros(n, dtype=bool)        # the last step was clamped on A's / B's boundary
@@ -267,6 +240,57 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
     if active.size:                         # the loop ran out with points still moving
         img_a[active], _, _, nrm_a[active] = _frame(surface_a, ua[active])
         img_b[active], _, _, nrm_b[active] = _frame(surface_b, ub[active])
+    return ua, ub, img_a, img_b, nrm_a, nrm_b, iterations, singular
+
+
+# ------------------------------------------------------------------ points
+def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayLike,
+                  uv_b: ArrayLike, *, tol: float = 1e-7, anchors: ArrayLike | None = None,
+                  max_iter: int = 40, tangent_sin: float = 1e-6) -> RefinedPoints:
+    """Auxiliary-plane refinement (Hosaka; eqs. 29.18–29.26) of ``n`` points at once.
+
+    Parameters
+    ----------
+    surface_a, surface_b : NurbsSurface
+    uv_a, uv_b : (n, 2) float
+        Start parameters (e.g. from the barycentric map of the triangles).
+    tol : float
+        Convergence when ``|S_a(uv_a) - S_b(uv_b)| <= tol``.
+    anchors : (n, 3) float, optional
+        Fixed points for the plane ``F_n``; default the current midpoint of the images.
+    max_iter : int
+    tangent_sin : float
+        ``|n_p x n_q|`` below this: near-tangential, midpoint fallback, flagged.
+
+    Returns
+    -------
+    RefinedPoints
+    """
+    _check_surface(surface_a, "surface_a")
+    _check_surface(surface_b, "surface_b")
+    tol = check_tolerance(tol)
+    ua = _clamp(_check_uv(uv_a, "uv_a"), surface_a)
+    ub = _clamp(_check_uv(uv_b, "uv_b", ua.shape[0]), surface_b)
+    n = ua.shape[0]
+    anchor = None if anchors is None else np.asarray(anchors, dtype=float)
+    if anchor is not None and anchor.shape != (n, 3):
+        raise InvalidGeometryError(f"anchors must have shape ({n}, 3), got {anchor.shape}")
+    if refine_kernel.AVAILABLE:
+        start_a, start_b = ua.copy(), ub.copy()
+        img_a, img_b, nrm_a, nrm_b, iterations, singular, fallback = \
+            refine_kernel.refine_compiled(surface_a, surface_b, ua, ub, anchor, tol, max_iter,
+                                          tangent_sin, _DEGENERATE)
+        if np.any(fallback):            # a pole on the way: the numpy form, from the start
+            k = np.flatnonzero(fallback)
+            ua[k], ub[k] = start_a[k], start_b[k]
+            sub = _iterate(surface_a, surface_b, ua[k], ub[k],
+                           None if anchor is None else anchor[k], tol, max_iter, tangent_sin)
+            ua[k], ub[k] = sub[0], sub[1]
+            for full, part in zip((img_a, img_b, nrm_a, nrm_b, iterations, singular), sub[2:]):
+                full[k] = part
+    else:
+        ua, ub, img_a, img_b, nrm_a, nrm_b, iterations, singular = _iterate(
+            surface_a, surface_b, ua, ub, anchor, tol, max_iter, tangent_sin)
     pa, pb, n_a, n_b = img_a, img_b, nrm_a, nrm_b
     gap = vectors.norm(pa - pb)
     converged = gap <= tol
