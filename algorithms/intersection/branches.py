@@ -179,7 +179,8 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
     ``(u, v, s, t)``: a common point with parallel normals (000 §29.5.1; 002
     §4: ``phi = 0`` and ``grad phi = 0``). At a double point the residual
     vanishes and the Jacobian has full rank, so the iteration converges
-    quadratically.
+    quadratically; once every start meets ``tol`` two more steps bring the
+    point to rounding level.
 
     Parameters
     ----------
@@ -203,13 +204,16 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
     z = np.concatenate([ua, ub], axis=1)
     converged = np.zeros(z.shape[0], dtype=bool)
     mu = np.full(z.shape[0], 1e-12)
+    polish = 0
     for _ in range(iterations):
         res, jac = _residual(surface_a, surface_b, z, scale)
         norm = np.linalg.norm(res, axis=1)
         converged = (np.linalg.norm(res[:, :3], axis=1) <= tol / 16) & \
             (np.linalg.norm(res[:, 3:], axis=1) <= tol / 16)
-        if converged.all():
-            break
+        if converged.all():           # two more steps: quadratic convergence to rounding
+            polish += 1
+            if polish > 2:
+                break
         jtj = np.einsum("nki,nkj->nij", jac, jac)
         jtr = np.einsum("nki,nk->ni", jac, res)
         diag = np.einsum("nii->ni", jtj)
@@ -217,7 +221,7 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
                                 * np.eye(4), jtr[..., None])[..., 0]
         trial = np.clip(z + step, lo, hi)
         new_norm = np.linalg.norm(_residual(surface_a, surface_b, trial, scale, False)[0], axis=1)
-        better = (new_norm < norm) & ~converged
+        better = new_norm < norm
         z = np.where(better[:, None], trial, z)
         mu = np.where(better, np.maximum(mu / 10, 1e-12), np.minimum(mu * 10, 1e6))
     return z[:, :2], z[:, 2:], converged & np.isfinite(z).all(axis=1)

@@ -1,0 +1,175 @@
+"""Singular points of intersection curves: second-order branch directions
+(algorithms.intersection.branches) and curves joined exactly at double points
+(algorithms.intersection.extend.join_at_singular_points).
+
+Exact answers: two cylinders of equal radius with perpendicular axes,
+``x^2 + y^2 = 1`` and ``y^2 + z^2 = 1``, meet along the ellipses ``x = +-z``,
+crossing at the double points ``(0, +-1, 0)`` with branch directions
+``(1, 0, +-1) / sqrt 2``; Viviani's figure eight (sphere r = 2, cylinder r = 1
+around ``(1, 0, z)``) has its double point at ``(2, 0, 0)``.
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+import pytest
+from test_ssi_pipeline import TAU, check_on_surfaces, cylinder, sphere
+
+from surfprep.algorithms.intersection import EndKind, intersect_surfaces, pipeline, polyline_distance
+from surfprep.algorithms.intersection.branches import (
+    SingularKind,
+    branch_directions,
+    locate_singular_points,
+    singular_branches,
+)
+from surfprep.algorithms.intersection.extend import join_at_singular_points
+
+
+def hook(monkeypatch):
+    """The pipeline with the singular join after the marching of open ends (the hook
+    proposed for ``pipeline._extend``; a no-op once the pipeline calls it itself)."""
+    if "join_at_singular_points" not in inspect.getsource(pipeline._extend):
+        original = pipeline._extend
+
+        def _extend(dense, kinds, a, b, tol, mesh_tol):
+            dense, kinds = original(dense, kinds, a, b, tol, mesh_tol)
+            return join_at_singular_points(dense, kinds, a, b, tol=tol, reach=64 * mesh_tol)
+
+        monkeypatch.setattr(pipeline, "_extend", _extend)
+    return intersect_surfaces
+
+
+@pytest.fixture
+def hooked(monkeypatch):
+    return hook(monkeypatch)
+
+
+# ---------------------------------------------------------------- the quadratic form
+@pytest.mark.parametrize("seed", range(8))
+def test_double_point_directions_are_roots_of_the_form(seed):
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.normal(size=(2, 2)))
+    lam = np.array([-rng.uniform(0.1, 5), rng.uniform(0.1, 5)])
+    h = q @ np.diag(lam) @ q.T
+    kinds, d = branch_directions(h[None])
+    assert kinds == [SingularKind.DOUBLE_POINT]
+    np.testing.assert_allclose(np.linalg.norm(d[0], axis=1), 1.0, atol=1e-14)
+    np.testing.assert_allclose(np.einsum("ji,ik,jk->j", d[0], h, d[0]), 0.0, atol=1e-12)
+    assert abs(d[0, 0] @ d[0, 1]) < 1 - 1e-6          # two different directions
+
+
+def test_isolated_cusp_and_degenerate_points():
+    kinds, d = branch_directions(np.array([[[2.0, 0.3], [0.3, 1.0]], [[1.0, 2.0], [2.0, 4.0]],
+                                           [[0.0, 0.0], [0.0, 0.0]]]))
+    assert kinds == [SingularKind.ISOLATED, SingularKind.CUSP, SingularKind.DEGENERATE]
+    assert np.isnan(d[0]).all() and np.isnan(d[2]).all() and np.isnan(d[1, 1]).all()
+    np.testing.assert_allclose(np.array([[1.0, 2.0], [2.0, 4.0]]) @ d[1, 0], 0.0, atol=1e-14)
+
+
+def test_saddle_level_curve_directions():
+    """f = x^2 - 3 y^2: the level curve f = 0 is the two lines x = +-sqrt(3) y."""
+    kinds, d = branch_directions(np.array([[[2.0, 0.0], [0.0, -6.0]]]))
+    assert kinds == [SingularKind.DOUBLE_POINT]
+    slopes = np.sort(np.abs(d[0, :, 0] / d[0, :, 1]))
+    np.testing.assert_allclose(slopes, np.sqrt(3), rtol=1e-14)
+    assert np.sign(d[0, 0, 0] * d[0, 0, 1]) != np.sign(d[0, 1, 0] * d[0, 1, 1])
+
+
+# ---------------------------------------------------------------- locating on surfaces
+def equal_cylinders():
+    return cylinder(1.0, 1.5), cylinder(1.0, 2.0, normal=(1, 0, 0))
+
+
+def uv_of(surface, points, grid: int = 201):
+    """(u, v) of points on a surface: the nearest of a parameter grid."""
+    d = surface.domain
+    u, v = np.meshgrid(np.linspace(d[0], d[1], grid), np.linspace(d[2], d[3], grid),
+                       indexing="ij")
+    p = surface.evaluate(u.ravel(), v.ravel())
+    k = np.argmin(np.linalg.norm(p[None] - points[:, None], axis=2), axis=1)
+    return np.stack([u.ravel()[k], v.ravel()[k]], 1)
+
+
+def test_equal_cylinders_double_points_and_branches():
+    a, b = equal_cylinders()
+    t = np.pi / 2 + np.array([0.04, -0.03, np.pi + 0.05, np.pi - 0.02])   # near (0, +-1, 0)
+    start = np.stack([np.cos(t), np.sin(t), np.cos(t)], 1)                 # on x = z
+    ua, ub = uv_of(a, start), uv_of(b, start)
+    ra, rb, ok = locate_singular_points(a, b, ua, ub, tol=1e-10, scale=0.1)
+    assert ok.all()
+    points, kinds, dirs = singular_branches(a, b, ra, rb)
+    expect = np.array([[0, 1, 0], [0, 1, 0], [0, -1, 0], [0, -1, 0]], float)
+    np.testing.assert_allclose(points, expect, atol=1e-12)
+    assert kinds == [SingularKind.DOUBLE_POINT] * 4
+    for d in dirs:
+        got = np.sort(np.abs(d @ np.array([1, 0, 1]) / np.sqrt(2)))
+        np.testing.assert_allclose(got, [0, 1], atol=1e-9)        # (1,0,1) and (1,0,-1)
+        np.testing.assert_allclose(d[:, 1], 0.0, atol=1e-9)
+
+
+def test_no_singular_point_on_a_transversal_pair():
+    """Cylinders of radii 1 and 0.5 cross transversally everywhere: nothing converges."""
+    a, b = cylinder(1.0, 1.5), cylinder(0.5, 2.0, normal=(1, 0, 0))
+    s = np.linspace(0.1, 6.0, 7)
+    y, z = 0.5 * np.cos(s), 0.5 * np.sin(s)
+    start = np.stack([np.sqrt(1 - y ** 2), y, z], 1)
+    _, _, ok = locate_singular_points(a, b, uv_of(a, start), uv_of(b, start), tol=1e-7,
+                                      scale=0.1)
+    assert not ok.any()
+
+
+# ---------------------------------------------------------------- joined curves
+def ellipses(n: int = 20001) -> np.ndarray:
+    t = np.linspace(0, TAU, n)
+    return np.concatenate([np.stack([np.cos(t), np.sin(t), s * np.cos(t)], 1)
+                           for s in (1.0, -1.0)])
+
+
+@pytest.mark.parametrize("tol", [1e-7, 1e-10])
+def test_equal_cylinders_curves_end_at_the_double_points(hooked, tol):
+    a, b = equal_cylinders()
+    curves = hooked(a, b, tol=tol)
+    check_on_surfaces(curves, a, b, tol=tol)
+    exact = ellipses()
+    assert polyline_distance(exact, curves).max() <= tol                 # coverage
+    singular = np.array([[0, 1, 0], [0, -1, 0]], float)
+    ends = [(c.points[0], c.start_kind) for c in curves] + [(c.points[-1], c.end_kind)
+                                                             for c in curves]
+    at = [p for p, k in ends if k is EndKind.BIFURCATION]
+    assert len(at) == 8                                     # four half-branches per point
+    for s in singular:
+        assert sum(np.linalg.norm(p - s) <= 1e-9 for p in at) == 4
+    # no piece twice: the total length is the two ellipses' (no overlap at the points)
+    exact_length = np.linalg.norm(np.diff(exact, axis=0), axis=1).sum() - np.linalg.norm(
+        exact[20001] - exact[20000])
+    assert sum(c.length for c in curves) == pytest.approx(exact_length, rel=1e-6)
+
+
+def test_viviani_double_point_on_a_seam(hooked):
+    """The double point (2, 0, 0) lies on the sphere's seam: both lobes keep a BOUNDARY
+    end there and a BIFURCATION end, all at the point; coverage within tol."""
+    tol = 1e-7
+    a = sphere(2.0, normal=(0, 1, 0), xdir=(-1, 0, 0))
+    b = cylinder(1.0, 2.5, origin=(1, 0, 0))
+    curves = hooked(a, b, tol=tol)
+    check_on_surfaces(curves, a, b, tol=tol)
+    t = np.linspace(0, 2 * TAU, 40001)
+    viviani = np.stack([1 + np.cos(t), np.sin(t), 2 * np.sin(t / 2)], 1)
+    assert polyline_distance(viviani, curves).max() <= tol
+    exact_length = np.linalg.norm(np.diff(viviani, axis=0), axis=1).sum()
+    assert sum(c.length for c in curves) == pytest.approx(exact_length, rel=1e-6)
+    for c in curves:
+        for p, k in ((c.points[0], c.start_kind), (c.points[-1], c.end_kind)):
+            if k is EndKind.BIFURCATION:
+                np.testing.assert_allclose(p, [2, 0, 0], atol=1e-9)
+
+
+def test_join_leaves_transversal_curves_alone(monkeypatch):
+    a, b = cylinder(1.0, 1.5), cylinder(0.5, 2.0, normal=(1, 0, 0))
+    plain = intersect_surfaces(a, b, tol=1e-7)
+    joined = hook(monkeypatch)(a, b, tol=1e-7)
+    assert len(plain) == len(joined)
+    for p, q in zip(plain, joined):
+        np.testing.assert_array_equal(p.points, q.points)
