@@ -36,7 +36,7 @@ not see (the sample count grows only as ``share^(-1/4)``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,6 +51,13 @@ from .interpolants import (
     span_errors,
 )
 from .refine import RefinedCurve, RefinedPoints, refine_points
+from .sampling_rounds import (
+    _MIDDLE,
+    _POINT_SHARE,
+    CHECK_FRACTIONS,
+    _Work,
+    verification_round,
+)
 
 __all__ = [
     "CHECK_FRACTIONS",
@@ -65,36 +72,11 @@ __all__ = [
 
 #: interpolants are sampled until they are within this share of tol at the check points
 CUBIC_SHARE = 0.5
-#: where every span is checked (fractions of the span)
-CHECK_FRACTIONS = (0.25, 0.5, 0.75)
 #: interior error constant of the chord-length C2 cubic: kappa^3 h^4 / 384
 _CUBIC_CONSTANT = 384.0
 #: the spacing is this share of what the constant predicts (the interior error then about
 #: 0.4 of the target; end spans and the closure of a closed curve are worse)
 _SPACING = 0.8
-#: samples are refined to this share of tol (as in :mod:`.refine`)
-_POINT_SHARE = 1.0 / 16.0
-#: Newton steps projecting left-out dense samples onto curve3d
-_PROJECTION_STEPS = 4
-#: a projection onto curve3d stops once its steps move the foot by this share of the target
-_SETTLED = 1e-2
-#: a span longer than this times a neighbour is split (graded sampling)
-_MAX_RATIO = 4.0
-#: a failing span takes a dense sample within this fraction of its middle, else a new one
-_MIDDLE = 0.25
-#: a new sample must project onto its span's chord this far from both ends
-_INSIDE = 0.02
-#: a failing span is cut into at most this many pieces per round
-_MAX_PIECES = 8
-#: a curve whose error has not halved in this many rounds is given up
-_STALL_ROUNDS = 3
-#: kept samples closer than this times tol to the previous one are duplicates
-_DUPLICATE = 1e-3
-#: spans within this many of a new sample are checked again (0.27^8 = 3e-5)
-_LOCALITY = 8
-#: a new sample is taken when its two images are this close (times tol), even if the
-#: refinement stopped short of tol / 16 (low-angle cuts near 1e-10 converge slowly)
-_ACCEPT = 0.25
 
 
 # ------------------------------------------------------------------ initial subset
@@ -220,319 +202,6 @@ class SampledCurve:
     error: float
 
 
-@dataclass
-class _Work:
-    """One curve under sampling: its dense samples and which of them are kept."""
-
-    points: NDArray
-    uv_a: NDArray
-    uv_b: NDArray
-    converged: NDArray
-    singular: NDArray
-    closed: bool
-    kept: NDArray          # (m,) bool
-    stuck: NDArray         # (m,) bool: the span starting at this sample cannot be split
-    done: bool = False
-    error: float = float("inf")    # largest check-point error in the last round
-    result: object = None          # the passing _Check (interpolants) once done
-    history: list = field(default_factory=list)     # (error, failing spans) per round
-    degenerate: bool = False       # all samples on one point (left out of the result)
-    fresh: NDArray | None = None   # (m,) bool: kept since the last check
-    span_error: NDArray | None = None   # (m,) float: last checked error of the span from here
-
-
-def _project_on_curve(curve: NurbsCurve, x: NDArray, t0: NDArray, lo: NDArray,
-                      hi: NDArray, settled: float = 0.0) -> NDArray:
-    """Distances ``(m,)`` of points ``x (m, 3)`` to the first three coordinates of
-    ``curve`` near ``t0`` (Newton within ``[lo, hi]``, ``_PROJECTION_STEPS`` at most;
-    stopped once every step moves the foot by ``settled`` model units or less: the
-    distance is stationary at the foot, so its error is of second order in that)."""
-    t = t0.copy()
-    for _ in range(_PROJECTION_STEPS):
-        d = curve.derivatives(t, 2)[..., :3]
-        r = d[:, 0] - x
-        num = np.einsum("ij,ij->i", r, d[:, 1])
-        speed = np.einsum("ij,ij->i", d[:, 1], d[:, 1])
-        den = speed + np.einsum("ij,ij->i", r, d[:, 2])
-        den = np.where(den > 0, den, speed)
-        moved = np.clip(t - num / np.where(den > 0, den, 1.0), lo, hi)
-        step = np.abs(moved - t) * np.sqrt(speed)
-        t = moved
-        if np.all(step <= settled):
-            break
-    return np.linalg.norm(curve.evaluate(t)[:, :3] - x, axis=1)
-
-
-@dataclass
-class _Check:
-    """One curve's interpolants and their check points in a verification round."""
-
-    kept: NDArray          # kept dense indices
-    t: NDArray             # their parameters ((k + 1,) when closed)
-    stacked: NurbsCurve    # curve3d | pcurve_a | pcurve_b in one 7-dimensional curve
-    at: NDArray            # (dirty * 3, 7) interpolant values at the check points
-    dirty: NDArray         # the spans checked this round
-
-
-def _drop_duplicates(w: _Work, tol: float) -> NDArray:
-    """Kept indices, after dropping kept samples within ``_DUPLICATE tol`` of the previous
-    one (near-tangential refinement can land two samples on one point); they are
-    marked unconverged so that no later round takes them again."""
-    k = np.flatnonzero(w.kept)
-    ring = np.vstack([w.points[k], w.points[k[:1]]]) if w.closed else w.points[k]
-    step = np.linalg.norm(np.diff(ring, axis=0), axis=1)
-    dup = step <= _DUPLICATE * tol                      # step i: kept i -> i + 1 (wrapping)
-    drop = k[1:][dup[: k.size - 1]]
-    if w.closed and k.size > 1 and dup[-1] and k[-1] not in drop:
-        drop = np.append(drop, k[-1])
-    w.kept[drop] = False
-    w.converged[drop] = False
-    if drop.size:                                        # their neighbours' spans changed
-        w.fresh[k[np.maximum(np.searchsorted(k, drop) - 1, 0)]] = True
-    return np.flatnonzero(w.kept)
-
-
-def _dirty_spans(w: _Work, k: NDArray, spans: int) -> NDArray:
-    """Spans (indices into the kept samples) to check this round: those within
-    ``_LOCALITY`` spans of a sample kept since the last check (all in the first
-    round). A C2 cubic interpolant moves by a factor ``2 - sqrt(3)`` less per span
-    away from a changed sample, so farther spans keep their checked error."""
-    if w.span_error is None:
-        return np.arange(spans)
-    pos = np.flatnonzero(w.fresh[k])
-    if pos.size == 0:
-        return np.zeros(0, dtype=np.int64)
-    near = (pos[:, None] + np.arange(-_LOCALITY - 1, _LOCALITY + 1)[None, :]).ravel()
-    near = np.mod(near, spans) if w.closed else near[(near >= 0) & (near < spans)]
-    return np.unique(near)
-
-
-def _checks(works: list[_Work], tol: float) -> list[_Check]:
-    out = []
-    s = np.asarray(CHECK_FRACTIONS)
-    for w in works:
-        if w.fresh is None:
-            w.fresh = np.zeros(w.points.shape[0], dtype=bool)
-        k = _drop_duplicates(w, tol)
-        if k.size < 2 + w.closed:          # collapsed onto a point: nothing to interpolate
-            out.append(None)
-            continue
-        t = sample_parameters(w.points[k], w.closed)
-        stacked = interpolate_samples(np.hstack([w.points[k], w.uv_a[k], w.uv_b[k]]), t,
-                                      w.closed)
-        dirty = _dirty_spans(w, k, t.size - 1)
-        w.fresh[:] = False
-        dt = np.diff(t)[dirty]
-        at = stacked.evaluate((t[dirty, None] + s[None, :] * dt[:, None]).ravel())
-        out.append(_Check(k, t, stacked, at, dirty))
-    return out
-
-
-def _check_errors(checks: list[_Check], surface_a, surface_b) -> list[NDArray]:
-    """Per curve ``(spans,)``: the largest of ``|S_a(pcurve_a) - curve3d|``,
-    ``|S_b(pcurve_b) - curve3d|``, ``|S_a - S_b|`` at the check points; one
-    evaluation per surface for all curves."""
-    at = np.concatenate([c.at for c in checks])
-    on_a = surface_a.evaluate(at[:, 3], at[:, 4])
-    on_b = surface_b.evaluate(at[:, 5], at[:, 6])
-    err = np.maximum.reduce([np.linalg.norm(on_a - at[:, :3], axis=1),
-                             np.linalg.norm(on_b - at[:, :3], axis=1),
-                             np.linalg.norm(on_a - on_b, axis=1)])
-    split = np.cumsum([c.at.shape[0] for c in checks])[:-1]
-    return [e.reshape(-1, len(CHECK_FRACTIONS)).max(axis=1) for e in np.split(err, split)]
-
-
-def _span_errors_now(w: _Work, check: _Check, dirty_error: NDArray) -> NDArray:
-    """Errors ``(spans,)`` of all spans: just checked, or as last checked."""
-    m = w.points.shape[0]
-    if w.span_error is None or w.span_error.shape[0] != m:
-        w.span_error = np.full(m, np.nan)
-    spans = check.t.size - 1
-    w.span_error[check.kept[check.dirty]] = dirty_error
-    return w.span_error[check.kept[:spans]]
-
-
-def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float):
-    """Spans (by index into the kept samples) over ``target`` at their check points or
-    too long beside a neighbour, their errors, the dense samples farther than
-    ``target`` from ``curve3d`` (the worst per span; those spans take them), and what
-    the insertion needs."""
-    k, t = check.kept, check.t
-    dt = np.diff(t)
-    error = np.nan_to_num(error)
-    # left-out dense samples: projected onto curve3d within their span
-    m = w.points.shape[0]
-    ends = np.append(k, m) if w.closed else k                     # span j: ends[j]..ends[j+1]
-    span_of = np.searchsorted(ends, np.arange(m), side="right") - 1
-    checked = np.zeros(dt.size + 1, dtype=bool)
-    checked[check.dirty] = True
-    inner = ~w.kept & w.converged & (span_of < dt.size)
-    inner &= checked[np.clip(span_of, 0, dt.size)]
-    ring = np.vstack([w.points, w.points[:1]]) if w.closed else w.points
-    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(ring, axis=0), axis=1))])
-    off = np.zeros(0, dtype=np.int64)           # dense samples off curve3d: kept next round
-    if np.any(inner):
-        idx = np.flatnonzero(inner)
-        j = span_of[idx]
-        a0, a1 = arc[ends[j]], arc[ends[j + 1]]
-        frac = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
-        dist = _project_on_curve(check.stacked, w.points[idx], t[j] + frac * dt[j], t[j],
-                                 t[j + 1], settled=_SETTLED * target)
-        far = dist > target
-        if np.any(far):                          # the worst of each span
-            order = np.lexsort((-dist[far], j[far]))
-            first = np.concatenate([[True], np.diff(j[far][order]) != 0])
-            off = idx[far][order][first]
-    # graded spans: one over _MAX_RATIO times a neighbour is split too (a C2 cubic
-    # swings between the check points of a long span next to a short one)
-    ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
-        np.concatenate([[np.inf], dt, [np.inf]])
-    steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
-    bad = ((error > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
-    bad[span_of[off]] = False                    # those get their dense sample instead
-    bad = np.flatnonzero(bad)
-    return bad, error[bad], off, ends, span_of, arc
-
-
-def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
-            singular: NDArray) -> None:
-    """New kept dense samples right after dense indices ``after`` (sorted, distinct)."""
-    pos = after + 1
-    w.points = np.insert(w.points, pos, points, axis=0)
-    w.uv_a = np.insert(w.uv_a, pos, uv_a, axis=0)
-    w.uv_b = np.insert(w.uv_b, pos, uv_b, axis=0)
-    w.converged = np.insert(w.converged, pos, True)
-    w.singular = np.insert(w.singular, pos, singular)
-    w.kept = np.insert(w.kept, pos, True)
-    w.stuck = np.insert(w.stuck, pos, False)
-    w.fresh = np.insert(w.fresh, pos, True)
-    w.span_error = np.insert(w.span_error, pos, np.nan)
-
-
-def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
-           ) -> tuple[NDArray, NDArray, NDArray]:
-    """Where new samples go in their spans ``start -> stop`` (dense indices, ``stop`` may
-    be ``m`` for the closing span): ``(inside, after, fraction)``, three ``(q,)`` arrays.
-
-    ``fraction``: where the point projects onto the span's chord; ``inside``:
-    in ``[_INSIDE, 1 - _INSIDE]`` (a point held on a domain side may slide onto
-    the span's end);
-    ``after``: the dense sample it follows (by that fraction among the dense
-    samples of the span).
-    """
-    m = w.points.shape[0]
-    p0, p1 = w.points[start], w.points[stop % m]
-    chord = p1 - p0
-    den = np.maximum(np.einsum("ij,ij->i", chord, chord), np.finfo(float).tiny)
-    frac = np.einsum("ij,ij->i", points - p0, chord) / den
-    # anywhere strictly inside: near-tangential surfaces let points slide along the
-    # curve (consistently, so the order is kept), which does not hurt the sampling
-    inside = (frac >= _INSIDE) & (frac <= 1.0 - _INSIDE)
-    after = start.copy()
-    for i in np.flatnonzero(inside & (stop - start > 1)):
-        between = w.points[start[i] + 1: stop[i]]
-        f = (between - p0[i]) @ chord[i] / den[i]
-        after[i] = start[i] + np.count_nonzero(f < frac[i])
-    return inside, after, frac
-
-
-def _stalled(history: list[tuple[float, int]], target: float) -> bool:
-    """True when a curve still fails and over the last ``_STALL_ROUNDS`` rounds neither
-    its largest error has halved nor its number of failing spans gone down
-    (near-tangential surfaces, where the samples themselves are only as good as the
-    refinement's convergence): it is given up and measured as it is. ``history``
-    holds ``(largest error, failing spans)`` of every round."""
-    if len(history) <= _STALL_ROUNDS or history[-1][0] <= target:
-        return False
-    (error, failing), (before, failing_before) = history[-1], history[-1 - _STALL_ROUNDS]
-    return error > 0.5 * before and failing >= failing_before
-
-
-def _pieces(error: NDArray, target: float) -> NDArray:
-    """Into how many pieces a failing span is cut: ``sqrt(error / target)`` (the error of
-    a C2 cubic across a kink in the second derivative, where a surface's parametrization
-    is only C1, falls only as ``h^2``), 2 to ``_MAX_PIECES``."""
-    ratio = np.maximum(error / target, 1.0)
-    return np.clip(np.ceil(np.sqrt(ratio)), 2, _MAX_PIECES).astype(np.int64)
-
-
-def _round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
-           tangent_sin: float) -> None:
-    """One verification round over all unfinished curves (module docstring, step 2)."""
-    todo = [w for w in works if not w.done]
-    checks = _checks(todo, tol)
-    for w, check in zip(todo, checks):
-        if check is None:
-            w.done, w.degenerate = True, True
-    todo = [w for w, check in zip(todo, checks) if check is not None]
-    checks = [check for check in checks if check is not None]
-    if not todo:
-        return
-    errors = _check_errors(checks, surface_a, surface_b)
-    jobs = []        # per curve: work, span start / stop (dense), parameters of the pieces
-    curves = []      # per job: the stacked interpolant
-    for w, check, error in zip(todo, checks, errors):
-        error = _span_errors_now(w, check, error)
-        w.error = float(np.nanmax(error)) if error.size else 0.0
-        bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
-        w.history.append((w.error, bad.size + off.size))
-        if _stalled(w.history, target):         # near-tangential: splitting does not help
-            w.done = True
-            if w.error <= tol:                  # within the contract all the same
-                w.result = check
-            continue
-        if bad.size == 0 and off.size == 0:
-            w.done = True
-            w.result = check
-            continue
-        w.kept[off] = True
-        w.fresh[off] = True
-        t = check.t
-        pieces = _pieces(error, target)
-        fresh = []
-        for j, n in zip(bad, pieces):
-            inside = np.flatnonzero((span_of == j) & ~w.kept & w.converged)
-            if n == 2 and inside.size:      # the dense sample nearest the middle, if near
-                a0, a1 = arc[ends[j]], arc[ends[j + 1]]
-                frac = (arc[inside] - a0) / (a1 - a0) if a1 > a0 else np.full(inside.size, 0.5)
-                best = int(np.argmin(np.abs(frac - 0.5)))
-                if abs(frac[best] - 0.5) <= _MIDDLE:
-                    w.kept[inside[best]] = True
-                    w.fresh[inside[best]] = True
-                    continue
-            fresh.append((j, n))
-        if fresh:
-            span = np.repeat([j for j, _ in fresh], [n - 1 for _, n in fresh])
-            count = np.repeat([n for _, n in fresh], [n - 1 for _, n in fresh])
-            local = np.concatenate([np.arange(1, n) for _, n in fresh])
-            jobs.append((w, ends[span], ends[span + 1],
-                         t[span] + local / count * np.diff(t)[span]))
-            curves.append(check.stacked)
-    if not jobs:
-        return
-    at = np.concatenate([c.evaluate(j[3]) for j, c in zip(jobs, curves)])
-    new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
-                        anchors=at[:, :3], tangent_sin=tangent_sin)
-    offset = 0
-    for w, start, stop, _ in jobs:
-        sl = slice(offset, offset + start.size)
-        offset += start.size
-        inside, after, frac = _place(w, start, stop, new.points[sl])
-        ok = (new.gap[sl] <= _ACCEPT * tol) & inside   # refined to tol / 16, or nearly
-        # two pieces of one span that slid onto each other: the first only
-        order = np.lexsort((frac, start))
-        same = np.zeros(start.size, dtype=bool)
-        same[order[1:]] = (start[order[1:]] == start[order[:-1]]) & \
-            (np.diff(frac[order]) < _INSIDE)
-        ok &= ~same
-        failed = np.setdiff1d(start[~ok], start[ok])
-        w.stuck[failed] = True                       # no piece of the span could be placed
-        if np.any(ok):
-            order = np.lexsort((frac[ok], after[ok]))
-            _insert(w, after[ok][order], new.points[sl][ok][order], new.uv_a[sl][ok][order],
-                    new.uv_b[sl][ok][order], new.singular[sl][ok][order])
-
-
 def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
                   curves: Sequence[RefinedCurve], *, tol: float, share: float = CUBIC_SHARE,
                   simplify: bool = True, max_rounds: int = 40,
@@ -593,7 +262,7 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
                              new.singular[sl][ok])
         works.append(_merged_work(c, t, pos[ok], part))
     for _ in range(max_rounds):
-        _round(works, surface_a, surface_b, target, tol, tangent_sin)
+        verification_round(works, surface_a, surface_b, target, tol, tangent_sin)
         if all(w.done for w in works):
             break
     out = []
@@ -606,8 +275,5 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         if w.result is None:                       # rounds ran out: not verified as is
             out.append(SampledCurve(curve, None, None, float("nan")))
             continue
-        stacked = w.result.stacked
-        parts = tuple(NurbsCurve(stacked.control_points[:, a:b], stacked.knots, stacked.degree)
-                      for a, b in ((0, 3), (3, 5), (5, 7)))
-        out.append(SampledCurve(curve, w.result.t, parts, w.error))
+        out.append(SampledCurve(curve, w.result.t, w.result.parts(), w.error))
     return out
