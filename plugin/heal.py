@@ -54,14 +54,15 @@ from ..algorithms.healing import (
     connect,
     local_approximant,
 )
-from ..algorithms.healing.connectivity import Side, _corner_number, side_points
 from ..algorithms.healing.clipping import trimmed_source
+from ..algorithms.healing.connectivity import Side, _corner_number, side_points
 from ..algorithms.healing.continuity import fit_side_to_curve
 from ..algorithms.healing.measure_joins import measure_join
 from ..algorithms.projection import project_to_curve
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
+from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches
 from .heal_overlap import find_overlaps, trimmed_back_boundary
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
@@ -208,6 +209,7 @@ class HealResult:
             "topology_violations": [] if net is None else list(net.connectivity.violations),
             "dropped_overlaps": [{"kept": a, "dropped": b} for a, b in self.dropped],
             "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
+            "cuts": self.extra.get("cuts", []),
             "snapped_sides": self.extra.get("snapped_sides", 0),
             "skipped": list(self.skipped),
             "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,
@@ -288,7 +290,7 @@ class _Job:
     reference: TrimmedFace | None     # face whose orientation the approximant takes
 
 
-def _jobs(faces, kept, holes, directed: list[DirectedPatch], trimmed: dict) -> list[_Job]:
+def _jobs(faces, kept, holes, trimmed: dict) -> list[_Job]:
     jobs = []
     for i in kept:
         curves = trimmed.get(i) or four_sided_boundary(faces[i])
@@ -297,10 +299,18 @@ def _jobs(faces, kept, holes, directed: list[DirectedPatch], trimmed: dict) -> l
     for k, loop in enumerate(holes):
         jobs.append(_Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
                          [e.curve for e in loop], f"heal_hole_{k}", None))
-    for k, patch in enumerate(directed):
-        jobs.append(_Job(PatchOrigin("directed", (), k), patch.boundary,
-                         patch.name or f"heal_patch_{k}", None))
     return jobs
+
+
+def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[_Job, Any]]:
+    """The directed patches' approximants (built by :func:`cut_under_patches` from the
+    uncut faces) as jobs done; their origin lists the input faces they cut."""
+    out = []
+    for k, la in cut.approximants:
+        faces = tuple(sorted({c.face for c in cut.cuts if c.patch == k}))
+        out.append((_Job(PatchOrigin("directed", faces, k), la.boundary,
+                         directed[k].name or f"heal_patch_{k}", None), la))
+    return out
 
 
 def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_tol,
@@ -502,6 +512,13 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
                else check_tolerance(gap_tol, "gap_tol", high=model.size))
     if tol is not None:
         tol = check_tolerance(tol, "tol", high=model.size)
+    directed = read_patch_spec(patches, faces) if patches is not None else []
+    cut = cut_under_patches(model, faces, directed, [face_source(f) for f in faces if f],
+                            tol=tol, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,
+                            skipped=skipped)
+    work, faces = cut.model, cut.faces
+    if cut.cuts:
+        edges = face_edges(faces)
     pairs = pair_edges(edges, gap_tol)
     dropped = duplicate_faces(faces, edges, pairs, gap_tol)
     gone = {b for _, b in dropped}
@@ -510,16 +527,16 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     pairs = pair_edges(edges, gap_tol)
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
-    holes = hole_loops(edges, free, gap_tol)
+    holes = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)
     trimmed = {o.trimmed: trimmed_back_boundary(faces, o) for o in overlaps}
-    directed = read_patch_spec(patches, faces) if patches is not None else []
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    done = _approximate(_jobs(faces, kept, holes, directed, trimmed), sources,
+    done = _approximate(_jobs(faces, kept, holes, trimmed), sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
+    done += directed_jobs(directed, cut)
     network = None
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
@@ -528,8 +545,9 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
         network, snapped = _snap_to_originals(
             network, [e for e in edges if e.face not in replaced], gap_tol,
             TIGHT_FACTOR * model.size)
-    result = _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity,
+    result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start)
+    result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["snapped_sides"] = snapped if network is not None else 0
     result.extra["trimmed_overlaps"] = [
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": any(
@@ -538,21 +556,23 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     return result
 
 
-def _assemble(model, faces, done, network, dropped, skipped, gap_tol, tol, continuity, start
+def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start
               ) -> HealResult:
+    """The output from ``work`` (the input with faces under directed patches cut) and the
+    approximants; figures before from ``model`` (the input)."""
     replaced = {job.origin.faces[0] for job, _ in done if job.origin.kind == "face"}
     gone = replaced | {b for _, b in dropped}
-    untouched = [i for i in range(model.n_faces) if i not in gone]
+    untouched = [i for i in range(work.n_faces) if i not in gone]
     new_faces, names = [], _FaceNames()
     for (job, _), surface in zip(done, network.patches if network else ()):
         face = _oriented_face(surface, job.reference)
         new_faces.append(face)
         if job.name:
             names.add(face, job.name)
-    originals = [model.faces[i] for i in untouched]
+    originals = [work.faces[i] for i in untouched]
     for i in untouched:
-        if model.face_names[i] is not None:
-            names.add(model.faces[i], model.face_names[i])
+        if work.face_names[i] is not None:
+            names.add(work.faces[i], work.face_names[i])
     shape, sewing = sew(originals + new_faces, gap_tol)
     out_faces = _all_faces(shape)
     out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
