@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
@@ -58,6 +59,7 @@ from .points import (
 )
 from .poles import pole_contacts
 from .projection import ProjectionStatus, Projector
+from .ridges import Ridge, ridge_starts, trace_ridges
 from .starts import (
     Start,
     away_from,
@@ -66,6 +68,7 @@ from .starts import (
     ray_starts,
     trace_uncovered,
 )
+from .trace import dense_polyline, to_intersection_curve
 
 __all__ = [
     "GRID_MAX",
@@ -133,6 +136,7 @@ class CharacteristicAnalysis:
     starts: Start
     coincident: tuple[CoincidentRegion, ...]
     time_s: float
+    ridges: tuple[Ridge, ...] = ()
 
     def of_kind(self, *kinds: PointKind) -> tuple[CharacteristicPoint, ...]:
         return tuple(p for p in self.points if p.kind in kinds)
@@ -375,7 +379,8 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         curves += _trace_characteristic(fld, kinds, np.concatenate(uvs), np.concatenate(sts),
                                         np.concatenate(dirs), h_max)
     # critical points: seed grid, then along the characteristic curves, in rounds
-    crit = critical_points(fld, grid_seeds(grid, shape, noise=noise))
+    hess_scale = float(np.abs(grid.hess[regular]).max()) if regular.any() else 0.0
+    crit = critical_points(fld, grid_seeds(grid, shape, noise=noise), hess_scale=hess_scale)
     traced_from = 0 if trace_critical else (0 if crit is None else crit.uv.shape[0])
     for _ in range(MAX_ROUNDS):
         seeds = []
@@ -385,7 +390,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
                 g0, g1 = c.grad[i, other_comp], c.grad[i + 1, other_comp]
                 w = g0 / (g0 - g1)
                 seeds.append(c.uv[i] + w * (c.uv[i + 1] - c.uv[i]))
-        found = critical_points(fld, np.array(seeds)) if seeds else None
+        found = critical_points(fld, np.array(seeds), hess_scale=hess_scale) if seeds else None
         merged = _merge_critical(fld, crit, found)
         crit = merged
         if crit is None:
@@ -416,17 +421,21 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
             points += make_points(fld, pk, jet.uv[ok], jet.st[ok], jet.point[ok], jet.phi[ok])
             n = int(ok.sum())
             starts.append(Start(jet.uv[ok], jet.st[ok], np.array(scale)[rows][ok], np.arange(n)))
-    # critical points: classify; rays from the extrema a loop must encircle
+    # critical points: classify; rays from the extrema a loop must encircle and
+    # across the ridges of degenerate ones (curves of critical points)
+    ridges: list[Ridge] = []
     if crit is not None:
         kinds = classify_critical(crit.phi, crit.hess, tol)
         points += make_points(fld, kinds, crit.uv, crit.st, crit.point, crit.phi)
         starts.append(ray_starts(fld, crit, kinds, tol))
+        ridges = trace_ridges(fld, crit, kinds, noise / NOISE_SHARE, h_max)
+        starts.append(ridge_starts(fld, ridges, tol))
     points += _pole_points(fld, a, b, tol, points)
     start = Start.concat(starts)
     start = Start.stack([Start(start.uv, start.st, start.scale, loop_keys(fld, grid, shape, start)),
                          border_keys(border_start)])
     return CharacteristicAnalysis(fld, tuple(points), tuple(curves), start, (),
-                                  time.perf_counter() - start_time)
+                                  time.perf_counter() - start_time, tuple(ridges))
 
 
 def _pole_points(fld: DistanceField, a: NurbsSurface, b: NurbsSurface, tol: float,
@@ -527,6 +536,45 @@ def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]
     return False
 
 
+def _tangential_curves(analysis: CharacteristicAnalysis, tol: float) -> list[IntersectionCurve]:
+    """The ridges with ``|phi| <= tol`` all along (tangential contact along a curve,
+    :mod:`.ridges`) as intersection curves."""
+    out = []
+    for ridge in analysis.ridges:
+        if ridge.is_tangential(tol):
+            curve = to_intersection_curve(analysis.field, ridge.curve, tol)
+            if curve is not None:
+                out.append(curve)
+    return out
+
+
+def _dense_trees(curves: Sequence[IntersectionCurve], radius: float) -> list[cKDTree]:
+    """A k-d tree per curve over its 3D interpolant cut into pieces under ``radius / 4``."""
+    trees = []
+    for t in curves:
+        line = dense_polyline(t)
+        chord = np.linalg.norm(np.diff(line, axis=0), axis=1)
+        pieces = np.maximum(np.ceil(4 * chord / radius).astype(int), 1)
+        start = np.repeat(np.arange(chord.size), pieces)
+        first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+        w = (np.arange(start.size) - first) / pieces[start]
+        dense = np.vstack([line[start] + w[:, None] * (line[start + 1] - line[start]),
+                           line[-1:]])
+        trees.append(cKDTree(dense))
+    return trees
+
+
+def _along(curve: IntersectionCurve, trees: Sequence[cKDTree], radius: float) -> bool:
+    """True when every sample of ``curve`` lies within ``radius`` of one tangential curve
+    (``trees`` from :func:`_dense_trees`): the fragments a triangle method leaves
+    along a tangential contact."""
+    for tree in trees:
+        gap, _ = tree.query(curve.points, distance_upper_bound=2 * radius)
+        if np.all(gap <= radius):
+            return True
+    return False
+
+
 def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], tol: float,
             a: NurbsSurface, b: NurbsSurface, borders: bool = True) -> CharacteristicRecord:
     start = time.perf_counter()
@@ -535,17 +583,22 @@ def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], to
     isolated = analysis.of_kind(PointKind.ISOLATED)
     # a tangential contact is a point: tiny curves around it are not curves
     radius = max(1e3 * tol, 1e-4 * size)
+    tangential = _tangential_curves(analysis, tol)
+    trees = _dense_trees(tangential, radius)
     kept = [c for c in known if not _near_isolated(c, isolated, radius)
-            and not _inside_region(c, analysis.coincident)]
+            and not _inside_region(c, analysis.coincident)
+            and not _along(c, trees, radius)]
     dropped = len(known) - len(kept)
-    added: list[IntersectionCurve] = []
+    added: list[IntersectionCurve] = list(tangential)
+    kept += added
     starts = away_from(analysis.starts, isolated, fld)
     if not borders:
         loop = starts.group >= 0
         starts = Start(starts.uv[loop], starts.st[loop], starts.scale[loop], starts.group[loop])
     if not analysis.coincident:
-        added = trace_uncovered(fld, starts, kept, tol, size)
-        added = [c for c in added if c.max_deviation(a, b).max <= tol]
+        traced = trace_uncovered(fld, starts, kept, tol, size)
+        added += [c for c in traced if c.max_deviation(a, b).max <= tol]
+    kept = kept[:len(kept) - len(tangential)]
     curves = tuple(kept) + tuple(added)
     found = (FoundBy.MESH,) * len(kept) + (FoundBy.CHARACTERISTIC,) * len(added)
     return CharacteristicRecord(curves, found, isolated, analysis.coincident, analysis.points,

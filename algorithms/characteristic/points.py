@@ -133,14 +133,34 @@ def classify_critical(phi: NDArray, hess: NDArray, tol: float) -> list[PointKind
 
 
 # ------------------------------------------------------------------ critical points
+def _newton_steps(h: NDArray, g: NDArray, flat: float) -> tuple[NDArray, NDArray]:
+    """Newton steps ``-H^{-1} g`` (m, 2) and ``ok (m,)``. Where ``H`` is degenerate
+    (``|det H| <= DEGENERATE_SHARE |H|^2``) the pseudo-inverse instead: the inverse
+    on the eigenvalues above ``DEGENERATE_SHARE`` of the largest (a rank-1 Hessian
+    on a ridge of critical points still gives the step across the ridge); ``ok``
+    False where ``H`` is below ``flat`` altogether."""
+    lam, vec = np.linalg.eigh(h)                                  # (m, 2), (m, 2, 2)
+    top = np.abs(lam).max(axis=1)
+    rank1 = np.abs(lam[:, 0] * lam[:, 1]) <= DEGENERATE_SHARE * top ** 2
+    big = ~rank1[:, None] | (np.abs(lam) > DEGENERATE_SHARE * top[:, None])
+    coef = np.where(big, np.einsum("mki,mk->mi", vec, g) / np.where(big, lam, 1.0), 0.0)
+    return -np.einsum("mki,mi->mk", vec, coef), top > flat
+
+
 def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = None, *,
-                    max_iter: int = 16, dedupe: float = 1e-7) -> DistanceJet | None:
+                    max_iter: int = 16, dedupe: float = 1e-7,
+                    hess_scale: float = 0.0) -> DistanceJet | None:
     """Newton on ``grad phi = 0`` (eq. 9) from ``seeds (k, 2)``, batched.
 
     Steps are limited to a tenth of the domain diagonal; a seed whose iterate
     leaves ``r``'s domain, loses its regular projection or does not converge in
     ``max_iter`` steps is dropped. Converged points closer than ``dedupe`` times
-    the diagonal are merged.
+    the diagonal are merged. With ``hess_scale`` (the largest ``|H|`` of ``phi``
+    over the domain) a degenerate ``H`` takes the pseudo-inverse step
+    (:func:`_newton_steps`): Newton then converges onto a curve of critical
+    points (a surface of revolution cut normal to its axis: ``det H = 0`` all
+    along it) instead of giving up; ``H`` below ``1e-9 hess_scale`` (``phi``
+    flat) still stops the seed.
 
     Returns
     -------
@@ -162,11 +182,14 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
             st = np.zeros_like(uv)
         st[todo] = jet.st
         h, g = jet.hess, jet.grad
-        det = h[:, 0, 0] * h[:, 1, 1] - h[:, 0, 1] ** 2
-        ok = np.abs(det) > 1e-300
-        det = np.where(ok, det, 1.0)
-        step = -np.stack([h[:, 1, 1] * g[:, 0] - h[:, 0, 1] * g[:, 1],
-                          h[:, 0, 0] * g[:, 1] - h[:, 0, 1] * g[:, 0]], -1) / det[:, None]
+        if hess_scale > 0:
+            step, ok = _newton_steps(h, g, 1e-9 * hess_scale)
+        else:
+            det = h[:, 0, 0] * h[:, 1, 1] - h[:, 0, 1] ** 2
+            ok = np.abs(det) > 1e-300
+            det = np.where(ok, det, 1.0)
+            step = -np.stack([h[:, 1, 1] * g[:, 0] - h[:, 0, 1] * g[:, 1],
+                              h[:, 0, 0] * g[:, 1] - h[:, 0, 1] * g[:, 0]], -1) / det[:, None]
         length = np.linalg.norm(step, axis=1)
         step *= np.minimum(1.0, 0.1 * diag / np.maximum(length, 1e-300))[:, None]
         uv[todo] += step
@@ -196,7 +219,11 @@ def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400,
     sample that is a local extremum of ``phi`` among its 8 neighbours, seeds
     Newton (the cell centre / the sample). Samples without a regular projection
     take no part; gradient components within ``noise`` of zero count as zero of
-    either sign only when the cell also holds a value beyond it.
+    either sign only when the cell also holds a value beyond it. A cell where one
+    component is within ``noise`` at all four corners (it vanishes identically:
+    ``phi`` constant along lines) and the other changes sign beyond it holds a
+    ridge of critical points; one seed per run of such cells along the null
+    direction (a ridge needs one point: :mod:`.ridges` traces the rest).
     """
     nu, nv = shape
     uv = jet.uv.reshape(nu, nv, 2)
@@ -224,10 +251,30 @@ def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400,
     if noise > 0:          # a flat grid (phi constant along lines) is no seed
         flat = np.all(np.abs(jet.grad) <= noise, axis=1).reshape(nu, nv)
         extreme = (top | bottom) & ~flat
-        out = np.concatenate([seeds[0], uv[extreme]])
+        out = np.concatenate([seeds[0], uv[extreme], _ridge_seeds(g, centre, cell_ok, corners,
+                                                                  noise)])
     if out.shape[0] > max_seeds:
         out = out[np.linspace(0, out.shape[0] - 1, max_seeds).astype(int)]
     return out
+
+
+def _ridge_seeds(g: NDArray, centre: NDArray, cell_ok: NDArray, corners: list, noise: float
+                 ) -> NDArray:
+    """Cell centres ``(k, 2)`` on ridges of critical points (:func:`grid_seeds`): the
+    first cell of every run along the direction in which ``phi`` is constant."""
+    out = [np.zeros((0, 2))]
+    for null in (0, 1):
+        vals = np.stack([g[c][..., null] for c in corners])
+        other = np.stack([g[c][..., 1 - null] for c in corners])
+        ridge = (cell_ok & np.all(np.abs(vals) <= noise, axis=0)
+                 & (other.min(axis=0) <= 0) & (other.max(axis=0) >= 0)
+                 & (np.abs(other).max(axis=0) > noise))
+        # phi_u = 0 identically: phi constant along u, runs go along axis 0
+        ridge = ridge if null == 0 else ridge.T
+        first = ridge & ~np.vstack([np.zeros((1, ridge.shape[1]), dtype=bool), ridge[:-1]])
+        first = first if null == 0 else first.T
+        out.append(centre[first])
+    return np.concatenate(out)
 
 
 # ------------------------------------------------------------------ sides

@@ -115,3 +115,29 @@ def near_coincident(eps: float, n: int = 5) -> tuple[NurbsSurface, NurbsSurface]
     X, Y = np.meshgrid(x, x, indexing="ij")
     z = 0.2 * np.sin(2.5 * X) * np.cos(1.7 * Y) + 0.1 * X * Y
     return height_field(z, p=2), height_field(z + eps * (X - 0.5), p=2)
+
+
+def torus(major: float = 1.0, minor: float = 0.3) -> NurbsSurface:
+    """Rational biquadratic torus about the z axis (exact): ``u`` around the axis,
+    ``v`` around the tube (``v = 1/4`` is the top circle, height ``minor``)."""
+    circ = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1],
+                     [1, 0]], float)
+    wc = np.array([1, R2, 1, R2, 1, R2, 1, R2, 1])
+    cp = np.empty((9, 9, 3))
+    radius = major + minor * circ[None, :, 0]
+    cp[..., 0] = circ[:, None, 0] * radius
+    cp[..., 1] = circ[:, None, 1] * radius
+    cp[..., 2] = minor * circ[None, :, 1]
+    knots = [0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1]
+    return NurbsSurface(cp, knots, knots, 2, 2, wc[:, None] * wc[None, :])
+
+
+def torus_and_plane(gap: float, major: float = 1.0, minor: float = 0.3
+                    ) -> tuple[NurbsSurface, NurbsSurface]:
+    """A torus and the plane ``z = minor - gap`` normal to its axis: two circles of
+    radii ``major +- sqrt(minor^2 - (minor - gap)^2)`` (gap > 0), the top circle
+    (gap = 0: a tangential curve), nothing (gap < 0)."""
+    z = minor - gap
+    half = 1.5 * (major + minor)
+    cp = np.array([[[-half, -half, z], [-half, half, z]], [[half, -half, z], [half, half, z]]])
+    return torus(major, minor), NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)

@@ -31,8 +31,8 @@ from surfprep.algorithms.characteristic import (
 )
 from surfprep.algorithms.intersection import connected_branches
 from surfprep.algorithms.projection import distance_to_surface
-
 from surfprep.plugin import occ_reference
+
 TOL = 1e-9
 
 

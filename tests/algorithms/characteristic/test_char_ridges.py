@@ -1,0 +1,81 @@
+"""Curves of critical points (ridges.py): a torus cut by planes normal to its axis.
+
+phi on the torus is constant along its circles of latitude (phi_u = 0
+identically), so the critical points form ridges (the top and bottom circles).
+Exact answers: the plane z = minor - gap meets the torus (major R, minor r) in
+the circles of radii R +- sqrt(r^2 - (r - gap)^2) (gap > 0), touches it along
+the top circle (gap = 0), misses it (gap < 0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from char_surfaces import torus, torus_and_plane
+
+from surfprep.algorithms.characteristic import FoundBy, certify
+from surfprep.algorithms.intersection import EndKind
+
+TOL = 1e-9
+MAJOR, MINOR = 1.0, 0.3
+
+
+def test_torus_is_exact():
+    t = torus(MAJOR, MINOR)
+    u, v = np.meshgrid(np.linspace(0, 1, 41), np.linspace(0, 1, 41))
+    p = t.evaluate(u.ravel(), v.ravel())
+    rho = np.hypot(p[:, 0], p[:, 1])
+    np.testing.assert_allclose(np.hypot(rho - MAJOR, p[:, 2]), MINOR, atol=1e-14)
+
+
+def radii_and_heights(curve, n=400):
+    """Radius about the axis and height of a dense sample of the curve's interpolant."""
+    t = np.linspace(curve.parameters[0], curve.parameters[-1], n)
+    p = curve.curve3d.evaluate(t)
+    return np.hypot(p[:, 0], p[:, 1]), p[:, 2]
+
+
+@pytest.mark.parametrize("gap", [1e-2, 1e-6])
+def test_certificate_alone_finds_both_circles_beside_the_top_ridge(gap):
+    """With no curve given, the ridge of maxima (phi = gap > tol) makes the certificate
+    start rays across it and trace the two circles flanking it; each is checked
+    densely against its exact radius and height."""
+    a, b = torus_and_plane(gap, MAJOR, MINOR)
+    rec = certify(a, b, [], tol=TOL)
+    assert len(rec.curves) == 2
+    assert all(f is FoundBy.CHARACTERISTIC for f in rec.found_by)
+    half = np.sqrt(MINOR ** 2 - (MINOR - gap) ** 2)
+    found = []
+    for c in rec.curves:
+        rho, z = radii_and_heights(c)
+        np.testing.assert_allclose(z, MINOR - gap, atol=10 * TOL)
+        found.append(rho.mean())
+        target = MAJOR + half if rho.mean() > MAJOR else MAJOR - half
+        # a point within tol of both surfaces: radial error <= tol / sin(angle)
+        assert np.abs(rho - target).max() <= 1e-6 * max(1.0, 1e-3 / half)
+    assert min(found) < MAJOR < max(found)
+
+
+def test_tangent_plane_gives_one_tangential_curve_not_fragments():
+    """gap = 0: the plane touches the torus along its top circle. The certificate
+    reports that circle as one curve (the triangle method's fragments along it are
+    replaced) and returns quickly."""
+    a, b = torus_and_plane(0.0, MAJOR, MINOR)
+    rec = certify(a, b, [], tol=TOL)
+    assert len(rec.curves) == 1
+    c = rec.curves[0]
+    rho, z = radii_and_heights(c)
+    np.testing.assert_allclose(z, MINOR, atol=TOL)
+    # along a tangency a point within tol of both surfaces may sit sqrt(2 r tol) off
+    assert np.abs(rho - MAJOR).max() <= np.sqrt(2 * MINOR * TOL) * 1.5
+    # the whole circle: it ends on the seam sides (u = 0 and u = 1 of the torus)
+    assert np.ptp(c.uv_a[:, 0]) > 0.99
+    assert c.start_kind is EndKind.BOUNDARY and c.end_kind is EndKind.BOUNDARY
+    counts = rec.counts()
+    assert counts.get("cusp", 0) >= 1
+
+
+def test_plane_above_the_torus_meets_nothing():
+    a, b = torus_and_plane(-1e-3, MAJOR, MINOR)
+    rec = certify(a, b, [], tol=TOL)
+    assert rec.curves == () and rec.isolated_points == ()
