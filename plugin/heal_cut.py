@@ -56,6 +56,8 @@ __all__ = ["CutModel", "FaceCut", "boundary_on_faces", "cut_faces", "cut_under_p
 BOUNDARY_SAMPLES = 65
 #: the slab's half thickness is this times the approximant's offset ``d`` (eq. 8)
 SLAB_FACTOR = 1.0
+#: samples per direction of a face tested for lying wholly under a patch
+COVER_SAMPLES = 21
 #: the slab reaches this times ``gap_tol`` beyond the patch's sides
 MARGIN_SHARE = 0.25
 #: a face is cut only when the area cut away exceeds this share of its area
@@ -224,10 +226,29 @@ def _is_sliver(piece: TopoDS_Face, width: float) -> bool:
     return 2.0 * face_area(piece) <= width * props.Mass()
 
 
+def covered(face: TrimmedFace, surface: NurbsSurface, h: float, rim: float) -> bool:
+    """Whether ``face`` lies wholly under the patch ``surface``: its surface's samples
+    ``(COVER_SAMPLES ** 2)`` all within ``h`` of the patch, and those whose closest
+    point is on the patch's border within ``rim`` of it (the face ends at the outline).
+    Such a face goes whole; a boolean with a slab whose sides run along all its edges
+    would be tangent there."""
+    u0, u1, v0, v1 = face.surface.domain
+    t = np.linspace(0.0, 1.0, COVER_SAMPLES)
+    pts = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0)).reshape(-1, 3)
+    foot = project_to_surface(surface, pts)
+    if foot.distance.max() > h:
+        return False
+    eps = 1e-6
+    border = np.any((foot.uv <= eps) | (foot.uv >= 1.0 - eps), axis=1)
+    return bool(np.all(foot.distance[border] <= rim))
+
+
 def cut_faces(faces: list[TopoDS_Face], tool: TopoDS_Shape, line: NDArray, patch: int,
-              fuzzy: float) -> tuple[dict[int, list[TopoDS_Face]], list[FaceCut]]:
+              fuzzy: float, whole: set[int] = frozenset()
+              ) -> tuple[dict[int, list[TopoDS_Face]], list[FaceCut]]:
     """Faces passing through ``tool`` (a slab) with the part inside it cut away;
-    slivers along ``line`` (the patch's :func:`outline`) dropped.
+    slivers along ``line`` (the patch's :func:`outline`) dropped; the faces ``whole``
+    (:func:`covered`) removed whole.
 
     Returns
     -------
@@ -240,6 +261,10 @@ def cut_faces(faces: list[TopoDS_Face], tool: TopoDS_Shape, line: NDArray, patch
         if not _boxes_meet(face, tool):
             continue
         area = face_area(face)
+        if i in whole:
+            pieces[i] = []
+            cuts.append(FaceCut(patch, i, area, area, 0))
+            continue
         result = _all_faces(_boolean(BRepAlgoAPI_Cut, face, tool, fuzzy))
         if area - sum(face_area(f) for f in result) <= MIN_CUT_SHARE * area:
             continue                                     # passes by, or only touches
@@ -314,8 +339,12 @@ def cut_under_patches(model, faces: list[TrimmedFace | None], directed: list, so
             continue
         done.append((k, la))
         try:
-            tool = slab(la.surface, SLAB_FACTOR * la.offset, tight, MARGIN_SHARE * gap_tol)
-            pieces, made = cut_faces(occ, tool, outline(la.surface), k, tight)
+            h = SLAB_FACTOR * la.offset
+            tool = slab(la.surface, h, tight, MARGIN_SHARE * gap_tol)
+            now = _read(occ, names)
+            whole = {i for i, f in enumerate(now) if f is not None
+                     and covered(f, la.surface, h, gap_tol)}
+            pieces, made = cut_faces(occ, tool, outline(la.surface), k, tight, whole)
         except OpenCascadeError as exc:
             skipped.append(f"directed {k}: faces under it not cut ({exc}); added on top")
             continue
@@ -323,14 +352,17 @@ def cut_under_patches(model, faces: list[TrimmedFace | None], directed: list, so
         occ, names, colors, origin = _replace_pieces(pieces, occ, names, colors, origin)
     if not cuts:
         return CutModel(model, faces, list(range(len(faces))), done, [])
-    new_faces = []
+    return CutModel(_rebuilt(model, occ, names, colors), _read(occ, names), origin, done, cuts)
+
+
+def _read(occ: list[TopoDS_Face], names: list) -> list[TrimmedFace | None]:
+    out = []
     for f, name in zip(occ, names):
         try:
-            new_faces.append(face_to_nurbs(f, name))
-        except SurfprepError as exc:
-            new_faces.append(None)
-            skipped.append(f"a piece of face {name}: not readable as NURBS ({exc})")
-    return CutModel(_rebuilt(model, occ, names, colors), new_faces, origin, done, cuts)
+            out.append(face_to_nurbs(f, name))
+        except SurfprepError:
+            out.append(None)          # kept as it is; heal's own reading says why
+    return out
 
 
 def _replace_pieces(pieces: dict, occ, names, colors, origin):

@@ -148,3 +148,18 @@ def truth_area() -> float:
     zx = (truth(gx + h, gy) - truth(gx - h, gy)) / (2 * h)
     zy = (truth(gx, gy + h) - truth(gx, gy - h)) / (2 * h)
     return float(np.trapezoid(np.trapezoid(np.sqrt(1 + zx ** 2 + zy ** 2), y, axis=1), x))
+
+
+def test_patch_over_a_whole_face_replaces_it():
+    # corners on the face's corners: the face lies wholly under the patch and goes
+    a = sheet(0.0, 1.0, 0.0)
+    pts = a.evaluate(np.array([0.0, 1.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0, 1.0]))
+    r = heal(make_face(a), patches=[{"name": "cap", "corners": pts.tolist()}])
+    assert [p.origin.kind for p in r.patches] == ["directed"]
+    (cut,) = r.report()["cuts"]
+    assert cut["pieces"] == 0 and cut["area_cut"] == pytest.approx(face_area(make_face(a)))
+    assert r.model.n_faces == 1 and r.model.face_names == ("cap",)
+    assert r.free_edges_after == 4 and r.valid_after
+    s = to_nurbs(r.model.faces[0]).surface
+    g = s.evaluate_grid(np.linspace(0, 1, 41), np.linspace(0, 1, 41)).reshape(-1, 3)
+    assert project_to_surface(a, g).distance.max() < 1e-3
