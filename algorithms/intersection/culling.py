@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 from ...errors import InvalidGeometryError
 from ..bezier import patch_bounding_boxes
 from ..surface import NurbsSurface
+from . import tessellation_kernels
 
 __all__ = [
     "BoxTree",
@@ -364,8 +365,14 @@ def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
     a, b, c, d = ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]
     if np.any((rects[:, 0] < a) | (rects[:, 1] > b) | (rects[:, 2] < c) | (rects[:, 3] > d)):
         raise InvalidGeometryError("every rectangle must lie inside one Bézier patch")
-    pairs, inverse = np.unique(np.stack([iu, iv], 1), axis=0, return_inverse=True)
-    coeffs = span_patches(surface, pairs[:, 0], pairs[:, 1])[inverse.ravel()]
+    key, inverse = np.unique(iu * (surface.knots_v.size + 1) + iv, return_inverse=True)
+    pairs_u, pairs_v = np.divmod(key, surface.knots_v.size + 1)
+    coeffs = span_patches(surface, pairs_u, pairs_v)
+    if tessellation_kernels.AVAILABLE:          # the blossoms below, compiled
+        return tessellation_kernels.restricted_boxes(
+            coeffs, inverse.ravel(), (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a),
+            (rects[:, 2] - c) / (d - c), (rects[:, 3] - c) / (d - c))
+    coeffs = coeffs[inverse.ravel()]
     coeffs = _blossom_restrict(coeffs, (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a))
     coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), (rects[:, 2] - c) / (d - c),
                                (rects[:, 3] - c) / (d - c))

@@ -57,6 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..surface import NurbsSurface
+from . import tessellation_kernels
 from .culling import BoxTree, build_tree, patch_rectangles, subpatch_boxes, tree_pairs
 from .mesh import TriangleMesh, collinear_mask
 
@@ -140,6 +141,8 @@ def _chord_errors(surface: NurbsSurface, rects: NDArray
     u = (1 - s) * rects[:, :1] + s * rects[:, 1:2]                  # (k, n)
     v = (1 - s) * rects[:, 2:3] + s * rects[:, 3:4]
     grid = surface.evaluate(u[:, :, None], v[:, None, :])          # (k, n, n, 3)
+    if tessellation_kernels.AVAILABLE:          # the formulas below, compiled
+        return tessellation_kernels.chord_errors_from_grid(grid, s)
     corners = grid[:, [0, -1, -1, 0], [0, 0, -1, -1]]               # (k, 4, 3)
     w0, w1 = _interpolation_weights(s)
     e0 = np.linalg.norm(grid - np.einsum("abc,kcd->kabd", w0, corners), axis=-1)

@@ -1,0 +1,137 @@
+"""Compiled inner loops of the adaptive tessellation (numba): per rectangle, a few
+hundred multiply-adds that numpy spends in temporaries and per-call overhead.
+
+* :func:`chord_errors_from_grid`: the chord errors of :func:`.tessellation._chord_errors`
+  from the evaluated test grid (both two-triangle interpolants, the u- and v-line
+  chords), the same formulas in the same order;
+* :func:`restricted_boxes`: the control-net boxes of Bézier patches restricted to
+  sub-rectangles (the blossoms of :func:`.culling._blossom_restrict` in u, then v).
+
+``AVAILABLE`` is False without numba; the callers keep their numpy forms then.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..basis_kernels import AVAILABLE, _jit
+
+__all__ = ["AVAILABLE", "chord_errors_from_grid", "restricted_boxes"]
+
+
+@_jit
+def _dist(g, a, b, c, d, wa, wb, wc, wd):
+    s = 0.0
+    for e in range(3):
+        x = g[e] - (wa * a[e] + wb * b[e] + wc * c[e] + wd * d[e])
+        s += x * x
+    return np.sqrt(s)
+
+
+@_jit
+def _chord_errors(grid, s, err, diag, error_u, error_v):
+    k, n = grid.shape[0], grid.shape[1]
+    for r in range(k):
+        g = grid[r]
+        c00, c10, c11, c01 = g[0, 0], g[n - 1, 0], g[n - 1, n - 1], g[0, n - 1]
+        e0 = 0.0
+        e1 = 0.0
+        eu = 0.0
+        ev = 0.0
+        for i in range(n):
+            si = s[i]
+            for j in range(n):
+                tj = s[j]
+                if si >= tj:        # diagonal 0 (c00-c11), weights of [c00, c10, c11, c01]
+                    d0 = _dist(g[i, j], c00, c10, c11, c01, 1 - si, si - tj, tj, 0.0)
+                else:
+                    d0 = _dist(g[i, j], c00, c10, c11, c01, 1 - tj, 0.0, si, tj - si)
+                if si + tj <= 1:    # diagonal 1 (c10-c01)
+                    d1 = _dist(g[i, j], c00, c10, c11, c01, 1 - si - tj, si, 0.0, tj)
+                else:
+                    d1 = _dist(g[i, j], c00, c10, c11, c01, 0.0, 1 - tj, si + tj - 1, 1 - si)
+                e0 = max(e0, d0)
+                e1 = max(e1, d1)
+                du = 0.0
+                dv = 0.0
+                for e in range(3):
+                    x = g[i, j, e] - ((1 - si) * g[0, j, e] + si * g[n - 1, j, e])
+                    y = g[i, j, e] - ((1 - tj) * g[i, 0, e] + tj * g[i, n - 1, e])
+                    du += x * x
+                    dv += y * y
+                eu = max(eu, np.sqrt(du))
+                ev = max(ev, np.sqrt(dv))
+        err[r] = min(e0, e1)
+        diag[r] = 1 if e1 < e0 else 0
+        error_u[r] = eu
+        error_v[r] = ev
+
+
+def chord_errors_from_grid(grid: NDArray, s: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """``(error, diagonal, error_u, error_v)``, four ``(k,)`` arrays, from the test grid
+    ``grid (k, n, n, 3)`` at the fractions ``s (n,)`` (see :func:`.tessellation._chord_errors`)."""
+    k = grid.shape[0]
+    err, eu, ev = np.empty(k), np.empty(k), np.empty(k)
+    diag = np.empty(k, dtype=np.int64)
+    _chord_errors(np.ascontiguousarray(grid, dtype=float), np.asarray(s, dtype=float), err, diag,
+                  eu, ev)
+    return err, diag, eu, ev
+
+
+@_jit
+def _restrict(line, s0, s1, out, work):
+    """Bernstein coefficients ``out (p + 1, c)`` of ``line (p + 1, c)`` on ``[s0, s1]``."""
+    p = line.shape[0] - 1
+    for i in range(p + 1):
+        for a in range(p + 1):
+            work[a] = line[a]
+        for r in range(1, p + 1):
+            x = s0 if r <= p - i else s1
+            for a in range(p + 1 - r):
+                work[a] = (1.0 - x) * work[a] + x * work[a + 1]
+        out[i] = work[0]
+
+
+@_jit
+def _boxes(coeffs, which, s0, s1, t0, t1, out):
+    k = which.size
+    p1, q1, c = coeffs.shape[1], coeffs.shape[2], coeffs.shape[3]
+    first = np.empty((p1, q1, c))
+    line_u = np.empty((p1, c))
+    res_u = np.empty((p1, c))
+    line_v = np.empty((q1, c))
+    res_v = np.empty((q1, c))
+    work_u = np.empty((p1, c))
+    work_v = np.empty((q1, c))
+    for r in range(k):
+        patch = coeffs[which[r]]
+        for j in range(q1):                    # u first (axis 1 of the patch)
+            for i in range(p1):
+                line_u[i] = patch[i, j]
+            _restrict(line_u, s0[r], s1[r], res_u, work_u)
+            for i in range(p1):
+                first[i, j] = res_u[i]
+        for e in range(3):
+            out[r, 0, e] = np.inf
+            out[r, 1, e] = -np.inf
+        for i in range(p1):                    # then v
+            for j in range(q1):
+                line_v[j] = first[i, j]
+            _restrict(line_v, t0[r], t1[r], res_v, work_v)
+            for j in range(q1):
+                w = res_v[j, c - 1]
+                for e in range(3):
+                    x = res_v[j, e] / w
+                    out[r, 0, e] = min(out[r, 0, e], x)
+                    out[r, 1, e] = max(out[r, 1, e], x)
+
+
+def restricted_boxes(coeffs: NDArray, which: NDArray, s0: NDArray, s1: NDArray, t0: NDArray,
+                     t1: NDArray) -> NDArray:
+    """Boxes ``(k, 2, 3)`` of the homogeneous Bézier patches ``coeffs[which] (k, p + 1,
+    q + 1, 4)`` restricted to local ``[s0, s1] x [t0, t1]`` (all ``(k,)``)."""
+    out = np.empty((which.size, 2, 3))
+    _boxes(np.ascontiguousarray(coeffs, dtype=float), np.asarray(which, dtype=np.int64),
+           *(np.ascontiguousarray(a, dtype=float) for a in (s0, s1, t0, t1)), out)
+    return out

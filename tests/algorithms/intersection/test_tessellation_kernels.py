@@ -1,0 +1,51 @@
+"""The compiled chord errors and sub-patch boxes (tessellation_kernels.py) against their
+numpy forms in tessellation.py / culling.py."""
+
+import numpy as np
+import pytest
+from ssi_surfaces import sphere_band
+
+from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms.intersection import tessellation_kernels
+from surfprep.algorithms.intersection.culling import patch_rectangles, subpatch_boxes
+from surfprep.algorithms.intersection.tessellation import _chord_errors
+
+pytestmark = pytest.mark.skipif(not tessellation_kernels.AVAILABLE, reason="numba not importable")
+
+
+def _bumpy() -> NurbsSurface:
+    rng = np.random.default_rng(4)
+    x = np.linspace(0, 1, 9)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    k = np.concatenate([[0.0] * 3, np.linspace(0, 1, 7), [1.0] * 3])
+    return NurbsSurface(np.stack([X, Y, 0.2 * rng.normal(size=X.shape)], -1), k, k, 3, 3)
+
+
+def _sub_rectangles(surface, rng, per_patch: int = 20) -> np.ndarray:
+    rects = np.repeat(patch_rectangles(surface), per_patch, axis=0)
+    a = rng.uniform(0, 1, (rects.shape[0], 2, 2))
+    a.sort(axis=1)
+    a[:, 1] = np.maximum(a[:, 1], a[:, 0] + 1e-3).clip(max=1.0)
+    lo_u, hi_u = rects[:, 0], rects[:, 1]
+    lo_v, hi_v = rects[:, 2], rects[:, 3]
+    return np.stack([lo_u + a[:, 0, 0] * (hi_u - lo_u), lo_u + a[:, 1, 0] * (hi_u - lo_u),
+                     lo_v + a[:, 0, 1] * (hi_v - lo_v), lo_v + a[:, 1, 1] * (hi_v - lo_v)], 1)
+
+
+@pytest.mark.parametrize("surface", [sphere_band(1.5), _bumpy()], ids=["rational", "bicubic"])
+def test_compiled_forms_match_numpy(monkeypatch, surface):
+    rects = _sub_rectangles(surface, np.random.default_rng(9))
+    errors, boxes = _chord_errors(surface, rects), subpatch_boxes(surface, rects)
+    monkeypatch.setattr(tessellation_kernels, "AVAILABLE", False)
+    errors_np, boxes_np = _chord_errors(surface, rects), subpatch_boxes(surface, rects)
+    scale = np.abs(boxes_np).max()
+    np.testing.assert_allclose(boxes, boxes_np, rtol=0, atol=1e-14 * scale)
+    for mine, ref in zip(errors, errors_np):
+        np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-14 * scale)
+    # the boxes hold the surface over their rectangles (densely)
+    s = np.linspace(0, 1, 9)
+    u = rects[:, :1] + s * (rects[:, 1:2] - rects[:, :1])
+    v = rects[:, 2:3] + s * (rects[:, 3:4] - rects[:, 2:3])
+    pts = surface.evaluate(u[:, :, None], v[:, None, :]).reshape(len(rects), -1, 3)
+    assert np.all(pts >= boxes[:, None, 0] - 1e-12 * scale)
+    assert np.all(pts <= boxes[:, None, 1] + 1e-12 * scale)
