@@ -45,7 +45,7 @@ from scipy.spatial import cKDTree
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .curves import CurveKind, TracedCurve, curve_value, trace_curves
+from .curves import CurveKind, TracedCurve, curve_value
 from .distance import DistanceField, DistanceJet
 from .points import (
     CharacteristicPoint,
@@ -53,7 +53,6 @@ from .points import (
     border_points,
     classify_critical,
     critical_points,
-    edge_roots,
     grid_seeds,
     make_points,
 )
@@ -68,6 +67,7 @@ from .starts import (
     ray_starts,
     trace_uncovered,
 )
+from .sweep import from_critical, sweep
 from .trace import dense_polyline, to_intersection_curve
 
 __all__ = [
@@ -85,11 +85,6 @@ __all__ = [
 
 #: grid samples per direction of r's domain for the critical-point seeds
 GRID_MIN, GRID_MAX = 33, 129
-#: largest turn per step on a characteristic curve (only sign changes are read off it)
-CHARACTERISTIC_TURN = 0.6
-#: corrector tolerance on a characteristic curve: a share of the step and of the
-#: diagonal (its sign changes seed Newton on the exact points afterwards)
-CHARACTERISTIC_CTOL = 5e-2
 #: derivatives of phi below this share of its largest gradient on the grid are rounding
 NOISE_SHARE = 1e-9
 #: rounds of "trace through new critical points" at most
@@ -302,28 +297,6 @@ def _turning_points(field: DistanceField, uv: NDArray, st: NDArray, kind: CurveK
     return jet, ok
 
 
-def _trace_characteristic(field: DistanceField, kind, uv: NDArray, st: NDArray,
-                          direction: NDArray, h_max: float) -> list[TracedCurve]:
-    return trace_curves(field, kind, uv, st, direction, h0=0.2 * h_max, h_max=h_max,
-                        max_steps=400, max_turn=CHARACTERISTIC_TURN,
-                        ctol=1e-3 * field.diagonal, relative_ctol=CHARACTERISTIC_CTOL)
-
-
-def _from_critical(field: DistanceField, crit: DistanceJet, h_max: float) -> list[TracedCurve]:
-    """Both characteristic curves through each critical point, both ways (§5)."""
-    uvs, sts, dirs, kinds = [], [], [], []
-    for kind in (CurveKind.U_CHARACTERISTIC, CurveKind.V_CHARACTERISTIC):
-        _, dg = curve_value(crit, kind)
-        tangent = np.stack([-dg[:, 1], dg[:, 0]], -1)
-        for sign in (1.0, -1.0):
-            uvs.append(crit.uv)
-            sts.append(crit.st)
-            dirs.append(sign * tangent)
-            kinds += [kind] * crit.uv.shape[0]
-    return _trace_characteristic(field, kinds, np.concatenate(uvs), np.concatenate(sts),
-                                 np.concatenate(dirs), h_max)
-
-
 # ------------------------------------------------------------------ the stage
 def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
                             phi_on: str | None = None, trace_critical: bool = True,
@@ -360,24 +333,11 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     if coincident:
         return CharacteristicAnalysis(fld, tuple(points), (), border_keys(border_start),
                                       coincident, time.perf_counter() - start_time)
-    # step 2: roots of phi_u, phi_v on the sides; step 3: characteristic curves
-    curves: list[TracedCurve] = []
-    uvs, sts, dirs, kinds = [], [], [], []
-    families = ((0, CurveKind.U_CHARACTERISTIC, PointKind.EDGE_ROOT_U),
-                (1, CurveKind.V_CHARACTERISTIC, PointKind.EDGE_ROOT_V))
-    for comp, kind, root_kind in families[:2 if trace_critical else 1]:
-        uv, st, _ = edge_roots(fld, comp, noise=noise)
-        if uv.shape[0] == 0:
-            continue
-        jet = fld.jet(uv, st)
-        points += make_points(fld, root_kind, uv, jet.st, jet.point, jet.phi)
-        uvs.append(uv)
-        sts.append(jet.st)
-        dirs.append(0.5 * (fld.lower + fld.upper) - uv)             # inward
-        kinds += [kind] * uv.shape[0]
-    if uvs:
-        curves += _trace_characteristic(fld, kinds, np.concatenate(uvs), np.concatenate(sts),
-                                        np.concatenate(dirs), h_max)
+    # step 2: roots of phi_u (phi_v) on the sides; step 3: characteristic curves,
+    # complete to the grid (sweep.py)
+    side_points, swept = sweep(fld, grid, shape, noise, h_max, both=trace_critical)
+    points += side_points
+    curves: list[TracedCurve] = list(swept)
     # critical points: seed grid, then along the characteristic curves, in rounds
     hess_scale = float(np.abs(grid.hess[regular]).max()) if regular.any() else 0.0
     crit = critical_points(fld, grid_seeds(grid, shape, noise=noise), hess_scale=hess_scale)
@@ -400,7 +360,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
             break
         fresh = _subset(fld, crit, np.arange(traced_from, crit.uv.shape[0]))
         traced_from = crit.uv.shape[0]
-        curves += _from_critical(fld, fresh, h_max)
+        curves += from_critical(fld, fresh, h_max)
     # turning points: sign changes of phi along the characteristic curves
     turning_uv, turning_st, turning_kind, scale = [], [], [], []
     for c in curves:
