@@ -31,7 +31,7 @@ from ..algorithms.intersection import IntersectionCurve, StrayCurves, intersect_
 from ..errors import InvalidGeometryError, InvalidToleranceError
 
 if TYPE_CHECKING:
-    from .intersect import FaceOperand
+    from .intersect_operands import FaceOperand
 
 __all__ = [
     "FULL_COINCIDENCE",

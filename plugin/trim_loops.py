@@ -1,5 +1,5 @@
 """Trimming loops of a face prepared for fast point-in-face tests (used by
-:func:`surfprep.plugin.intersect.inside_face`).
+:func:`surfprep.plugin.intersect_operands.inside_face`).
 
 * :func:`loop_segments`: every trimming edge's pcurve sampled into polygon
   segments in ``(u, v)`` (``EDGE_SAMPLES`` per edge, more for edges long in the
