@@ -43,6 +43,8 @@ from ...errors import (
     InvalidGeometryError,
     InvalidToleranceError,
 )
+from ..curve import NurbsCurve
+from ..projection import project_to_curve
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .boundary import Boundary, BoundaryCurve, as_boundary
@@ -180,6 +182,40 @@ def _sides(found: NDArray, t: NDArray, y: NDArray, x: NDArray, keep_boundary: bo
     return rim, found & ~off_surface, np.where(rim, 0.5, t)
 
 
+def _side_error(surface: NurbsSurface, bnd: Boundary, m: int, n: int) -> ErrorSample:
+    """Distance of the approximant's sides, halfway between the kept boundary samples,
+    to the boundary curves: ``(2 m + 2 n,)`` points (between the samples a C1 side
+    may cut across a tight bend of its curve)."""
+    u, v = (np.arange(m) + 0.5) / m, (np.arange(n) + 0.5) / n
+    uv = [np.column_stack([u, np.zeros(m)]), np.column_stack([np.ones(n), v]),
+          np.column_stack([u, np.ones(m)]), np.column_stack([np.zeros(n), v])]
+    pts = [surface.evaluate(q[:, 0], q[:, 1]) for q in uv]
+    dist = [_distance_to_boundary_curve(c, p) for c, p in zip(bnd.curves, pts, strict=True)]
+    d = np.concatenate(dist)
+    return ErrorSample(np.concatenate(uv), np.concatenate(pts), d, float(d.max()),
+                       float(np.sqrt(np.mean(d ** 2))))
+
+
+def _distance_to_boundary_curve(curve, points: NDArray) -> NDArray:
+    if isinstance(curve, NurbsCurve):
+        return project_to_curve(curve, points).distance
+    line = np.asarray(curve, float)
+    a, ab = line[:-1], np.diff(line, axis=0)
+    denom = np.maximum(np.einsum("kc,kc->k", ab, ab), np.finfo(float).tiny)
+    t = np.clip(np.einsum("mkc,kc->mk", points[:, None] - a[None], ab) / denom, 0.0, 1.0)
+    return np.min(np.linalg.norm(points[:, None] - (a[None] + t[..., None] * ab[None]),
+                                 axis=2), axis=1)
+
+
+def _merged(a: ErrorSample, b: ErrorSample) -> ErrorSample:
+    d = np.concatenate([a.distance, b.distance])
+    finite = d[np.isfinite(d)]
+    if finite.size == 0:
+        return a
+    return ErrorSample(np.concatenate([a.uv, b.uv]), np.concatenate([a.points, b.points]), d,
+                       float(finite.max()), float(np.sqrt(np.mean(finite ** 2))))
+
+
 def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache, preferred):
     """Segments of the grid (and of the ring around it, :mod:`.ring`) projected."""
     ring = ring_segments(coons, off.distance, ring_rows) if ring_rows > 0 else None
@@ -218,7 +254,8 @@ def _fill(coons, ring, t, known, t_ring, found_ring, hardy, neighbours) -> NDArr
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
               interpolant: Interpolant, hardy: HardyMode, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
-              ring_rows: int, preferred: int | None, cache: dict) -> _Pass:
+              ring_rows: int, preferred: int | None, cache: dict,
+              side_error: bool = False) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
     ring, y, t, found, src = _project(off, coons, ring_rows, sources, mesh_tol, size, cache,
@@ -241,6 +278,8 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
     grid[rim] = coons.points[rim]
     surface = interpolate_grid(grid, interpolant)
     error = measure_error(surface, found, clipped, tol=_INVERSION_FRACTION * size)
+    if side_error and keep_boundary:
+        error = _merged(error, _side_error(surface, boundary, m, n))
     return _Pass(surface, grid, found, ~(found | rim), src.reshape(shape), error, off.distance)
 
 
@@ -254,7 +293,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       gap_tol: float | None = None, mesh_tol: float | None = None,
                       keep_boundary: bool = True, ring_rows: int | None = None,
                       fill_resolution: tuple[int, int] = FILL_RESOLUTION,
-                      preferred_source: int | None = None,
+                      preferred_source: int | None = None, side_error: bool = False,
                       strict: bool = False) -> LocalApproximant:
     """A bicubic B-spline surface over four boundary curves that follows the sources.
 
@@ -311,6 +350,13 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         originals) do not count as on the originals in the error of §7.
         False: the boundary samples are projected like the interior (001 as
         written; 003's four picked points on the originals).
+    side_error : bool
+        With ``keep_boundary``: also measure the sides against the boundary
+        curves halfway between their samples, in the error (and the
+        resolution loop): a side that cuts across a tight bend of its curve
+        (e.g. a side made of several edges of a face) then raises the
+        resolution like an interior miss. Off by default (001's error is the
+        interior's only).
     strict : bool
         Raise :class:`InvalidToleranceError` instead of returning an
         unconverged approximant.
@@ -360,7 +406,8 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
                       hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
                       keep_boundary=keep_boundary, tol=tol, size=size,
-                      ring_rows=ring_rows, preferred=preferred_source, cache=cache)
+                      ring_rows=ring_rows, preferred=preferred_source, cache=cache,
+                      side_error=side_error)
         share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)

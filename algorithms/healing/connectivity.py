@@ -272,11 +272,29 @@ def _ends_match(samples: _SideSamples, pa: int, sa: int, pb: int, sb: int, tol: 
 
 
 def _candidate_pairs(samples: _SideSamples, tol: float) -> list[tuple[int, int, int, int]]:
+    """Side pairs whose boxes overlap and where at least two interior samples of one
+    side lie within ``tol`` (plus the polylines' chord error) of the other side's box:
+    sides meeting only at a corner are culled before any distance is computed."""
     boxes = samples.boxes.reshape(-1, 2, 3)
     lo, hi = boxes[:, 0] - tol, boxes[:, 1] + tol
     overlap = np.all((lo[:, None] <= hi[None]) & (lo[None] <= hi[:, None]), axis=2)
     i, j = np.nonzero(np.triu(overlap, 1))
-    return [(a // 4, a % 4, b // 4, b % 4) for a, b in zip(i.tolist(), j.tolist())]
+    coarse = samples.coarse.reshape(-1, SIDE_SAMPLES, 3)[:, 1:-1]
+    slack = tol + 2.0 * samples.sag.reshape(-1)
+
+    def near(p: NDArray, q: NDArray) -> NDArray:
+        """Interior samples of sides ``p`` within reach of the boxes of sides ``q``."""
+        out = np.zeros(p.size, np.int64)
+        for start in range(0, p.size, 4096):
+            a, b = p[start:start + 4096], q[start:start + 4096]
+            gap = np.maximum(boxes[b, 0][:, None] - coarse[a], coarse[a] - boxes[b, 1][:, None])
+            dist = np.linalg.norm(np.maximum(gap, 0.0), axis=2)
+            reach = np.maximum(slack[a], slack[b])[:, None]
+            out[start:start + 4096] = np.count_nonzero(dist <= reach, axis=1)
+        return out
+
+    keep = (near(i, j) >= 2) | (near(j, i) >= 2)
+    return [(a // 4, a % 4, b // 4, b % 4) for a, b in zip(i[keep].tolist(), j[keep].tolist())]
 
 
 def _describe(pa: int, sa: int, pb: int, sb: int) -> str:

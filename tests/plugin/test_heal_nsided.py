@@ -101,3 +101,4 @@ def test_triangle_sub_patches_follow_the_trimmed_face_and_join_g1():
     for la, p in zip(las, net.patches):
         assert distance_to_surface(face.surface, p.evaluate_grid(t, t).reshape(-1, 3)).max() \
             <= la.tol
+
