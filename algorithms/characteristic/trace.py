@@ -165,12 +165,17 @@ def _locate(field: DistanceField, kind: CurveKind, uv: NDArray, st: NDArray, gto
     return jet, h, ok
 
 
-def _candidates(curve: TracedCurve) -> NDArray:
+def _candidates(field: DistanceField, curve: TracedCurve) -> NDArray:
     """Sample indices where ``|grad g|`` dips (local minima below ``_GRAD_DIP`` of the
-    median) and the last sample of a trace that stopped SINGULAR."""
-    norm = np.linalg.norm(curve.grad, axis=1) if curve.kind is CurveKind.INTERSECTION else None
+    median) and the end samples of a trace that stopped SINGULAR. (A trace
+    stores ``grad phi``; for a characteristic curve ``grad g`` is a row of the
+    Hessian, from one batched jet.)"""
+    if curve.kind is CurveKind.INTERSECTION:
+        norm = np.linalg.norm(curve.grad, axis=1)
+    else:
+        norm = np.linalg.norm(curve_value(field.jet(curve.uv, curve.st), curve.kind)[1], axis=1)
     out = []
-    if norm is not None and norm.size >= 3:
+    if norm.size >= 3:
         inner = np.flatnonzero((norm[1:-1] <= norm[:-2]) & (norm[1:-1] <= norm[2:])) + 1
         out.extend(inner[norm[inner] < _GRAD_DIP * np.median(norm)])
     if curve.end_reason is EndReason.SINGULAR:
@@ -313,7 +318,7 @@ def _split_at_found(field: DistanceField, kind: CurveKind, work: list[TracedCurv
     uv, st, reach = [], [], []
     for i in fresh:
         c = work[i]
-        idx = _candidates(c)
+        idx = _candidates(field, c)
         if idx.size:
             uv.append(c.uv[idx])
             st.append(c.st[idx])

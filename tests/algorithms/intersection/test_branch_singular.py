@@ -17,6 +17,8 @@ import numpy as np
 import pytest
 from test_ssi_pipeline import TAU, check_on_surfaces, cylinder, sphere
 
+from surfprep.algorithms.characteristic.algorithm import choose_field
+from surfprep.algorithms.characteristic.trace import to_intersection_curve, trace_intersections
 from surfprep.algorithms.intersection import EndKind, intersect_surfaces, pipeline, polyline_distance
 from surfprep.algorithms.intersection.branches import (
     SingularKind,
@@ -173,3 +175,30 @@ def test_join_leaves_transversal_curves_alone(monkeypatch):
     assert len(plain) == len(joined)
     for p, q in zip(plain, joined):
         np.testing.assert_array_equal(p.points, q.points)
+
+
+# ---------------------------------------------------------------- the characteristic tracer
+def test_characteristic_tracer_equal_cylinders_traced_whole():
+    """From one start on the ellipse x = z, the tracer splits at (0, +-1, 0) and traces
+    the other ellipse too: seven pieces (cut at the seams), covering both within tol."""
+    tol = 1e-7
+    a, b = cylinder(1.0, 1.5), cylinder(1.0, 2.0, normal=(1, 0, 0))
+    field = choose_field(a, b, tol=tol, phi_on="a")
+    t = 0.7
+    d = a.domain
+    u, v = np.meshgrid(np.linspace(d[0], d[1], 401), np.linspace(d[2], d[3], 401), indexing="ij")
+    grid = a.evaluate(u.ravel(), v.ravel())
+    k = np.argmin(np.linalg.norm(grid - [np.cos(t), np.sin(t), np.cos(t)], axis=1))
+    uv = np.array([[u.ravel()[k], v.ravel()[k]]])
+    traced = trace_intersections(field, uv, field.jet(uv).st, np.array([0.5]), tol=tol,
+                                 branches=True)
+    curves = [c for c in (to_intersection_curve(field, x, tol) for x in traced) if c is not None]
+    s = np.linspace(0, TAU, 20001)
+    exact = np.concatenate([np.stack([np.cos(s), np.sin(s), sign * np.cos(s)], 1)
+                            for sign in (1.0, -1.0)])
+    assert polyline_distance(exact, curves).max() <= tol
+    bif = [p for c in curves for p, k in ((c.points[0], c.start_kind), (c.points[-1], c.end_kind))
+           if k is EndKind.BIFURCATION]
+    assert len(bif) == 8
+    for p in ([0, 1, 0], [0, -1, 0]):
+        assert sum(np.linalg.norm(q - p) <= 1e-9 for q in bif) == 4
