@@ -28,7 +28,7 @@ try:                                    # numba is optional: the numpy forms rem
 except ImportError:                     # pragma: no cover - numba is installed in CI
     numba = None
 
-__all__ = ["AVAILABLE", "basis_derivatives_compiled", "surface_homogeneous_derivatives"]
+__all__ = ["AVAILABLE", "basis_derivatives_compiled", "surface_derivatives_compiled"]
 
 AVAILABLE = numba is not None
 
@@ -109,7 +109,30 @@ def basis_derivatives_compiled(knots: NDArray, p: int, t: NDArray, span: NDArray
 
 
 @_jit
-def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order):
+def _rational_inplace(hom, order):
+    """A4.4 of [PT] on one point's ``hom (order + 1, order + 1, d + 1)``, in place: the
+    Cartesian derivatives into ``hom[..., :d]`` (the loop of
+    :func:`.rational.surface_derivatives_from_homogeneous`, same operations)."""
+    d = hom.shape[2] - 1
+    comb = np.zeros((order + 1, order + 1))
+    for n in range(order + 1):
+        comb[n, 0] = 1.0
+        for r in range(1, n + 1):
+            comb[n, r] = comb[n - 1, r - 1] + (comb[n - 1, r] if r <= n - 1 else 0.0)
+    inv_w = 1.0 / hom[0, 0, d]
+    for k in range(order + 1):
+        for l in range(order + 1):
+            for c in range(d):
+                v = hom[k, l, c]
+                for i in range(k + 1):
+                    for j in range(l + 1):
+                        if i or j:
+                            v -= (comb[k, i] * comb[l, j] * hom[i, j, d]) * hom[k - i, l - j, c]
+                hom[k, l, c] = v * inv_w
+
+
+@_jit
+def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order, rational):
     m = u.size
     c = net.shape[2]
     tu, tv = min(order, p), min(order, q)
@@ -142,16 +165,19 @@ def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order):
                     for jj in range(q + 1):
                         s += dv[ll, jj] * tmp[k, jj, cc]
                     out[i, k, ll, cc] = s
+        if rational:
+            _rational_inplace(out[i], order)
     return out
 
 
-def surface_homogeneous_derivatives(knots_u: NDArray, knots_v: NDArray, p: int, q: int,
-                                    net: NDArray, u: NDArray, v: NDArray, su: NDArray,
-                                    sv: NDArray, order: int) -> NDArray:
-    """Homogeneous partial derivatives ``(m, order + 1, order + 1, d + 1)`` (A3.6 of [PT]).
+def surface_derivatives_compiled(knots_u: NDArray, knots_v: NDArray, p: int, q: int,
+                                 net: NDArray, u: NDArray, v: NDArray, su: NDArray,
+                                 sv: NDArray, order: int, rational: bool) -> NDArray:
+    """Partial derivatives ``(m, order + 1, order + 1, d)`` (A3.6 and A4.4 of [PT]).
 
     ``net (n_u, n_v, d + 1)`` the homogeneous control net, ``u, v (m,)``, ``su, sv (m,)``
-    their spans; ``[i, k, l]`` is the k-th u- and l-th v-derivative at point ``i``.
+    their spans; ``[i, k, l]`` is the k-th u- and l-th v-derivative at point ``i``
+    (of the homogeneous numerator divided out when ``rational``).
     """
     return _surface_hom(np.ascontiguousarray(knots_u, dtype=np.float64),
                         np.ascontiguousarray(knots_v, dtype=np.float64), int(p), int(q),
@@ -159,4 +185,5 @@ def surface_homogeneous_derivatives(knots_u: NDArray, knots_v: NDArray, p: int, 
                         np.ascontiguousarray(u, dtype=np.float64),
                         np.ascontiguousarray(v, dtype=np.float64),
                         np.ascontiguousarray(su, dtype=np.int64),
-                        np.ascontiguousarray(sv, dtype=np.int64), int(order))
+                        np.ascontiguousarray(sv, dtype=np.int64), int(order),
+                        bool(rational))[..., :-1]

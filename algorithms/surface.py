@@ -148,9 +148,9 @@ class NurbsSurface:
         sv = find_span(self.knots_v, q, v)
         net = self._homogeneous_net
         if basis_kernels.AVAILABLE:           # the same sums, compiled (no per-call overhead)
-            hom = basis_kernels.surface_homogeneous_derivatives(
-                self.knots_u, self.knots_v, p, q, net, u, v, su, sv, order)
-            out = self._project(hom)
+            out = basis_kernels.surface_derivatives_compiled(
+                self.knots_u, self.knots_v, p, q, net, u, v, su, sv, order,
+                self.weights is not None)
             return out.reshape(shape + out.shape[1:])
         du, _ = basis_derivatives(self.knots_u, p, u, order, su)    # (m, o+1, p+1)
         dv, _ = basis_derivatives(self.knots_v, q, v, order, sv)    # (m, o+1, q+1)
