@@ -37,8 +37,10 @@ from char_surfaces import (
     near_coincident,
     several_bumps,
     sphere_and_plane,
+    torus_and_plane,
     touching_bumps,
 )
+
 from surfprep.algorithms.characteristic import certify, characteristic_intersection
 from surfprep.algorithms.intersection import (
     StrayCurves,
@@ -87,6 +89,10 @@ def cases():
     out.append(("coincident quadratics", a, b, 0, 0))
     a, b = bumpy_flat()
     out.append(("bumpy bicubic x plane (issue 3)", a, b, 4, 0))
+    a, b = torus_and_plane(1e-6)
+    out.append(("torus x plane normal to its axis, 1e-6 below the top", a, b, 2, 0))
+    a, b = torus_and_plane(0.0)
+    out.append(("torus x plane touching its top circle", a, b, 1, 0))
     return out
 
 

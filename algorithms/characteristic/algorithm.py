@@ -48,6 +48,7 @@ from ..tolerance import check_tolerance
 from .curves import CurveKind, TracedCurve, curve_value
 from .distance import DistanceField, DistanceJet
 from .points import (
+    DEGENERATE_SHARE,
     CharacteristicPoint,
     PointKind,
     border_points,
@@ -358,9 +359,14 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         new = crit.uv.shape[0] - traced_from
         if new <= 0 or not trace_critical:
             break
-        fresh = _subset(fld, crit, np.arange(traced_from, crit.uv.shape[0]))
+        rows = np.arange(traced_from, crit.uv.shape[0])
         traced_from = crit.uv.shape[0]
-        curves += from_critical(fld, fresh, h_max)
+        # through isolated critical points only: a degenerate one lies on a ridge
+        # (a curve of critical points, traced by ridges.py), where every point is one
+        rows = rows[np.abs(crit.det_hess[rows]) > DEGENERATE_SHARE * np.einsum(
+            "mij,mij->m", crit.hess[rows], crit.hess[rows])]
+        if rows.size:
+            curves += from_critical(fld, _subset(fld, crit, rows), h_max)
     # turning points: sign changes of phi along the characteristic curves
     turning_uv, turning_st, turning_kind, scale = [], [], [], []
     for c in curves:
