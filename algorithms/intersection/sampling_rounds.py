@@ -251,16 +251,21 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
 def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
             singular: NDArray) -> None:
     """New kept dense samples right after dense indices ``after`` (sorted, distinct)."""
-    pos = after + 1
-    w.points = np.insert(w.points, pos, points, axis=0)
-    w.uv_a = np.insert(w.uv_a, pos, uv_a, axis=0)
-    w.uv_b = np.insert(w.uv_b, pos, uv_b, axis=0)
-    w.converged = np.insert(w.converged, pos, True)
-    w.singular = np.insert(w.singular, pos, singular)
-    w.kept = np.insert(w.kept, pos, True)
-    w.stuck = np.insert(w.stuck, pos, False)
-    w.fresh = np.insert(w.fresh, pos, True)
-    w.span_error = np.insert(w.span_error, pos, np.nan)
+    m, q = w.points.shape[0], after.size
+    new_at = after + 1 + np.arange(q)            # as np.insert places them
+    old_at = np.ones(m + q, dtype=bool)
+    old_at[new_at] = False
+
+    def put(old: NDArray, new) -> NDArray:
+        out = np.empty((m + q,) + old.shape[1:], dtype=old.dtype)
+        out[old_at] = old
+        out[new_at] = new
+        return out
+
+    w.points, w.uv_a, w.uv_b = put(w.points, points), put(w.uv_a, uv_a), put(w.uv_b, uv_b)
+    w.converged, w.singular = put(w.converged, True), put(w.singular, singular)
+    w.kept, w.stuck, w.fresh = put(w.kept, True), put(w.stuck, False), put(w.fresh, True)
+    w.span_error = put(w.span_error, np.nan)
 
 
 def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
@@ -283,10 +288,15 @@ def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
     # curve (consistently, so the order is kept), which does not hurt the sampling
     inside = (frac >= _INSIDE) & (frac <= 1.0 - _INSIDE)
     after = start.copy()
-    for i in np.flatnonzero(inside & (stop - start > 1)):
-        between = w.points[start[i] + 1: stop[i]]
-        f = (between - p0[i]) @ chord[i] / den[i]
-        after[i] = start[i] + np.count_nonzero(f < frac[i])
+    busy = np.flatnonzero(inside & (stop - start > 1))      # dense samples inside the span
+    if busy.size:
+        count = stop[busy] - start[busy] - 1
+        item = np.repeat(busy, count)
+        between = start[item] + 1 + np.arange(item.size) - np.repeat(np.cumsum(count) - count,
+                                                                      count)
+        f = np.einsum("ij,ij->i", w.points[between] - p0[item], chord[item]) / den[item]
+        after[busy] += np.bincount(np.searchsorted(busy, item[f < frac[item]]),
+                                   minlength=busy.size)
     return inside, after, frac
 
 
@@ -308,6 +318,33 @@ def _pieces(error: NDArray, target: float) -> NDArray:
     is only C1, falls only as ``h^2``), 2 to ``_MAX_PIECES``."""
     ratio = np.maximum(error / target, 1.0)
     return np.clip(np.ceil(np.sqrt(ratio)), 2, _MAX_PIECES).astype(np.int64)
+
+
+def _middle_samples(w: _Work, bad: NDArray, pieces: NDArray, span_of: NDArray, ends: NDArray,
+                    arc: NDArray) -> tuple[NDArray, NDArray]:
+    """Dense samples that split failing spans in two: for every span of ``bad`` to be cut
+    in 2 pieces, the left-out converged dense sample nearest its middle (by arc length),
+    if within ``_MIDDLE`` of it. Returns the dense indices taken and a ``(len(bad),)``
+    mask of the spans they split (all spans at once)."""
+    covered = np.zeros(bad.size, dtype=bool)
+    halves = bad[pieces == 2]
+    if halves.size == 0:
+        return np.zeros(0, dtype=np.int64), covered
+    wanted = np.zeros(max(int(span_of.max()), int(halves.max())) + 2, dtype=bool)
+    wanted[halves] = True
+    cand = np.flatnonzero(~w.kept & w.converged & wanted[span_of])
+    if cand.size == 0:
+        return np.zeros(0, dtype=np.int64), covered
+    j = span_of[cand]
+    a0, a1 = arc[ends[j]], arc[ends[j + 1]]
+    frac = np.where(a1 > a0, (arc[cand] - a0) / np.where(a1 > a0, a1 - a0, 1.0), 0.5)
+    dev = np.abs(frac - 0.5)
+    order = np.lexsort((dev, j))                     # per span, the nearest first (stable)
+    first = np.concatenate([[True], np.diff(j[order]) != 0])
+    best = order[first]
+    best = best[dev[best] <= _MIDDLE]
+    covered = np.isin(bad, j[best]) & (pieces == 2)
+    return cand[best], covered
 
 
 def verification_round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
@@ -343,18 +380,10 @@ def verification_round(works: list[_Work], surface_a, surface_b, target: float, 
         w.fresh[off] = True
         t = check.t
         pieces = _pieces(error, target)
-        fresh = []
-        for j, n in zip(bad, pieces):
-            inside = np.flatnonzero((span_of == j) & ~w.kept & w.converged)
-            if n == 2 and inside.size:      # the dense sample nearest the middle, if near
-                a0, a1 = arc[ends[j]], arc[ends[j + 1]]
-                frac = (arc[inside] - a0) / (a1 - a0) if a1 > a0 else np.full(inside.size, 0.5)
-                best = int(np.argmin(np.abs(frac - 0.5)))
-                if abs(frac[best] - 0.5) <= _MIDDLE:
-                    w.kept[inside[best]] = True
-                    w.fresh[inside[best]] = True
-                    continue
-            fresh.append((j, n))
+        taken, covered = _middle_samples(w, bad, pieces, span_of, ends, arc)
+        w.kept[taken] = True
+        w.fresh[taken] = True
+        fresh = [(j, n) for j, n, c in zip(bad, pieces, covered) if not c]
         if fresh:
             span = np.repeat([j for j, _ in fresh], [n - 1 for _, n in fresh])
             count = np.repeat([n for _, n in fresh], [n - 1 for _, n in fresh])
