@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 
+import cadquery as cq
 import numpy as np
 import pytest
 from OCP.BRepCheck import BRepCheck_Analyzer
@@ -14,7 +15,6 @@ import surfprep
 from surfprep.plugin import cli
 from surfprep.plugin.intersect import FoundBy, IntersectionResult, Method, intersect
 
-import cadquery as cq
 R2 = np.sqrt(0.5)
 
 
@@ -152,3 +152,49 @@ def test_cadquery_sphere_resting_on_a_plate_touches_at_its_pole(method):
                     tol=1e-6, method=method)
     assert cut.isolated_points == [] and len(cut) == 1
     assert cut[0].curve.length == pytest.approx(2 * np.pi * np.sqrt(100 - 9.999 ** 2), rel=1e-5)
+
+
+@pytest.fixture(scope="module")
+def torus():
+    return cq.Solid.makeTorus(1.0, 0.3)
+
+
+def top_plane(gap: float):
+    return cq.Face.makePlane(3.0, 3.0, basePnt=(0, 0, 0.3 - gap), dir=(0, 0, 1))
+
+
+def test_torus_cut_just_below_its_top_gives_both_circles(torus):
+    """A plane normal to the torus axis 1e-6 below the top: two circles 1.5e-3 apart
+    (radii 1 +- sqrt(0.3^2 - 0.299999^2)). phi is constant along the circles of
+    latitude (a ridge of critical points, not isolated ones); the certificate traces
+    the ridge and finds both circles, which the triangles miss."""
+    gap, tol = 1e-6, 1e-8
+    auto = intersect(torus, top_plane(gap), tol=tol)
+    mesh = intersect(torus, top_plane(gap), tol=tol, method="mesh")
+    assert len(auto) == 2 and len(mesh) < 2                  # pinned: the triangles miss
+    half = np.sqrt(0.3 ** 2 - (0.3 - gap) ** 2)
+    radii = []
+    for c in auto:
+        assert c.closed and c.found_by is FoundBy.CHARACTERISTIC
+        assert c.max_deviation().max <= tol
+        p = c.curve.curve3d.evaluate(np.linspace(*c.curve.curve3d.domain, 500))
+        np.testing.assert_allclose(p[:, 2], 0.3 - gap, atol=tol)
+        rho = np.hypot(p[:, 0], p[:, 1])
+        radii.append(rho.mean())
+        target = 1 + half if rho.mean() > 1 else 1 - half
+        # within tol of both surfaces, meeting at a small angle: radial slack tol / sin
+        assert np.abs(rho - target).max() <= 10 * tol / (half / 0.3)
+    assert min(radii) < 1 < max(radii)
+
+
+def test_torus_touching_a_plane_along_its_top_circle(torus):
+    """Tangential contact along a whole circle: one curve (not fragments, not a hang)."""
+    tol = 1e-8
+    res = intersect(torus, top_plane(0.0), tol=tol)
+    assert len(res) == 1 and res.isolated_points == []
+    c = res[0]
+    assert c.closed and c.max_deviation().max <= tol
+    p = c.curve.curve3d.evaluate(np.linspace(*c.curve.curve3d.domain, 500))
+    np.testing.assert_allclose(p[:, 2], 0.3, atol=tol)
+    # along a tangency a point within tol of both surfaces may sit sqrt(2 r tol) off
+    np.testing.assert_allclose(np.hypot(p[:, 0], p[:, 1]), 1.0, atol=2 * np.sqrt(0.6 * tol))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import cadquery as cq
 import numpy as np
 import pytest
 from OCP.IFSelect import IFSelect_RetDone
@@ -14,8 +15,6 @@ from OCP.TopExp import TopExp_Explorer
 
 import surfprep
 from surfprep.plugin import cli
-
-import cadquery as cq
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:

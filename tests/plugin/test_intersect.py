@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-
+import cadquery as cq
 import numpy as np
 import pytest
 from OCP.BRep import BRep_Tool
@@ -15,8 +15,6 @@ from surfprep.algorithms.intersection import connected_branches, curve_set_dista
 from surfprep.errors import ConversionError, InvalidToleranceError
 from surfprep.plugin.intersect import FaceIntersection, face_operands, inside_face, intersect
 from surfprep.plugin.occ_reference import section_faces_occ
-
-import cadquery as cq
 
 
 def unit_sphere():
