@@ -273,7 +273,7 @@ def continue_at_singular_points(field: DistanceField, curves: list[TracedCurve],
     Parameters
     ----------
     curves : list of TracedCurve
-        One kind each (the tracer's output).
+        The tracer's output (kinds may be mixed: each kind is handled on its own).
     tol : float
         Model units: ``|phi| <= tol`` at a singular point of the intersection
         (for characteristic curves ``|g|`` of about the Hessian times ``1e-6``
@@ -288,6 +288,10 @@ def continue_at_singular_points(field: DistanceField, curves: list[TracedCurve],
         reason SINGULAR) and the traces of the half-branches nobody arrived
         along, starting at the point (reason SINGULAR).
     """
+    kinds = {c.kind for c in curves}
+    if len(kinds) > 1:                    # each kind on its own
+        return [p for k in CurveKind for p in continue_at_singular_points(
+            field, [c for c in curves if c.kind is k], tol=tol, h_max=h_max, ctol=ctol)]
     if not curves:
         return curves
     kind = curves[0].kind
