@@ -3,7 +3,12 @@
 Steps, on anything that holds faces (file path, :class:`CadModel`,
 ``TopoDS_Shape``, cadquery / build123d object):
 
-1. every face is read as a :class:`TrimmedFace`; faces that lie on another face
+1. every face is read as a :class:`TrimmedFace`; directed patches (``patches``,
+   :mod:`.heal_spec`) are approximated over the original faces and the faces
+   under each are cut away (:mod:`.heal_cut`), so a patch replaces what it
+   covers; of two faces overlapping partially (a corner, a face partly on
+   another, any number of sides, trimmed or not) the later is trimmed back to
+   the other's boundary (:mod:`.heal_overlap_trim`); faces that lie on another face
    within ``gap_tol`` (all their edges on its edges, interior points on its
    surface; exact duplicates as in overture_marscapsule_proe.igs) are dropped,
    and of two four-sided faces overlapping over a strip the later one is
@@ -64,6 +69,7 @@ from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches
 from .heal_overlap import find_overlaps, trimmed_back_boundary
+from .heal_overlap_trim import trim_overlaps_of
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
     FaceEdge,
@@ -210,6 +216,7 @@ class HealResult:
             "dropped_overlaps": [{"kept": a, "dropped": b} for a, b in self.dropped],
             "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
             "cuts": self.extra.get("cuts", []),
+            "partial_overlaps": self.extra.get("partial_overlaps", []),
             "snapped_sides": self.extra.get("snapped_sides", 0),
             "skipped": list(self.skipped),
             "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,
@@ -517,7 +524,9 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
                             tol=tol, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,
                             skipped=skipped)
     work, faces = cut.model, cut.faces
-    if cut.cuts:
+    work, faces, partial = trim_overlaps_of(work, faces, gap_tol=gap_tol,
+                                            tight=TIGHT_FACTOR * model.size, skipped=skipped)
+    if cut.cuts or partial:
         edges = face_edges(faces)
     pairs = pair_edges(edges, gap_tol)
     dropped = duplicate_faces(faces, edges, pairs, gap_tol)
@@ -548,6 +557,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start)
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
+    result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped if network is not None else 0
     result.extra["trimmed_overlaps"] = [
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": any(

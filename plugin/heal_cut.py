@@ -50,7 +50,8 @@ from .heal_topology import is_valid, polyline_distance, sew
 from .step_iges import _all_faces
 
 __all__ = ["CutModel", "FaceCut", "boundary_on_faces", "cut_faces", "cut_under_patches",
-           "face_area", "outline", "slab"]
+           "face_area", "outline", "read_faces", "rebuilt_model",
+           "replace_pieces", "slab"]
 
 #: samples per boundary curve put onto the faces
 BOUNDARY_SAMPLES = 65
@@ -171,7 +172,7 @@ def slab(surface: NurbsSurface, h: float, tol: float, margin: float = 0.0) -> To
              _ruled(lo[0, :], hi[0, :], kv, dv), _ruled(lo[-1, :], hi[-1, :], kv, dv)]
     shape, _ = sew([make_face(s) for s in faces], tol)
     if shape.ShapeType() != TopAbs_SOLID or not is_valid(shape):
-        raise OpenCascadeError("heal: the slab under a directed patch is no valid solid")
+        raise OpenCascadeError("heal: the slab around the surface is no valid solid")
     solid = TopoDS.Solid_s(shape)
     classifier = BRepClass3d_SolidClassifier(solid)
     classifier.PerformInfinitePoint(tol)
@@ -198,7 +199,7 @@ def _boolean(op, face: TopoDS_Face, tool: TopoDS_Shape, fuzzy: float) -> TopoDS_
     builder.SetFuzzyValue(fuzzy)
     builder.Build()
     if not builder.IsDone():
-        raise OpenCascadeError(f"heal: {op.__name__} of a face by a directed patch's slab failed")
+        raise OpenCascadeError(f"heal: {op.__name__} of a face by a slab failed")
     return builder.Shape()
 
 
@@ -306,7 +307,7 @@ class CutModel:
     cuts: list[FaceCut]
 
 
-def _rebuilt(model, faces: list[TopoDS_Face], names: list, colors: list):
+def rebuilt_model(model, faces: list[TopoDS_Face], names: list, colors: list):
     from OCP.BRep import BRep_Builder
     from OCP.TopoDS import TopoDS_Compound
     compound, builder = TopoDS_Compound(), BRep_Builder()
@@ -341,7 +342,7 @@ def cut_under_patches(model, faces: list[TrimmedFace | None], directed: list, so
         try:
             h = SLAB_FACTOR * la.offset
             tool = slab(la.surface, h, tight, MARGIN_SHARE * gap_tol)
-            now = _read(occ, names)
+            now = read_faces(occ, names)
             whole = {i for i, f in enumerate(now) if f is not None
                      and covered(f, la.surface, h, gap_tol)}
             pieces, made = cut_faces(occ, tool, outline(la.surface), k, tight, whole)
@@ -349,13 +350,13 @@ def cut_under_patches(model, faces: list[TrimmedFace | None], directed: list, so
             skipped.append(f"directed {k}: faces under it not cut ({exc}); added on top")
             continue
         cuts += [replace(c, face=origin[c.face]) for c in made]
-        occ, names, colors, origin = _replace_pieces(pieces, occ, names, colors, origin)
+        occ, names, colors, origin = replace_pieces(pieces, occ, names, colors, origin)
     if not cuts:
         return CutModel(model, faces, list(range(len(faces))), done, [])
-    return CutModel(_rebuilt(model, occ, names, colors), _read(occ, names), origin, done, cuts)
+    return CutModel(rebuilt_model(model, occ, names, colors), read_faces(occ, names), origin, done, cuts)
 
 
-def _read(occ: list[TopoDS_Face], names: list) -> list[TrimmedFace | None]:
+def read_faces(occ: list[TopoDS_Face], names: list) -> list[TrimmedFace | None]:
     out = []
     for f, name in zip(occ, names):
         try:
@@ -365,7 +366,7 @@ def _read(occ: list[TopoDS_Face], names: list) -> list[TrimmedFace | None]:
     return out
 
 
-def _replace_pieces(pieces: dict, occ, names, colors, origin):
+def replace_pieces(pieces: dict, occ, names, colors, origin):
     out = ([], [], [], [])
     for i, f in enumerate(occ):
         for piece in pieces.get(i, [f]):
