@@ -16,7 +16,11 @@ was left out:
   singular point of ``phi_u = 0``, §6.2, or hits the step cap) or when
   ``trace_critical`` asks for the full §6.3, the v-characteristic curves
   (``phi_v = 0``, eq. 14) are traced the same way; with ``trace_critical``
-  both curves through every critical point too (:func:`from_critical`).
+  both curves through every critical point too (:func:`from_critical`);
+* where ``det K`` changes sign along a traced curve (the cut locus of ``q``:
+  multiple projections, §6.2 case 2) the point is projected afresh and, on
+  another foot, the curve is traced again on that branch
+  (:func:`other_branches`).
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ __all__ = [
     "CHARACTERISTIC_TURN",
     "SWEEP_ROUNDS",
     "from_critical",
+    "other_branches",
     "sweep",
     "trace_characteristic",
     "unvisited_seeds",
@@ -147,6 +152,49 @@ def _both_ways(field: DistanceField, kind: CurveKind, seeds: NDArray, h_max: flo
                                 np.vstack([tangent, -tangent]), h_max)
 
 
+def other_branches(field: DistanceField, curves: list[TracedCurve], h_max: float
+                   ) -> list[TracedCurve]:
+    """Where the foot a traced curve carries stops being a minimum of the distance
+    (``K`` no longer positive definite: ``det K`` changes sign, or a focal point was
+    crossed; the cut locus of ``q``, §6.2 case 2), the point is projected afresh
+    (seed grid); when that foot is another one, the curve of the same kind is
+    traced from it both ways: each projection branch followed."""
+    if not curves:
+        return []
+    every = field.jet(np.concatenate([c.uv for c in curves]),
+                      np.concatenate([c.st for c in curves]))
+    multiple = every.status == ProjectionStatus.MULTIPLE
+    uv, st, kinds, offset = [], [], [], 0
+    for c in curves:
+        n = c.uv.shape[0]
+        # K stops being positive definite (det K changes sign, or both eigenvalues
+        # turn negative past an umbilic focal point: det K keeps its sign there)
+        past = multiple[offset:offset + n] | (np.sign(c.det_k) != np.sign(c.det_k[0]))
+        for j in np.flatnonzero(past):
+            uv.append(c.uv[j])
+            st.append(c.st[j])
+            kinds.append(c.kind)
+            break                                       # one re-start per curve and round
+        offset += n
+    if not uv:
+        return []
+    uv, st = np.array(uv), np.array(st)
+    fresh = field.jet(uv)
+    q_diag = float(np.linalg.norm(field.projector.upper - field.projector.lower))
+    new = (fresh.status == ProjectionStatus.UNIQUE) & (
+        np.linalg.norm(fresh.st - st, axis=1) > 1e-3 * q_diag)
+    if not new.any():
+        return []
+    rows = np.flatnonzero(new)
+    kind = [kinds[i] for i in rows]
+    _, dg = curve_value(fresh, np.array([0 if k is CurveKind.U_CHARACTERISTIC else 1
+                                         for k in kinds]))
+    tangent = np.stack([-dg[rows, 1], dg[rows, 0]], -1)
+    return trace_characteristic(field, kind + kind, np.vstack([uv[rows]] * 2),
+                                np.vstack([fresh.st[rows]] * 2),
+                                np.vstack([tangent, -tangent]), h_max)
+
+
 def _family(field: DistanceField, grid: DistanceJet, shape: tuple[int, int], comp: int,
             kind: CurveKind, root_kind: PointKind, noise: float, h_max: float
             ) -> tuple[list[CharacteristicPoint], list[TracedCurve]]:
@@ -164,6 +212,12 @@ def _family(field: DistanceField, grid: DistanceJet, shape: tuple[int, int], com
         if seeds.shape[0] == 0:
             break
         curves += _both_ways(field, kind, seeds, h_max)
+    fresh = curves
+    for _ in range(SWEEP_ROUNDS):               # each projection branch (§6.2 case 2)
+        fresh = other_branches(field, fresh, h_max)
+        if not fresh:
+            break
+        curves += fresh
     return points, curves
 
 

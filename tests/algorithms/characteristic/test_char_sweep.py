@@ -11,6 +11,7 @@ from char_surfaces import plane_patch, several_bumps
 from surfprep.algorithms.characteristic import (
     CurveKind,
     DistanceField,
+    ProjectionStatus,
     Projector,
     critical_points,
 )
@@ -56,3 +57,42 @@ def test_components_without_side_roots_are_traced_from_the_grid():
     # the bump (0.28, 0.3) sits on Greville points: the top is near, phi_u = phi_v = 0 there
     assert np.linalg.norm(top - [0.28, 0.3]) < 0.02
     assert np.abs(crit.grad).max() <= 1e-10
+
+
+def test_a_curve_past_the_cut_locus_is_traced_again_on_the_nearest_branch():
+    """Inside a sphere the centre is a focal point: a curve that carries its foot
+    through it keeps the far foot (K negative definite, distance 1 + rho). other_branches
+    projects the point afresh, finds the near foot (distance 1 - rho) and traces
+    the curve on that branch (§6.2 case 2)."""
+    from char_surfaces import sphere_band
+
+    from surfprep.algorithms.characteristic import TracedCurve
+    from surfprep.algorithms.characteristic.curves import EndReason
+    from surfprep.algorithms.characteristic.sweep import other_branches
+
+    field = DistanceField(plane_patch([0, 0, 0], [0, 0, 1.0], 0.6),
+                          Projector(sphere_band(), tol=1e-13))
+    uv = np.array([[0.5, 0.7], [0.5, 0.3]])            # on either side of the centre
+    points = field.r.evaluate(uv[:, 0], uv[:, 1])
+    near = field.jet(uv[:1])
+    # the far foot of the second point: the near foot of its mirror image
+    far_foot = field.projector.project(-points[1:]).st
+    far = field.jet(uv[1:], far_foot)
+    assert far.status[0] == ProjectionStatus.MULTIPLE      # K negative definite
+    np.testing.assert_allclose(np.abs(far.phi), 1 + np.linalg.norm(points[1]), atol=1e-9)
+    curve = TracedCurve(CurveKind.U_CHARACTERISTIC, uv, np.vstack([near.st, far.st]),
+                        np.r_[near.phi, far.phi], np.vstack([near.grad, far.grad]),
+                        np.r_[near.projection.det_k, far.projection.det_k],
+                        EndReason.START, EndReason.DOMAIN)
+    again = other_branches(field, [curve], 0.15 * field.diagonal)
+    assert len(again) == 2                                 # both ways from the fresh foot
+    whole = 0
+    for c in again:
+        rho = np.linalg.norm(field.r.evaluate(c.uv[:, 0], c.uv[:, 1]), axis=1)
+        regular = field.jet(c.uv, c.st).status == ProjectionStatus.UNIQUE
+        assert regular[0]
+        # on the near branch: phi = rho - 1 (the way back through the centre
+        # crosses the focal point again: the next round takes it from there)
+        np.testing.assert_allclose(c.phi[regular], rho[regular] - 1.0, atol=1e-6)
+        whole += bool(regular.all())
+    assert whole >= 1
