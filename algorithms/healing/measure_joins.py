@@ -78,14 +78,22 @@ def _normals(surface: NurbsSurface, uv: NDArray) -> NDArray:
         return out
 
 
-def _one_way(sa: NurbsSurface, side_a: Side, sb: NurbsSurface, side_b: Side, n: int
-             ) -> tuple[NDArray, NDArray]:
-    """Gaps ``(n,)`` and angles ``(n,)`` (degrees) from side a's samples to side b."""
+def _one_way(sa: NurbsSurface, side_a: Side, sb: NurbsSurface, side_b: Side, n: int,
+             reversed_: bool = False) -> tuple[NDArray, NDArray]:
+    """Gaps ``(n,)`` and angles ``(n,)`` (degrees) from side a's samples to side b.
+
+    The closest points on side b start from the samples' positions carried over
+    linearly (reversed when the sides run opposite ways): the shared sides
+    correspond, so no global search is needed; a start in a wrong valley could
+    only overstate a gap, never hide one."""
     lo, hi = side_a.running_domain(sa)
-    uv_a = side_a.uv(sa, np.linspace(lo, hi, n))
+    s = np.linspace(0.0, 1.0, n)
+    uv_a = side_a.uv(sa, lo + s * (hi - lo))
     points = sa.evaluate(uv_a[:, 0], uv_a[:, 1])
     curve_b = sb.isocurve(side_b.parameter(sb), side_b.fixed)
-    foot = project_to_curve(curve_b, points)
+    lo_b, hi_b = side_b.running_domain(sb)
+    guess = lo_b + (1.0 - s if reversed_ else s) * (hi_b - lo_b)
+    foot = project_to_curve(curve_b, points, guess=guess)
     uv_b = side_b.uv(sb, foot.t)
     na = _normals(sa, uv_a)
     nb = _normals(sb, uv_b)
@@ -97,8 +105,10 @@ def _one_way(sa: NurbsSurface, side_a: Side, sb: NurbsSurface, side_b: Side, n: 
 def measure_join(patches: list[NurbsSurface], edge: SharedEdge, *,
                  samples: int = JOIN_SAMPLES) -> JoinReport:
     """Gap and normal angle of ``edge`` measured on ``patches`` (both directions)."""
-    ga, aa = _one_way(patches[edge.a], edge.side_a, patches[edge.b], edge.side_b, samples)
-    gb, ab = _one_way(patches[edge.b], edge.side_b, patches[edge.a], edge.side_a, samples)
+    ga, aa = _one_way(patches[edge.a], edge.side_a, patches[edge.b], edge.side_b, samples,
+                      edge.reversed)
+    gb, ab = _one_way(patches[edge.b], edge.side_b, patches[edge.a], edge.side_a, samples,
+                      edge.reversed)
     gaps, angles = np.concatenate([ga, gb]), np.concatenate([aa, ab])
     return JoinReport(edge.a, edge.side_a, edge.b, edge.side_b, edge.reversed,
                       float(gaps.max()), float(np.sqrt(np.mean(gaps ** 2))),
