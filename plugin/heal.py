@@ -69,7 +69,7 @@ from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches
 from .heal_overlap import find_overlaps, trimmed_back_boundary
-from .heal_overlap_trim import trim_overlaps_of
+from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
     FaceEdge,
@@ -105,8 +105,6 @@ _GAP_FACTOR_EDGE = 0.01
 MAX_SNAP_SPANS = 64
 #: samples of a fitted side checked against the edge
 SNAP_CHECK_SAMPLES = 257
-#: pcurve samples per edge of a trimming loop (:func:`face_source`)
-LOOP_SAMPLES_PER_EDGE = 33
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
 
@@ -247,35 +245,13 @@ def _read_faces(model: CadModel) -> tuple[list[TrimmedFace | None], list[str]]:
     return faces, skipped
 
 
-def _loop_uv(loop) -> NDArray:
-    """(n, 2) float: one trimming loop sampled along its pcurves, in loop order."""
-    parts = []
-    for e in loop.edges:
-        t = np.linspace(e.t0, e.t1, LOOP_SAMPLES_PER_EDGE)
-        uv = e.pcurve.evaluate(t[::-1] if e.reversed else t)
-        parts.append(uv[:-1])
-    return np.concatenate(parts)
-
-
-def _is_natural(face: TrimmedFace, loops: list[NDArray]) -> bool:
-    """One loop running along the domain's rectangle: the whole surface is the face."""
-    if len(loops) != 1:
-        return False
-    u0, u1, v0, v1 = face.surface.domain
-    eps = 1e-7 * max(u1 - u0, v1 - v0)
-    uv = loops[0]
-    on_side = ((np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps)
-               | (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps))
-    return bool(np.all(on_side))
-
-
 def face_source(face: TrimmedFace):
     """A face as a source of :func:`local_approximant`: its surface where the face is
     the whole surface, else :func:`trimmed_source` (only the part inside its loops is
     projected onto, so a hole in the face or a part trimmed away gets the fill)."""
-    loops = [_loop_uv(lp) for lp in face.loops]
-    if not loops or _is_natural(face, loops):
+    if is_natural(face):
         return face.surface
+    loops = [loop_uv(lp) for lp in face.loops]
     try:
         return trimmed_source(face.surface, loops, name=face.name or "")
     except SurfprepError:

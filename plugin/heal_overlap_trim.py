@@ -33,9 +33,11 @@ from .heal_cut import cut_faces, outline, read_faces, rebuilt_model, replace_pie
 from .heal_overlap import find_overlaps
 from .heal_topology import duplicate_faces, face_edges, four_sided_boundary, pair_edges
 
-__all__ = ["PartialOverlap", "is_strip", "on_face", "overlap_area", "overlap_share",
-           "trim_overlaps_of", "trim_partial_overlaps"]
+__all__ = ["PartialOverlap", "is_natural", "is_strip", "loop_uv", "on_face", "overlap_area",
+           "overlap_share", "trim_overlaps_of", "trim_partial_overlaps"]
 
+#: pcurve samples per edge of a trimming loop (:func:`loop_uv`)
+LOOP_SAMPLES_PER_EDGE = 33
 #: samples per direction of a face tested for lying on another
 SAMPLES = 15
 #: the slab around the kept face is this many gap_tol thick on either side
@@ -114,10 +116,29 @@ def is_strip(mask: NDArray) -> bool:
     return False
 
 
-def _natural(face: TrimmedFace) -> bool:
-    from .heal import _is_natural, _loop_uv
-    loops = [_loop_uv(lp) for lp in face.loops]
-    return not loops or _is_natural(face, loops)
+def loop_uv(loop) -> NDArray:
+    """(n, 2) float: one trimming loop sampled along its pcurves, in loop order."""
+    parts = []
+    for e in loop.edges:
+        t = np.linspace(e.t0, e.t1, LOOP_SAMPLES_PER_EDGE)
+        uv = e.pcurve.evaluate(t[::-1] if e.reversed else t)
+        parts.append(uv[:-1])
+    return np.concatenate(parts)
+
+
+def is_natural(face: TrimmedFace) -> bool:
+    """No loop, or one loop running along the domain's rectangle: the face is its
+    whole surface."""
+    if not face.loops:
+        return True
+    if len(face.loops) != 1:
+        return False
+    u0, u1, v0, v1 = face.surface.domain
+    eps = 1e-7 * max(u1 - u0, v1 - v0)
+    uv = loop_uv(face.loops[0])
+    on_side = ((np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps)
+               | (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps))
+    return bool(np.all(on_side))
 
 
 def _pairs(faces: list, candidates: list[int], skip: set, gap_tol: float):
@@ -155,8 +176,8 @@ def trim_partial_overlaps(model, faces: list[TrimmedFace | None], candidates: li
     for i, j, share in found:
         if j in used or i in used:
             continue
-        if not _natural(faces[i]):
-            if not _natural(faces[j]):
+        if not is_natural(faces[i]):
+            if not is_natural(faces[j]):
                 skipped.append(f"faces {i} and {j} overlap ({100 * share:.0f}% of {j} on "
                                f"{i}), but both are trimmed: left as they are")
                 continue
