@@ -11,7 +11,12 @@ distance function, characteristic points and characteristic curves
 * :mod:`.starts`: starts on loops (rays from extrema) and their check against known curves;
 * :mod:`.algorithm`: the algorithm of §6.3 (:func:`characteristic_intersection`)
   and the certificate for the triangle method (:func:`certify`);
+* :mod:`.sweep`: the characteristic curves of the stage, complete to the sample
+  grid (components reaching no side, projection branches past the cut locus);
+* :mod:`.ridges`: curves of critical points (surfaces of revolution cut normal
+  to their axis): tangential curves, and starts beside maximum/minimum ridges;
 * :mod:`.evaluator`: fast power-basis evaluation for the tracers;
+* :mod:`.kernels`: the distance jet and the projection as numba kernels;
 * :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them).
 """
 
@@ -31,6 +36,7 @@ from .evaluator import PatchEvaluator
 from .points import CharacteristicPoint, PointKind, classify_critical, critical_points
 from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
 from .projection import Projection, ProjectionStatus, Projector
+from .ridges import Ridge
 from .trace import to_intersection_curve, trace_intersections
 
 __all__ = [
@@ -49,6 +55,7 @@ __all__ = [
                         "Projection",
                         "ProjectionStatus",
                         "Projector",
+                        "Ridge",
                         "TracedCurve",
                         "certify",
                         "characteristic_analysis",
