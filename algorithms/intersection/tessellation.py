@@ -200,6 +200,8 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         return np.ones(rects.shape[0], bool)
     boxes = subpatch_boxes(surface, rects)
     if isinstance(keep, BoxTree):
+        if tessellation_kernels.AVAILABLE:
+            return tessellation_kernels.any_overlap(keep, boxes, pad)
         pairs = tree_pairs(build_tree(boxes), keep, pad=pad)
         mask = np.zeros(rects.shape[0], bool)
         mask[pairs[:, 0]] = True
@@ -211,6 +213,8 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         if keep.tree is None:
             object.__setattr__(keep, "tree", build_tree(keep.boxes))
         return _near(surface, rects, region, keep.tree, pad)
+    if tessellation_kernels.AVAILABLE:          # each rectangle against its region's boxes
+        return tessellation_kernels.any_overlap_in_range(boxes, lo, hi, keep.boxes, pad)
     rect = np.repeat(np.arange(rects.shape[0]), counts)
     other = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(rect.size)
     k = keep.boxes[other]

@@ -5,7 +5,9 @@ hundred multiply-adds that numpy spends in temporaries and per-call overhead.
   from the evaluated test grid (both two-triangle interpolants, the u- and v-line
   chords), the same formulas in the same order;
 * :func:`restricted_boxes`: the control-net boxes of Bézier patches restricted to
-  sub-rectangles (the blossoms of :func:`.culling._blossom_restrict` in u, then v).
+  sub-rectangles (the blossoms of :func:`.culling._blossom_restrict` in u, then v);
+* :func:`any_overlap`: which boxes come near any leaf of a box tree (the pruning test
+  of :func:`.tessellation._near`, without listing the pairs).
 
 ``AVAILABLE`` is False without numba; the callers keep their numpy forms then.
 """
@@ -17,7 +19,8 @@ from numpy.typing import NDArray
 
 from ..basis_kernels import AVAILABLE, _jit
 
-__all__ = ["AVAILABLE", "chord_errors_from_grid", "restricted_boxes"]
+__all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "chord_errors_from_grid",
+           "restricted_boxes"]
 
 
 @_jit
@@ -134,4 +137,68 @@ def restricted_boxes(coeffs: NDArray, which: NDArray, s0: NDArray, s1: NDArray, 
     out = np.empty((which.size, 2, 3))
     _boxes(np.ascontiguousarray(coeffs, dtype=float), np.asarray(which, dtype=np.int64),
            *(np.ascontiguousarray(a, dtype=float) for a in (s0, s1, t0, t1)), out)
+    return out
+
+
+@_jit
+def _any_overlap(lo, hi, left, right, boxes, pad, out):
+    stack = np.empty(128, dtype=np.int64)
+    for r in range(boxes.shape[0]):
+        top = 0
+        stack[0] = 0
+        hit = False
+        while top >= 0 and not hit:
+            node = stack[top]
+            top -= 1
+            inside = True
+            for e in range(3):
+                if lo[node, e] > boxes[r, 1, e] + pad or boxes[r, 0, e] > hi[node, e] + pad:
+                    inside = False
+                    break
+            if not inside:
+                continue
+            if left[node] < 0:
+                hit = True
+            else:
+                if top + 2 >= stack.size:
+                    stack = np.concatenate((stack, np.empty(stack.size, dtype=np.int64)))
+                stack[top + 1] = right[node]
+                stack[top + 2] = left[node]
+                top += 2
+        out[r] = hit
+
+
+def any_overlap(tree, boxes: NDArray, pad: float) -> NDArray:
+    """Mask ``(k,)``: box ``boxes[i] (2, 3)`` is within ``pad`` of some leaf box of
+    ``tree`` (a :class:`.culling.BoxTree`) on every axis; a depth-first search per box
+    that stops at the first hit (the pairs of :func:`.culling.tree_pairs` are not needed)."""
+    out = np.zeros(boxes.shape[0], dtype=bool)
+    if tree.n_nodes and boxes.shape[0]:
+        _any_overlap(tree.lo, tree.hi, tree.left, tree.right,
+                     np.ascontiguousarray(boxes, dtype=float), float(pad), out)
+    return out
+
+
+@_jit
+def _region_any(boxes, first, last, keep, pad, out):
+    for r in range(boxes.shape[0]):
+        for b in range(first[r], last[r]):
+            inside = True
+            for e in range(3):
+                if boxes[r, 0, e] > keep[b, 1, e] + pad or keep[b, 0, e] > boxes[r, 1, e] + pad:
+                    inside = False
+                    break
+            if inside:
+                out[r] = True
+                break
+
+
+def any_overlap_in_range(boxes: NDArray, first: NDArray, last: NDArray, keep: NDArray,
+                         pad: float) -> NDArray:
+    """Mask ``(k,)``: box ``boxes[i]`` is within ``pad`` of some of ``keep[first[i]:last[i]]``
+    on every axis (stops at the first hit)."""
+    out = np.zeros(boxes.shape[0], dtype=bool)
+    _region_any(np.ascontiguousarray(boxes, dtype=float), np.asarray(first, dtype=np.int64),
+                np.asarray(last, dtype=np.int64), np.ascontiguousarray(keep, dtype=float),
+                float(pad), out)
     return out

@@ -49,3 +49,27 @@ def test_compiled_forms_match_numpy(monkeypatch, surface):
     pts = surface.evaluate(u[:, :, None], v[:, None, :]).reshape(len(rects), -1, 3)
     assert np.all(pts >= boxes[:, None, 0] - 1e-12 * scale)
     assert np.all(pts <= boxes[:, None, 1] + 1e-12 * scale)
+
+
+def _random_boxes(rng, n: int, size: float) -> np.ndarray:
+    lo = rng.uniform(0, 1, (n, 3))
+    return np.stack([lo, lo + rng.uniform(0, size, (n, 3))], axis=1)
+
+
+@pytest.mark.parametrize("pad", [0.0, 0.02])
+def test_overlap_queries_match_brute_force(pad):
+    from surfprep.algorithms.intersection.culling import build_tree
+
+    rng = np.random.default_rng(11)
+    keep, query = _random_boxes(rng, 700, 0.03), _random_boxes(rng, 400, 0.05)
+    near = np.all((query[:, None, 0] <= keep[None, :, 1] + pad)
+                  & (keep[None, :, 0] <= query[:, None, 1] + pad), axis=2)      # (400, 700)
+    np.testing.assert_array_equal(
+        tessellation_kernels.any_overlap(build_tree(keep), query, pad), near.any(axis=1))
+    first = rng.integers(0, 700, 400)
+    last = np.minimum(first + rng.integers(0, 300, 400), 700)
+    cols = np.arange(700)
+    in_range = (cols >= first[:, None]) & (cols < last[:, None])
+    np.testing.assert_array_equal(
+        tessellation_kernels.any_overlap_in_range(query, first, last, keep, pad),
+        (near & in_range).any(axis=1))
