@@ -202,7 +202,7 @@ def default_gap_tol(patches: list[NurbsSurface]) -> float:
         boxes.append(s.bounding_box())
     box = np.concatenate(boxes)
     diag = float(np.linalg.norm(box.max(axis=0) - box.min(axis=0)))
-    positive = [x for x in lengths if x > 0]
+    positive = [x for x in lengths if x > 1e-9 * diag]        # collapsed sides left out
     shortest = min(positive) if positive else diag
     return min(_GAP_FACTOR_SIDE * shortest, _GAP_FACTOR_MODEL * diag)
 
@@ -274,7 +274,8 @@ def _ends_match(samples: _SideSamples, pa: int, sa: int, pb: int, sb: int, tol: 
 def _candidate_pairs(samples: _SideSamples, tol: float) -> list[tuple[int, int, int, int]]:
     """Side pairs whose boxes overlap and where at least two interior samples of one
     side lie within ``tol`` (plus the polylines' chord error) of the other side's box:
-    sides meeting only at a corner are culled before any distance is computed."""
+    sides meeting only at a corner are culled before any distance is computed. A side
+    collapsed to a point (a three-sided patch) shares nothing."""
     boxes = samples.boxes.reshape(-1, 2, 3)
     lo, hi = boxes[:, 0] - tol, boxes[:, 1] + tol
     overlap = np.all((lo[:, None] <= hi[None]) & (lo[None] <= hi[:, None]), axis=2)
@@ -293,6 +294,8 @@ def _candidate_pairs(samples: _SideSamples, tol: float) -> list[tuple[int, int, 
             out[start:start + 4096] = np.count_nonzero(dist <= reach, axis=1)
         return out
 
+    length = np.linalg.norm(np.diff(samples.fine, axis=2), axis=3).sum(axis=2).reshape(-1)
+    i, j = i[(length[i] > tol) & (length[j] > tol)], j[(length[i] > tol) & (length[j] > tol)]
     keep = (near(i, j) >= 2) | (near(j, i) >= 2)
     return [(a // 4, a % 4, b // 4, b % 4) for a, b in zip(i[keep].tolist(), j[keep].tolist())]
 
