@@ -7,7 +7,9 @@ hundred multiply-adds that numpy spends in temporaries and per-call overhead.
 * :func:`restricted_boxes`: the control-net boxes of Bézier patches restricted to
   sub-rectangles (the blossoms of :func:`.culling._blossom_restrict` in u, then v);
 * :func:`any_overlap`: which boxes come near any leaf of a box tree (the pruning test
-  of :func:`.tessellation._near`, without listing the pairs).
+  of :func:`.tessellation._near`, without listing the pairs);
+* :func:`query_pairs`: the overlapping pairs of :func:`.culling.candidate_pairs` with a
+  tree on one side only.
 
 ``AVAILABLE`` is False without numba; the callers keep their numpy forms then.
 """
@@ -20,7 +22,7 @@ from numpy.typing import NDArray
 from ..basis_kernels import AVAILABLE, _jit
 
 __all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "chord_errors_from_grid",
-           "restricted_boxes"]
+           "query_pairs", "restricted_boxes"]
 
 
 @_jit
@@ -202,3 +204,49 @@ def any_overlap_in_range(boxes: NDArray, first: NDArray, last: NDArray, keep: ND
                 np.asarray(last, dtype=np.int64), np.ascontiguousarray(keep, dtype=float),
                 float(pad), out)
     return out
+
+
+@_jit
+def _query_pairs(lo, hi, left, right, item, boxes, pad):
+    out = np.empty((max(16, 4 * boxes.shape[0]), 2), dtype=np.int64)
+    k = 0
+    stack = np.empty(128, dtype=np.int64)
+    for r in range(boxes.shape[0]):
+        top = 0
+        stack[0] = 0
+        while top >= 0:
+            node = stack[top]
+            top -= 1
+            inside = True
+            for e in range(3):
+                if lo[node, e] > boxes[r, 1, e] + pad or boxes[r, 0, e] > hi[node, e] + pad:
+                    inside = False
+                    break
+            if not inside:
+                continue
+            if left[node] < 0:
+                if k == out.shape[0]:
+                    grown = np.empty((2 * k, 2), dtype=np.int64)
+                    grown[:k] = out
+                    out = grown
+                out[k, 0] = r
+                out[k, 1] = item[node]
+                k += 1
+            else:
+                if top + 2 >= stack.size:
+                    stack = np.concatenate((stack, np.empty(stack.size, dtype=np.int64)))
+                stack[top + 1] = right[node]
+                stack[top + 2] = left[node]
+                top += 2
+    return out[:k]
+
+
+def query_pairs(tree, boxes: NDArray, pad: float) -> NDArray:
+    """All pairs ``(i, item)`` with ``boxes[i]`` within ``pad`` of the leaf box of ``item``
+    in ``tree`` on every axis, sorted lexicographically: :func:`.culling.tree_pairs`
+    with a tree on one side only (a depth-first search per box)."""
+    if tree.n_nodes == 0 or boxes.shape[0] == 0:
+        return np.zeros((0, 2), np.int64)
+    pairs = _query_pairs(tree.lo, tree.hi, tree.left, tree.right, tree.item,
+                         np.ascontiguousarray(boxes, dtype=float), float(pad))
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]

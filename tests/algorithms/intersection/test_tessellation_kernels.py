@@ -73,3 +73,15 @@ def test_overlap_queries_match_brute_force(pad):
     np.testing.assert_array_equal(
         tessellation_kernels.any_overlap_in_range(query, first, last, keep, pad),
         (near & in_range).any(axis=1))
+
+
+@pytest.mark.parametrize("pad", [0.0, 0.01])
+def test_candidate_pairs_match_tree_pairs(monkeypatch, pad):
+    from surfprep.algorithms.intersection.culling import candidate_pairs
+
+    rng = np.random.default_rng(12)
+    a, b = _random_boxes(rng, 300, 0.5), _random_boxes(rng, 200, 0.5)
+    pairs = candidate_pairs(a, b, pad=pad)
+    monkeypatch.setattr(tessellation_kernels, "AVAILABLE", False)
+    np.testing.assert_array_equal(pairs, candidate_pairs(a, b, pad=pad))
+    assert pairs.shape[0] > 4 * 300                     # the buffer had to grow
