@@ -33,7 +33,7 @@ from .branches import SingularKind, locate_singular_points, singular_branches
 from .refine import RefinedCurve, refine_points
 from .topology import EndKind
 
-__all__ = ["extend_open_ends", "join_at_singular_points"]
+__all__ = ["extend_open_ends", "join_at_singular_points", "points_on_branch"]
 
 _MAX_STEPS = 400
 #: largest tangent turn of one accepted step (radians)
@@ -307,9 +307,10 @@ def _pieces(curve: RefinedCurve, kind: tuple, centre: NDArray, radius: float) ->
     return out
 
 
-def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArray,
-                uv_a: NDArray, uv_b: NDArray, direction: NDArray, heights: NDArray, tol: float,
-                iterations: int = 30) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def points_on_branch(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArray,
+                     uv_a: NDArray, uv_b: NDArray, direction: NDArray, heights: NDArray,
+                     tol: float, iterations: int = 30, guess: tuple | None = None
+                     ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Points of branches leaving singular points along unit directions, all at once.
 
     Row ``i`` is the intersection of the branch leaving ``centre[i] (3,)`` (at
@@ -320,6 +321,8 @@ def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArra
     mapped by each surface's Jacobian pseudo-inverse there. Its Jacobian is
     regular on the branch away from the centre (the normals differ by about
     ``h |II_a - II_b|``).
+
+    ``guess = (uv_a, uv_b)``, ``(m, 2)`` each, replaces that prediction.
 
     Returns ``points (m, 3)``, ``uv_a, uv_b (m, 2)`` and ``converged (m,) bool``
     (``|a - b| <= tol / 16`` and within ``tol / 16`` of its plane).
@@ -332,6 +335,8 @@ def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArra
     pb = np.linalg.pinv(np.stack([db[:, 1, 0], db[:, 0, 1]], axis=2))
     z = np.concatenate([uv_a + np.einsum("mij,mj->mi", pa, step),
                         uv_b + np.einsum("mij,mj->mi", pb, step)], axis=1)
+    if guess is not None:
+        z = np.concatenate([guess[0], guess[1]], axis=1).astype(float)
     lo = np.concatenate([surface_a.domain[0::2], surface_b.domain[0::2]])
     hi = np.concatenate([surface_a.domain[1::2], surface_b.domain[1::2]])
     ok = np.zeros(m, dtype=bool)
@@ -343,8 +348,9 @@ def _arc_points(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: NDArra
         d = direction[todo]
         gap = da[:, 0, 0] - db[:, 0, 0]
         off = np.einsum("mi,mi->m", da[:, 0, 0] - centre[todo], d) - heights[todo]
-        done = (np.linalg.norm(gap, axis=1) <= tol / 16) & (np.abs(off) <= tol / 16)
-        ok[todo[done]] = True
+        met = (np.linalg.norm(gap, axis=1) <= tol / 16) & (np.abs(off) <= tol / 16)
+        done = met & ok[todo]          # one more step once met: rounding level, since
+        ok[todo[met]] = True           # near the point tol / 16 would slide tol / (16 sin)
         keep = ~done
         todo, zt, da, db, d = todo[keep], zt[keep], da[keep], db[keep], d[keep]
         gap, off = gap[keep], off[keep]
@@ -445,7 +451,7 @@ def _resolve_one(curves: list, kinds: list, centre: tuple, directions: NDArray,
         cu = np.concatenate([local[key][1] for key in keys])
         cv = np.concatenate([local[key][2] for key in keys])
         dirs = np.stack([halves[joins[key]] for key in keys])
-        solved = _arc_points(surface_a, surface_b, np.broadcast_to(p, (rows.size, 3)),
+        solved = points_on_branch(surface_a, surface_b, np.broadcast_to(p, (rows.size, 3)),
                              cu[rows], cv[rows], dirs[rows], np.concatenate(heights), tol)
         for n, key in enumerate(keys):
             arcs[key] = tuple(x[rows == n] for x in solved)
@@ -483,7 +489,7 @@ def join_at_singular_points(curves: list[RefinedCurve], kinds: list[tuple[EndKin
     3. every curve is cut out of a ball around the point (``_BALL_MARGIN`` times
        the farthest end that led to it), and each cut end is joined to the
        half-branch it points along by points solved on planes across that
-       branch (:func:`_arc_points`), so four curves end at the point, with end
+       branch (:func:`points_on_branch`), so four curves end at the point, with end
        kind BIFURCATION and the point itself as their first sample.
 
     Parameters
