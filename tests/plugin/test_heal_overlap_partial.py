@@ -92,7 +92,7 @@ def _with_hole(face, centre, radius):
     return out
 
 
-@pytest.mark.parametrize("trimmed_first", [False, True])
+@pytest.mark.parametrize("trimmed_first", [False, pytest.param(True, marks=pytest.mark.slow)])
 def test_partial_overlap_of_a_trimmed_face(big, trimmed_first):
     # B has a round hole (trimmed, two loops) and lies on A over a corner; the
     # untrimmed A is kept whichever comes first, B trimmed back and keeps its hole
