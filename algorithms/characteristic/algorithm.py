@@ -228,6 +228,7 @@ def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | 
     field = DistanceField(a, proj_b, False) if phi_on == "a" else DistanceField(b, proj_a, True)
     # the other role (border points) reuses the other projector instead of building it again
     field._cache["other_projector"] = proj_a if phi_on == "a" else proj_b
+    field._cache["evaluator"] = field._cache["other_projector"].evaluator   # r's, built once
     return field
 
 

@@ -44,8 +44,12 @@ def _powers(x, scale, degree, out):
 
 
 @_jit
-def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out):
-    """Derivatives to order 2 in each direction at one point: ``out (3, 3, 3)``."""
+def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out, full=True):
+    """Derivatives to order 2 in each direction at one point: ``out (3, 3, 3)``.
+
+    ``full`` False: only the entries of total order <= 2 (what the projection and
+    the distance jet read); the mixed third and fourth ones are set to zero.
+    """
     su = _span(iu[:, 0], u)
     sv = _span(iv[:, 0], v)
     scale_u = 1.0 / (iu[su, 1] - iu[su, 0])
@@ -54,26 +58,35 @@ def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out):
     _powers((u - iu[su, 0]) * scale_u, scale_u, p, du)
     _powers((v - iv[sv, 0]) * scale_v, scale_v, q, dv)
     dim = coef.shape[4]
-    for k in range(3):
+    tmp = np.empty((p + 1, 3, dim))          # the v-sums first: sum_j dv[m, j] coef[i, j]
+    for i in range(p + 1):
         for m in range(3):
             for c in range(dim):
-                s = 0.0
-                for i in range(p + 1):
-                    t = 0.0
-                    for j in range(q + 1):
-                        t += dv[m, j] * coef[su, sv, i, j, c]
-                    s += du[k, i] * t
-                hom[k, m, c] = s
-    if not rational:
-        for k in range(3):
-            for m in range(3):
-                for c in range(3):
-                    out[k, m, c] = hom[k, m, c]
-        return
-    # quotient rule (eq. 4.20 of Piegl & Tiller), as evaluator._rational_to_second_order
-    inv = 1.0 / hom[0, 0, 3]
+                t = 0.0
+                for j in range(q + 1):
+                    t += dv[m, j] * coef[su, sv, i, j, c]
+                tmp[i, m, c] = t
     for k in range(3):
         for m in range(3):
+            if not full and k + m > 2:
+                continue
+            for c in range(dim):
+                acc = 0.0
+                for i in range(p + 1):
+                    acc += du[k, i] * tmp[i, m, c]
+                hom[k, m, c] = acc
+    for k in range(3):
+        for m in range(3):
+            if not full and k + m > 2:
+                for c in range(3):
+                    out[k, m, c] = 0.0
+                continue
+            if not rational:
+                for c in range(3):
+                    out[k, m, c] = hom[k, m, c]
+                continue
+            # quotient rule (eq. 4.20 of Piegl & Tiller), as evaluator._rational_to_second_order
+            inv = 1.0 / hom[0, 0, 3]
             for c in range(3):
                 acc = hom[k, m, c]
                 for i in range(k + 1):
@@ -108,7 +121,7 @@ def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, to
     t0 = min(max(t0, lo[1]), hi[1])
     moved, before = np.inf, np.inf
     for _ in range(max_iter):
-        _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, d)
+        _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, d, False)
         off0, off1, off2 = x0 - d[0, 0, 0], x1 - d[0, 0, 1], x2 - d[0, 0, 2]
         f0 = off0 * d[1, 0, 0] + off1 * d[1, 0, 1] + off2 * d[1, 0, 2]
         f1 = off0 * d[0, 1, 0] + off1 * d[0, 1, 1] + off2 * d[0, 1, 2]
@@ -139,7 +152,7 @@ def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, to
             nxt = moved ** 3 / max(before, 1e-300) ** 2
         if moved <= tol or nxt <= tol:
             break
-    _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, qd)
+    _point_derivatives(coef, iu, iv, du, dv, rational, s0, t0, hom, qd, False)
     return s0, t0, moved, before
 
 
@@ -239,7 +252,8 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     n_t = np.empty(3)
     for i in range(n):
         _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
-                           r_rational, uv[i, 0], uv[i, 1], hom[:, :, :r_coef.shape[4]], rd)
+                           r_rational, uv[i, 0], uv[i, 1], hom[:, :, :r_coef.shape[4]], rd,
+                           False)
         for c in range(3):
             point[i, c] = rd[0, 0, c]
         st[i, 0], st[i, 1], moved[i], before[i] = _project_one(
