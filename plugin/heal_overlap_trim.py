@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from ..algorithms.projection import project_to_surface
 from ..errors import OpenCascadeError
@@ -141,10 +142,48 @@ def is_natural(face: TrimmedFace) -> bool:
     return bool(np.all(on_side))
 
 
+@dataclass(frozen=True, eq=False)
+class _Grid:
+    """A face's surface sampled on ``(SAMPLES + 1) ** 2`` points, border rows included,
+    in a k-d tree; ``spacing`` is the largest distance between grid neighbours."""
+
+    tree: cKDTree
+    interior: NDArray
+    spacing: float
+    box: NDArray
+
+
+def _grid(face: TrimmedFace) -> _Grid:
+    u0, u1, v0, v1 = face.surface.domain
+    t = np.linspace(0.0, 1.0, SAMPLES + 1)
+    g = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
+    spacing = max(np.linalg.norm(np.diff(g, axis=0), axis=-1).max(),
+                  np.linalg.norm(np.diff(g, axis=1), axis=-1).max())
+    interior = np.zeros(g.shape[:2], bool)
+    interior[1:-1, 1:-1] = True
+    pts = g.reshape(-1, 3)
+    return _Grid(cKDTree(pts), interior.ravel(), float(spacing),
+                 np.array([pts.min(axis=0), pts.max(axis=0)]))
+
+
+def _may_lie_on(b_samples: NDArray, a: _Grid, b_box: NDArray, gap_tol: float) -> bool:
+    """Cheap test before projecting: enough of ``b``'s samples have an interior sample
+    of ``a`` as nearest grid point within ``spacing`` (a point beyond ``a``'s edge has
+    a border sample nearest)."""
+    reach = a.spacing + gap_tol
+    if np.any(a.box[0] - reach > b_box[1]) or np.any(b_box[0] > a.box[1] + reach):
+        return False
+    d, k = a.tree.query(b_samples, distance_upper_bound=reach)
+    hit = np.isfinite(d)
+    return int(np.sum(a.interior[k[hit]])) >= MIN_SHARE * len(b_samples)
+
+
 def _pairs(faces: list, candidates: list[int], skip: set, gap_tol: float):
+    grids = {i: _grid(faces[i]) for i in candidates}
+    samples = {i: _samples(faces[i], SAMPLES) for i in candidates}
     for n, i in enumerate(candidates):
         for j in candidates[n + 1:]:
-            if (i, j) in skip:
+            if (i, j) in skip or not _may_lie_on(samples[j], grids[i], grids[j].box, gap_tol):
                 continue
             mask = on_face(faces[j], faces[i], gap_tol)
             share = float(mask.mean())

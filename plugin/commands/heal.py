@@ -72,6 +72,14 @@ def _summary(report: dict) -> list[str]:
              f"({sum(p['kind'] == 'hole' for p in patches)} hole(s) filled), "
              f"largest error {worst_err:.3g} mm, {len(report['dropped_overlaps'])} duplicate "
              f"face(s) dropped, {report['time_s']:.2f} s")]
+    cuts, partial = report.get("cuts", []), report.get("partial_overlaps", [])
+    if cuts:
+        lines.append(f"directed patches cut away {sum(c['area_cut'] for c in cuts):.4g} mm2 "
+                     f"of {len({c['face'] for c in cuts})} face(s) under them")
+    if partial or report.get("trimmed_overlaps"):
+        lines.append(f"overlaps trimmed back: {len(partial)} partial "
+                     f"({sum(o['area_cut'] for o in partial):.4g} mm2 of doubled area cut), "
+                     f"{len(report.get('trimmed_overlaps', []))} strip(s)")
     if joins:
         lines.append(f"{len(joins)} shared edge(s): max gap "
                      f"{max(j['max_gap'] for j in joins):.3g} mm, max normal angle "
@@ -111,13 +119,15 @@ def _run(args: argparse.Namespace, console: Console) -> int:
 
 COMMAND = Command(
     name="heal",
-    summary="replace gaps, holes and duplicate faces by joined bicubic approximants",
+    summary="replace gaps, holes, overlaps and crossings by joined bicubic approximants",
     description=(
         "Every four-sided face gets a bicubic B-spline approximant over its own four "
         "edges, projected onto all original faces (Hamann & Jean 1996); four-sided holes "
         "bounded by free edges of neighbouring faces are filled the same way (Hardy's "
-        "multiquadric over the hole); faces lying on other faces are dropped; directed "
-        "patches come from --patches. The approximants are joined G0 (shared control "
+        "multiquadric over the hole); faces lying on other faces are dropped, a face "
+        "lying partly on another is trimmed back to the other's boundary; directed "
+        "patches come from --patches and replace what they cover (the faces under "
+        "them are cut away). The approximants are joined G0 (shared control "
         "rows averaged) or G1 (tangent planes at corners, collinear control triples "
         "along edges), the result is sewn into a shell (a solid when closed) and checked "
         "with BRepCheck. The report gives per patch its resolution, error (max, RMS) and "

@@ -62,3 +62,29 @@ def test_heal_errors_are_one_line(gap_file, tmp_path, capsys):
     assert code != 0 and "JSON" in err
     code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "y.step", "--gap-tol", "-1")
     assert code != 0 and "gap_tol" in err
+
+
+@pytest.mark.slow
+def test_heal_directed_patch_over_crossing(tmp_path, capsys):
+    # two sheets cutting through each other and a patch spec over the crossing: the
+    # faces under the patch are cut away, the summary and the JSON say how much
+    def sheet(x0, x1, slope):
+        x, y = np.linspace(x0, x1, 9), np.linspace(0, 1, 6)
+        gx, gy = np.meshgrid(x, y, indexing="ij")
+        z = 0.05 * np.sin(2 * gy) + slope * (gx - 1.0)
+        return interpolate_surface(np.stack([gx, gy, z], axis=-1))
+    src = tmp_path / "crossing.step"
+    surfprep.write([make_face(sheet(0, 1.2, 0.0)), make_face(sheet(0.8, 2, 0.4))], src)
+    z = [0.0, 0.12, 0.12 + 0.05 * np.sin(2), 0.05 * np.sin(2)]
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps({"patches": [{"name": "over", "corners": [
+        [0.7, 0, z[0]], [1.3, 0, z[1]], [1.3, 1, z[2]], [0.7, 1, z[3]]]}]}))
+    out, report = tmp_path / "healed.step", tmp_path / "r.json"
+    code, stdout, err = run(capsys, "heal", src, "-o", out, "--patches", spec,
+                            "--json", report)
+    assert code == 0, err
+    assert "directed patches cut away" in stdout and "of 2 face(s)" in stdout
+    rep = json.loads(report.read_text())
+    assert sorted(c["face"] for c in rep["cuts"]) == [0, 1]
+    assert all(0.4 < c["area_cut"] < 0.6 for c in rep["cuts"])
+    assert rep["valid"]["after"] and surfprep.read(out).n_faces == 3
