@@ -315,14 +315,17 @@ def edge_roots(field: DistanceField, component: int, iterations: int = 6, noise:
     """
     count = _edge_count(field.r)
     brackets = []
-    for coord, _, uv in edge_samples(field.lower, field.upper, count):
-        jet = field.jet(uv)
-        g = jet.grad[:, component]
-        ok = jet.status == ProjectionStatus.UNIQUE
+    sides = edge_samples(field.lower, field.upper, count)
+    every = field.jet(np.concatenate([uv for _, _, uv in sides]))      # one batch, 4 sides
+    for n, (coord, _, uv) in enumerate(sides):
+        rows = slice(n * count, (n + 1) * count)
+        g = every.grad[rows, component]
+        ok = every.status[rows] == ProjectionStatus.UNIQUE
+        st_side = every.st[rows]
         k = np.flatnonzero(ok[:-1] & ok[1:] & (np.sign(g[:-1]) != np.sign(g[1:]))
                            & (np.maximum(np.abs(g[:-1]), np.abs(g[1:])) > noise))
         for i in k:
-            brackets.append((uv[i], uv[i + 1], g[i], g[i + 1], jet.st[i], coord))
+            brackets.append((uv[i], uv[i + 1], g[i], g[i + 1], st_side[i], coord))
     if not brackets:
         return np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, dtype=int)
     a = np.array([b[0] for b in brackets])
