@@ -109,16 +109,22 @@ def basis_derivatives_compiled(knots: NDArray, p: int, t: NDArray, span: NDArray
 
 
 @_jit
-def _rational_inplace(hom, order):
-    """A4.4 of [PT] on one point's ``hom (order + 1, order + 1, d + 1)``, in place: the
-    Cartesian derivatives into ``hom[..., :d]`` (the loop of
-    :func:`.rational.surface_derivatives_from_homogeneous`, same operations)."""
-    d = hom.shape[2] - 1
+def _binomials(order):
     comb = np.zeros((order + 1, order + 1))
     for n in range(order + 1):
         comb[n, 0] = 1.0
         for r in range(1, n + 1):
             comb[n, r] = comb[n - 1, r - 1] + (comb[n - 1, r] if r <= n - 1 else 0.0)
+    return comb
+
+
+@_jit
+def _rational_inplace(hom, order, comb):
+    """A4.4 of [PT] on one point's ``hom (order + 1, order + 1, d + 1)``, in place: the
+    Cartesian derivatives into ``hom[..., :d]`` (the loop of
+    :func:`.rational.surface_derivatives_from_homogeneous`, same operations);
+    ``comb`` the binomial coefficients (:func:`_binomials`)."""
+    d = hom.shape[2] - 1
     inv_w = 1.0 / hom[0, 0, d]
     for k in range(order + 1):
         for l in range(order + 1):
@@ -144,6 +150,7 @@ def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order, rational):
     lv, rv = np.empty(q + 1), np.empty(q + 1)
     tmp = np.empty((order + 1, q + 1, c))
     out = np.zeros((m, order + 1, order + 1, c))
+    comb = _binomials(order)
     for i in range(m):
         du[:, :] = 0.0
         dv[:, :] = 0.0
@@ -166,7 +173,7 @@ def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order, rational):
                         s += dv[ll, jj] * tmp[k, jj, cc]
                     out[i, k, ll, cc] = s
         if rational:
-            _rational_inplace(out[i], order)
+            _rational_inplace(out[i], order, comb)
     return out
 
 

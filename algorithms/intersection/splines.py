@@ -83,16 +83,15 @@ class SplineSet:
 def _evaluate_many(knots, knot_start, control, control_start, degree, index, t, order):
     m, d = t.size, control.shape[1]
     out = np.zeros((m, order + 1, d))
-    top = 0
-    for i in range(degree.size):
-        top = max(top, degree[i])
-    ndu = np.empty((top + 1, top + 1))
-    a = np.zeros((2, top + 1))
-    left, right = np.empty(top + 1), np.empty(top + 1)
-    ders = np.zeros((order + 1, top + 1))
+    p = -1
+    ndu, a = np.empty((1, 1)), np.zeros((2, 1))
+    left, right, ders = np.empty(1), np.empty(1), np.zeros((order + 1, 1))
     for j in range(m):
         c = index[j]
-        p = degree[c]
+        if degree[c] != p:                  # scratch of this degree (C-contiguous)
+            p = degree[c]
+            ndu, a = np.empty((p + 1, p + 1)), np.zeros((2, p + 1))
+            left, right, ders = np.empty(p + 1), np.empty(p + 1), np.zeros((order + 1, p + 1))
         kn = knots[knot_start[c]:knot_start[c + 1]]
         n = control_start[c + 1] - control_start[c]
         first, last = p, n - 1
@@ -103,8 +102,7 @@ def _evaluate_many(knots, knot_start, control, control_start, degree, index, t, 
         span = np.searchsorted(kn, t[j], side="right") - 1
         span = min(max(span, first), last)
         ders[:, :] = 0.0
-        _ders_one(kn, p, t[j], span, min(order, p), ndu[:p + 1, :p + 1], a[:, :p + 1],
-                  left[:p + 1], right[:p + 1], ders[:, :p + 1])
+        _ders_one(kn, p, t[j], span, min(order, p), ndu, a, left, right, ders)
         base = control_start[c] + span - p
         for k in range(order + 1):
             for e in range(d):

@@ -87,15 +87,18 @@ def chord_errors_from_grid(grid: NDArray, s: NDArray) -> tuple[NDArray, NDArray,
 @_jit
 def _restrict(line, s0, s1, out, work):
     """Bernstein coefficients ``out (p + 1, c)`` of ``line (p + 1, c)`` on ``[s0, s1]``."""
-    p = line.shape[0] - 1
+    p, c = line.shape[0] - 1, line.shape[1]
     for i in range(p + 1):
         for a in range(p + 1):
-            work[a] = line[a]
+            for e in range(c):
+                work[a, e] = line[a, e]
         for r in range(1, p + 1):
             x = s0 if r <= p - i else s1
             for a in range(p + 1 - r):
-                work[a] = (1.0 - x) * work[a] + x * work[a + 1]
-        out[i] = work[0]
+                for e in range(c):
+                    work[a, e] = (1.0 - x) * work[a, e] + x * work[a + 1, e]
+        for e in range(c):
+            out[i, e] = work[0, e]
 
 
 @_jit
@@ -103,26 +106,25 @@ def _boxes(coeffs, which, s0, s1, t0, t1, out):
     k = which.size
     p1, q1, c = coeffs.shape[1], coeffs.shape[2], coeffs.shape[3]
     first = np.empty((p1, q1, c))
-    line_u = np.empty((p1, c))
-    res_u = np.empty((p1, c))
-    line_v = np.empty((q1, c))
-    res_v = np.empty((q1, c))
-    work_u = np.empty((p1, c))
-    work_v = np.empty((q1, c))
+    line_u, res_u, work_u = np.empty((p1, c)), np.empty((p1, c)), np.empty((p1, c))
+    line_v, res_v, work_v = np.empty((q1, c)), np.empty((q1, c)), np.empty((q1, c))
     for r in range(k):
-        patch = coeffs[which[r]]
+        w_ = which[r]
         for j in range(q1):                    # u first (axis 1 of the patch)
             for i in range(p1):
-                line_u[i] = patch[i, j]
+                for e in range(c):
+                    line_u[i, e] = coeffs[w_, i, j, e]
             _restrict(line_u, s0[r], s1[r], res_u, work_u)
             for i in range(p1):
-                first[i, j] = res_u[i]
+                for e in range(c):
+                    first[i, j, e] = res_u[i, e]
         for e in range(3):
             out[r, 0, e] = np.inf
             out[r, 1, e] = -np.inf
         for i in range(p1):                    # then v
             for j in range(q1):
-                line_v[j] = first[i, j]
+                for e in range(c):
+                    line_v[j, e] = first[i, j, e]
             _restrict(line_v, t0[r], t1[r], res_v, work_v)
             for j in range(q1):
                 w = res_v[j, c - 1]
@@ -143,8 +145,8 @@ def restricted_boxes(coeffs: NDArray, which: NDArray, s0: NDArray, s1: NDArray, 
 
 
 @_jit
-def _any_overlap(lo, hi, left, right, boxes, pad, out):
-    stack = np.empty(128, dtype=np.int64)
+def _any_overlap(lo, hi, left, right, boxes, pad, depth, out):
+    stack = np.empty(depth, dtype=np.int64)
     for r in range(boxes.shape[0]):
         top = 0
         stack[0] = 0
@@ -162,8 +164,6 @@ def _any_overlap(lo, hi, left, right, boxes, pad, out):
             if left[node] < 0:
                 hit = True
             else:
-                if top + 2 >= stack.size:
-                    stack = np.concatenate((stack, np.empty(stack.size, dtype=np.int64)))
                 stack[top + 1] = right[node]
                 stack[top + 2] = left[node]
                 top += 2
@@ -177,7 +177,7 @@ def any_overlap(tree, boxes: NDArray, pad: float) -> NDArray:
     out = np.zeros(boxes.shape[0], dtype=bool)
     if tree.n_nodes and boxes.shape[0]:
         _any_overlap(tree.lo, tree.hi, tree.left, tree.right,
-                     np.ascontiguousarray(boxes, dtype=float), float(pad), out)
+                     np.ascontiguousarray(boxes, dtype=float), float(pad), 2 * tree.depth + 4, out)
     return out
 
 
@@ -207,10 +207,10 @@ def any_overlap_in_range(boxes: NDArray, first: NDArray, last: NDArray, keep: ND
 
 
 @_jit
-def _query_pairs(lo, hi, left, right, item, boxes, pad):
+def _query_pairs(lo, hi, left, right, item, boxes, pad, depth):
     out = np.empty((max(16, 4 * boxes.shape[0]), 2), dtype=np.int64)
     k = 0
-    stack = np.empty(128, dtype=np.int64)
+    stack = np.empty(depth, dtype=np.int64)
     for r in range(boxes.shape[0]):
         top = 0
         stack[0] = 0
@@ -227,18 +227,18 @@ def _query_pairs(lo, hi, left, right, item, boxes, pad):
             if left[node] < 0:
                 if k == out.shape[0]:
                     grown = np.empty((2 * k, 2), dtype=np.int64)
-                    grown[:k] = out
+                    for x in range(k):
+                        grown[x, 0] = out[x, 0]
+                        grown[x, 1] = out[x, 1]
                     out = grown
                 out[k, 0] = r
                 out[k, 1] = item[node]
                 k += 1
             else:
-                if top + 2 >= stack.size:
-                    stack = np.concatenate((stack, np.empty(stack.size, dtype=np.int64)))
                 stack[top + 1] = right[node]
                 stack[top + 2] = left[node]
                 top += 2
-    return out[:k]
+    return out, k
 
 
 def query_pairs(tree, boxes: NDArray, pad: float) -> NDArray:
@@ -247,6 +247,7 @@ def query_pairs(tree, boxes: NDArray, pad: float) -> NDArray:
     with a tree on one side only (a depth-first search per box)."""
     if tree.n_nodes == 0 or boxes.shape[0] == 0:
         return np.zeros((0, 2), np.int64)
-    pairs = _query_pairs(tree.lo, tree.hi, tree.left, tree.right, tree.item,
-                         np.ascontiguousarray(boxes, dtype=float), float(pad))
+    pairs, k = _query_pairs(tree.lo, tree.hi, tree.left, tree.right, tree.item,
+                            np.ascontiguousarray(boxes, dtype=float), float(pad), 2 * tree.depth + 4)
+    pairs = pairs[:k]
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
