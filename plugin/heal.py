@@ -68,7 +68,7 @@ from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches
-from .heal_overlap import find_overlaps, trimmed_back_boundary
+from .heal_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
@@ -273,9 +273,12 @@ class _Job:
     reference: TrimmedFace | None     # face whose orientation the approximant takes
 
 
-def _jobs(faces, kept, holes, trimmed: dict) -> list[_Job]:
+def _jobs(faces, kept, holes, trimmed: dict, unions: dict) -> list[_Job]:
     jobs = []
-    for i in kept:
+    for i, (j, outline) in unions.items():
+        jobs.append(_Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
+    in_union = set(unions) | {j for j, _ in unions.values()}
+    for i in (i for i in kept if i not in in_union):
         curves = trimmed.get(i) or four_sided_boundary(faces[i])
         if curves is not None:
             jobs.append(_Job(PatchOrigin("face", (i,), i), curves, faces[i].name, faces[i]))
@@ -283,6 +286,10 @@ def _jobs(faces, kept, holes, trimmed: dict) -> list[_Job]:
         jobs.append(_Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
                          [e.curve for e in loop], f"heal_hole_{k}", None))
     return jobs
+
+
+def _replaced(done) -> set[int]:
+    return {f for job, _ in done if job.origin.kind in ("face", "union") for f in job.origin.faces}
 
 
 def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[_Job, Any]]:
@@ -310,7 +317,7 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
                            f"({type(exc).__name__}: {exc}); left as it was")
             continue
-        if job.origin.kind == "face" and not la.converged:
+        if job.origin.kind in ("face", "union") and not la.converged:
             skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
                            f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
                            "kept as it was")
@@ -462,7 +469,8 @@ def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
 
 # ---------------------------------------------------------------------- heal
 def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
-         gap_tol: float | None = None, patches: Any = None) -> HealResult:
+         gap_tol: float | None = None, patches: Any = None,
+         overlap: OverlapRepair | str = "trim") -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -479,7 +487,11 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
         close, duplicates). Default ``min(1e-3 x model diagonal, 0.01 x median
         edge length)``.
     patches : path, dict or list, optional
-        Directed patches (:func:`.heal_spec.read_patch_spec`).
+        Directed patches (:func:`.heal_spec.read_patch_spec`); each replaces the
+        region it covers (the faces under it are cut away, :mod:`.heal_cut`).
+    overlap : "trim" or "union"
+        A strip overlap of two four-sided faces: the later face trimmed back, or
+        one approximant over the union's outline replacing both.
 
     Returns
     -------
@@ -515,18 +527,19 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     holes = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)
-    trimmed = {o.trimmed: trimmed_back_boundary(faces, o) for o in overlaps}
+    trimmed, unions = overlap_boundaries(faces, overlaps, OverlapRepair.parse(overlap),
+                                          gap_tol)
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    done = _approximate(_jobs(faces, kept, holes, trimmed), sources,
+    done = _approximate(_jobs(faces, kept, holes, trimmed, unions), sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
     done += directed_jobs(directed, cut)
     network = None
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
-        replaced = {job.origin.index for job, _ in done if job.origin.kind == "face"}
+        replaced = _replaced(done)
         network, snapped = _snap_to_originals(
             network, [e for e in edges if e.face not in replaced], gap_tol,
             TIGHT_FACTOR * model.size)
@@ -536,9 +549,8 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped if network is not None else 0
     result.extra["trimmed_overlaps"] = [
-        {"kept": o.kept, "trimmed": o.trimmed, "replaced": any(
-            j.origin.kind == "face" and j.origin.index == o.trimmed for j, _ in done)}
-        for o in overlaps]
+        {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in _replaced(done),
+         "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
 
 
@@ -546,8 +558,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
               ) -> HealResult:
     """The output from ``work`` (the input with faces under directed patches cut) and the
     approximants; figures before from ``model`` (the input)."""
-    replaced = {job.origin.faces[0] for job, _ in done if job.origin.kind == "face"}
-    gone = replaced | {b for _, b in dropped}
+    gone = _replaced(done) | {b for _, b in dropped}
     untouched = [i for i in range(work.n_faces) if i not in gone]
     new_faces, names = [], _FaceNames()
     for (job, _), surface in zip(done, network.patches if network else ()):

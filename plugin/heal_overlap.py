@@ -7,25 +7,37 @@ covered twice. B (the later face) is trimmed back: its approximant is built
 over A's side, the parts of B's two adjacent sides beyond it (each curve cut
 at the closest point to the end of A's side) and B's far side. A and the
 trimmed B then share A's side as a full boundary curve, and the network joins
-them G0/G1 like any neighbours. Exact duplicates are handled before this
-(:func:`.heal_topology.duplicate_faces`).
+them G0/G1 like any neighbours. With ``overlap="union"`` both are replaced
+instead by one approximant over the union's outline (:func:`union_boundary`).
+Exact duplicates are handled before this (:func:`.heal_topology.duplicate_faces`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..algorithms import NurbsCurve
 from ..algorithms.projection import distance_to_surface, project_to_curve
+from ..errors import InvalidGeometryError
 from .faces import TrimmedFace
 from .heal_topology import four_sided_boundary
 
-__all__ = ["Overlap", "find_overlaps", "trimmed_back_boundary"]
+__all__ = [
+    "Overlap",
+    "OverlapRepair",
+    "find_overlaps",
+    "overlap_boundaries",
+    "trimmed_back_boundary",
+    "union_boundary",
+]
 
 _SAMPLES = 9
+#: samples per side of a union outline
+_UNION_SAMPLES = 65
 
 
 @dataclass(frozen=True)
@@ -122,3 +134,76 @@ def _nearest_end(gone: NurbsCurve, curve: NurbsCurve) -> NDArray:
     c = curve.evaluate(np.array(curve.domain))
     d = np.linalg.norm(g[:, None] - c[None], axis=2)
     return g[np.unravel_index(np.argmin(d), d.shape)[0]]
+
+
+class OverlapRepair(str, Enum):
+    """What :func:`surfprep.heal` does with a strip overlap of two four-sided faces:
+    ``TRIM`` the later face back to the other's side, or one approximant over the
+    ``UNION``'s outline (four-sided: the two faces' adjacent sides continue each other)
+    replacing both."""
+
+    TRIM = "trim"
+    UNION = "union"
+
+    @classmethod
+    def parse(cls, value) -> OverlapRepair:
+        try:
+            return cls(value.value if isinstance(value, cls) else str(value).lower())
+        except ValueError:
+            raise InvalidGeometryError(f"overlap repair must be 'trim' or 'union', got "
+                                       f"{value!r}") from None
+
+
+def _dense(curve: NurbsCurve, n: int = _UNION_SAMPLES) -> NDArray:
+    t0, t1 = curve.domain
+    return curve.evaluate(np.linspace(t0, t1, n))
+
+
+def union_boundary(faces: list[TrimmedFace | None], overlap: Overlap, gap_tol: float
+                   ) -> list[NDArray] | None:
+    """Four polylines ``(n, 3) float`` (loop order) around the union of the two faces of a
+    strip overlap: the kept face's three other sides and the trimmed face's three sides
+    beyond the strip (:func:`trimmed_back_boundary`), chained end to end, the two pairs
+    meeting at the ends of the kept face's inside side merged. None when they do not
+    chain within ``gap_tol`` into such a loop."""
+    sides_a = four_sided_boundary(faces[overlap.kept])
+    k = overlap.side_kept
+    cut = sides_a[k]
+    ends = cut.evaluate(np.array(cut.domain))
+    pieces = [_dense(sides_a[(k + s) % 4]) for s in (1, 2, 3)]
+    pieces += [_dense(c) for c in trimmed_back_boundary(faces, overlap)[1:]]
+    chain = [pieces.pop(0)]
+    while pieces:
+        end = chain[-1][-1]
+        gaps = [min(np.linalg.norm(p[0] - end), np.linalg.norm(p[-1] - end)) for p in pieces]
+        n = int(np.argmin(gaps))
+        if gaps[n] > gap_tol:
+            return None
+        p = pieces.pop(n)
+        chain.append(p if np.linalg.norm(p[0] - end) <= np.linalg.norm(p[-1] - end)
+                     else p[::-1])
+    if np.linalg.norm(chain[-1][-1] - chain[0][0]) > gap_tol:
+        return None
+    out = []
+    for p in chain:
+        if out and np.min(np.linalg.norm(ends - out[-1][-1], axis=1)) <= gap_tol:
+            out[-1] = np.concatenate([out[-1], p[1:]])
+        else:
+            out.append(p)
+    if len(out) == 5 and np.min(np.linalg.norm(ends - out[-1][-1], axis=1)) <= gap_tol:
+        out = [np.concatenate([out[-1], out[0][1:]])] + out[1:-1]
+    return out if len(out) == 4 else None
+
+
+def overlap_boundaries(faces: list[TrimmedFace | None], overlaps: list[Overlap],
+                       repair: OverlapRepair, gap_tol: float) -> tuple[dict, dict]:
+    """``(trimmed, unions)``: trimmed face -> its boundary without the strip, and with
+    ``UNION`` kept face -> (trimmed face, the union's outline) where that is four-sided."""
+    unions = {}
+    if repair is OverlapRepair.UNION:
+        for o in overlaps:
+            outline = union_boundary(faces, o, gap_tol)
+            if outline is not None:
+                unions[o.kept] = (o.trimmed, outline)
+    return ({o.trimmed: trimmed_back_boundary(faces, o) for o in overlaps
+             if o.kept not in unions}, unions)

@@ -162,19 +162,27 @@ def _graph_area(x0, x1) -> float:
     return float(np.trapezoid(np.trapezoid(f, y, axis=1), x))
 
 
-def test_overlapping_faces_trimmed_back():
+@pytest.mark.parametrize("overlap", ["trim", "union"])
+def test_overlapping_faces_trimmed_back(overlap):
     continuity = "G1"
     a = graph_patch(0, 1, 0, 1, 6, 6)
     b = graph_patch(0.7, 1.7, 0, 1, 7, 6)          # overlaps a over 0.7 <= x <= 1
     shape = compound([make_face(a), make_face(b)])
     assert _area(shape) > _graph_area(0, 1.7) + 0.25      # the strip counted twice
-    r = heal(shape, continuity=continuity)
+    r = heal(shape, continuity=continuity, overlap=overlap)
     rep = r.report()
-    assert rep["trimmed_overlaps"] == [{"kept": 0, "trimmed": 1, "replaced": True}]
-    assert len(r.joins) == 1 and r.joins[0].max_gap < 1e-12
+    action = "union" if overlap == "union" else "trimmed back"
+    assert rep["trimmed_overlaps"] == [{"kept": 0, "trimmed": 1, "replaced": True,
+                                        "action": action}]
     assert abs(_area(r.model.shape) - _graph_area(0, 1.7)) < 2e-3     # no doubled area
-    assert r.tight_free_edges_after == 6 and r.valid_after
+    assert r.valid_after
     assert deviation_from_graph(r) < 1.5e-3
+    if overlap == "union":            # one approximant over the union's outline
+        assert [p.origin.kind for p in r.patches] == ["union"]
+        assert r.model.n_faces == 1 and r.tight_free_edges_after == 4
+        return
+    assert len(r.joins) == 1 and r.joins[0].max_gap < 1e-12
+    assert r.tight_free_edges_after == 6
     if continuity == "G1":
         assert r.joins[0].max_angle < 1e-2
 
