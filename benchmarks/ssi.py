@@ -24,7 +24,12 @@ ratio and our sample count. OpenCascade's time grows about with the cube of n;
 ``--quick`` (the default) skips its runs above 163^2 poles, ``--full`` does them
 (about 90 s at 323^2 against the plane).
 
-Run:  python benchmarks/ssi.py [--full] [--repeat 3]     (markdown tables)
+Part 0, first call. The timings above are of warm processes (a warm-up call
+first). Our kernels are compiled by numba on first use and cached on disk, so the
+first call in a fresh process pays for loading them (cache present) or compiling
+them (cache empty, e.g. a fresh checkout); printed beside OpenCascade's first call.
+
+Run:  python benchmarks/ssi.py [--full] [--repeat 3] [--skip-cold]     (markdown tables)
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ import time
 import numpy as np
 from intersect import bumpy, cylinder, deviation, flat, plane, sphere, torus
 from intersect import densely as dense_points
+
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import (
     connected_branches,
@@ -201,6 +207,55 @@ def scaling_rows(sizes, full: bool, repeat: int, tol: float = 1e-7) -> list[dict
     return rows
 
 
+# ------------------------------------------------------------------ cold start
+_FIRST_CALL = """
+import sys, time
+sys.path.insert(0, {bench!r})
+from intersect import plane, sphere
+a, b = plane(2, origin=(0, 0, 0.3)), sphere(1.0)
+start = time.perf_counter()
+if {occ}:
+    from surfprep.plugin.geom import surface_to_occ
+    from surfprep.plugin.occ_reference import intersect_surfaces_occ
+    ga, gb = surface_to_occ(a), surface_to_occ(b)
+    start = time.perf_counter()
+    intersect_surfaces_occ(ga, gb, 1e-7, samples=2)
+else:
+    from surfprep.algorithms.intersection import intersect_surfaces
+    intersect_surfaces(a, b, tol=1e-7)
+print(time.perf_counter() - start)
+"""
+
+
+def first_call(occ: bool, numba_cache: str | None = None) -> float:
+    """Seconds of the first plane x sphere intersection in a fresh process (ours with
+    its import; OpenCascade after converting the surfaces); ``numba_cache`` a numba
+    cache folder (an empty one: the compiled kernels are built from scratch)."""
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ)
+    if numba_cache is not None:
+        env["NUMBA_CACHE_DIR"] = numba_cache
+    code = _FIRST_CALL.format(bench=os.path.dirname(os.path.abspath(__file__)), occ=occ)
+    out = subprocess.run([sys.executable, "-c", code], env=env, check=True,
+                         capture_output=True, text=True)
+    return float(out.stdout.strip().splitlines()[-1])
+
+
+def cold_start_table() -> str:
+    """First-call costs: ours with numba's cache emptied (every kernel compiled), ours
+    with the cache in place (the normal case after the first run), OpenCascade."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as empty:
+        cold = first_call(False, empty)
+    warm, occ = first_call(False), first_call(True)
+    return ("| first plane x sphere call in a fresh process | s |\n|---|---|\n"
+            f"| ours, numba cache empty (all kernels compiled) | {cold:.2f} |\n"
+            f"| ours, numba cache present | {warm:.2f} |\n"
+            f"| OpenCascade GeomAPI_IntSS | {occ:.3f} |")
+
+
 # ------------------------------------------------------------------ tables
 def exact_table(rows) -> str:
     lines = [("| case | tol | ours s | OCC s | ours/OCC | branches ours / OCC / exact | samples "
@@ -251,7 +306,12 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3, help="timing runs, best kept")
     parser.add_argument("--skip-exact", action="store_true")
     parser.add_argument("--skip-scaling", action="store_true")
+    parser.add_argument("--skip-cold", action="store_true",
+                        help="skip the first-call costs (fresh processes, numba compile)")
     args = parser.parse_args()
+    if not args.skip_cold:
+        print("\n## First call (JIT compile and cache load, not in the tables below)\n")
+        print(cold_start_table())
     if not args.skip_exact:
         rows = exact_rows((1e-7, 1e-10), args.repeat)
         print("\n## Exact pairs\n")
