@@ -19,6 +19,7 @@ from enum import Enum
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from ..algorithms import NurbsCurve
 from ..algorithms.projection import distance_to_surface, project_to_curve
@@ -38,6 +39,10 @@ __all__ = [
 _SAMPLES = 9
 #: samples per side of a union outline
 _UNION_SAMPLES = 65
+#: grid samples per direction of a face for the cheap nearness test
+_GRID_SAMPLES = 16
+#: a point on a surface is within this many grid spacings of a grid point
+_NEAR_CELLS = 1.5
 
 
 @dataclass(frozen=True)
@@ -60,7 +65,32 @@ def _distance_to_curves(points: NDArray, curves: list[NurbsCurve]) -> NDArray:
     return np.min([project_to_curve(c, points).distance for c in curves], axis=0)
 
 
-def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float) -> list[int]:
+@dataclass(frozen=True, eq=False)
+class SurfaceGrid:
+    """A face's surface sampled on ``(samples + 1) ** 2`` points, border rows included,
+    in a k-d tree; ``spacing`` is the largest distance between grid neighbours."""
+
+    tree: cKDTree
+    interior: NDArray
+    spacing: float
+    box: NDArray
+
+
+def surface_grid(face: TrimmedFace, samples: int) -> SurfaceGrid:
+    u0, u1, v0, v1 = face.surface.domain
+    t = np.linspace(0.0, 1.0, samples + 1)
+    g = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
+    spacing = max(np.linalg.norm(np.diff(g, axis=0), axis=-1).max(),
+                  np.linalg.norm(np.diff(g, axis=1), axis=-1).max())
+    interior = np.zeros(g.shape[:2], bool)
+    interior[1:-1, 1:-1] = True
+    pts = g.reshape(-1, 3)
+    return SurfaceGrid(cKDTree(pts), interior.ravel(), float(spacing),
+                 np.array([pts.min(axis=0), pts.max(axis=0)]))
+
+
+def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float,
+                  grid: SurfaceGrid) -> list[int]:
     """Sides of ``a`` lying on ``b``'s surface and away from ``b``'s edges."""
     sides_a, sides_b = four_sided_boundary(a), four_sided_boundary(b)
     out = []
@@ -69,6 +99,10 @@ def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float) -> list[int]:
         pts = _interior_samples(curve)
         if np.any((pts < box[0] - gap_tol) | (pts > box[1] + gap_tol)):
             continue                          # a sample off b's box is off b's surface
+        near, _ = grid.tree.query(pts, distance_upper_bound=_NEAR_CELLS * grid.spacing
+                                  + gap_tol)
+        if not np.all(np.isfinite(near)):
+            continue                          # a sample far from every grid point of b
         if distance_to_surface(b.surface, pts).max() > gap_tol:
             continue
         if _distance_to_curves(pts, sides_b).min() > gap_tol:
@@ -84,14 +118,19 @@ def _boxes_overlap(a: TrimmedFace, b: TrimmedFace, tol: float) -> bool:
 def find_overlaps(faces: list[TrimmedFace | None], candidates: list[int], gap_tol: float
                   ) -> list[Overlap]:
     """Overlapping pairs among the four-sided ``candidates`` (each face trimmed once)."""
-    out, used = [], set()
+    out, used, grids = [], set(), {}
     for n, i in enumerate(candidates):
         for j in candidates[n + 1:]:
             if i in used or j in used or not _boxes_overlap(faces[i], faces[j], gap_tol):
                 continue
-            ka = _inside_sides(faces[i], faces[j], gap_tol)
-            kb = _inside_sides(faces[j], faces[i], gap_tol)
-            if len(ka) == 1 and len(kb) == 1:
+            for f in (i, j):
+                if f not in grids:
+                    grids[f] = surface_grid(faces[f], _GRID_SAMPLES)
+            ka = _inside_sides(faces[i], faces[j], gap_tol, grids[j])
+            if len(ka) != 1:
+                continue
+            kb = _inside_sides(faces[j], faces[i], gap_tol, grids[i])
+            if len(kb) == 1:
                 out.append(Overlap(i, ka[0], j, kb[0]))
                 used.add(j)
     return out

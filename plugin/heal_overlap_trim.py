@@ -25,14 +25,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 
 from ..algorithms.projection import project_to_surface
 from ..errors import OpenCascadeError
 from .faces import TrimmedFace
 from .heal_cut import cut_faces, outline, read_faces, rebuilt_model, replace_pieces, slab
-from .heal_overlap import find_overlaps
-from .heal_topology import duplicate_faces, face_edges, four_sided_boundary, pair_edges
+from .heal_overlap import SurfaceGrid, surface_grid
+from .heal_topology import duplicate_faces, face_edges, pair_edges
 
 __all__ = ["PartialOverlap", "is_natural", "is_strip", "loop_uv", "on_face", "overlap_area",
            "overlap_share", "trim_overlaps_of", "trim_partial_overlaps"]
@@ -142,31 +141,7 @@ def is_natural(face: TrimmedFace) -> bool:
     return bool(np.all(on_side))
 
 
-@dataclass(frozen=True, eq=False)
-class _Grid:
-    """A face's surface sampled on ``(SAMPLES + 1) ** 2`` points, border rows included,
-    in a k-d tree; ``spacing`` is the largest distance between grid neighbours."""
-
-    tree: cKDTree
-    interior: NDArray
-    spacing: float
-    box: NDArray
-
-
-def _grid(face: TrimmedFace) -> _Grid:
-    u0, u1, v0, v1 = face.surface.domain
-    t = np.linspace(0.0, 1.0, SAMPLES + 1)
-    g = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0))
-    spacing = max(np.linalg.norm(np.diff(g, axis=0), axis=-1).max(),
-                  np.linalg.norm(np.diff(g, axis=1), axis=-1).max())
-    interior = np.zeros(g.shape[:2], bool)
-    interior[1:-1, 1:-1] = True
-    pts = g.reshape(-1, 3)
-    return _Grid(cKDTree(pts), interior.ravel(), float(spacing),
-                 np.array([pts.min(axis=0), pts.max(axis=0)]))
-
-
-def _may_lie_on(b_samples: NDArray, a: _Grid, b_box: NDArray, gap_tol: float) -> bool:
+def _may_lie_on(b_samples: NDArray, a: SurfaceGrid, b_box: NDArray, gap_tol: float) -> bool:
     """Cheap test before projecting: enough of ``b``'s samples have an interior sample
     of ``a`` as nearest grid point within ``spacing`` (a point beyond ``a``'s edge has
     a border sample nearest)."""
@@ -179,7 +154,7 @@ def _may_lie_on(b_samples: NDArray, a: _Grid, b_box: NDArray, gap_tol: float) ->
 
 
 def _pairs(faces: list, candidates: list[int], skip: set, gap_tol: float):
-    grids = {i: _grid(faces[i]) for i in candidates}
+    grids = {i: surface_grid(faces[i], SAMPLES) for i in candidates}
     samples = {i: _samples(faces[i], SAMPLES) for i in candidates}
     for n, i in enumerate(candidates):
         for j in candidates[n + 1:]:
@@ -256,13 +231,12 @@ def _unit(surface):
 def trim_overlaps_of(work, faces: list[TrimmedFace | None], *, gap_tol: float, tight: float,
                      skipped: list[str]):
     """:func:`trim_partial_overlaps` over the readable faces of ``work`` that are no
-    duplicates (:func:`duplicate_faces`, dropped later), strips of two four-sided faces
-    left to :func:`find_overlaps`. Returns ``(model, faces, overlaps)``."""
+    duplicates (:func:`duplicate_faces`, dropped later); strips (:func:`is_strip`) are
+    left to :func:`.heal_overlap.find_overlaps`. Returns ``(model, faces, overlaps)``."""
     edges = face_edges(faces)
     twins = {b for _, b in duplicate_faces(faces, edges, pair_edges(edges, gap_tol), gap_tol)}
     readable = [i for i, f in enumerate(faces) if f is not None and i not in twins]
-    four = [i for i in readable if four_sided_boundary(faces[i]) is not None]
-    strips = {(o.kept, o.trimmed) for o in find_overlaps(faces, four, gap_tol)}
+    strips: set = set()            # strips are told apart by is_strip (cheaper)
     work, faces, _, partial = trim_partial_overlaps(work, faces, readable, strips,
                                                     gap_tol=gap_tol, tight=tight,
                                                     skipped=skipped)
