@@ -3,17 +3,16 @@
 Steps, on anything that holds faces (file path, :class:`CadModel`,
 ``TopoDS_Shape``, cadquery / build123d object):
 
-1. every face is read as a :class:`TrimmedFace`; directed patches (``patches``,
-   :mod:`.heal_spec`) are approximated over the original faces and the faces
-   under each are cut away (:mod:`.heal_cut`), so a patch replaces what it
-   covers; of two faces overlapping partially (a corner, a face partly on
-   another, any number of sides, trimmed or not) the later is trimmed back to
-   the other's boundary (:mod:`.heal_overlap_trim`); faces that lie on another face
-   within ``gap_tol`` (all their edges on its edges, interior points on its
-   surface; exact duplicates as in overture_marscapsule_proe.igs) are dropped,
-   and of two four-sided faces overlapping over a strip the later one is
-   trimmed back to the other's side (:mod:`.heal_overlap`), so the output has
-   no doubled area;
+1. every face is read as a :class:`TrimmedFace`; each directed patch
+   (``patches``, :mod:`.heal_spec`) is approximated over the original faces,
+   which are then cut away under it (:mod:`.heal_cut`): it replaces what it
+   covers; of two faces overlapping partially (any sides, trimmed or not) the
+   later is trimmed back to the other's boundary (:mod:`.heal_overlap_trim`);
+   faces lying on another within ``gap_tol`` (exact duplicates as in
+   overture_marscapsule_proe.igs) are dropped; of two four-sided faces
+   overlapping over a strip the later one is trimmed back to the other's side,
+   or both replaced by one approximant over the union (``overlap="union"``,
+   :mod:`.heal_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; free
    edges chained into loops of four from two or more faces are holes;
 3. every four-sided face (one loop of four real edges, trimmed or not) gets a
@@ -23,8 +22,7 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    the segments; a face whose approximant misses ``tol`` at the largest
    resolution is kept as it is, and the report says so); every hole one over
    its four free edges (a loop whose patch lands on faces, e.g. the mouth of
-   a slot, is no hole and stays open); every directed patch of ``patches``
-   (:mod:`.heal_spec`) one over its curves or corners;
+   a slot, is no hole and stays open);
 4. the approximants are joined by :func:`connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
    as it was (not re-approximated) is fitted to that face's edge or edges
@@ -67,7 +65,7 @@ from ..algorithms.projection import project_to_curve
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
-from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches
+from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches, inner_edges
 from .heal_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
 from .heal_spec import DirectedPatch, read_patch_spec
@@ -111,8 +109,10 @@ TIGHT_FACTOR = 1e-7
 
 @dataclass(frozen=True)
 class PatchOrigin:
-    """Where an approximant comes from: ``kind`` "face", "hole" or "directed", and
-    the face indices (the face replaced, the faces bounding the hole)."""
+    """Where an approximant comes from: ``kind`` "face", "hole", "union" or "directed",
+    and face indices: the face replaced, the faces bounding the hole, the two faces of
+    a union, the input faces a directed patch cut. Indices other than a directed
+    patch's count the faces after the cuts (a cut face's pieces take its place)."""
 
     kind: str
     faces: tuple[int, ...]
@@ -541,7 +541,8 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
                           gap_tol=gap_tol, strict=False)
         replaced = _replaced(done)
         network, snapped = _snap_to_originals(
-            network, [e for e in edges if e.face not in replaced], gap_tol,
+            network, [e for e in edges if e.face not in replaced]
+            + inner_edges(faces, replaced | gone), gap_tol,
             TIGHT_FACTOR * model.size)
     result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start)

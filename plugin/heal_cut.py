@@ -46,11 +46,11 @@ from ..algorithms.healing.boundary import Boundary, as_boundary
 from ..algorithms.projection import project_to_surface
 from ..errors import OpenCascadeError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
-from .heal_topology import is_valid, polyline_distance, sew
+from .heal_topology import EDGE_SAMPLES, FaceEdge, is_valid, polyline_distance, sew
 from .step_iges import _all_faces
 
 __all__ = ["CutModel", "FaceCut", "boundary_on_faces", "cut_faces", "cut_under_patches",
-           "face_area", "outline", "read_faces", "rebuilt_model",
+           "face_area", "inner_edges", "outline", "read_faces", "rebuilt_model",
            "replace_pieces", "slab"]
 
 #: samples per boundary curve put onto the faces
@@ -382,3 +382,21 @@ def covered_holes_dropped(holes: list, cut: CutModel, gap_tol: float) -> list:
     return [loop for loop in holes
             if not any(all(polyline_distance(e.samples, line).max() <= gap_tol for e in loop)
                        for line in lines)]
+
+
+def inner_edges(faces: list[TrimmedFace | None], skip: set[int]) -> list[FaceEdge]:
+    """Real edges of the inner loops (holes) of the faces not in ``skip``, sampled like
+    :func:`.heal_topology.face_edges` (``k`` counts from -1 down): a directed patch in
+    the middle of a face leaves a hole whose edges the patch's sides are snapped to."""
+    out = []
+    for i, face in enumerate(faces):
+        if face is None or i in skip:
+            continue
+        inner = [lp for n, lp in enumerate(face.loops) if n != face.outer_loop_index]
+        for k, e in enumerate(e for lp in inner for e in lp.edges):
+            if e.degenerated or e.curve3d is None or e.is_seam:
+                continue
+            t0, t1 = e.curve3d.domain
+            out.append(FaceEdge(i, -1 - k, e.curve3d,
+                                e.curve3d.evaluate(np.linspace(t0, t1, EDGE_SAMPLES))))
+    return out
