@@ -13,8 +13,9 @@ corner, the others join their edges into one side. With ``c`` corners:
 * ``c = 3`` or ``c >= 5``: the classic split into ``c`` quads around a centre
   point: the midpoint (half the arc length) of every side is joined to a centre
   on the surface by a *spoke*, quad ``k`` is ``V_k, M_k, C, M_{k-1}``;
-* ``c <= 2`` (a disc, a lens, a half disc): split points are added at the
-  middle (in arc length) of the longest sides until there are four, one patch.
+* ``c <= 2`` (a disc, a lens, a half disc): the vertices (all of them when the
+  loop has at most four edges) and split points at the middle (in arc length)
+  of the longest stretches between them, four in all, one patch.
 
 Spokes are straight lines in the face's parameter plane from the centre (the
 mean ``(u, v)`` of the side midpoints) mapped onto the surface and interpolated
@@ -364,7 +365,11 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         raise NotDecomposableError(f"{corners.size} corners: more than {MAX_SIDES} sides")
     cuts = [(int(k), real[k].curve.domain[0]) for k in corners]
     if len(cuts) <= 2:
-        cuts = _extra_cuts(real, cuts, 4)
+        # every vertex of a loop of at most four edges stays a corner (the neighbours'
+        # edges end there), split points fill the longest stretches up to four
+        seeds = [(k, real[k].curve.domain[0]) for k in range(len(real))] if len(real) <= 4 \
+            else cuts
+        cuts = _extra_cuts(real, seeds, 4)
     n = len(cuts)
     sides = [_side(real, _pieces(real, cuts[i], cuts[(i + 1) % n])) for i in range(n)]
     outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]

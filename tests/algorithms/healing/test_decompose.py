@@ -77,10 +77,24 @@ def test_six_edges_merge_at_the_four_cornery_vertices():
     assert np.degrees(d.turning[[1, 4]]).max() < 1.0
 
 
-def test_disc_of_three_arcs_is_one_quad_of_four_equal_sides():
-    d = decompose_loop(SURFACE, disc(SURFACE, pieces=3))
+def test_disc_of_three_arcs_keeps_its_vertices_as_corners():
+    edges = disc(SURFACE, pieces=3)
+    d = decompose_loop(SURFACE, edges)
+    corners = np.array([c.evaluate(c.domain[0]) for c in d.quads[0]])
+    vertices = np.array([e.curve.evaluate(0.0) for e in edges])
+    assert np.min(np.linalg.norm(corners[:, None] - vertices[None], axis=2), axis=0).max() < 1e-9
     lengths = [c.arc_length() for c in d.quads[0]]
-    assert max(lengths) / min(lengths) < 1.05
+    arcs = [e.curve.arc_length() for e in edges]
+    whole = [x for x in lengths if np.isclose(arcs, x, rtol=1e-9).any()]
+    halves = [x for x in lengths if x not in whole]
+    assert len(whole) == 2 and len(halves) == 2             # two arcs whole, one cut in two
+    assert abs(sum(lengths) - sum(arcs)) < 1e-9 and abs(halves[0] - halves[1]) < 1e-3
+
+
+def test_disc_of_one_edge_is_cut_in_four_equal_arcs():
+    d = decompose_loop(SURFACE, disc(SURFACE, pieces=1))
+    lengths = [c.arc_length() for c in d.quads[0]]
+    assert max(lengths) / min(lengths) < 1.01
 
 
 def test_very_non_convex_outline_is_refused_with_the_reason():
