@@ -6,11 +6,11 @@ import json
 
 import numpy as np
 import pytest
+
+import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.plugin import cli
 from surfprep.plugin.faces import make_face
-
-import surfprep
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:

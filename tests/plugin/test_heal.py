@@ -13,15 +13,15 @@ import numpy as np
 import pytest
 from OCP.BRep import BRep_Builder
 from OCP.TopoDS import TopoDS_Compound
+
+import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.surface import NurbsSurface
+from surfprep.errors import InvalidGeometryError
 from surfprep.plugin.convert import to_nurbs
 from surfprep.plugin.faces import make_face
 from surfprep.plugin.heal import heal
 from surfprep.plugin.io import CadModel
-
-import surfprep
-from surfprep.errors import InvalidGeometryError
 
 
 def graph(x, y):

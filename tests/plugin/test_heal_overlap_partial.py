@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from OCP.BRep import BRep_Builder
 from OCP.TopoDS import TopoDS_Compound
+
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.plugin.convert import to_nurbs
