@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "algorithms" / "healing"))
-from decompose_cases import (  # noqa: E402
+from decompose_cases import (
     disc,
     line,
     edge_from_uv,
@@ -21,18 +21,18 @@ from decompose_cases import (  # noqa: E402
     triangle,
     wavy_surface,
 )
-from surfprep.algorithms.healing import connect, local_approximant  # noqa: E402
-from surfprep.algorithms.healing.decompose import reverse_curve  # noqa: E402
-from surfprep.algorithms.projection import distance_to_surface  # noqa: E402
-from surfprep.plugin.edges import TrimEdge  # noqa: E402
-from surfprep.plugin.faces import TrimLoop, face_to_nurbs, make_face  # noqa: E402
-from surfprep.plugin.heal import face_source  # noqa: E402
-from surfprep.plugin.heal_nsided import (  # noqa: E402
+from surfprep.algorithms.healing import connect, local_approximant
+from surfprep.algorithms.healing.decompose import reverse_curve
+from surfprep.algorithms.projection import distance_to_surface
+from surfprep.plugin.edges import TrimEdge
+from surfprep.plugin.faces import TrimLoop, face_to_nurbs, make_face
+from surfprep.plugin.heal import face_source
+from surfprep.plugin.heal_nsided import (
     decompose_face,
     quad_boundaries,
     why_not_decomposable,
 )
-from surfprep.plugin.heal_topology import four_sided_boundary  # noqa: E402
+from surfprep.plugin.heal_topology import four_sided_boundary
 
 SURFACE = wavy_surface()
 GAP = 1e-6
