@@ -163,10 +163,10 @@ def _compiled_jet(r: PatchEvaluator, projector: Projector, uv: NDArray,
         st0 = projector.seeds(r.evaluate(uv[:, 0], uv[:, 1]))
     st0 = np.ascontiguousarray(np.asarray(st0, dtype=float).reshape(-1, 2))
     lo, hi, quarter = projector.newton_bounds()
-    point, foot, normal, st, phi, grad, hess, jac, k, moved, before = kernels.distance_points(
+    point, foot, normal, st, phi, grad, hess, jac, status, det = kernels.distance_points(
         *r.compiled, *projector.evaluator.compiled, np.ascontiguousarray(uv), st0, lo, hi,
-        quarter, float(projector.tol), int(projector.max_iter))
-    status, det = projector.status(st, k, moved, before)
+        quarter, float(projector.tol), int(projector.max_iter), projector.lower,
+        projector.upper)
     return DistanceJet(uv, point, Projection(st, foot, status, det), normal, phi, grad, hess, jac)
 
 

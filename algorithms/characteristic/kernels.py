@@ -208,8 +208,28 @@ def _normal_derivative(c1, c2, n, length, out):
 
 
 @_jit
+def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
+    """The §6.2 case of one foot, as :meth:`.projection.Projector.status`:
+    0 unique, 1 multiple (``K`` not positive definite), 2 none (outside ``q``'s
+    domain, or Newton did not converge)."""
+    eps0 = 1e-9 * (upper[0] - lower[0])
+    eps1 = 1e-9 * (upper[1] - lower[1])
+    if s < lower[0] - eps0 or s > upper[0] + eps0 or t < lower[1] - eps1 or t > upper[1] + eps1:
+        return 2
+    if moved > 10 * tol:
+        fast = (moved < before and np.isfinite(before)
+                and moved ** 3 / max(before, 1e-300) ** 2 <= tol)
+        if not fast:
+            return 2
+    det = k00 * k11 - k01 * k01
+    if det <= 1e-12 * (k00 + k11) ** 2 or k00 <= 0:
+        return 1
+    return 0
+
+
+@_jit
 def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
-                    lo, hi, quarter, tol, max_iter):
+                    lo, hi, quarter, tol, max_iter, lower, upper):
     """``phi``, its gradient and Hessian (002 eqs. 2, 24-31) at ``uv (n, 2)`` of ``r``.
 
     Per point: ``r``'s derivatives, the foot on ``q`` (:func:`_project_one`), the
@@ -223,9 +243,11 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     st : (n, 2) float
     phi : (n,) float
     grad : (n, 2) float
-    hess, jac, k : (n, 2, 2) float
-        Hessian of phi, ``K^{-1} G``, ``K``.
-    moved, before : (n,) float
+    hess, jac : (n, 2, 2) float
+        Hessian of phi, ``K^{-1} G``.
+    status : (n,) int8
+        §6.2 case of each foot (:func:`_status`; ``lower``, ``upper``: ``q``'s domain).
+    det_k : (n,) float
     """
     n = uv.shape[0]
     point = np.empty((n, 3))
@@ -236,9 +258,8 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     grad = np.empty((n, 2))
     hess = np.empty((n, 2, 2))
     jac = np.empty((n, 2, 2))
-    kmat = np.empty((n, 2, 2))
-    moved = np.empty(n)
-    before = np.empty(n)
+    status = np.empty(n, dtype=np.int8)
+    det_k = np.empty(n)
     du = np.empty((3, max(r_coef.shape[2], q_coef.shape[2])))
     dv = np.empty((3, max(r_coef.shape[3], q_coef.shape[3])))
     hom = np.empty((3, 3, 4))
@@ -256,7 +277,7 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
                            False)
         for c in range(3):
             point[i, c] = rd[0, 0, c]
-        st[i, 0], st[i, 1], moved[i], before[i] = _project_one(
+        st[i, 0], st[i, 1], moved, before = _project_one(
             q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
             st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter,
             du[:, :q_coef.shape[2]], dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
@@ -293,8 +314,10 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
             k11 += qt[c] * qt[c] - off * qd[0, 2, c]
         phi[i] = p_
         grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
-        kmat[i, 0, 0], kmat[i, 0, 1], kmat[i, 1, 0], kmat[i, 1, 1] = k00, k01, k01, k11
+        status[i] = _status(st[i, 0], st[i, 1], k00, k01, k11, moved, before, lower, upper,
+                            tol)
         det = k00 * k11 - k01 * k01
+        det_k[i] = det
         j00 = j01 = j10 = j11 = 0.0
         if abs(det) > 1e-300:                                              # eq. (21)
             j00 = (k11 * g00 - k01 * g10) / det
@@ -312,7 +335,7 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
             hvv += nv_c * rv[c] + nq[c] * rd[0, 2, c]                      # (29)
         mixed = 0.5 * (huv + hvu)
         hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
-    return point, foot, normal, st, phi, grad, hess, jac, kmat, moved, before
+    return point, foot, normal, st, phi, grad, hess, jac, status, det_k
 
 
 def evaluator_arrays(coef: NDArray, iu: NDArray, iv: NDArray) -> tuple[NDArray, NDArray, NDArray]:

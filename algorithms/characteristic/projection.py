@@ -312,5 +312,8 @@ class Projector:
 
     def newton_bounds(self) -> tuple[NDArray, NDArray, NDArray]:
         """``(lo, hi, quarter)``: Newton's clip box (domain and extension) and step limit."""
-        span = self.upper - self.lower
-        return self.lower - EXTENSION * span, self.upper + EXTENSION * span, 0.25 * span
+        if "bounds" not in self._grid:
+            span = self.upper - self.lower
+            self._grid["bounds"] = (self.lower - EXTENSION * span, self.upper + EXTENSION * span,
+                                    0.25 * span)
+        return self._grid["bounds"]
