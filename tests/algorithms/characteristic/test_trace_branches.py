@@ -21,8 +21,8 @@ import pytest
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.characteristic.algorithm import choose_field
 from surfprep.algorithms.characteristic.curves import CurveKind, EndReason, trace_curves
+from surfprep.algorithms.characteristic.singular import continue_at_singular_points
 from surfprep.algorithms.characteristic.trace import (
-    continue_at_singular_points,
     to_intersection_curve,
     trace_intersections,
 )
