@@ -59,7 +59,7 @@ _FAMILIES = ((0, CurveKind.U_CHARACTERISTIC, PointKind.EDGE_ROOT_U),
 def trace_characteristic(field: DistanceField, kind, uv: NDArray, st: NDArray,
                          direction: NDArray, h_max: float) -> list[TracedCurve]:
     """Characteristic curves from ``uv (m, 2)`` one way each, with the loose corrector."""
-    return trace_curves(field, kind, uv, st, direction, h0=0.2 * h_max, h_max=h_max,
+    return trace_curves(field, kind, uv, st, direction, h0=h_max, h_max=h_max,
                         max_steps=400, max_turn=CHARACTERISTIC_TURN,
                         ctol=1e-3 * field.diagonal, relative_ctol=CHARACTERISTIC_CTOL)
 
