@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 from ..intersection import IntersectionCurve
 from .curves import TracedCurve
@@ -78,21 +79,9 @@ class Start:
 
 
 def _label(mask: NDArray) -> NDArray:
-    """4-connected components of a boolean grid: labels ``1, 2, ...`` (0 outside the mask),
-    by propagating the smallest label to neighbours until nothing changes."""
-    big = mask.size + 1
-    lab = np.where(mask, np.arange(1, mask.size + 1).reshape(mask.shape), big)
-    while True:
-        new = lab.copy()
-        new[1:] = np.minimum(new[1:], lab[:-1])
-        new[:-1] = np.minimum(new[:-1], lab[1:])
-        new[:, 1:] = np.minimum(new[:, 1:], lab[:, :-1])
-        new[:, :-1] = np.minimum(new[:, :-1], lab[:, 1:])
-        new = np.where(mask, new, big)
-        if np.array_equal(new, lab):
-            break
-        lab = new
-    return np.where(mask, lab, 0)
+    """4-connected components of a boolean grid: labels ``1, 2, ...`` (0 outside the mask)."""
+    labels, _ = ndimage.label(mask)
+    return labels
 
 
 def loop_keys(field: DistanceField, grid: DistanceJet, shape: tuple[int, int],
