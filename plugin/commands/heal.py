@@ -58,6 +58,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              "min(1e-3 x size, 0.01 x median edge length))")
     parser.add_argument("--patches", type=Path, default=None, metavar="SPEC.json",
                         help="directed patches: four corners or four curves each")
+    parser.add_argument("--overlap", choices=("trim", "union"), default="trim",
+                        help="a strip overlap of two four-sided faces: trim the later face "
+                             "back (default) or replace both by one approximant over their "
+                             "union when it is four-sided")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
@@ -98,7 +102,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read(args.input)
     result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
-                  patches=args.patches)
+                  patches=args.patches, overlap=args.overlap)
     report = {"input": str(args.input), **result.report()}
     report["output"] = str(write(result.model, args.output, overwrite=True))
     if args.plot is not None:

@@ -88,3 +88,21 @@ def test_heal_directed_patch_over_crossing(tmp_path, capsys):
     assert sorted(c["face"] for c in rep["cuts"]) == [0, 1]
     assert all(0.4 < c["area_cut"] < 0.6 for c in rep["cuts"])
     assert rep["valid"]["after"] and surfprep.read(out).n_faces == 3
+
+
+@pytest.mark.parametrize("overlap, faces_out", [("trim", 2), ("union", 1)])
+def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
+    # a strip overlap of two four-sided sheets: --overlap trim keeps two faces (the later
+    # one trimmed back), --overlap union replaces both by one approximant
+    src = tmp_path / "overlap.step"
+    surfprep.write([make_face(graph_patch(0, 1, 6, 0.0)), make_face(graph_patch(0.7, 1.7, 7, 0.0))],
+                   src)
+    out, report = tmp_path / f"{overlap}.step", tmp_path / f"{overlap}.json"
+    code, _, err = run(capsys, "heal", src, "-o", out, "--overlap", overlap, "--json", report)
+    assert code == 0, err
+    rep = json.loads(report.read_text())
+    action = "union" if overlap == "union" else "trimmed back"
+    assert [t["action"] for t in rep["trimmed_overlaps"]] == [action]
+    assert surfprep.read(out).n_faces == faces_out
+    code, _, err = run(capsys, "heal", src, "-o", tmp_path / "x.step", "--overlap", "merge")
+    assert code != 0 and "overlap" in err
