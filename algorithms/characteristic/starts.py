@@ -234,10 +234,11 @@ def trace_uncovered(field: DistanceField, starts: Start, known: list[Intersectio
         # one start per group and round (several starts of one loop trace once)
         _, first = np.unique(group[todo], return_index=True)
         batch = todo[np.sort(first)]
-        traced = trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol)
+        traced = trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol,
+                                     branches=True)
         kept_traces: list[TracedCurve] = []
         for t in traced:
-            if any(_on_trace(t.uv[0], k) for k in kept_traces):
+            if any(_on_trace(t.uv[t.uv.shape[0] // 2], k) for k in kept_traces):
                 continue                                  # a loop traced twice in one round
             curve = to_intersection_curve(field, t, tol)
             if curve is None:

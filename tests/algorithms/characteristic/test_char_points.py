@@ -21,6 +21,7 @@ from surfprep.algorithms.characteristic.points import (
     edge_roots,
     solve_held,
 )
+from surfprep.algorithms.intersection import EndKind
 
 
 @pytest.fixture(scope="module")
@@ -128,8 +129,9 @@ def test_intersection_loop_closes_and_step_cap_is_a_cap(bumps_field):
 
 def test_saddle_on_the_intersection_is_a_double_point():
     """z = g(x) - g(y) against z = 0: the diagonals x = y and x = 1 - y cross at the
-    centre, a saddle of phi with phi = 0 (eq. 8, det H < 0); both lines are traced
-    from side to side, exactly."""
+    centre, a saddle of phi with phi = 0 (eq. 8, det H < 0); the tracer splits at the
+    double point, so four half-diagonals come back, each from a side to the centre
+    (a BIFURCATION end there), exactly."""
     from char_surfaces import clamped, height_field
 
     from surfprep.algorithms.basis import greville_abscissae
@@ -141,9 +143,10 @@ def test_saddle_on_the_intersection_is_a_double_point():
     rec = characteristic_intersection(a, b, tol=1e-9)
     (double,) = rec.of_kind(PointKind.DOUBLE_POINT)
     np.testing.assert_allclose(double.uv_a, [0.5, 0.5], atol=1e-9)
-    assert len(rec.curves) == 2 and not any(c.closed for c in rec.curves)
+    assert len(rec.curves) == 4 and not any(c.closed for c in rec.curves)
     for c in rec.curves:
+        assert EndKind.BIFURCATION in (c.start_kind, c.end_kind)
         p = c.curve3d.evaluate(np.linspace(0, c.parameters[-1], 101))
         np.testing.assert_allclose(p[:, 2], 0.0, atol=1e-9)
         np.testing.assert_allclose(np.abs(p[:, 0] - 0.5), np.abs(p[:, 1] - 0.5), atol=1e-9)
-        assert c.parameters[-1] == pytest.approx(np.sqrt(2), rel=1e-9)
+        assert c.parameters[-1] == pytest.approx(np.sqrt(2) / 2, rel=1e-9)
