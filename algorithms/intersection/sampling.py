@@ -58,6 +58,7 @@ from .sampling_rounds import (
     _Work,
     verification_round,
 )
+from .splines import interpolate_many
 
 __all__ = [
     "CHECK_FRACTIONS",
@@ -122,15 +123,14 @@ def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float) -> NDArray:
     return np.concatenate([[0.0], np.cumsum(ds * per_length)])
 
 
-def _resample_targets(curve: RefinedCurve, target: float
-                      ) -> tuple[NDArray, NurbsCurve, NDArray] | None:
+def _resample_targets(curve: RefinedCurve, target: float) -> tuple[NDArray, NDArray] | None:
     """New sample positions of a densely refined curve (module docstring, step 1).
 
-    Returns ``(t, stacked, positions)``: the dense chord-length parameters,
-    the interpolant through all dense samples (3D | uv_a | uv_b, 7 coordinates) and the interior
+    Returns ``(t, positions)``: the dense chord-length parameters and the interior
     parameters where samples should go, equally many cubic spans apart (at least
-    four spans on a closed curve); None when the curve has too few converged
-    samples to interpolate (every dense sample is kept then).
+    four spans on a closed curve), on the interpolant through all dense samples;
+    None when the curve has too few converged samples to interpolate (every dense
+    sample is kept then).
     """
     if not curve.converged.all() or curve.points.shape[0] < 2 + 2 * curve.closed:
         return None
@@ -142,9 +142,7 @@ def _resample_targets(curve: RefinedCurve, target: float
     goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
         t[-1] * np.arange(1, spans) / spans
     positions = np.interp(goal, phase, t) if phase[-1] > 0 else goal
-    stacked = interpolate_samples(np.hstack([curve.points, curve.uv_a, curve.uv_b]), t,
-                                  curve.closed)
-    return t, stacked, positions
+    return t, positions
 
 
 def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _Work:
@@ -236,10 +234,13 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
     """
     target = share * tol
     plans = [_resample_targets(c, target) if simplify else None for c in curves]
-    starts = [(stacked, pos) for _, stacked, pos in filter(None, plans)]
+    planned = [(c, plan) for c, plan in zip(curves, plans) if plan is not None]
     new = None
-    if starts:
-        at = np.concatenate([stacked.evaluate(pos) for stacked, pos in starts])
+    if planned:             # the interpolants through all dense samples, evaluated at once
+        dense = interpolate_many([np.hstack([c.points, c.uv_a, c.uv_b]) for c, _ in planned],
+                                 [t for _, (t, _) in planned], [c.closed for c, _ in planned])
+        at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
+                            np.concatenate([p for _, (_, p) in planned]))
         anchors = at[:, :3]
         new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
                             anchors=anchors, tangent_sin=tangent_sin)
@@ -252,7 +253,7 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
             works.append(_Work(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
                                c.closed, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
             continue
-        t, _, pos = plan
+        t, pos = plan
         sl = slice(offset, offset + pos.size)
         offset += pos.size
         spacing = t[-1] / (pos.size + 1)
