@@ -42,11 +42,10 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms.healing import (
@@ -58,21 +57,17 @@ from ..algorithms.healing import (
     local_approximant,
 )
 from ..algorithms.healing.clipping import trimmed_source
-from ..algorithms.healing.connectivity import Side, _corner_number, side_points
-from ..algorithms.healing.continuity import fit_side_to_curve
-from ..algorithms.healing.measure_joins import measure_join
-from ..algorithms.projection import project_to_curve
+from ..algorithms.healing.connectivity import Side
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches, inner_edges
 from .heal_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
+from .heal_snap import snap_to_originals
 from .heal_spec import DirectedPatch, read_patch_spec
 from .heal_topology import (
-    FaceEdge,
     count_free_edges,
-    dense_edge,
     duplicate_faces,
     face_edges,
     four_sided_boundary,
@@ -80,7 +75,6 @@ from .heal_topology import (
     is_valid,
     max_edge_tolerance,
     pair_edges,
-    polyline_distance,
     sew,
 )
 from .io import CadModel, read, to_shape
@@ -99,10 +93,6 @@ __all__ = [
 DEFAULT_GAP_FACTOR = 1e-3
 #: ... and at most this times the median edge length
 _GAP_FACTOR_EDGE = 0.01
-#: a side fitted to an untouched face's edge gets at most this many knot spans
-MAX_SNAP_SPANS = 64
-#: samples of a fitted side checked against the edge
-SNAP_CHECK_SAMPLES = 257
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
 
@@ -349,124 +339,6 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
     return make_face(surface, reversed=bool(np.dot(n_new, n_old) < 0))
 
 
-# ------------------------------------------------------- untouched neighbours
-def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], gap_tol: float):
-    """The edge lying closest along the whole side, within ``gap_tol`` both ways; else
-    the edges of one face that lie on the side and together cover it (a T-junction:
-    the side meets several edges of a kept face), as a list; else None."""
-    lo, hi = side.min(axis=0) - gap_tol, side.max(axis=0) + gap_tol
-    best, best_distance = None, gap_tol
-    on_side = []
-    for e in edges:
-        if np.any(e.samples.min(axis=0) > hi) or np.any(e.samples.max(axis=0) < lo):
-            continue
-        along = polyline_distance(e.samples, dense_side).max()
-        if along > gap_tol:
-            continue
-        on_side.append(e)
-        distance = max(along, polyline_distance(side, dense_edge(e)).max())
-        if distance <= best_distance:
-            best, best_distance = e.curve, distance
-    if best is not None:
-        return best
-    for face in {e.face for e in on_side}:
-        pieces = [e for e in on_side if e.face == face]
-        if len(pieces) < 2:
-            continue
-        cover = np.min([polyline_distance(side, dense_edge(e)) for e in pieces], axis=0)
-        if cover.max() <= gap_tol:
-            return [e.curve for e in pieces]
-    return None
-
-
-def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
-    """Whether the corner at ``end`` of ``side`` is shared with another approximant."""
-    number = _corner_number(side, end)
-    return any(_corner_number(s, e) == number for p, s, e in members if p == patch)
-
-
-def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float):
-    """``surface`` with ``side`` fitted to ``target`` (an edge or a list of edges): knot
-    spans along the side doubled (up to :data:`MAX_SNAP_SPANS`) until the side lies
-    within ``tight`` of the edges."""
-    curves = _curves(target)
-    spans = min(MAX_SNAP_SPANS, sum(2 * (np.unique(c.knots).size - 1) for c in curves) + 8)
-    while True:
-        fitted = fit_side_to_curve(surface, side, target, min_spans=spans, free_corners=free)
-        pts = side_points(fitted, side, SNAP_CHECK_SAMPLES)
-        gap = np.min([project_to_curve(c, pts).distance for c in curves], axis=0).max()
-        if spans >= MAX_SNAP_SPANS or gap <= tight:
-            return fitted
-        spans = min(MAX_SNAP_SPANS, 2 * spans)
-
-
-def _curves(target) -> list:
-    return target if isinstance(target, list) else [target]
-
-
-def _snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
-                       tight: float) -> tuple[Network, int]:
-    """Sides of approximants that meet a face kept as it was (not another approximant)
-    fitted to that face's edge (:func:`fit_side_to_curve`), joins measured again.
-
-    A corner shared with other approximants is first moved, in every patch that
-    shares it, onto the nearer end of the edge (:func:`_pin_corners`), so the side
-    can follow the edge to its end instead of stopping at the averaged corner."""
-    if not edges:
-        return network, 0
-    shared = {(e.a, e.side_a) for e in network.edges} | {(e.b, e.side_b) for e in network.edges}
-    patches = list(network.patches)
-    targets = []
-    for p in range(len(patches)):
-        for side in Side:
-            if (p, side) in shared:
-                continue
-            target = _matching_edge(side_points(patches[p], side, 17),
-                                    side_points(patches[p], side, 129), edges, gap_tol)
-            if target is not None:
-                targets.append((p, side, target))
-    if not targets:
-        return network, 0
-    clusters = network.connectivity.corners
-    _pin_corners(patches, targets, clusters, tight)
-    in_clusters = {(m[0], m[1], m[2]) for c in clusters for m in c.members}
-    for p, side, target in targets:
-        free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
-        patches[p] = _snapped(patches[p], side, target, free, tight)
-    joins = tuple(measure_join(patches, e) for e in network.edges)
-    return replace(network, patches=tuple(patches), joins=joins), len(targets)
-
-
-def _corner_index(surface, number: int) -> tuple[int, int]:
-    nu, nv = surface.n_control
-    return (0 if number % 2 == 0 else nu - 1), (0 if number // 2 == 0 else nv - 1)
-
-
-def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
-    """Corners of approximant clusters moved (in place, in every member patch: their
-    shared boundary rows stay identical) onto the end of a kept face's edge a member
-    side is snapped to, where they are farther from it than ``tight``."""
-    for p, side, target in targets:
-        ends = np.concatenate([c.evaluate(np.array(c.domain)) for c in _curves(target)])
-        for end in (0, 1):
-            number = _corner_number(side, end)
-            cluster = next((c for c in clusters if any(
-                m[0] == p and _corner_number(m[1], m[2]) == number for m in c.members)), None)
-            if cluster is None:
-                continue
-            i, j = _corner_index(patches[p], number)
-            corner = patches[p].control_points[i, j]
-            goal = ends[int(np.argmin(np.linalg.norm(ends - corner, axis=1)))]
-            if np.linalg.norm(goal - corner) <= tight:
-                continue
-            for q in {m[0] for m in cluster.members}:
-                numbers = {_corner_number(m[1], m[2]) for m in cluster.members if m[0] == q}
-                net = patches[q].control_points.copy()
-                for n in numbers:
-                    net[_corner_index(patches[q], n)] = goal
-                patches[q] = replace(patches[q], control_points=net)
-
-
 # ---------------------------------------------------------------------- heal
 def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
@@ -540,7 +412,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
         replaced = _replaced(done)
-        network, snapped = _snap_to_originals(
+        network, snapped = snap_to_originals(
             network, [e for e in edges if e.face not in replaced]
             + inner_edges(faces, replaced | gone), gap_tol,
             TIGHT_FACTOR * model.size)

@@ -5,11 +5,12 @@ one curve), so the snapped side closes in the geometry, not only up to the input
 from __future__ import annotations
 
 import numpy as np
+
 from surfprep.algorithms.fitting import interpolate_curve, interpolate_surface
 from surfprep.algorithms.healing import connect
 from surfprep.algorithms.healing.connectivity import Side, side_points
 from surfprep.algorithms.projection import project_to_curve
-from surfprep.plugin.heal import _snap_to_originals
+from surfprep.plugin.heal_snap import snap_to_originals as _snap_to_originals
 from surfprep.plugin.heal_topology import FaceEdge
 
 
