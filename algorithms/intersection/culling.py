@@ -33,6 +33,7 @@ from . import tessellation_kernels
 __all__ = [
     "BoxTree",
     "PatchOverlap",
+    "RegionPatches",
     "build_tree",
     "candidate_pairs",
     "exact_patch_boxes",
@@ -40,6 +41,7 @@ __all__ = [
     "overlap_boxes",
     "overlap_patches",
     "patch_rectangles",
+    "region_patches",
     "span_hull_boxes",
     "span_patches",
     "subpatch_boxes",
@@ -333,6 +335,66 @@ def span_patches(surface: NurbsSurface, span_u: ArrayLike, span_v: ArrayLike) ->
     return np.swapaxes(_blossom_spans(np.swapaxes(net, 1, 2), kv, q), 1, 2)
 
 
+@dataclass(frozen=True, eq=False)
+class RegionPatches:
+    """The Bézier patch of every region of a tessellation, extracted once
+    (:func:`region_patches`), so that the boxes of sub-rectangles at every refinement
+    level need only the restriction (:meth:`boxes`).
+
+    Attributes
+    ----------
+    coeffs : (r, p + 1, q + 1, d + 1) float
+        Homogeneous Bernstein coefficients of the patch holding region ``i``.
+    bounds : (r, 4) float
+        That patch's parameter rectangle ``[u0, u1, v0, v1]``.
+    """
+
+    coeffs: NDArray
+    bounds: NDArray
+
+    def boxes(self, rects: NDArray, region: NDArray) -> NDArray:
+        """Control-net boxes ``(k, 2, d)`` over ``rects (k, 4)`` inside regions ``region (k,)``
+        (as :func:`subpatch_boxes` gives them)."""
+        a, b, c, d = self.bounds[region].T
+        s0, s1 = (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a)
+        t0, t1 = (rects[:, 2] - c) / (d - c), (rects[:, 3] - c) / (d - c)
+        if tessellation_kernels.AVAILABLE and self.coeffs.shape[-1] == 4:
+            return tessellation_kernels.restricted_boxes(self.coeffs, region, s0, s1, t0, t1)
+        coeffs = _blossom_restrict(self.coeffs[region], s0, s1)
+        coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), t0, t1)
+        cartesian = coeffs[..., :-1] / coeffs[..., -1:]
+        return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
+
+
+def _patch_spans(surface: NurbsSurface, rects: NDArray) -> tuple[NDArray, NDArray]:
+    """Knot span indices ``(iu, iv)`` of the Bézier patch holding each rectangle."""
+    nu, nv = surface.n_control
+    su = _spans(surface.knots_u, surface.degree_u, nu)
+    sv = _spans(surface.knots_v, surface.degree_v, nv)
+    ku, kv = surface.knots_u, surface.knots_v
+    iu = su[np.clip(np.searchsorted(ku[su + 1], rects[:, 0], side="right"), 0, su.size - 1)]
+    iv = sv[np.clip(np.searchsorted(kv[sv + 1], rects[:, 2], side="right"), 0, sv.size - 1)]
+    a, b, c, d = ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]
+    if np.any((rects[:, 0] < a) | (rects[:, 1] > b) | (rects[:, 2] < c) | (rects[:, 3] > d)):
+        raise InvalidGeometryError("every rectangle must lie inside one Bézier patch")
+    return iu, iv
+
+
+def region_patches(surface: NurbsSurface, regions: ArrayLike) -> RegionPatches:
+    """The Bézier patches holding parameter rectangles ``regions (r, 4)`` (each inside one).
+
+    Raises
+    ------
+    InvalidGeometryError
+        A region spanning more than one Bézier patch.
+    """
+    regions = np.asarray(regions, dtype=float).reshape(-1, 4)
+    iu, iv = _patch_spans(surface, regions)
+    ku, kv = surface.knots_u, surface.knots_v
+    return RegionPatches(span_patches(surface, iu, iv),
+                         np.stack([ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]], axis=1))
+
+
 def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
     """Control-net boxes of the surface over parameter rectangles inside Bézier patches.
 
@@ -358,19 +420,13 @@ def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
         A rectangle spanning more than one Bézier patch.
     """
     rects = np.asarray(rects, dtype=float).reshape(-1, 4)
-    nu, nv = surface.n_control
-    su = _spans(surface.knots_u, surface.degree_u, nu)
-    sv = _spans(surface.knots_v, surface.degree_v, nv)
+    iu, iv = _patch_spans(surface, rects)
     ku, kv = surface.knots_u, surface.knots_v
-    iu = su[np.clip(np.searchsorted(ku[su + 1], rects[:, 0], side="right"), 0, su.size - 1)]
-    iv = sv[np.clip(np.searchsorted(kv[sv + 1], rects[:, 2], side="right"), 0, sv.size - 1)]
     a, b, c, d = ku[iu], ku[iu + 1], kv[iv], kv[iv + 1]
-    if np.any((rects[:, 0] < a) | (rects[:, 1] > b) | (rects[:, 2] < c) | (rects[:, 3] > d)):
-        raise InvalidGeometryError("every rectangle must lie inside one Bézier patch")
     key, inverse = np.unique(iu * (surface.knots_v.size + 1) + iv, return_inverse=True)
     pairs_u, pairs_v = np.divmod(key, surface.knots_v.size + 1)
     coeffs = span_patches(surface, pairs_u, pairs_v)
-    if tessellation_kernels.AVAILABLE:          # the blossoms below, compiled
+    if tessellation_kernels.AVAILABLE and coeffs.shape[-1] == 4:   # the blossoms below, compiled
         return tessellation_kernels.restricted_boxes(
             coeffs, inverse.ravel(), (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a),
             (rects[:, 2] - c) / (d - c), (rects[:, 3] - c) / (d - c))

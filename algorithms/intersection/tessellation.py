@@ -58,7 +58,15 @@ from numpy.typing import ArrayLike, NDArray
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..surface import NurbsSurface
 from . import tessellation_kernels
-from .culling import BoxTree, build_tree, patch_rectangles, subpatch_boxes, tree_pairs
+from .culling import (
+    BoxTree,
+    RegionPatches,
+    build_tree,
+    patch_rectangles,
+    region_patches,
+    subpatch_boxes,
+    tree_pairs,
+)
 from .mesh import TriangleMesh, collinear_mask
 
 __all__ = ["Tessellation", "patch_rectangles", "tessellate"]
@@ -193,12 +201,14 @@ def _region_boxes(boxes: NDArray, owner: NDArray, n_regions: int) -> _RegionBoxe
 
 
 def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
-          keep: BoxTree | _RegionBoxes | None, pad: float) -> NDArray:
+          keep: BoxTree | _RegionBoxes | None, pad: float,
+          patches: RegionPatches | None = None) -> NDArray:
     """Mask of rectangles whose sub-patch box is within ``pad`` of some keep box (of
-    their own region only, for keep boxes given per region)."""
+    their own region only, for keep boxes given per region); ``patches`` the Bézier
+    patches of the regions, extracted once per tessellation."""
     if keep is None:
         return np.ones(rects.shape[0], bool)
-    boxes = subpatch_boxes(surface, rects)
+    boxes = subpatch_boxes(surface, rects) if patches is None else patches.boxes(rects, region)
     if isinstance(keep, BoxTree):
         if tessellation_kernels.AVAILABLE:
             return tessellation_kernels.any_overlap(keep, boxes, pad)
@@ -212,7 +222,7 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         # few large regions (a face of one or two Bezier patches): a tree is cheaper
         if keep.tree is None:
             object.__setattr__(keep, "tree", build_tree(keep.boxes))
-        return _near(surface, rects, region, keep.tree, pad)
+        return _near(surface, rects, region, keep.tree, pad, patches)
     if tessellation_kernels.AVAILABLE:          # each rectangle against its region's boxes
         return tessellation_kernels.any_overlap_in_range(boxes, lo, hi, keep.boxes, pad)
     rect = np.repeat(np.arange(rects.shape[0]), counts)
@@ -227,11 +237,12 @@ def _refine(surface: NurbsSurface, regions: NDArray, tol: float, max_depth: int,
             ) -> tuple[NDArray, NDArray, NDArray, NDArray, int]:
     """Breadth-first refinement: leaves, their regions, errors and diagonals."""
     rects, region = regions, np.arange(regions.shape[0])
+    patches = None if keep is None else region_patches(surface, regions)
     out_rects, out_region = [np.zeros((0, 4))], [np.zeros(0, np.int64)]
     out_err, out_diag = [np.zeros(0)], [np.zeros(0, np.int64)]
     depth = 0
     while rects.shape[0]:
-        near = _near(surface, rects, region, keep, pad)
+        near = _near(surface, rects, region, keep, pad, patches)
         rects, region = rects[near], region[near]
         if rects.shape[0] == 0:
             break

@@ -85,3 +85,15 @@ def test_candidate_pairs_match_tree_pairs(monkeypatch, pad):
     monkeypatch.setattr(tessellation_kernels, "AVAILABLE", False)
     np.testing.assert_array_equal(pairs, candidate_pairs(a, b, pad=pad))
     assert pairs.shape[0] > 4 * 300                     # the buffer had to grow
+
+
+@pytest.mark.parametrize("surface", [sphere_band(1.5), _bumpy()], ids=["rational", "bicubic"])
+def test_region_patch_boxes_equal_subpatch_boxes(surface):
+    from surfprep.algorithms.intersection.culling import region_patches
+
+    rng = np.random.default_rng(13)
+    regions = patch_rectangles(surface)
+    rects = _sub_rectangles(surface, rng, per_patch=5)
+    region = np.repeat(np.arange(regions.shape[0]), 5)
+    boxes = region_patches(surface, regions).boxes(rects, region)
+    np.testing.assert_array_equal(boxes, subpatch_boxes(surface, rects))
