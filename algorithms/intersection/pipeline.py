@@ -50,7 +50,7 @@ from .result import (
 )
 from .seams import cut_at_seams
 from .segments import mesh_segments
-from .sides import DomainSide, box_sides, covered_by_sides, may_run_along, side_curves
+from .sides import DomainSide, box_sides, covered_by_sides, may_run_along_many, side_curves
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
 __all__ = [
@@ -290,6 +290,7 @@ def _traced_sides(topology: SegmentTopology, chains: list[Chain], surface_a: Nur
     uvs = (topology.uv_a, topology.uv_b)
     for owner, surface in enumerate(surfaces):
         uv_all = uvs[owner]
+        candidates, ts, guesses = [], [], []
         for coord, value, slack in _domain_sides(surface.domain):
             ends, ids = 0, []
             for chain in chains:
@@ -300,11 +301,14 @@ def _traced_sides(topology: SegmentTopology, chains: list[Chain], surface_a: Nur
                 ends += 0 if chain.closed else int(on[0]) + int(on[-1])
             if ends < 2:
                 continue
-            side = DomainSide(owner, coord, float(value))
             ids = np.concatenate(ids)
-            if may_run_along(surface, surfaces[1 - owner], side, uv_all[ids, 1 - coord],
-                             uvs[1 - owner][ids], tol=tol):
-                sides.append(side)
+            candidates.append(DomainSide(owner, coord, float(value)))
+            ts.append(uv_all[ids, 1 - coord])
+            guesses.append(uvs[1 - owner][ids])
+        if candidates:          # all sides of this surface tested in one projection
+            keep = may_run_along_many(surface, surfaces[1 - owner], candidates, ts, guesses,
+                                      tol=tol)
+            sides.extend(side for side, k in zip(candidates, keep) if k)
     return sides
 
 

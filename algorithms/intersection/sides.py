@@ -34,7 +34,7 @@ from ..surface import NurbsSurface
 from .refine import RefinedCurve
 
 __all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "may_run_along",
-           "side_curves"]
+           "may_run_along_many", "side_curves"]
 
 #: samples of a side curve per knot span (at least ``_MIN_SAMPLES`` in all)
 SIDE_SAMPLES_PER_SPAN = 16
@@ -118,16 +118,35 @@ def may_run_along(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: N
     there by about the spacing times the crossing angle. Probes beyond the
     side's ends are left out (a run reaching an end has the inner one inside).
     """
-    t = np.asarray(t, dtype=float)
-    lo, hi, _ = _free_range(own, side.coord)
-    delta = 0.5 * float(np.min(np.diff(_side_samples(own, side.coord))))
-    probes = np.concatenate([t - delta, t + delta])
-    inside = (probes >= lo) & (probes <= hi)      # a run at the side's end: the inner probe
-    if not np.any(inside):
-        return True
-    guess = np.concatenate([guess, guess])[inside]
-    found = _gap(own, other, side, probes[inside], tol, np.asarray(guess, dtype=float))[2]
-    return bool(np.any(found.distance <= _SHARE * tol))
+    return may_run_along_many(own, other, [side], [t], [guess], tol=tol)[0]
+
+
+def may_run_along_many(own: NurbsSurface, other: NurbsSurface, sides: list[DomainSide],
+                       ts: list[NDArray], guesses: list[NDArray], *, tol: float) -> list[bool]:
+    """:func:`may_run_along` for several sides of ``own`` at once: their probes are
+    projected onto ``other`` in one batch (each from its own guess)."""
+    uv, guess, owner, answer = [], [], [], [True] * len(sides)
+    for i, (side, t, g) in enumerate(zip(sides, ts, guesses)):
+        t = np.asarray(t, dtype=float)
+        lo, hi, _ = _free_range(own, side.coord)
+        delta = 0.5 * float(np.min(np.diff(_side_samples(own, side.coord))))
+        probes = np.concatenate([t - delta, t + delta])
+        inside = (probes >= lo) & (probes <= hi)  # a run at the side's end: the inner probe
+        if not np.any(inside):
+            continue                               # True, as may_run_along says
+        uv.append(_uv_on_side(side, probes[inside]))
+        guess.append(np.concatenate([g, g])[inside])
+        owner.append(np.full(int(inside.sum()), i))
+        answer[i] = False
+    if uv:
+        uv = np.concatenate(uv)
+        p = own.evaluate(uv[:, 0], uv[:, 1])
+        found = project_to_surface(other, p, tol=1e-3 * tol,
+                                   guess=np.asarray(np.concatenate(guess), dtype=float))
+        near = np.concatenate(owner)[found.distance <= _SHARE * tol]
+        for i in np.unique(near):
+            answer[int(i)] = True
+    return answer
 
 
 def _runs(near: NDArray) -> list[tuple[int, int]]:

@@ -12,7 +12,12 @@ import pytest
 
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import intersect_surfaces
-from surfprep.algorithms.intersection.sides import DomainSide, may_run_along, side_curves
+from surfprep.algorithms.intersection.sides import (
+    DomainSide,
+    may_run_along,
+    may_run_along_many,
+    side_curves,
+)
 from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
 
 TOL = 1e-7
@@ -112,3 +117,13 @@ def test_may_run_along_tells_a_side_on_the_surface_from_a_crossing():
     # a curve through the corner: the probe beyond the side's end is not taken
     assert not may_run_along(standing, flat, end, np.array([0.0]), np.array([[0.25, 0.5]]),
                              tol=TOL)
+    # several sides in one batch: the same answers as one by one
+    far = DomainSide(owner=0, coord=0, value=1.0)
+    sides = [foot, end, far, end]
+    ts = [np.array([0.5, 0.25]), np.array([0.0]), np.array([2.0]), np.array([0.5])]
+    guesses = [np.array([[0.5, 0.75], [0.25, 0.75]]), np.array([[0.25, 0.5]]),
+               np.array([[0.25, 0.5]]), np.array([[0.25, 0.5]])]
+    one_by_one = [may_run_along(standing, flat, s, t, g, tol=TOL)
+                  for s, t, g in zip(sides, ts, guesses)]
+    assert may_run_along_many(standing, flat, sides, ts, guesses, tol=TOL) == one_by_one
+    assert one_by_one[0] and one_by_one[2]          # on the plane; no probe inside: True
