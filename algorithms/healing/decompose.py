@@ -55,11 +55,14 @@ DEFAULT_SMOOTH_ANGLE = np.radians(20.0)
 MAX_SIDES = 16
 #: a vertex turning by more than this (radians) is a cusp: no sub-patch fits in it
 CUSP_ANGLE = np.radians(179.0)
+#: tangents at a vertex: chord to the point this fraction of the edge's end-to-end distance away
+TANGENT_REACH = 0.01
 #: samples of a spoke in (u, v) interpolated in 3D
 SPOKE_SAMPLES = 33
 #: samples per side of the (u, v) Coons check of a sub-patch
 CHECK_SAMPLES = 16
 _DENSE = 65                  # parameter samples per edge for arc lengths
+
 
 
 class NotDecomposableError(InvalidGeometryError):
@@ -159,12 +162,26 @@ def turning_angles(edges: Sequence[LoopEdge]) -> NDArray:
     and the start tangent of real edge ``k`` (cyclic; a degenerated edge between them,
     a surface pole, is skipped: the 3D tangents meet there as at any vertex)."""
     real = [e.curve for e in edges if e.curve is not None]
-    t_in = np.array([c.derivatives(c.domain[1], 1)[1] for c in real])
-    t_out = np.array([c.derivatives(c.domain[0], 1)[1] for c in real])
-    t_in = np.roll(t_in, 1, axis=0)
+    t_in = np.roll(np.array([_end_tangent(c, 1) for c in real]), 1, axis=0)
+    t_out = np.array([_end_tangent(c, 0) for c in real])
     denom = np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1)
     cos = np.einsum("kc,kc->k", t_in, t_out) / np.where(denom > 0, denom, 1.0)
     return np.where(denom > 0, np.arccos(np.clip(cos, -1.0, 1.0)), np.pi)
+
+
+def _end_tangent(curve: NurbsCurve, end: int) -> NDArray:
+    """(3,) float: the curve's direction at its start (``end = 0``) or end (1), along
+    the curve, as the chord to the first point :data:`TANGENT_REACH` of the edge's
+    length away: a vanishing or wild end derivative (repeated or nearly repeated
+    control points of high-degree edges, tiny hooks) does not fake a cusp."""
+    t0, t1 = curve.domain
+    steps = np.geomspace(1e-7, 1.0, 60) * (t1 - t0)
+    t = t1 - steps if end else t0 + steps
+    pts = curve.evaluate(np.r_[t1 if end else t0, t])
+    reach = np.linalg.norm(pts[1:] - pts[0], axis=1)
+    k = int(np.argmax(reach >= TANGENT_REACH * reach[-1])) if reach[-1] > 0 else 0
+    chord = pts[k + 1] - pts[0]
+    return -chord if end else chord
 
 
 # ------------------------------------------------------------ loop positions

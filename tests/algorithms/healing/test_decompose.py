@@ -162,3 +162,23 @@ def test_pentagon_sub_patches(continuity):
     _, las, net = _approximate(edges, continuity)
     assert len(net.joins) == 5
     _check_network(edges, las, net, continuity)
+
+
+def test_turning_angle_where_an_edge_has_a_vanishing_end_derivative():
+    """An edge whose last control point is repeated (C' = 0 at its end, as in high-degree
+    edges of occt_t4m_euclid.stp) continuing straight on: turning 0, not a cusp."""
+    from surfprep.algorithms.curve import NurbsCurve
+    from surfprep.algorithms.healing.decompose import LoopEdge, turning_angles
+
+    def edge(points):
+        p = np.asarray(points, float)
+        n = len(p)
+        knots = np.r_[np.zeros(n), np.ones(n)]
+        return LoopEdge(NurbsCurve(p, knots, n - 1), NurbsCurve(p[:, :2], knots, n - 1))
+
+    square = [edge([[0, 0, 0], [0.5, 0, 0], [1, 0, 0], [1, 0, 0]]),    # C'(1) = 0
+              edge([[1, 0, 0], [2, 0, 0]]), edge([[2, 0, 0], [2, 1, 0]]),
+              edge([[2, 1, 0], [0, 1, 0]]), edge([[0, 1, 0], [0, 0, 0]])]
+    turning = np.degrees(turning_angles(square))
+    assert turning[1] < 1e-6
+    assert np.allclose(turning[[0, 2, 3, 4]], 90.0)
