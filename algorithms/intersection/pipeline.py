@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .extend import extend_open_ends
+from .extend import extend_open_ends, join_at_singular_points
 from .mesh import TriangleMesh
 from .refine import RefinedCurve
 from .result import (
@@ -90,6 +90,8 @@ _RETRY_FLOOR = 16.0
 _SEAM_CLOSURE = 64.0
 #: first marching step from a hanging end, times ``mesh_tol``
 _MARCH_STEP = 0.25
+#: singular points are looked for within this times the mesh tolerance of curve ends
+_SINGULAR_REACH = 64.0
 #: consecutive chords of refined samples turning by more than this: a fold
 _FOLD_ANGLE = np.radians(120.0)
 
@@ -260,15 +262,17 @@ def _close_boundary_gaps(curves: list[RefinedCurve], chains: list[Chain], ends_u
 def _extend(dense: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
             surface_b: NurbsSurface, tol: float, mesh_tol: float):
     """OPEN (hanging) ends continued on the exact surfaces (:mod:`.extend`); an end
-    that reaches a domain side becomes BOUNDARY."""
+    that reaches a domain side becomes BOUNDARY; then curves meeting at singular
+    points (double points) are made to end exactly there (BIFURCATION,
+    :func:`.extend.join_at_singular_points`)."""
     open_ends = [(s is EndKind.OPEN, e is EndKind.OPEN) for s, e in kinds]
-    if not any(a or b for a, b in open_ends):
-        return dense, kinds
-    dense, reached = extend_open_ends(dense, open_ends, surface_a, surface_b, tol=tol,
-                                      step=_MARCH_STEP * mesh_tol)
-    kinds = [tuple(EndKind.BOUNDARY if r else k for k, r in zip(kind, hit))
-             for kind, hit in zip(kinds, reached)]
-    return dense, kinds
+    if any(a or b for a, b in open_ends):
+        dense, reached = extend_open_ends(dense, open_ends, surface_a, surface_b, tol=tol,
+                                          step=_MARCH_STEP * mesh_tol)
+        kinds = [tuple(EndKind.BOUNDARY if r else k for k, r in zip(kind, hit))
+                 for kind, hit in zip(kinds, reached)]
+    return join_at_singular_points(dense, kinds, surface_a, surface_b, tol=tol,
+                                   reach=_SINGULAR_REACH * mesh_tol)
 
 
 def _domain_sides(domain) -> list[tuple[int, float, float]]:
