@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import os
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -62,6 +63,7 @@ from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches, inner_edges
+from .heal_nsided import quad_boundaries, why_not_decomposable
 from .heal_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
 from .heal_snap import snap_to_originals
@@ -261,17 +263,43 @@ class _Job:
     boundary: Any
     name: str | None
     reference: TrimmedFace | None     # face whose orientation the approximant takes
+    split: bool = False               # one of the sub-patches of a face that is not four-sided
 
 
-def _jobs(faces, kept, holes, trimmed: dict, unions: dict) -> list[_Job]:
+def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: float,
+                     skipped: list[str]) -> tuple[list, bool]:
+    """The four-curve boundaries replacing ``face``: its own four edges, or with
+    ``split_faces`` the sub-patches of :func:`.heal_nsided.quad_boundaries`; and
+    whether the face was split (its sides then also checked against the edges)."""
+    curves = four_sided_boundary(face)
+    if curves is not None:
+        return [curves], False
+    if not split_faces:
+        return [], False
+    boundaries = quad_boundaries(face, gap_tol=gap_tol)
+    if boundaries is None:
+        skipped.append(f"face {index}: not split into four-sided patches "
+                       f"({why_not_decomposable(face, gap_tol=gap_tol)}); kept as it is")
+        return [], False
+    return boundaries, True
+
+
+def _jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: bool = False,
+          gap_tol: float = 0.0, skipped: list[str] | None = None) -> list[_Job]:
     jobs = []
     for i, (j, outline) in unions.items():
         jobs.append(_Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
     in_union = set(unions) | {j for j, _ in unions.values()}
     for i in (i for i in kept if i not in in_union):
-        curves = trimmed.get(i) or four_sided_boundary(faces[i])
-        if curves is not None:
-            jobs.append(_Job(PatchOrigin("face", (i,), i), curves, faces[i].name, faces[i]))
+        if trimmed.get(i):
+            boundaries, split = [trimmed[i]], False
+        else:
+            boundaries, split = _face_boundaries(faces[i], i, split_faces, gap_tol,
+                                                 [] if skipped is None else skipped)
+        for n, curves in enumerate(boundaries):
+            name = faces[i].name if len(boundaries) == 1 or not faces[i].name \
+                else f"{faces[i].name}_{n}"
+            jobs.append(_Job(PatchOrigin("face", (i,), i), curves, name, faces[i], split))
     for k, loop in enumerate(holes):
         jobs.append(_Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
                          [e.curve for e in loop], f"heal_hole_{k}", None))
@@ -302,7 +330,7 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
         own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
         try:
             la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
-                                   preferred_source=own)
+                                   preferred_source=own, side_error=job.split)
         except (SurfprepError, np.linalg.LinAlgError) as exc:
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
                            f"({type(exc).__name__}: {exc}); left as it was")
@@ -322,7 +350,17 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
                            "left open")
             continue
         out.append((job, la))
-    return out
+    return _whole_faces_only(jobs, out, skipped)
+
+
+def _whole_faces_only(jobs: list[_Job], out: list, skipped: list[str]) -> list:
+    """A face split into sub-patches is replaced only when every sub-patch fits."""
+    want = Counter(j.origin.index for j in jobs if j.origin.kind == "face")
+    got = Counter(j.origin.index for j, _ in out if j.origin.kind == "face")
+    partial = {i for i, k in want.items() if got[i] not in (0, k)}
+    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit; kept as it was"
+                for i in sorted(partial)]
+    return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
 
 
 def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
@@ -342,7 +380,7 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 # ---------------------------------------------------------------------- heal
 def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
-         overlap: OverlapRepair | str = "trim") -> HealResult:
+         overlap: OverlapRepair | str = "trim", split_faces: bool = False) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -364,6 +402,12 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     overlap : "trim" or "union"
         A strip overlap of two four-sided faces: the later face trimmed back, or
         one approximant over the union's outline replacing both.
+    split_faces : bool
+        Faces that are not four-sided are split into four-sided sub-patches on the
+        face (:func:`.heal_nsided.quad_boundaries`) and replaced when every
+        sub-patch fits (sides checked against the edges too). Off by default: a
+        sub-patch side meeting part of a kept neighbour's edge is not yet fitted
+        to it, which can leave more open edges on some models.
 
     Returns
     -------
@@ -404,7 +448,9 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    done = _approximate(_jobs(faces, kept, holes, trimmed, unions), sources,
+    jobs = _jobs(faces, kept, holes, trimmed, unions, split_faces=split_faces, gap_tol=gap_tol,
+                 skipped=skipped)
+    done = _approximate(jobs, sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
     done += directed_jobs(directed, cut)
     network = None

@@ -62,6 +62,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a strip overlap of two four-sided faces: trim the later face "
                              "back (default) or replace both by one approximant over their "
                              "union when it is four-sided")
+    parser.add_argument("--split-faces", action="store_true", dest="split_faces",
+                        help="also replace faces that are not four-sided, split into "
+                             "four-sided sub-patches on the face")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
@@ -102,7 +105,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read(args.input)
     result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
-                  patches=args.patches, overlap=args.overlap)
+                  patches=args.patches, overlap=args.overlap,
+                  split_faces=args.split_faces)
     report = {"input": str(args.input), **result.report()}
     report["output"] = str(write(result.model, args.output, overwrite=True))
     if args.plot is not None:

@@ -106,3 +106,15 @@ def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
     assert surfprep.read(out).n_faces == faces_out
     code, _, err = run(capsys, "heal", src, "-o", tmp_path / "x.step", "--overlap", "merge")
     assert code != 0 and "overlap" in err
+
+
+def test_heal_split_faces_option(tmp_path, capsys):
+    # a three-sided face: kept as it is by default, three sub-patches with --split-faces
+    from test_heal_nsided import _occ_triangle_face
+    src = tmp_path / "triangle.step"
+    surfprep.write([_occ_triangle_face()], src)
+    for flags, faces_out in (((), 1), (("--split-faces",), 3)):
+        out = tmp_path / f"out{len(flags)}.step"
+        code, _, err = run(capsys, "heal", src, "-o", out, *flags)
+        assert code == 0, err
+        assert surfprep.read(out).n_faces == faces_out

@@ -102,3 +102,37 @@ def test_triangle_sub_patches_follow_the_trimmed_face_and_join_g1():
         assert distance_to_surface(face.surface, p.evaluate_grid(t, t).reshape(-1, 3)).max() \
             <= la.tol
 
+
+
+def _occ_triangle_face():
+    trim = [TrimLoop([TrimEdge(e.curve, e.pcurve, 0.0, 1.0) for e in triangle(SURFACE)])]
+    return make_face(SURFACE, trim)
+
+
+def test_heal_split_faces_replaces_a_triangle_by_three_patches():
+    # surfprep.heal(split_faces=True): the three-sided face becomes three sub-patches
+    # that follow it (dense check against the surface), keep its area and outline, and
+    # are joined G0 into one valid face set; without the option the face is kept
+    from surfprep.plugin.heal import heal
+    from surfprep.plugin.heal_topology import face_edges, polyline_distance
+    shape = _occ_triangle_face()
+    kept = heal(shape)
+    assert kept.patches == () and kept.model.n_faces == 1
+    r = heal(shape, split_faces=True)
+    assert [p.origin.kind for p in r.patches] == ["face"] * 3
+    assert {p.origin.faces for p in r.patches} == {(0,)}
+    assert r.valid_after and r.model.n_faces == 3
+    for la in r.approximants:
+        u0, u1, v0, v1 = la.surface.domain
+        uu, vv = np.meshgrid(np.linspace(u0, u1, 25), np.linspace(v0, v1, 25), indexing="ij")
+        pts = la.surface.evaluate(uu.ravel(), vv.ravel())
+        assert distance_to_surface(SURFACE, pts).max() <= la.tol
+    assert all(j.max_gap < 1e-9 for j in r.joins) and len(r.joins) == 3
+    before = face_edges([face_to_nurbs(shape)])
+    after = face_edges([face_to_nurbs(f) for f in r.model.faces])
+    outline = np.concatenate([e.samples for e in before])
+    on_outline = np.concatenate([e.samples for e in after])
+    near = [polyline_distance(e.samples, outline).max() for e in after]
+    tol = max(la.tol for la in r.approximants)
+    assert sum(d <= tol for d in near) == 6               # two outer sides per sub-patch
+    assert polyline_distance(outline, on_outline).max() <= tol   # the whole outline kept
