@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from . import trace_kernel
 from .distance import DistanceField, DistanceJet
 from .projection import Projection, ProjectionStatus
 
@@ -200,7 +201,8 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
                  direction: NDArray, *, h0: float | NDArray, h_max: float,
                  h_min: float | None = None, max_steps: int = 2000,
                  ctol: float | None = None, max_turn: float = MAX_TURN,
-                 relative_ctol: float = RELATIVE_CTOL) -> list[TracedCurve]:
+                 relative_ctol: float = RELATIVE_CTOL, compiled: bool | None = None
+                 ) -> list[TracedCurve]:
     """Trace ``m`` curves of ``kind`` from ``uv0 (m, 2)`` one way each, all at once.
 
     Parameters
@@ -228,6 +230,9 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         Share of the step the corrector must reach (default ``RELATIVE_CTOL``);
         curves read only for sign changes (characteristic curves) take a
         looser one: their crossings are refined by Newton afterwards.
+    compiled : bool, optional
+        Trace by :mod:`.trace_kernel` (the same steps in one numba call); default
+        whenever numba is there. False: the batched numpy form (the reference).
 
     Returns
     -------
@@ -241,6 +246,12 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
     diag = field.diagonal
     h_min = 1e-9 * diag if h_min is None else h_min
     ctol = 1e-7 * diag if ctol is None else ctol
+    if compiled is None:
+        compiled = trace_kernel.AVAILABLE
+    if compiled:
+        return _traced_compiled(field, kinds, comp_all, uv0, st0, direction, h0=h0, h_max=h_max,
+                                h_min=h_min, max_steps=max_steps, ctol=ctol, max_turn=max_turn,
+                                relative_ctol=relative_ctol)
     none = np.full(m, -1)
     uv, jet, _ = _correct(field, comp_all, np.asarray(uv0, float), np.asarray(st0, float), none,
                           ctol)
@@ -321,3 +332,20 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         out.append(TracedCurve(kinds[i], uv_s, st_s, phi_s, grad_s, det_s, EndReason.START,
                                reason[i] or EndReason.STEP_LIMIT))
     return out
+
+
+def _traced_compiled(field: DistanceField, kinds: list[CurveKind], comps: NDArray, uv0: NDArray,
+                     st0: NDArray, direction: NDArray, *, h0: float | NDArray, h_max: float,
+                     h_min: float, max_steps: int, ctol: float, max_turn: float,
+                     relative_ctol: float) -> list[TracedCurve]:
+    """:func:`trace_curves` by :func:`.trace_kernel.trace_compiled`."""
+    m = comps.size
+    h0 = np.broadcast_to(np.asarray(h0, dtype=float), (m,))
+    uv, st, phi, grad, det, count, reason = trace_kernel.trace_compiled(
+        field, comps, np.asarray(uv0, float).reshape(m, 2), np.asarray(st0, float).reshape(m, 2),
+        np.asarray(direction, float).reshape(m, 2), h0=h0, h_max=h_max, h_min=h_min,
+        max_steps=max_steps, ctol=ctol, max_turn=max_turn, relative_ctol=relative_ctol)
+    ends = [EndReason(name) for name in trace_kernel.REASONS]
+    return [TracedCurve(kinds[i], uv[i, :n].copy(), st[i, :n].copy(), phi[i, :n].copy(),
+                        grad[i, :n].copy(), det[i, :n].copy(), EndReason.START, ends[reason[i]])
+            for i, n in enumerate(count)]

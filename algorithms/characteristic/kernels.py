@@ -228,6 +228,76 @@ def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
 
 
 @_jit
+def _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, u, v, s0, t0,
+             lo, hi, quarter, tol, max_iter, lower, upper, i, point, foot, normal, st, phi,
+             grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
+    """Row ``i`` of :func:`distance_points`' outputs at ``(u, v)``, foot seeded at
+    ``(s0, t0)``; the trailing arrays are scratch (see :func:`distance_points`)."""
+    _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
+                       r_rational, u, v, hom[:, :, :r_coef.shape[4]], rd, False)
+    for c in range(3):
+        point[i, c] = rd[0, 0, c]
+    st[i, 0], st[i, 1], moved, before = _project_one(
+        q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
+        s0, t0, lo, hi, quarter, tol, max_iter,
+        du[:, :q_coef.shape[2]], dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
+    qs, qt = qd[1, 0], qd[0, 1]
+    _cross(qs, qt, big)
+    length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
+    nq = normal[i]
+    for c in range(3):
+        nq[c] = big[c] / length
+        foot[i, c] = qd[0, 0, c]
+    _cross(qd[2, 0], qt, c1)
+    _cross(qs, qd[1, 1], c2)
+    _normal_derivative(c1, c2, nq, length, n_s)
+    _cross(qd[1, 1], qt, c1)
+    _cross(qs, qd[0, 2], c2)
+    _normal_derivative(c1, c2, nq, length, n_t)
+    ru, rv = rd[1, 0], rd[0, 1]
+    p_ = 0.0
+    gu = 0.0
+    gv = 0.0
+    g00 = g01 = g10 = g11 = 0.0
+    k00 = k01 = k11 = 0.0
+    for c in range(3):
+        off = rd[0, 0, c] - qd[0, 0, c]
+        p_ += nq[c] * off
+        gu += nq[c] * ru[c]
+        gv += nq[c] * rv[c]
+        g00 += ru[c] * qs[c]                                           # eq. (23)
+        g01 += rv[c] * qs[c]
+        g10 += ru[c] * qt[c]
+        g11 += rv[c] * qt[c]
+        k00 += qs[c] * qs[c] - off * qd[2, 0, c]                       # eq. (22)
+        k01 += qs[c] * qt[c] - off * qd[1, 1, c]
+        k11 += qt[c] * qt[c] - off * qd[0, 2, c]
+    phi[i] = p_
+    grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
+    status[i] = _status(st[i, 0], st[i, 1], k00, k01, k11, moved, before, lower, upper,
+                        tol)
+    det = k00 * k11 - k01 * k01
+    det_k[i] = det
+    j00 = j01 = j10 = j11 = 0.0
+    if abs(det) > 1e-300:                                              # eq. (21)
+        j00 = (k11 * g00 - k01 * g10) / det
+        j01 = (k11 * g01 - k01 * g11) / det
+        j10 = (k00 * g10 - k01 * g00) / det
+        j11 = (k00 * g11 - k01 * g01) / det
+    jac[i, 0, 0], jac[i, 0, 1], jac[i, 1, 0], jac[i, 1, 1] = j00, j01, j10, j11
+    huu = huv = hvu = hvv = 0.0
+    for c in range(3):
+        nu_c = n_s[c] * j00 + n_t[c] * j10                             # (30)
+        nv_c = n_s[c] * j01 + n_t[c] * j11                             # (31)
+        huu += nu_c * ru[c] + nq[c] * rd[2, 0, c]                      # (26)
+        huv += nv_c * ru[c] + nq[c] * rd[1, 1, c]                      # (27)
+        hvu += nu_c * rv[c] + nq[c] * rd[1, 1, c]                      # (28)
+        hvv += nv_c * rv[c] + nq[c] * rd[0, 2, c]                      # (29)
+    mixed = 0.5 * (huv + hvu)
+    hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
+
+
+@_jit
 def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
                     lo, hi, quarter, tol, max_iter, lower, upper):
     """``phi``, its gradient and Hessian (002 eqs. 2, 24-31) at ``uv (n, 2)`` of ``r``.
@@ -272,69 +342,10 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     n_s = np.empty(3)
     n_t = np.empty(3)
     for i in range(n):
-        _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
-                           r_rational, uv[i, 0], uv[i, 1], hom[:, :, :r_coef.shape[4]], rd,
-                           False)
-        for c in range(3):
-            point[i, c] = rd[0, 0, c]
-        st[i, 0], st[i, 1], moved, before = _project_one(
-            q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
-            st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter,
-            du[:, :q_coef.shape[2]], dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
-        qs, qt = qd[1, 0], qd[0, 1]
-        _cross(qs, qt, big)
-        length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
-        nq = normal[i]
-        for c in range(3):
-            nq[c] = big[c] / length
-            foot[i, c] = qd[0, 0, c]
-        _cross(qd[2, 0], qt, c1)
-        _cross(qs, qd[1, 1], c2)
-        _normal_derivative(c1, c2, nq, length, n_s)
-        _cross(qd[1, 1], qt, c1)
-        _cross(qs, qd[0, 2], c2)
-        _normal_derivative(c1, c2, nq, length, n_t)
-        ru, rv = rd[1, 0], rd[0, 1]
-        p_ = 0.0
-        gu = 0.0
-        gv = 0.0
-        g00 = g01 = g10 = g11 = 0.0
-        k00 = k01 = k11 = 0.0
-        for c in range(3):
-            off = rd[0, 0, c] - qd[0, 0, c]
-            p_ += nq[c] * off
-            gu += nq[c] * ru[c]
-            gv += nq[c] * rv[c]
-            g00 += ru[c] * qs[c]                                           # eq. (23)
-            g01 += rv[c] * qs[c]
-            g10 += ru[c] * qt[c]
-            g11 += rv[c] * qt[c]
-            k00 += qs[c] * qs[c] - off * qd[2, 0, c]                       # eq. (22)
-            k01 += qs[c] * qt[c] - off * qd[1, 1, c]
-            k11 += qt[c] * qt[c] - off * qd[0, 2, c]
-        phi[i] = p_
-        grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
-        status[i] = _status(st[i, 0], st[i, 1], k00, k01, k11, moved, before, lower, upper,
-                            tol)
-        det = k00 * k11 - k01 * k01
-        det_k[i] = det
-        j00 = j01 = j10 = j11 = 0.0
-        if abs(det) > 1e-300:                                              # eq. (21)
-            j00 = (k11 * g00 - k01 * g10) / det
-            j01 = (k11 * g01 - k01 * g11) / det
-            j10 = (k00 * g10 - k01 * g00) / det
-            j11 = (k00 * g11 - k01 * g01) / det
-        jac[i, 0, 0], jac[i, 0, 1], jac[i, 1, 0], jac[i, 1, 1] = j00, j01, j10, j11
-        huu = huv = hvu = hvv = 0.0
-        for c in range(3):
-            nu_c = n_s[c] * j00 + n_t[c] * j10                             # (30)
-            nv_c = n_s[c] * j01 + n_t[c] * j11                             # (31)
-            huu += nu_c * ru[c] + nq[c] * rd[2, 0, c]                      # (26)
-            huv += nv_c * ru[c] + nq[c] * rd[1, 1, c]                      # (27)
-            hvu += nu_c * rv[c] + nq[c] * rd[1, 1, c]                      # (28)
-            hvv += nv_c * rv[c] + nq[c] * rd[0, 2, c]                      # (29)
-        mixed = 0.5 * (huv + hvu)
-        hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
+        _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv[i, 0],
+                 uv[i, 1], st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter, lower, upper, i,
+                 point, foot, normal, st, phi, grad, hess, jac, status, det_k, du, dv, hom, d,
+                 rd, qd, big, c1, c2, n_s, n_t)
     return point, foot, normal, st, phi, grad, hess, jac, status, det_k
 
 
