@@ -29,32 +29,68 @@ MAX_SNAP_SPANS = 64
 SNAP_CHECK_SAMPLES = 257
 
 def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], gap_tol: float):
-    """The edge lying closest along the whole side, within ``gap_tol`` both ways; else
-    the edges of one face that lie on the side and together cover it (a T-junction:
-    the side meets several edges of a kept face), as a list; else None."""
+    """What ``side`` is fitted to: the edge lying closest along the whole side, within
+    ``gap_tol`` both ways; else the pieces of edges lying along the side
+    (:func:`_edge_pieces`: whole edges, or the part of an edge between the
+    projections of the side's ends, for a side meeting only part of an edge) that
+    together cover it, of one face if they can, as a list; else None."""
     lo, hi = side.min(axis=0) - gap_tol, side.max(axis=0) + gap_tol
     best, best_distance = None, gap_tol
-    on_side = []
+    near = []
     for e in edges:
         if np.any(e.samples.min(axis=0) > hi) or np.any(e.samples.max(axis=0) < lo):
             continue
+        near.append(e)
         along = polyline_distance(e.samples, dense_side).max()
         if along > gap_tol:
             continue
-        on_side.append(e)
         distance = max(along, polyline_distance(side, dense_edge(e)).max())
         if distance <= best_distance:
             best, best_distance = e.curve, distance
     if best is not None:
         return best
-    for face in {e.face for e in on_side}:
-        pieces = [e for e in on_side if e.face == face]
-        if len(pieces) < 2:
-            continue
-        cover = np.min([polyline_distance(side, dense_edge(e)) for e in pieces], axis=0)
+    pieces = [(e.face, c) for e in near for c in _edge_pieces(e, side, dense_side, gap_tol)]
+    if not pieces:
+        return None
+    groups = [[c for f, c in pieces if f == face] for face in dict.fromkeys(f for f, _ in pieces)]
+    groups.append([c for _, c in pieces])
+    for curves in groups:
+        cover = np.min([polyline_distance(side, _dense(c)) for c in curves], axis=0)
         if cover.max() <= gap_tol:
-            return [e.curve for e in pieces]
+            return curves[0] if len(curves) == 1 else curves
     return None
+
+
+def _dense(curve, n: int = 129) -> NDArray:
+    return curve.evaluate(np.linspace(*curve.domain, n))
+
+
+def _edge_pieces(edge: FaceEdge, side: NDArray, dense_side: NDArray, gap_tol: float) -> list:
+    """The part of ``edge`` lying along ``side`` (within ``gap_tol``), as curves: the
+    edge restricted between the projections of the side's two ends (both pieces of a
+    closed edge's wrap-around, when the side runs over its seam); [] when that part
+    is shorter than ``gap_tol`` (a corner contact) or leaves the side."""
+    curve = edge.curve
+    t0, t1 = curve.domain
+    ends = project_to_curve(curve, side[[0, -1]]).t
+    a, b = float(min(ends)), float(max(ends))
+    span = t1 - t0
+    closed = np.linalg.norm(edge.ends[0] - edge.ends[1]) <= gap_tol
+    candidates = [[(a, b)]]
+    if closed:
+        candidates.append([(b, t1), (t0, a)])
+    for intervals in candidates:
+        intervals = [(x, y) for x, y in intervals if y - x > 1e-9 * span]
+        if not intervals:
+            continue
+        curves = [curve if (y - x) >= (1 - 1e-9) * span else curve.restrict(x, y)
+                  for x, y in intervals]
+        samples = np.concatenate([_dense(c, 17) for c in curves])
+        length = sum(float(np.linalg.norm(np.diff(_dense(c, 17), axis=0), axis=1).sum())
+                     for c in curves)
+        if length > gap_tol and polyline_distance(samples, dense_side).max() <= gap_tol:
+            return curves
+    return []
 
 
 def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
