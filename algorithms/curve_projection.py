@@ -19,8 +19,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
-from .projection import (_MIN_SAMPLES, _best_per_query, _check_count, _check_points, _pick_seeds,
-                         _Pieces, _sample_counts, _solve, _span_extents, _span_samples, _tolerance)
+from .projection import (
+    _MIN_SAMPLES,
+    _best_per_query,
+    _check_count,
+    _check_points,
+    _pick_seeds,
+    _Pieces,
+    _sample_counts,
+    _seed_grid,
+    _solve,
+    _span_extents,
+    _span_samples,
+    _tolerance,
+)
 
 __all__ = ["CurveProjectionResult", "distance_to_curve", "project_to_curve"]
 
@@ -82,13 +94,16 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
             raise InvalidGeometryError(f"guess must be finite of shape {shape}, got {x0.shape}")
         rows, x0 = np.arange(targets.shape[0]), np.clip(x0.reshape(-1, 1), lo, hi)
     else:
-        extents = _span_extents(curve.control_points, curve.knots, curve.degree)
-        (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
-                                   4 * _MIN_SAMPLES, density=4)
-        st = _span_samples(curve.knots, curve.degree, counts)
-        rows, sample = _pick_seeds(curve.evaluate(st), targets, n_seeds,
-                                   [pieces.axis_index(0, st)])
-        x0 = st[sample][:, None]
+        def build():
+            extents = _span_extents(curve.control_points, curve.knots, curve.degree)
+            (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
+                                       4 * _MIN_SAMPLES, density=4)
+            st = _span_samples(curve.knots, curve.degree, counts)
+            return (st,), curve.evaluate(st), [pieces.axis_index(0, st)]
+
+        seeds = _seed_grid(curve, ("curve", samples_per_span), build)
+        rows, sample = _pick_seeds(seeds, targets, n_seeds)
+        x0 = seeds.params[0][sample][:, None]
     local, value = _curve_local(curve)
     rows, x0 = pieces.split_seeds(rows, x0)
     x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)

@@ -70,13 +70,13 @@ from .surface import NurbsSurface
 from .tolerance import check_tolerance
 
 __all__ = [
-    "ProjectionResult",
-    "CurveProjectionResult",
-    "project_to_surface",
-    "project_to_curve",
-    "distance_to_surface",
-    "distance_to_curve",
     "DEFAULT_RELATIVE_TOL",
+    "CurveProjectionResult",
+    "ProjectionResult",
+    "distance_to_curve",
+    "distance_to_surface",
+    "project_to_curve",
+    "project_to_surface",
 ]
 
 #: Default ``tol``: this fraction of the control-net bounding-box diagonal.
@@ -194,8 +194,45 @@ def _grid_spacing(grid: NDArray) -> float:
     return max(float(np.linalg.norm(s, axis=-1).max(initial=0.0)) for s in steps)
 
 
-def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int, pieces: list[NDArray]
-                ) -> tuple[NDArray, NDArray]:
+@dataclass(frozen=True, eq=False)
+class _SeedGrid:
+    """The sample grid of a surface or curve for :func:`_pick_seeds`, built once per
+    geometry and sampling (:func:`_seed_grid`): parameters per axis, the grid
+    ``(a, [b,] d)``, its k-d tree, crease pieces per axis and :func:`_grid_spacing`."""
+
+    params: tuple[NDArray, ...]
+    grid: NDArray
+    tree: cKDTree
+    pieces: list[NDArray]
+    spacing: float
+
+
+#: attribute of a NurbsSurface / NurbsCurve instance holding its seed grids
+_SEED_CACHE = "_projection_seed_grids"
+
+
+def _seed_grid(geometry, key, build: Callable[[], tuple[tuple[NDArray, ...], NDArray,
+                                                      list[NDArray]]]) -> _SeedGrid:
+    """The :class:`_SeedGrid` of ``geometry`` for sampling ``key``, cached on the
+    instance (geometry is immutable, so its grid never goes stale; the cache lives
+    in the instance ``__dict__`` as a ``functools.cached_property`` would, and dies
+    with it). ``build()`` gives ``(params, grid, pieces)``."""
+    cache = geometry.__dict__.get(_SEED_CACHE)
+    if cache is None:
+        cache = {}
+        geometry.__dict__[_SEED_CACHE] = cache
+    found = cache.get(key)
+    if found is None:
+        params, grid, pieces = build()
+        for a in (*params, grid):
+            a.setflags(write=False)
+        found = _SeedGrid(params, grid, cKDTree(grid.reshape(-1, grid.shape[-1])), pieces,
+                          _grid_spacing(grid))
+        cache[key] = found
+    return found
+
+
+def _pick_seeds(seeds: _SeedGrid, points: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
     """(query, sample) pairs for the Newton starts.
 
     The nearest sample (distance ``d0``) is always a seed. Any basin whose minimum
@@ -208,26 +245,26 @@ def _pick_seeds(grid: NDArray, points: NDArray, n_seeds: int, pieces: list[NDArr
 
     Parameters
     ----------
-    grid : (a, [b,] d) float
-        Samples on a 1D or 2D parameter grid.
-    pieces : list of (a,) and (b,) int
-        Crease-free piece of the samples along each axis.
+    seeds : _SeedGrid
+        Samples on a 1D or 2D parameter grid ``(a, [b,] d)`` with their tree and
+        crease-free piece along each axis ((a,) and (b,) int).
 
     Returns
     -------
     rows : (s,) int, every query at least once
     sample : (s,) int, flat index into the grid
     """
+    grid, pieces = seeds.grid, seeds.pieces
     shape = grid.shape[:-1]
     samples = grid.reshape(-1, grid.shape[-1])
     k = min(_CANDIDATES, samples.shape[0])
-    dist, nearest = cKDTree(samples).query(points, k=k, workers=-1)
+    dist, nearest = seeds.tree.query(points, k=k, workers=-1)
     dist, nearest = dist.reshape(points.shape[0], k), nearest.reshape(points.shape[0], k)
     if n_seeds == 1 or k == 1:
         return np.arange(points.shape[0]), nearest[:, 0]
     index = np.stack(np.unravel_index(nearest, shape), axis=-1)          # (m, k, dims)
     candidate = (np.abs(index - index[:, :1]).max(axis=2) > 1) \
-        & (dist <= dist[:, :1] + _grid_spacing(grid))
+        & (dist <= dist[:, :1] + seeds.spacing)
     offsets = np.array(list(itertools.product((-1, 0, 1), repeat=len(shape))))
     rows, cols = np.nonzero(candidate)
     for part in np.array_split(np.arange(rows.size), 1 + rows.size // 50_000):
@@ -530,15 +567,20 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
 
 def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
                    samples_per_span: int | None, pieces: _Pieces) -> tuple[NDArray, NDArray]:
-    net = surface.control_points
-    extents = [_span_extents(net, surface.knots_u, surface.degree_u),
-               _span_extents(np.swapaxes(net, 0, 1), surface.knots_v, surface.degree_v)]
-    per_u, per_v = _sample_counts(extents, [surface.degree_u, surface.degree_v],
-                                  samples_per_span, _MIN_SAMPLES)
-    su = _span_samples(surface.knots_u, surface.degree_u, per_u)
-    sv = _span_samples(surface.knots_v, surface.degree_v, per_v)
-    sample_pieces = [pieces.axis_index(0, su), pieces.axis_index(1, sv)]
-    rows, sample = _pick_seeds(surface.evaluate_grid(su, sv), targets, n_seeds, sample_pieces)
+    def build():
+        net = surface.control_points
+        extents = [_span_extents(net, surface.knots_u, surface.degree_u),
+                   _span_extents(np.swapaxes(net, 0, 1), surface.knots_v, surface.degree_v)]
+        per_u, per_v = _sample_counts(extents, [surface.degree_u, surface.degree_v],
+                                      samples_per_span, _MIN_SAMPLES)
+        su = _span_samples(surface.knots_u, surface.degree_u, per_u)
+        sv = _span_samples(surface.knots_v, surface.degree_v, per_v)
+        return ((su, sv), surface.evaluate_grid(su, sv),
+                [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
+
+    seeds = _seed_grid(surface, ("surface", samples_per_span), build)
+    su, sv = seeds.params
+    rows, sample = _pick_seeds(seeds, targets, n_seeds)
     iu, iv = np.unravel_index(sample, (su.size, sv.size))
     return rows, np.stack([su[iu], sv[iv]], axis=1)
 
@@ -555,5 +597,4 @@ def distance_to_surface(surface: NurbsSurface, points: ArrayLike, *,
 
 # Curves share the machinery above; their functions live in their own module and
 # are served from here too (imported last: that module uses the names above).
-from .curve_projection import (CurveProjectionResult, distance_to_curve,  # noqa: E402
-                               project_to_curve)
+from .curve_projection import CurveProjectionResult, distance_to_curve, project_to_curve
