@@ -159,14 +159,15 @@ def distance_jet(r: NurbsSurface | PatchEvaluator, projector: Projector, uv: Arr
 def _compiled_jet(r: PatchEvaluator, projector: Projector, uv: NDArray,
                   st0: ArrayLike | None) -> DistanceJet:
     """:func:`distance_jet` by :func:`.kernels.distance_points` (one compiled pass)."""
-    if st0 is None:
-        st0 = projector.seeds(r.evaluate(uv[:, 0], uv[:, 1]))
+    if st0 is None:                   # a parallelogram q is projected in closed form
+        st0 = (np.zeros_like(uv) if projector.is_affine
+               else projector.seeds(r.evaluate(uv[:, 0], uv[:, 1])))
     st0 = np.ascontiguousarray(np.asarray(st0, dtype=float).reshape(-1, 2))
     lo, hi, quarter = projector.newton_bounds()
     point, foot, normal, st, phi, grad, hess, jac, status, det = kernels.distance_points(
         *r.compiled, *projector.evaluator.compiled, np.ascontiguousarray(uv), st0, lo, hi,
         quarter, float(projector.tol), int(projector.max_iter), projector.lower,
-        projector.upper)
+        projector.upper, projector.kernel_frame())
     return DistanceJet(uv, point, Projection(st, foot, status, det), normal, phi, grad, hess, jac)
 
 

@@ -228,19 +228,43 @@ def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
 
 
 @_jit
+def _project_affine(frame, x0, x1, x2, lo, hi, lower, qd):
+    """The foot on a parallelogram ``q`` in closed form (as
+    :meth:`.projection.Projector._project_affine`): ``frame (5, 3)`` from
+    :meth:`.projection.Projector.kernel_frame`; ``qd (3, 3, 3)`` filled (second
+    derivatives zero). Returns ``(s, t, moved, before)`` as :func:`_project_one`
+    (no Newton move: the §6.2 case is decided by the domain alone)."""
+    e0, e1, e2 = x0 - frame[0, 0], x1 - frame[0, 1], x2 - frame[0, 2]
+    r0 = e0 * frame[1, 0] + e1 * frame[1, 1] + e2 * frame[1, 2]
+    r1 = e0 * frame[2, 0] + e1 * frame[2, 1] + e2 * frame[2, 2]
+    s = min(max(lower[0] + frame[3, 0] * r0 + frame[3, 1] * r1, lo[0]), hi[0])
+    t = min(max(lower[1] + frame[3, 1] * r0 + frame[3, 2] * r1, lo[1]), hi[1])
+    qd[:] = 0.0
+    for c in range(3):
+        qd[0, 0, c] = frame[0, c] + (s - lower[0]) * frame[1, c] + (t - lower[1]) * frame[2, c]
+        qd[1, 0, c] = frame[1, c]
+        qd[0, 1, c] = frame[2, c]
+    return s, t, 0.0, np.inf
+
+
+@_jit
 def _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, u, v, s0, t0,
-             lo, hi, quarter, tol, max_iter, lower, upper, i, point, foot, normal, st, phi,
-             grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
+             lo, hi, quarter, tol, max_iter, lower, upper, frame, i, point, foot, normal, st,
+             phi, grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
     """Row ``i`` of :func:`distance_points`' outputs at ``(u, v)``, foot seeded at
     ``(s0, t0)``; the trailing arrays are scratch (see :func:`distance_points`)."""
     _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
                        r_rational, u, v, hom[:, :, :r_coef.shape[4]], rd, False)
     for c in range(3):
         point[i, c] = rd[0, 0, c]
-    st[i, 0], st[i, 1], moved, before = _project_one(
-        q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
-        s0, t0, lo, hi, quarter, tol, max_iter,
-        du[:, :q_coef.shape[2]], dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
+    if frame[4, 0] > 0:
+        st[i, 0], st[i, 1], moved, before = _project_affine(
+            frame, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2], lo, hi, lower, qd)
+    else:
+        st[i, 0], st[i, 1], moved, before = _project_one(
+            q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
+            s0, t0, lo, hi, quarter, tol, max_iter, du[:, :q_coef.shape[2]],
+            dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
     qs, qt = qd[1, 0], qd[0, 1]
     _cross(qs, qt, big)
     length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
@@ -299,7 +323,7 @@ def _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, u, 
 
 @_jit
 def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
-                    lo, hi, quarter, tol, max_iter, lower, upper):
+                    lo, hi, quarter, tol, max_iter, lower, upper, frame):
     """``phi``, its gradient and Hessian (002 eqs. 2, 24-31) at ``uv (n, 2)`` of ``r``.
 
     Per point: ``r``'s derivatives, the foot on ``q`` (:func:`_project_one`), the
@@ -318,6 +342,9 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     status : (n,) int8
         §6.2 case of each foot (:func:`_status`; ``lower``, ``upper``: ``q``'s domain).
     det_k : (n,) float
+
+    ``frame (5, 3)``: :meth:`.projection.Projector.kernel_frame` (a parallelogram
+    ``q`` is projected in closed form, ``st0`` unread).
     """
     n = uv.shape[0]
     point = np.empty((n, 3))
@@ -343,7 +370,8 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     n_t = np.empty(3)
     for i in range(n):
         _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv[i, 0],
-                 uv[i, 1], st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter, lower, upper, i,
+                 uv[i, 1], st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter, lower, upper,
+                 frame, i,
                  point, foot, normal, st, phi, grad, hess, jac, status, det_k, du, dv, hom, d,
                  rd, qd, big, c1, c2, n_s, n_t)
     return point, foot, normal, st, phi, grad, hess, jac, status, det_k

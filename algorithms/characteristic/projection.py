@@ -310,6 +310,20 @@ class Projector:
         status[~self.inside(st) | lost] = ProjectionStatus.NONE
         return status, det
 
+    def kernel_frame(self) -> NDArray:
+        """``(5, 3)`` float for :mod:`.kernels`: a parallelogram's ``p0, q_s, q_t``, the
+        inverse Gram matrix ``(g00, g01, g11)`` and ``(1, 0, 0)``; zeros otherwise."""
+        if "frame" not in self._grid:
+            frame = np.zeros((5, 3))
+            if self.is_affine:
+                origin, qs, qt, gram = self._grid["affine"]
+                inv = np.linalg.inv(gram)
+                frame[:3] = origin, qs, qt
+                frame[3] = inv[0, 0], inv[0, 1], inv[1, 1]
+                frame[4, 0] = 1.0
+            self._grid["frame"] = frame
+        return self._grid["frame"]
+
     def newton_bounds(self) -> tuple[NDArray, NDArray, NDArray]:
         """``(lo, hi, quarter)``: Newton's clip box (domain and extension) and step limit."""
         if "bounds" not in self._grid:

@@ -42,7 +42,7 @@ _CORRECTOR = 5
 def _jet(rq, pp, o, w, u, v, s0, t0):
     """The jet at ``(u, v)`` (foot seeded at ``(s0, t0)``) into row 0 of the buffers ``o``."""
     _jet_row(rq[0], rq[1], rq[2], rq[3], rq[4], rq[5], rq[6], rq[7], u, v, s0, t0,
-             pp[0], pp[1], pp[2], pp[3], pp[4], pp[5], pp[6], 0,
+             pp[0], pp[1], pp[2], pp[3], pp[4], pp[5], pp[6], pp[7], 0,
              o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], o[8], o[9],
              w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10])
 
@@ -231,7 +231,7 @@ def trace_compiled(field, comps: NDArray, uv0: NDArray, st0: NDArray, direction:
     r, q = field.evaluator.compiled, projector.evaluator.compiled
     rq = (r[0], r[1], r[2], bool(r[3]), q[0], q[1], q[2], bool(q[3]))
     pp = (lo, hi, quarter, float(projector.tol), int(projector.max_iter), projector.lower,
-          projector.upper)
+          projector.upper, projector.kernel_frame())
     c = np.ascontiguousarray
     return _trace_all(rq, pp, c(comps, dtype=np.int64), c(uv0, dtype=float),
                       c(st0, dtype=float), c(direction, dtype=float), c(h0, dtype=float),

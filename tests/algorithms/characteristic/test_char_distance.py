@@ -113,21 +113,31 @@ def test_distance_jet_function_and_field_agree():
     np.testing.assert_allclose(one.hess, two.hess, atol=1e-9)
 
 
-@pytest.mark.parametrize("pair", ["bicubic", "sphere"])
+@pytest.mark.parametrize("pair", ["bicubic", "sphere", "plane", "plane by Newton"])
 def test_compiled_jet_matches_the_numpy_jet(pair, monkeypatch):
     """The numba pass (kernels.distance_points, project_points, patch_derivatives)
-    computes what the numpy forms compute: same feet, cases, phi and derivatives."""
+    computes what the numpy forms compute: same feet, cases, phi and derivatives.
+    A plane q is projected in closed form in both (kernels._project_affine); "plane
+    by Newton" checks the compiled closed form against the compiled Newton."""
     from surfprep.algorithms.characteristic import kernels
     if pair == "bicubic":
         a, b = random_pair(4)
+    elif pair.startswith("plane"):
+        a, b = random_pair(4)[0], plane_patch([0.5, 0.5, 0.1], [0.1, 0.2, 1.0], 0.45)
+        assert Projector(b, tol=1e-13).is_affine
     else:
         a, b = plane_patch(0.99 * DIAGONAL, DIAGONAL, 0.4), sphere_band()
     uv = np.random.default_rng(5).uniform(-0.02, 1.02, (300, 2))
     uv = np.clip(uv, 0.0, 1.0)
     compiled = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
-    monkeypatch.setattr(kernels, "AVAILABLE", False)
-    ref = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
-    assert kernels.AVAILABLE is False
+    if pair == "plane by Newton":
+        newton = Projector(b, tol=1e-13)
+        newton._grid["affine"] = None
+        ref = DistanceField(a, newton).jet(uv)
+    else:
+        monkeypatch.setattr(kernels, "AVAILABLE", False)
+        ref = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
+        assert kernels.AVAILABLE is False
     np.testing.assert_array_equal(compiled.status, ref.status)
     ok = ref.status != ProjectionStatus.NONE
     assert ok.sum() > 100
