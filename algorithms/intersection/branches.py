@@ -230,13 +230,19 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
 def _residual(surface_a: NurbsSurface, surface_b: NurbsSurface, z: NDArray, scale: float,
               with_jacobian: bool = True) -> tuple[NDArray, NDArray | None]:
     """``(k, 6)`` residual of :func:`locate_singular_points` and its ``(k, 6, 4)`` Jacobian."""
+    if not with_jacobian:          # the residual alone needs first derivatives only
+        da = surface_a.derivatives(z[:, 0], z[:, 1], 1)
+        db = surface_b.derivatives(z[:, 2], z[:, 3], 1)
+        na, nb = _cross(da[:, 1, 0], da[:, 0, 1]), _cross(db[:, 1, 0], db[:, 0, 1])
+        tiny = np.finfo(float).tiny
+        na /= np.maximum(np.linalg.norm(na, axis=1), tiny)[:, None]
+        nb /= np.maximum(np.linalg.norm(nb, axis=1), tiny)[:, None]
+        return np.concatenate([da[:, 0, 0] - db[:, 0, 0], scale * _cross(na, nb)], axis=1), None
     da = surface_a.derivatives(z[:, 0], z[:, 1], 2)
     db = surface_b.derivatives(z[:, 2], z[:, 3], 2)
     na, na_u, na_v = _unit_normal(da)
     nb, nb_s, nb_t = _unit_normal(db)
     res = np.concatenate([da[:, 0, 0] - db[:, 0, 0], scale * _cross(na, nb)], axis=1)
-    if not with_jacobian:
-        return res, None
     top = np.stack([da[:, 1, 0], da[:, 0, 1], -db[:, 1, 0], -db[:, 0, 1]], axis=2)
     bottom = scale * np.stack([_cross(na_u, nb), _cross(na_v, nb),
                                _cross(na, nb_s), _cross(na, nb_t)], axis=2)

@@ -201,6 +201,9 @@ _MAX_SAMPLE_STARTS = 16
 _BALL_MARGIN = 1.25
 #: a piece end is joined to the half-branch it points along within this angle
 _JOIN_COS = np.cos(np.radians(35.0))
+#: a cut end whose (u, v) differ from the singular point's by more than this share of
+#: the domain's extent (either surface) lies across a seam from it
+_SAME_SIDE = 0.25
 
 
 def _normal_sines(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray,
@@ -402,17 +405,41 @@ def _centres_per_end(surface_a: NurbsSurface, surface_b: NurbsSurface, centre: t
                      ends: list, tol: float, radius: float) -> list[tuple]:
     """The singular point located again from each cut end ``(piece, end)`` at once,
     so that its (u, v) lie on that end's side of a seam; the shared ``centre``
-    where that fails."""
+    where that fails, and for an end whose (u, v) lie within ``_SAME_SIDE`` of the
+    domain's extent of the centre's on both surfaces (no seam between them: the
+    only other representation of the point is a whole period away)."""
     if not ends:
         return []
     ua = np.array([piece.uv_a[-end] for piece, end in ends])
     ub = np.array([piece.uv_b[-end] for piece, end in ends])
-    ra, rb, ok = locate_singular_points(surface_a, surface_b, ua, ub, tol=tol,
-                                        scale=max(radius, tol))
-    where = surface_a.evaluate(ra[:, 0], ra[:, 1])
-    ok &= np.linalg.norm(where - centre[0], axis=1) <= 16 * tol
-    return [(centre[0], ra[i:i + 1], rb[i:i + 1]) if ok[i] else centre
-            for i in range(len(ends))]
+    out = [centre] * len(ends)
+    far = np.zeros(len(ends), dtype=bool)
+    shifted, extents = [], []   # the centre's (u, v) moved by whole extents towards the end's
+    for uv, at, surface in ((ua, centre[1], surface_a), (ub, centre[2], surface_b)):
+        extent = np.array([surface.domain[1] - surface.domain[0],
+                           surface.domain[3] - surface.domain[2]])
+        extents.append(extent)
+        far |= np.any(np.abs(uv - at) > _SAME_SIDE * extent, axis=1)
+        shifted.append(np.clip(at + extent * np.round((uv - at) / extent), surface.domain[0::2],
+                               surface.domain[1::2]))
+    if not far.any():
+        return out
+    idx = np.flatnonzero(far)
+    # first from the shifted centre (a seam: a few steps), then from the ends themselves
+    for start_a, start_b in ((shifted[0], shifted[1]), (ua, ub)):
+        ra, rb, ok = locate_singular_points(surface_a, surface_b, start_a[idx], start_b[idx],
+                                            tol=tol, scale=max(radius, tol))
+        where = surface_a.evaluate(ra[:, 0], ra[:, 1])
+        ok &= np.linalg.norm(where - centre[0], axis=1) <= 16 * tol
+        for got, end_uv, extent in ((ra, ua[idx], extents[0]), (rb, ub[idx], extents[1])):
+            ok &= np.all(np.abs(got - end_uv) <= _SAME_SIDE * extent, axis=1)   # its side
+        for n, i in enumerate(idx):
+            if ok[n]:
+                out[i] = (centre[0], ra[n:n + 1], rb[n:n + 1])
+        idx = idx[~ok]
+        if idx.size == 0:
+            break
+    return out
 
 
 def _resolve_one(curves: list, kinds: list, centre: tuple, directions: NDArray,

@@ -111,33 +111,85 @@ def _scaled(uv: NDArray, points: NDArray) -> NDArray:
     return uv * (float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0)
 
 
-def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float) -> NDArray:
+def _scale(uv: NDArray, points: NDArray) -> float:
+    """Median ratio of 3D to ``uv`` chords (model units per parameter unit)."""
+    duv = np.linalg.norm(np.diff(uv, axis=0), axis=1)
+    dp = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    ok = duv > 0
+    return float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0
+
+
+def _fourth_derivatives(curve: RefinedCurve, t: NDArray) -> NDArray:
+    """Fourth derivative estimate ``(chords,)`` of the stacked curve
+    ``(points | uv_a | uv_b)`` per dense chord, in model units (the parameter-space
+    parts scaled by :func:`_scale`): 24 times the fourth divided difference over the
+    chord-length parameters ``t`` of every five consecutive dense samples (wrapping
+    round a closed curve; ``f[t_i, ..., t_i+4] = f^(4)(xi) / 24``), given to the two
+    middle chords of the five and the larger taken per chord.
+
+    Where a surface's parametrization is only C1 (the knot lines of converted
+    rational surfaces) the pcurve's second derivative jumps and this estimate is
+    large on the chords next to the crossing, so the first subset is already
+    denser there instead of rounds of splitting finding it out."""
+    pts, closed = curve.points, curve.closed
+    chords = t.size - 1
+    out = np.zeros(chords)
+    if pts.shape[0] < 5:
+        return out
+    values = np.hstack([pts, curve.uv_a, curve.uv_b])
+    if closed:
+        values = np.vstack([values, values[:4]])
+        t = np.concatenate([t, t[1:4] + t[-1]])
+    dd = values
+    for k in range(1, 5):
+        dd = np.diff(dd, axis=0) / (t[k:] - t[:-k])[:, None]
+    weights = (1.0, _scale(curve.uv_a, pts), _scale(curve.uv_b, pts))
+    f4 = 24.0 * np.maximum.reduce([w * np.linalg.norm(dd[:, a:b], axis=1)
+                                   for w, (a, b) in zip(weights, ((0, 3), (3, 5), (5, 7)))])
+    for shift in (1, 2):       # window i covers chords i .. i + 3: the middle ones
+        idx = np.arange(f4.size) + shift
+        np.maximum.at(out, idx % chords if closed else idx, f4)
+    if not closed:             # the end chords take their neighbours' values
+        out[0], out[-1] = max(out[0], out[1]), max(out[-1], out[-2])
+    return out
+
+
+def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float,
+                   fourth: NDArray | None = None) -> NDArray:
     """Cumulative number of cubic spans needed ``(len(t),)`` at the dense samples:
-    the integral of ``(kappa^3 / (384 target))^(1/4)`` along the chord lengths ``t``."""
+    the integral of ``(f4 / (384 target))^(1/4)`` along the chord lengths ``t``,
+    ``f4`` the larger of ``kappa^3`` (Menger curvature of the 3D and parameter-space
+    polylines) and ``fourth (chords,)`` (:func:`_fourth_derivatives`)."""
     pts, closed = curve.points, curve.closed
     kappa = np.maximum.reduce([_menger(pts, closed), _menger(_scaled(curve.uv_a, pts), closed),
                                _menger(_scaled(curve.uv_b, pts), closed)])
     ds = np.diff(t)
     k_chord = np.maximum(kappa, np.roll(kappa, -1))[: ds.size]
-    per_length = (np.maximum(k_chord, 0.0) ** 3 / (_CUBIC_CONSTANT * target)) ** 0.25 / _SPACING
+    f4 = np.maximum(k_chord, 0.0) ** 3
+    if fourth is not None:     # measured, not modelled: without the _SPACING margin
+        f4 = np.maximum(f4, _SPACING ** 4 * fourth)
+    per_length = (f4 / (_CUBIC_CONSTANT * target)) ** 0.25 / _SPACING
     return np.concatenate([[0.0], np.cumsum(ds * per_length)])
 
 
-def _resample_targets(curve: RefinedCurve, target: float) -> tuple[NDArray, NDArray] | None:
-    """New sample positions of a densely refined curve (module docstring, step 1).
-
-    Returns ``(t, positions)``: the dense chord-length parameters and the interior
-    parameters where samples should go, equally many cubic spans apart (at least
-    four spans on a closed curve), on the interpolant through all dense samples;
-    None when the curve has too few converged samples to interpolate (every dense
-    sample is kept then).
-    """
+def _dense_parameters(curve: RefinedCurve) -> NDArray | None:
+    """Chord-length parameters of a densely refined curve, or None when it has too few
+    converged samples to interpolate (every dense sample is kept then)."""
     if not curve.converged.all() or curve.points.shape[0] < 2 + 2 * curve.closed:
         return None
     t = sample_parameters(curve.points, curve.closed)
-    if np.any(np.diff(t) <= 0):
-        return None
-    phase = _spacing_phase(curve, t, target)
+    return None if np.any(np.diff(t) <= 0) else t
+
+
+def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
+                      fourth: NDArray | None = None) -> tuple[NDArray, NDArray]:
+    """New sample positions of a densely refined curve (module docstring, step 1).
+
+    Returns ``(t, positions)``: the dense chord-length parameters ``t`` and the
+    interior parameters where samples should go, equally many cubic spans apart (at
+    least four spans on a closed curve), on the interpolant through all dense samples.
+    """
+    phase = _spacing_phase(curve, t, target, fourth)
     spans = max(int(np.ceil(phase[-1] - 1e-9)), 4 if curve.closed else 1)
     goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
         t[-1] * np.arange(1, spans) / spans
@@ -233,12 +285,17 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         samples all collapse onto one point (within ``tol / 1000``).
     """
     target = share * tol
-    plans = [_resample_targets(c, target) if simplify else None for c in curves]
-    planned = [(c, plan) for c, plan in zip(curves, plans) if plan is not None]
+    plans = [_dense_parameters(c) if simplify else None for c in curves]
+    live = [i for i, t in enumerate(plans) if t is not None]
     new = None
-    if planned:             # the interpolants through all dense samples, evaluated at once
-        dense = interpolate_many([np.hstack([c.points, c.uv_a, c.uv_b]) for c, _ in planned],
-                                 [t for _, (t, _) in planned], [c.closed for c, _ in planned])
+    if live:                # the interpolants through all dense samples, evaluated at once
+        dense = interpolate_many([np.hstack([curves[i].points, curves[i].uv_a, curves[i].uv_b])
+                                  for i in live], [plans[i] for i in live],
+                                 [curves[i].closed for i in live])
+        for i in live:
+            plans[i] = _resample_targets(curves[i], plans[i], target,
+                                         _fourth_derivatives(curves[i], plans[i]))
+        planned = [(curves[i], plans[i]) for i in live]
         at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
                             np.concatenate([p for _, (_, p) in planned]))
         anchors = at[:, :3]
