@@ -105,7 +105,10 @@ class PatchEvaluator:
         patches, iu, iv = bezier_patches(self.surface)
         mu = _bernstein_to_monomial(self.surface.degree_u)
         mv = _bernstein_to_monomial(self.surface.degree_v)
-        coef = np.einsum("ik,jl,abijc->abklc", mu, mv, patches)
+        # coef[a, b, k, l] = sum_ij mu[i, k] mv[j, l] patches[a, b, i, j]: two tensordots
+        # (a three-operand einsum loops over every index at once: ~1 ms at degree 6)
+        coef = np.tensordot(mv, np.tensordot(mu, patches, axes=([0], [2])), axes=([0], [3]))
+        coef = np.ascontiguousarray(coef.transpose(2, 3, 1, 0, 4))
         self._data.update(coef=coef, iu=iu, iv=iv)
         self._data["compiled"] = kernels.evaluator_arrays(coef, iu, iv) + (
             self.surface.weights is not None,)
