@@ -227,7 +227,7 @@ def trace_uncovered(field: DistanceField, starts: Start, known: list[Intersectio
     for _ in range(MAX_TRACE_ROUNDS):
         if todo.size == 0:
             break
-        gap = curve_gap(pts[todo], curves)
+        gap = curve_gap(pts[todo], curves, within=cover[todo])
         todo = todo[gap > cover[todo]]
         if todo.size == 0:
             break

@@ -119,10 +119,16 @@ def dense_polyline(curve: IntersectionCurve, per_span: int = 32) -> NDArray:
 
 
 def curve_gap(points: NDArray, curves: list[IntersectionCurve], per_span: int = 64,
-              k: int = 3) -> NDArray:
+              k: int = 3, within: float | NDArray | None = None) -> NDArray:
     """Distance ``(n,)`` from each of ``points (n, 3)`` to the nearest of ``curves``,
     measured on their 3D interpolants: the spans next to the ``k`` nearest samples
-    (a k-d tree over all samples) are evaluated at ``per_span`` points each."""
+    (a k-d tree over all samples) are evaluated at ``per_span`` points each.
+
+    ``within`` (a scalar or ``(n,)``): a point for which a closest-point Newton on
+    the interpolant from its nearest sample already finds a curve point within it
+    gets that distance (an upper bound of the gap: the point found lies on the
+    curve) and skips the dense sampling; a caller that only asks ``gap <= within``
+    gets the same answer for less."""
     if not curves or points.shape[0] == 0:
         return np.full(points.shape[0], np.inf)
     from scipy.spatial import cKDTree
@@ -132,6 +138,14 @@ def curve_gap(points: NDArray, curves: list[IntersectionCurve], per_span: int = 
     _, idx = cKDTree(np.concatenate([c.points for c in curves])).query(points, k=k)
     idx = idx.reshape(points.shape[0], k)
     best = np.full(points.shape[0], np.inf)
+    if within is not None:
+        best = _newton_gap(points, curves, owner[idx[:, 0]], local[idx[:, 0]])
+        undecided = np.flatnonzero(~(best <= np.broadcast_to(within, best.shape)))
+        if undecided.size == 0:
+            return best
+        best[undecided] = np.minimum(best[undecided], curve_gap(points[undecided], curves,
+                                                                 per_span, k))
+        return best
     s = np.linspace(0.0, 1.0, per_span + 1)
     for i, curve in enumerate(curves):
         rows, cols = np.nonzero(owner[idx] == i)
@@ -160,6 +174,33 @@ def curve_gap(points: NDArray, curves: list[IntersectionCurve], per_span: int = 
         w = np.clip(np.einsum("mjc,mjc->mj", x - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
         gap = np.linalg.norm(a + w[..., None] * d - x, axis=-1).min(axis=1)
         np.minimum.at(best, who, gap)
+    return best
+
+
+def _newton_gap(points: NDArray, curves: list[IntersectionCurve], owner: NDArray,
+                sample: NDArray, iterations: int = 4) -> NDArray:
+    """``(n,)`` distance from each of ``points (n, 3)`` to a point of its curve
+    ``owner (n,)`` found by Newton on ``C'(t) . (C(t) - p) = 0`` from the parameter of
+    its nearest sample ``sample (n,)``, kept within the two spans next to it (an
+    upper bound of the distance to the curve, equal to it once Newton converged)."""
+    best = np.full(points.shape[0], np.inf)
+    for i in np.unique(owner):
+        curve = curves[i]
+        rows = np.flatnonzero(owner == i)
+        t_all = curve.parameters
+        j = sample[rows]
+        if curve.curve3d is None:
+            best[rows] = np.linalg.norm(curve.points[j] - points[rows], axis=1)
+            continue
+        lo, hi = t_all[np.maximum(j - 1, 0)], t_all[np.minimum(j + 1, t_all.size - 1)]
+        t, p = t_all[j].astype(float), points[rows]
+        for _ in range(iterations):
+            d = curve.curve3d.derivatives(t, 2)                       # (m, 3, 3)
+            off = d[:, 0] - p
+            f = np.einsum("mc,mc->m", d[:, 1], off)
+            df = np.einsum("mc,mc->m", d[:, 2], off) + np.einsum("mc,mc->m", d[:, 1], d[:, 1])
+            t = np.clip(t - f / np.where(np.abs(df) > 1e-300, df, 1e-300), lo, hi)
+        best[rows] = np.linalg.norm(curve.curve3d.evaluate(t) - p, axis=1)
     return best
 
 
