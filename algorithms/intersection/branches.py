@@ -169,6 +169,12 @@ def surface_pair_form(da: NDArray, db: NDArray) -> tuple[NDArray, NDArray]:
     return frame, _second_form(da, na, frame) - _second_form(db, na, frame)
 
 
+#: a start of :func:`locate_singular_points` whose residual has not fallen below this share
+#: of what it was ``_STALL_STEPS`` steps before is given up (no singular point near it)
+_STALL_GAIN = 0.9
+_STALL_STEPS = 10
+
+
 def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayLike,
                            uv_b: ArrayLike, *, tol: float, scale: float, iterations: int = 40
                            ) -> tuple[NDArray, NDArray, NDArray]:
@@ -179,8 +185,10 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
     ``(u, v, s, t)``: a common point with parallel normals (000 §29.5.1; 002
     §4: ``phi = 0`` and ``grad phi = 0``). At a double point the residual
     vanishes and the Jacobian has full rank, so the iteration converges
-    quadratically; once every start meets ``tol`` two more steps bring the
-    point to rounding level.
+    quadratically; once a start meets ``tol`` two more steps bring its point to
+    rounding level. A start whose residual has not fallen by 10 % in 10 steps
+    (a minimum of ``|N_a x N_b|`` off zero: near-tangential surfaces, no
+    singular point) is given up, not iterated to the end.
 
     Parameters
     ----------
@@ -204,26 +212,35 @@ def locate_singular_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_
     z = np.concatenate([ua, ub], axis=1)
     converged = np.zeros(z.shape[0], dtype=bool)
     mu = np.full(z.shape[0], 1e-12)
-    polish = 0
-    for _ in range(iterations):
-        res, jac = _residual(surface_a, surface_b, z, scale)
+    polish = np.zeros(z.shape[0], dtype=np.int64)
+    history = np.full((iterations, z.shape[0]), np.inf)     # residual norm per iteration
+    active = np.arange(z.shape[0])
+    for it in range(iterations):
+        res, jac = _residual(surface_a, surface_b, z[active], scale)
         norm = np.linalg.norm(res, axis=1)
-        converged = (np.linalg.norm(res[:, :3], axis=1) <= tol / 16) & \
+        history[it, active] = norm
+        converged[active] = (np.linalg.norm(res[:, :3], axis=1) <= tol / 16) & \
             (np.linalg.norm(res[:, 3:], axis=1) <= tol / 16)
-        if converged.all():           # two more steps: quadratic convergence to rounding
-            polish += 1
-            if polish > 2:
-                break
+        polish[active] += converged[active]   # two more steps once within tol: rounding
+        # a start that is done, or has not gained _STALL_GAIN in _STALL_STEPS steps (no
+        # singular point near it: a minimum of |N_a x N_b| off zero), leaves the batch
+        stalled = (it >= _STALL_STEPS) & ~converged[active] & \
+            (norm > _STALL_GAIN * history[it - _STALL_STEPS, active])
+        stay = (polish[active] <= 2) & ~stalled
+        active, res, jac, norm = active[stay], res[stay], jac[stay], norm[stay]
+        if active.size == 0:
+            break
         jtj = np.einsum("nki,nkj->nij", jac, jac)
         jtr = np.einsum("nki,nk->ni", jac, res)
         diag = np.einsum("nii->ni", jtj)
-        step = -np.linalg.solve(jtj + (mu[:, None] * np.maximum(diag, 1e-300))[:, :, None]
+        step = -np.linalg.solve(jtj + (mu[active, None] * np.maximum(diag, 1e-300))[:, :, None]
                                 * np.eye(4), jtr[..., None])[..., 0]
-        trial = np.clip(z + step, lo, hi)
+        trial = np.clip(z[active] + step, lo, hi)
         new_norm = np.linalg.norm(_residual(surface_a, surface_b, trial, scale, False)[0], axis=1)
         better = new_norm < norm
-        z = np.where(better[:, None], trial, z)
-        mu = np.where(better, np.maximum(mu / 10, 1e-12), np.minimum(mu * 10, 1e6))
+        z[active] = np.where(better[:, None], trial, z[active])
+        mu[active] = np.where(better, np.maximum(mu[active] / 10, 1e-12),
+                              np.minimum(mu[active] * 10, 1e6))
     return z[:, :2], z[:, 2:], converged & np.isfinite(z).all(axis=1)
 
 
