@@ -59,6 +59,7 @@ from ..algorithms.healing import (
 )
 from ..algorithms.healing.clipping import trimmed_source
 from ..algorithms.healing.connectivity import Side
+from ..algorithms.projection import project_to_surface
 from ..algorithms.tolerance import check_tolerance
 from ..errors import InvalidGeometryError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
@@ -363,15 +364,26 @@ def _whole_faces_only(jobs: list[_Job], out: list, skipped: list[str]) -> list:
     return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
 
 
+#: samples per direction of the replaced face's surface for the orientation start
+_ORIENT_SAMPLES = 9
+
+
 def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
-    """A face on ``surface`` whose normal agrees with the replaced face's."""
+    """A face on ``surface`` whose normal agrees with the replaced face's (compared at
+    the foot of the approximant's centre, projected from the nearest of a coarse grid:
+    only the sign of the normals' dot product is used)."""
     if reference is None:
         return make_face(surface)
     n_new = surface.normals(0.5, 0.5)
     center = surface.evaluate(0.5, 0.5)
-    from ..algorithms.projection import project_to_surface
-    foot = project_to_surface(reference.surface, center)
-    n_old = reference.surface.normals(foot.uv[0], foot.uv[1])
+    old = reference.surface
+    u0, u1, v0, v1 = old.domain
+    uu, vv = np.meshgrid(np.linspace(u0, u1, _ORIENT_SAMPLES),
+                         np.linspace(v0, v1, _ORIENT_SAMPLES), indexing="ij")
+    grid = old.evaluate_grid(uu[:, 0], vv[0]).reshape(-1, 3)
+    k = int(np.argmin(np.linalg.norm(grid - center, axis=1)))
+    foot = project_to_surface(old, center, guess=np.array([uu.ravel()[k], vv.ravel()[k]]))
+    n_old = old.normals(foot.uv[0], foot.uv[1])
     if reference.reversed:
         n_old = -n_old
     return make_face(surface, reversed=bool(np.dot(n_new, n_old) < 0))
@@ -436,8 +448,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     dropped = duplicate_faces(faces, edges, pairs, gap_tol)
     gone = {b for _, b in dropped}
     kept = [i for i, f in enumerate(faces) if f is not None and i not in gone]
-    edges = [e for e in edges if e.face not in gone]
-    pairs = pair_edges(edges, gap_tol)
+    edges, pairs = _without_faces(edges, pairs, gone)
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
     holes = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
@@ -471,6 +482,16 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in _replaced(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
+
+
+def _without_faces(edges: list, pairs: list[tuple[int, int]], gone: set[int]
+                   ) -> tuple[list, list[tuple[int, int]]]:
+    """``edges`` of faces not in ``gone`` and their pairs (renumbered): pairing is
+    edge by edge, so this is what :func:`pair_edges` gives on the kept edges."""
+    keep = [k for k, e in enumerate(edges) if e.face not in gone]
+    new = {k: n for n, k in enumerate(keep)}
+    return ([edges[k] for k in keep],
+            [(new[a], new[b]) for a, b in pairs if a in new and b in new])
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from ..algorithms import NurbsCurve
-from ..algorithms.projection import distance_to_surface, project_to_curve
+from ..algorithms.projection import distance_to_surface, project_to_curve, project_to_surface
 from ..errors import InvalidGeometryError
 from .faces import TrimmedFace
 from .heal_topology import four_sided_boundary
@@ -68,12 +68,14 @@ def _distance_to_curves(points: NDArray, curves: list[NurbsCurve]) -> NDArray:
 @dataclass(frozen=True, eq=False)
 class SurfaceGrid:
     """A face's surface sampled on ``(samples + 1) ** 2`` points, border rows included,
-    in a k-d tree; ``spacing`` is the largest distance between grid neighbours."""
+    in a k-d tree; ``spacing`` is the largest distance between grid neighbours, ``uv``
+    ``(n, 2)`` the samples' parameters (starts for projections)."""
 
     tree: cKDTree
     interior: NDArray
     spacing: float
     box: NDArray
+    uv: NDArray | None = None
 
 
 def surface_grid(face: TrimmedFace, samples: int) -> SurfaceGrid:
@@ -85,13 +87,21 @@ def surface_grid(face: TrimmedFace, samples: int) -> SurfaceGrid:
     interior = np.zeros(g.shape[:2], bool)
     interior[1:-1, 1:-1] = True
     pts = g.reshape(-1, 3)
+    uu, vv = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0), indexing="ij")
     return SurfaceGrid(cKDTree(pts), interior.ravel(), float(spacing),
-                 np.array([pts.min(axis=0), pts.max(axis=0)]))
+                       np.array([pts.min(axis=0), pts.max(axis=0)]),
+                       np.stack([uu.ravel(), vv.ravel()], axis=1))
 
 
 def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float,
                   grid: SurfaceGrid) -> list[int]:
-    """Sides of ``a`` lying on ``b``'s surface and away from ``b``'s edges."""
+    """Sides of ``a`` lying on ``b``'s surface and away from ``b``'s edges.
+
+    Cheap tests first: samples off ``b``'s control-net box or far from its grid, then
+    near ``b``'s edges (a side shared with ``b`` lies on its surface too); the surface
+    distance is projected from the nearest grid samples' parameters, and globally
+    only where that start finds a sample off the surface (a proof of "on" is cheap,
+    of "off" is not)."""
     sides_a, sides_b = four_sided_boundary(a), four_sided_boundary(b)
     out = []
     box = b.surface.bounding_box()           # control net: holds the surface
@@ -99,15 +109,22 @@ def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float,
         pts = _interior_samples(curve)
         if np.any((pts < box[0] - gap_tol) | (pts > box[1] + gap_tol)):
             continue                          # a sample off b's box is off b's surface
-        near, _ = grid.tree.query(pts, distance_upper_bound=_NEAR_CELLS * grid.spacing
-                                  + gap_tol)
+        near, nearest = grid.tree.query(pts, distance_upper_bound=_NEAR_CELLS * grid.spacing
+                                        + gap_tol)
         if not np.all(np.isfinite(near)):
             continue                          # a sample far from every grid point of b
-        if distance_to_surface(b.surface, pts).max() > gap_tol:
+        if _distance_to_curves(pts, sides_b).min() <= gap_tol:
             continue
-        if _distance_to_curves(pts, sides_b).min() > gap_tol:
+        if _on_surface(b, pts, grid.uv[nearest] if grid.uv is not None else None, gap_tol):
             out.append(k)
     return out
+
+
+def _on_surface(face: TrimmedFace, pts: NDArray, guess: NDArray | None, gap_tol: float) -> bool:
+    if guess is not None and project_to_surface(face.surface, pts, guess=guess
+                                                ).distance.max() <= gap_tol:
+        return True
+    return bool(distance_to_surface(face.surface, pts).max() <= gap_tol)
 
 
 def _boxes_overlap(a: TrimmedFace, b: TrimmedFace, tol: float) -> bool:
