@@ -58,23 +58,16 @@ def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out, full=True
     _powers((u - iu[su, 0]) * scale_u, scale_u, p, du)
     _powers((v - iv[sv, 0]) * scale_v, scale_v, q, dv)
     dim = coef.shape[4]
-    tmp = np.empty((p + 1, 3, dim))          # the v-sums first: sum_j dv[m, j] coef[i, j]
-    for i in range(p + 1):
+    hom[:] = 0.0                             # the v-sums first: sum_j dv[m, j] coef[i, j]
+    for i in range(p + 1):                   # (no scratch array: this runs per Newton step)
         for m in range(3):
             for c in range(dim):
                 t = 0.0
                 for j in range(q + 1):
                     t += dv[m, j] * coef[su, sv, i, j, c]
-                tmp[i, m, c] = t
-    for k in range(3):
-        for m in range(3):
-            if not full and k + m > 2:
-                continue
-            for c in range(dim):
-                acc = 0.0
-                for i in range(p + 1):
-                    acc += du[k, i] * tmp[i, m, c]
-                hom[k, m, c] = acc
+                for k in range(3):
+                    if full or k + m <= 2:
+                        hom[k, m, c] += du[k, i] * t
     for k in range(3):
         for m in range(3):
             if not full and k + m > 2:
@@ -248,77 +241,89 @@ def _project_affine(frame, x0, x1, x2, lo, hi, lower, qd):
 
 
 @_jit
-def _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, u, v, s0, t0,
-             lo, hi, quarter, tol, max_iter, lower, upper, frame, i, point, foot, normal, st,
-             phi, grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
-    """Row ``i`` of :func:`distance_points`' outputs at ``(u, v)``, foot seeded at
-    ``(s0, t0)``; the trailing arrays are scratch (see :func:`distance_points`)."""
-    _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
-                       r_rational, u, v, hom[:, :, :r_coef.shape[4]], rd, False)
-    for c in range(3):
-        point[i, c] = rd[0, 0, c]
-    if frame[4, 0] > 0:
-        st[i, 0], st[i, 1], moved, before = _project_affine(
-            frame, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2], lo, hi, lower, qd)
-    else:
-        st[i, 0], st[i, 1], moved, before = _project_one(
-            q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
-            s0, t0, lo, hi, quarter, tol, max_iter, du[:, :q_coef.shape[2]],
-            dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
-    qs, qt = qd[1, 0], qd[0, 1]
-    _cross(qs, qt, big)
-    length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
-    nq = normal[i]
-    for c in range(3):
-        nq[c] = big[c] / length
-        foot[i, c] = qd[0, 0, c]
-    _cross(qd[2, 0], qt, c1)
-    _cross(qs, qd[1, 1], c2)
-    _normal_derivative(c1, c2, nq, length, n_s)
-    _cross(qd[1, 1], qt, c1)
-    _cross(qs, qd[0, 2], c2)
-    _normal_derivative(c1, c2, nq, length, n_t)
-    ru, rv = rd[1, 0], rd[0, 1]
-    p_ = 0.0
-    gu = 0.0
-    gv = 0.0
-    g00 = g01 = g10 = g11 = 0.0
-    k00 = k01 = k11 = 0.0
-    for c in range(3):
-        off = rd[0, 0, c] - qd[0, 0, c]
-        p_ += nq[c] * off
-        gu += nq[c] * ru[c]
-        gv += nq[c] * rv[c]
-        g00 += ru[c] * qs[c]                                           # eq. (23)
-        g01 += rv[c] * qs[c]
-        g10 += ru[c] * qt[c]
-        g11 += rv[c] * qt[c]
-        k00 += qs[c] * qs[c] - off * qd[2, 0, c]                       # eq. (22)
-        k01 += qs[c] * qt[c] - off * qd[1, 1, c]
-        k11 += qt[c] * qt[c] - off * qd[0, 2, c]
-    phi[i] = p_
-    grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
-    status[i] = _status(st[i, 0], st[i, 1], k00, k01, k11, moved, before, lower, upper,
-                        tol)
-    det = k00 * k11 - k01 * k01
-    det_k[i] = det
-    j00 = j01 = j10 = j11 = 0.0
-    if abs(det) > 1e-300:                                              # eq. (21)
-        j00 = (k11 * g00 - k01 * g10) / det
-        j01 = (k11 * g01 - k01 * g11) / det
-        j10 = (k00 * g10 - k01 * g00) / det
-        j11 = (k00 * g11 - k01 * g01) / det
-    jac[i, 0, 0], jac[i, 0, 1], jac[i, 1, 0], jac[i, 1, 1] = j00, j01, j10, j11
-    huu = huv = hvu = hvv = 0.0
-    for c in range(3):
-        nu_c = n_s[c] * j00 + n_t[c] * j10                             # (30)
-        nv_c = n_s[c] * j01 + n_t[c] * j11                             # (31)
-        huu += nu_c * ru[c] + nq[c] * rd[2, 0, c]                      # (26)
-        huv += nv_c * ru[c] + nq[c] * rd[1, 1, c]                      # (27)
-        hvu += nu_c * rv[c] + nq[c] * rd[1, 1, c]                      # (28)
-        hvv += nv_c * rv[c] + nq[c] * rd[0, 2, c]                      # (29)
-    mixed = 0.5 * (huv + hvu)
-    hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
+def _jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
+              lo, hi, quarter, tol, max_iter, lower, upper, frame, point, foot, normal, st,
+              phi, grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
+    """The rows of :func:`distance_points`' outputs at ``uv (n, 2)``, feet seeded at
+    ``st0``; the trailing arrays are scratch (see :func:`distance_points`). One call
+    for all rows: a numba call passing some forty arrays costs about a microsecond
+    (reference counts of every argument), more than the body for a plane ``q``."""
+    for i in range(uv.shape[0]):
+        u, v, s0, t0 = uv[i, 0], uv[i, 1], st0[i, 0], st0[i, 1]
+        _point_derivatives(r_coef, r_iu, r_iv, du[:, :r_coef.shape[2]], dv[:, :r_coef.shape[3]],
+                           r_rational, u, v, hom[:, :, :r_coef.shape[4]], rd, False)
+        for c in range(3):
+            point[i, c] = rd[0, 0, c]
+        if frame[4, 0] > 0:
+            st[i, 0], st[i, 1], moved, before = _project_affine(
+                frame, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2], lo, hi, lower, qd)
+        else:
+            st[i, 0], st[i, 1], moved, before = _project_one(
+                q_coef, q_iu, q_iv, q_rational, rd[0, 0, 0], rd[0, 0, 1], rd[0, 0, 2],
+                s0, t0, lo, hi, quarter, tol, max_iter, du[:, :q_coef.shape[2]],
+                dv[:, :q_coef.shape[3]], hom[:, :, :q_coef.shape[4]], d, qd)
+        # written on indices, without array views: every view of a numba array costs a
+        # reference count (atomic) and this body runs for every point of every jet
+        for c in range(3):
+            a, b = (c + 1) % 3, (c + 2) % 3
+            big[c] = qd[1, 0, a] * qd[0, 1, b] - qd[1, 0, b] * qd[0, 1, a]      # q_s x q_t
+            # d(q_s x q_t)/ds = q_ss x q_t + q_s x q_st, d/dt = q_st x q_t + q_s x q_tt
+            c1[c] = (qd[2, 0, a] * qd[0, 1, b] - qd[2, 0, b] * qd[0, 1, a]
+                     + qd[1, 0, a] * qd[1, 1, b] - qd[1, 0, b] * qd[1, 1, a])
+            c2[c] = (qd[1, 1, a] * qd[0, 1, b] - qd[1, 1, b] * qd[0, 1, a]
+                     + qd[1, 0, a] * qd[0, 2, b] - qd[1, 0, b] * qd[0, 2, a])
+        length = max(np.sqrt(big[0] ** 2 + big[1] ** 2 + big[2] ** 2), 1e-300)
+        dot_s = dot_t = 0.0
+        for c in range(3):
+            normal[i, c] = big[c] / length
+            foot[i, c] = qd[0, 0, c]
+            dot_s += normal[i, c] * c1[c]
+            dot_t += normal[i, c] * c2[c]
+        for c in range(3):                       # the unit normal's derivatives (Weingarten)
+            n_s[c] = (c1[c] - normal[i, c] * dot_s) / length
+            n_t[c] = (c2[c] - normal[i, c] * dot_t) / length
+        p_ = 0.0
+        gu = 0.0
+        gv = 0.0
+        g00 = g01 = g10 = g11 = 0.0
+        k00 = k01 = k11 = 0.0
+        for c in range(3):
+            off = rd[0, 0, c] - qd[0, 0, c]
+            nc, ru, rv, qs, qt = normal[i, c], rd[1, 0, c], rd[0, 1, c], qd[1, 0, c], qd[0, 1, c]
+            p_ += nc * off
+            gu += nc * ru
+            gv += nc * rv
+            g00 += ru * qs                                                 # eq. (23)
+            g01 += rv * qs
+            g10 += ru * qt
+            g11 += rv * qt
+            k00 += qs * qs - off * qd[2, 0, c]                             # eq. (22)
+            k01 += qs * qt - off * qd[1, 1, c]
+            k11 += qt * qt - off * qd[0, 2, c]
+        phi[i] = p_
+        grad[i, 0], grad[i, 1] = gu, gv                                    # (24)-(25)
+        status[i] = _status(st[i, 0], st[i, 1], k00, k01, k11, moved, before, lower, upper,
+                            tol)
+        det = k00 * k11 - k01 * k01
+        det_k[i] = det
+        j00 = j01 = j10 = j11 = 0.0
+        if abs(det) > 1e-300:                                              # eq. (21)
+            j00 = (k11 * g00 - k01 * g10) / det
+            j01 = (k11 * g01 - k01 * g11) / det
+            j10 = (k00 * g10 - k01 * g00) / det
+            j11 = (k00 * g11 - k01 * g01) / det
+        jac[i, 0, 0], jac[i, 0, 1], jac[i, 1, 0], jac[i, 1, 1] = j00, j01, j10, j11
+        huu = huv = hvu = hvv = 0.0
+        for c in range(3):
+            nu_c = n_s[c] * j00 + n_t[c] * j10                             # (30)
+            nv_c = n_s[c] * j01 + n_t[c] * j11                             # (31)
+            nc, ru, rv = normal[i, c], rd[1, 0, c], rd[0, 1, c]
+            huu += nu_c * ru + nc * rd[2, 0, c]                            # (26)
+            huv += nv_c * ru + nc * rd[1, 1, c]                            # (27)
+            hvu += nu_c * rv + nc * rd[1, 1, c]                            # (28)
+            hvv += nv_c * rv + nc * rd[0, 2, c]                            # (29)
+        mixed = 0.5 * (huv + hvu)
+        hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
 
 
 @_jit
@@ -368,12 +373,9 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     c2 = np.empty(3)
     n_s = np.empty(3)
     n_t = np.empty(3)
-    for i in range(n):
-        _jet_row(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv[i, 0],
-                 uv[i, 1], st0[i, 0], st0[i, 1], lo, hi, quarter, tol, max_iter, lower, upper,
-                 frame, i,
-                 point, foot, normal, st, phi, grad, hess, jac, status, det_k, du, dv, hom, d,
-                 rd, qd, big, c1, c2, n_s, n_t)
+    _jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0, lo, hi,
+              quarter, tol, max_iter, lower, upper, frame, point, foot, normal, st, phi, grad,
+              hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t)
     return point, foot, normal, st, phi, grad, hess, jac, status, det_k
 
 

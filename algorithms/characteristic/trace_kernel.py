@@ -5,7 +5,7 @@ costs some fifty small numpy operations (predictor, side clipping, the Newton
 corrector's rounds, the acceptance test, the per-curve bookkeeping): on the
 benchmark pairs the certificate spent about half its time there, for jets of a
 few dozen points. :func:`trace_compiled` runs the same steps, stops and end
-reasons curve by curve in one compiled pass, with :func:`.kernels._jet_row`
+reasons curve by curve in one compiled pass, with :func:`.kernels._jet_rows`
 (the distance jet, 002 eqs. 24-31) at one point per evaluation:
 
 * predictor ``x + h t + h^2 / 2 bend``, shortened to land on a side it would
@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..basis_kernels import _jit
-from .kernels import AVAILABLE, _jet_row
+from .kernels import AVAILABLE, _jet_rows
 
 __all__ = ["AVAILABLE", "REASONS", "trace_compiled"]
 
@@ -41,10 +41,12 @@ _CORRECTOR = 5
 @_jit
 def _jet(rq, pp, o, w, u, v, s0, t0):
     """The jet at ``(u, v)`` (foot seeded at ``(s0, t0)``) into row 0 of the buffers ``o``."""
-    _jet_row(rq[0], rq[1], rq[2], rq[3], rq[4], rq[5], rq[6], rq[7], u, v, s0, t0,
-             pp[0], pp[1], pp[2], pp[3], pp[4], pp[5], pp[6], pp[7], 0,
-             o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], o[8], o[9],
-             w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10])
+    uv, st0 = w[11], w[12]
+    uv[0, 0], uv[0, 1], st0[0, 0], st0[0, 1] = u, v, s0, t0
+    _jet_rows(rq[0], rq[1], rq[2], rq[3], rq[4], rq[5], rq[6], rq[7], uv, st0,
+              pp[0], pp[1], pp[2], pp[3], pp[4], pp[5], pp[6], pp[7],
+              o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], o[8], o[9],
+              w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10])
 
 
 @_jit
@@ -201,7 +203,7 @@ def _trace_all(rq, pp, comps, uv0, st0, direction, h0, r_lo, r_hi, diag, h_max, 
     height = max(rq[0].shape[3], rq[4].shape[3])
     w = (np.empty((3, width)), np.empty((3, height)), np.empty((3, 3, 4)), np.empty((3, 3, 3)),
          np.empty((3, 3, 3)), np.empty((3, 3, 3)), np.empty(3), np.empty(3), np.empty(3),
-         np.empty(3), np.empty(3))
+         np.empty(3), np.empty(3), np.empty((1, 2)), np.empty((1, 2)))
     for k in range(m):
         count[k], reason[k] = _trace_one(rq, pp, o, w, k, comps[k], uv0, st0, direction, r_lo,
                                          r_hi, diag, h0[k], h_max, h_min, max_steps, ctol,
