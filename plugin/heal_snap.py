@@ -19,7 +19,7 @@ from ..algorithms.healing.connectivity import Side, _corner_number, side_points
 from ..algorithms.healing.continuity import fit_side_to_curve
 from ..algorithms.healing.measure_joins import measure_join
 from ..algorithms.projection import project_to_curve
-from .heal_topology import FaceEdge, dense_edge, polyline_distance
+from .heal_topology import EDGE_SAMPLES, FaceEdge, dense_edge, polyline_distance
 
 __all__ = ["MAX_SNAP_SPANS", "SNAP_CHECK_SAMPLES", "snap_to_originals"]
 
@@ -125,30 +125,82 @@ def snap_to_originals(network: Network, edges: list[FaceEdge], gap_tol: float,
 
     A corner shared with other approximants is first moved, in every patch that
     shares it, onto the nearer end of the edge (:func:`_pin_corners`), so the side
-    can follow the edge to its end instead of stopping at the averaged corner."""
-    if not edges:
-        return network, 0
+    can follow the edge to its end instead of stopping at the averaged corner.
+
+    Then the T-junctions between approximants, which :func:`connect` does not join
+    (it joins whole sides only): a free side lying along PART of another
+    approximant's free side (e.g. two sides of a split face's sub-patch, meeting at
+    a straight corner, along one side of a neighbour) is fitted to that part; the
+    longer side stays.
+    """
     shared = {(e.a, e.side_a) for e in network.edges} | {(e.b, e.side_b) for e in network.edges}
     patches = list(network.patches)
-    targets = []
+    clusters = network.connectivity.corners
+    targets = _targets(patches, shared, edges, gap_tol)
+    _apply(patches, targets, clusters, tight)
+    done = shared | {(p, side) for p, side, _ in targets}
+    longer = _targets(patches, done, _free_sides(patches, done), gap_tol, part_only=True)
+    _apply(patches, longer, clusters, tight)
+    if not targets and not longer:
+        return network, 0
+    joins = tuple(measure_join(patches, e) for e in network.edges)
+    return replace(network, patches=tuple(patches), joins=joins), len(targets) + len(longer)
+
+
+def _targets(patches: list, skip: set, edges: list[FaceEdge], gap_tol: float,
+             part_only: bool = False) -> list:
+    """``(patch, side, target)`` for the sides not in ``skip`` that :func:`_matching_edge`
+    finds among ``edges`` (those of the patch itself left out; boxes tested at once);
+    with ``part_only`` only a strict part of one edge (a side along a whole edge, or
+    covered by several, is left alone)."""
+    if not edges:
+        return []
+    lo = np.array([e.samples.min(axis=0) for e in edges]) - gap_tol
+    hi = np.array([e.samples.max(axis=0) for e in edges]) + gap_tol
+    owner = np.array([e.face for e in edges])
+    out = []
     for p in range(len(patches)):
         for side in Side:
-            if (p, side) in shared:
+            if (p, side) in skip:
                 continue
-            target = _matching_edge(side_points(patches[p], side, 17),
-                                    side_points(patches[p], side, 129), edges, gap_tol)
-            if target is not None:
-                targets.append((p, side, target))
+            pts = side_points(patches[p], side, 17)
+            near = np.all((lo <= pts.max(axis=0)) & (hi >= pts.min(axis=0)), axis=1)
+            near &= owner != -1 - p
+            if not near.any():
+                continue
+            candidates = [edges[k] for k in np.flatnonzero(near)]
+            target = _matching_edge(pts, side_points(patches[p], side, 129), candidates,
+                                    gap_tol)
+            if target is None or (part_only and (
+                    isinstance(target, list) or any(target is e.curve for e in candidates))):
+                continue
+            out.append((p, side, target))
+    return out
+
+
+def _free_sides(patches: list, skip: set) -> list[FaceEdge]:
+    """The sides of approximants not in ``skip`` as :class:`FaceEdge` (face ``-1 - q``
+    for patch ``q``)."""
+    out = []
+    for q, surface in enumerate(patches):
+        for k, side in enumerate(Side):
+            if (q, side) in skip:
+                continue
+            curve = surface.isocurve(side.parameter(surface), side.fixed)
+            out.append(FaceEdge(-1 - q, k, curve,
+                                curve.evaluate(np.linspace(*curve.domain, EDGE_SAMPLES))))
+    return out
+
+
+def _apply(patches: list, targets: list, clusters, tight: float) -> None:
+    """Corners pinned, then every target side fitted (``patches`` changed in place)."""
     if not targets:
-        return network, 0
-    clusters = network.connectivity.corners
+        return
     _pin_corners(patches, targets, clusters, tight)
     in_clusters = {(m[0], m[1], m[2]) for c in clusters for m in c.members}
     for p, side, target in targets:
         free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
         patches[p] = _snapped(patches[p], side, target, free, tight)
-    joins = tuple(measure_join(patches, e) for e in network.edges)
-    return replace(network, patches=tuple(patches), joins=joins), len(targets)
 
 
 def _corner_index(surface, number: int) -> tuple[int, int]:

@@ -78,3 +78,30 @@ def test_edge_touching_only_a_corner_is_no_target():
     edge = interpolate_curve(np.stack([np.ones_like(y), y, 0 * y], axis=1))
     _, count = snap_to_originals(net, [_edge(edge)], 1e-2, 1e-9)
     assert count == 0
+
+
+def _sheet(x0, x1, y0, y1, bump=0.0):
+    x, y = np.linspace(x0, x1, 5), np.linspace(y0, y1, 5)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    return interpolate_surface(np.stack([gx, gy, 0.1 * gy * np.sin(gx) + bump * np.sin(
+        np.pi * gx / 2)], axis=-1))
+
+
+def test_t_junction_between_approximants_closed_on_the_longer_side():
+    # two sub-patches (x in [0, 1] and [1, 2]) above ONE approximant whose top side runs
+    # along both bottom sides, 2e-3 off them: connect joins whole sides only
+    below = _sheet(0.0, 2.0, -1.0, 0.0, bump=2e-3)
+    net = connect([_sheet(0.0, 1.0, 0.0, 1.0), _sheet(1.0, 2.0, 0.0, 1.0), below],
+                  continuity="G0", gap_tol=1e-2, strict=False)    # as heal calls it
+    assert len(net.edges) == 1                     # only the two sub-patches' shared side
+    below = net.patches[2]
+    top = below.isocurve(below.domain[3], Side.V1.fixed)
+    before = [project_to_curve(top, side_points(p, Side.V0, 401)).distance.max()
+              for p in net.patches[:2]]
+    assert min(before) > 1e-3
+    snapped, count = snap_to_originals(net, [], 1e-2, 1e-9)
+    assert count == 2
+    for p in snapped.patches[:2]:
+        assert project_to_curve(top, side_points(p, Side.V0, 401)).distance.max() < 1e-7
+    assert np.array_equal(snapped.patches[2].control_points, below.control_points)
+    assert snapped.joins[0].max_gap < 1e-12
