@@ -38,6 +38,9 @@ _MIDDLE = 0.25
 _INSIDE = 0.02
 #: a failing span is cut into at most this many pieces per round
 _MAX_PIECES = 8
+#: spans within this many of a failing span are split with it when over _NEAR_SHARE target
+_SPREAD = 4
+_NEAR_SHARE = 0.6
 #: a curve whose error has not halved in this many rounds is given up
 _STALL_ROUNDS = 3
 #: kept samples closer than this times tol to the previous one are duplicates
@@ -242,7 +245,19 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
     ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
         np.concatenate([[np.inf], dt, [np.inf]])
     steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
-    bad = ((error > target) | steep) & (dt > tol) & ~w.stuck[k[: dt.size]]
+    can = (dt > tol) & ~w.stuck[k[: dt.size]]
+    bad = ((error > target) | steep) & can
+    # spans next to a failing one and nearly failing themselves are split with it: a
+    # C2 cubic spreads a split to its neighbours, which would otherwise fail one
+    # after another over as many rounds (a front moving a few spans per round)
+    near = np.zeros(bad.size, dtype=bool)
+    for shift in range(1, _SPREAD + 1):
+        near[shift:] |= bad[:-shift]
+        near[:-shift] |= bad[shift:]
+        if w.closed:
+            near[:shift] |= bad[-shift:]
+            near[-shift:] |= bad[:shift]
+    bad |= near & (error > _NEAR_SHARE * target) & can
     bad[span_of[off]] = False                    # those get their dense sample instead
     bad = np.flatnonzero(bad)
     return bad, error[bad], off, ends, span_of, arc
