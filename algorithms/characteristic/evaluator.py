@@ -3,8 +3,9 @@
 The curve tracers of this package evaluate both surfaces hundreds of times at
 a few dozen points each; :meth:`NurbsSurface.derivatives` spends most of such a
 call on per-call set-up (basis triangles, einsum path search). Here every
-Bézier patch (:func:`surfprep.algorithms.bezier.bezier_patches`) is converted
-once to the power basis in its local coordinates, so one evaluation is a span
+polynomial piece (Bézier patch) is written once in the power basis of its local
+coordinates, straight from the B-spline by Taylor rows at the span starts
+(:func:`_power_patches`), so one evaluation is a span
 lookup, the monomials and two batched matrix products; rational surfaces go
 through :func:`surfprep.algorithms.rational.surface_derivatives_from_homogeneous`.
 Outside the domain the end patches' polynomials continue (the same extension
@@ -16,26 +17,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from math import comb, factorial
+from math import factorial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..bezier import bezier_patches
+from ..basis import basis_derivatives
 from ..rational import surface_derivatives_from_homogeneous
 from ..surface import NurbsSurface
 from . import kernels
 
 __all__ = ["PatchEvaluator"]
-
-
-def _bernstein_to_monomial(degree: int) -> NDArray:
-    """``M (p+1, p+1)``: ``B_i(x) = sum_k M[i, k] x^k``."""
-    m = np.zeros((degree + 1, degree + 1))
-    for i in range(degree + 1):
-        for k in range(i, degree + 1):
-            m[i, k] = comb(degree, k) * comb(k, i) * (-1) ** (k - i)
-    return m
 
 
 @lru_cache(maxsize=64)
@@ -94,6 +86,36 @@ def _rational_to_second_order(hom: NDArray, order: int) -> NDArray:
     return out
 
 
+def _taylor_rows(knots: NDArray, degree: int, count: int) -> tuple[NDArray, NDArray, NDArray]:
+    """Per non-empty span ``[a, b]`` of the domain: ``M (k, p+1, p+1)`` with the piece's
+    power-basis coefficient ``x^i`` (``x = (u - a) / (b - a)``) of basis function
+    ``span - p + j`` in ``M[s, i, j]`` (Taylor at ``a``: ``N^(i)(a) (b - a)^i / i!``,
+    the derivatives by A2.3), the spans and the intervals ``(k, 2)``."""
+    spans = np.flatnonzero(knots[degree:count] < knots[degree + 1:count + 1]) + degree
+    a, b = knots[spans], knots[spans + 1]
+    ders, _ = basis_derivatives(knots, degree, a, degree, spans)      # (k, p+1, p+1)
+    i = np.arange(degree + 1)
+    scale = (b - a)[:, None] ** i / np.array([factorial(k) for k in i], dtype=float)
+    return ders * scale[:, :, None], spans, np.stack([a, b], axis=1)
+
+
+def _power_patches(surface: NurbsSurface) -> tuple[NDArray, NDArray, NDArray]:
+    """``coef (ku, kv, p+1, q+1, d+1)``: the homogeneous power-basis coefficients of
+    every patch in its local coordinates, with the patch intervals ``(ku, 2)``,
+    ``(kv, 2)``. Straight from the B-spline by Taylor rows (:func:`_taylor_rows`):
+    the same polynomials as the Bezier patches converted to the power basis, without
+    the knot insertion."""
+    pw = surface.homogeneous_points()                                 # (nu, nv, d+1)
+    p, q = surface.degree_u, surface.degree_v
+    mu, su, iu = _taylor_rows(surface.knots_u, p, pw.shape[0])
+    mv, sv, iv = _taylor_rows(surface.knots_v, q, pw.shape[1])
+    rows_u = su[:, None] - p + np.arange(p + 1)                       # (ku, p+1)
+    rows_v = sv[:, None] - q + np.arange(q + 1)
+    cu = np.einsum("sij,sjvc->sivc", mu, pw[rows_u])                  # (ku, p+1, nv, d+1)
+    coef = np.einsum("tlj,sitjc->stilc", mv, cu[:, :, rows_v])        # (ku, kv, p+1, q+1, d+1)
+    return np.ascontiguousarray(coef), iu, iv
+
+
 @dataclass(frozen=True, eq=False)
 class PatchEvaluator:
     """Power-basis form of a :class:`NurbsSurface`, for repeated small evaluations."""
@@ -102,13 +124,7 @@ class PatchEvaluator:
     _data: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
-        patches, iu, iv = bezier_patches(self.surface)
-        mu = _bernstein_to_monomial(self.surface.degree_u)
-        mv = _bernstein_to_monomial(self.surface.degree_v)
-        # coef[a, b, k, l] = sum_ij mu[i, k] mv[j, l] patches[a, b, i, j]: two tensordots
-        # (a three-operand einsum loops over every index at once: ~1 ms at degree 6)
-        coef = np.tensordot(mv, np.tensordot(mu, patches, axes=([0], [2])), axes=([0], [3]))
-        coef = np.ascontiguousarray(coef.transpose(2, 3, 1, 0, 4))
+        coef, iu, iv = _power_patches(self.surface)
         self._data.update(coef=coef, iu=iu, iv=iv)
         self._data["compiled"] = kernels.evaluator_arrays(coef, iu, iv) + (
             self.surface.weights is not None,)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from char_surfaces import DIAGONAL, height_field, plane_patch, sphere_band
+from char_surfaces import DIAGONAL, degree_six_pair, height_field, plane_patch, sphere_band
 
 from surfprep.algorithms.characteristic import (
     DistanceField,
@@ -35,6 +35,33 @@ def test_patch_evaluator_matches_the_reference_evaluation(surface):
     ref = surface.derivatives(u, v, 2)
     scale = np.abs(ref).max(axis=0)
     assert np.all(np.abs(ours - ref) <= 1e-10 * np.maximum(scale, 1.0))
+
+
+@pytest.mark.parametrize("surface", [random_pair()[0], sphere_band(), degree_six_pair()[0]],
+                         ids=["bicubic", "sphere", "degree six"])
+def test_power_patches_are_the_bezier_patches_in_the_power_basis(surface):
+    """The evaluator's Taylor rows (evaluator._power_patches) give the polynomials of
+    the Bezier patches (knot insertion, bezier.bezier_patches) in the power basis."""
+    from math import comb
+
+    from surfprep.algorithms.bezier import bezier_patches
+    from surfprep.algorithms.characteristic.evaluator import _power_patches
+
+    def to_monomial(p):
+        m = np.zeros((p + 1, p + 1))
+        for i in range(p + 1):
+            for k in range(i, p + 1):
+                m[i, k] = comb(p, k) * comb(k, i) * (-1) ** (k - i)
+        return m
+
+    patches, iu, iv = bezier_patches(surface)
+    ref = np.einsum("ik,jl,abijc->abklc", to_monomial(surface.degree_u),
+                    to_monomial(surface.degree_v), patches)
+    coef, ju, jv = _power_patches(surface)
+    np.testing.assert_array_equal(iu, ju)
+    np.testing.assert_array_equal(iv, jv)
+    assert coef.shape == ref.shape
+    assert np.abs(coef - ref).max() <= 1e-11 * np.abs(ref).max()
 
 
 def finite_difference_check(field: DistanceField, uv: np.ndarray, h: float = 1e-5):
