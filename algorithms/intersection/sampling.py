@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from . import vectors
+from .crossings import c1_knots, crossing_positions
 from .interpolants import (
     interpolate_samples,
     interpolate_stacked,
@@ -182,18 +183,30 @@ def _dense_parameters(curve: RefinedCurve) -> NDArray | None:
 
 
 def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
-                      fourth: NDArray | None = None) -> tuple[NDArray, NDArray]:
+                      fourth: NDArray | None = None, knots: tuple | None = None
+                      ) -> tuple[NDArray, NDArray]:
     """New sample positions of a densely refined curve (module docstring, step 1).
 
     Returns ``(t, positions)``: the dense chord-length parameters ``t`` and the
     interior parameters where samples should go, equally many cubic spans apart (at
-    least four spans on a closed curve), on the interpolant through all dense samples.
+    least four spans on a closed curve), on the interpolant through all dense samples;
+    graded towards the crossings of C1 knot lines (:mod:`.crossings`) when ``knots``
+    gives ``(c1_knots(a), c1_knots(b), domain_a, domain_b)``.
     """
     phase = _spacing_phase(curve, t, target, fourth)
     spans = max(int(np.ceil(phase[-1] - 1e-9)), 4 if curve.closed else 1)
     goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
         t[-1] * np.arange(1, spans) / spans
     positions = np.interp(goal, phase, t) if phase[-1] > 0 else goal
+    if knots is not None and phase[-1] > 0:
+        ds, dphase = np.diff(t), np.diff(phase)
+        regular = np.minimum(ds / np.maximum(dphase, 1e-300), t[-1] / spans)
+        pts = curve.points
+        stacked = np.hstack([pts, curve.uv_a * _scale(curve.uv_a, pts),
+                             curve.uv_b * _scale(curve.uv_b, pts)])
+        positions = crossing_positions(positions, t, regular, stacked, curve.uv_a, curve.uv_b,
+                                       knots[0], knots[1], knots[2], knots[3], curve.closed,
+                                       target)
     return t, positions
 
 
@@ -292,9 +305,10 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         dense = interpolate_many([np.hstack([curves[i].points, curves[i].uv_a, curves[i].uv_b])
                                   for i in live], [plans[i] for i in live],
                                  [curves[i].closed for i in live])
+        knots = (c1_knots(surface_a), c1_knots(surface_b), surface_a.domain, surface_b.domain)
         for i in live:
             plans[i] = _resample_targets(curves[i], plans[i], target,
-                                         _fourth_derivatives(curves[i], plans[i]))
+                                         _fourth_derivatives(curves[i], plans[i]), knots)
         planned = [(curves[i], plans[i]) for i in live]
         at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
                             np.concatenate([p for _, (_, p) in planned]))

@@ -1,0 +1,186 @@
+"""Graded samples where an intersection curve crosses a C1 knot line of a surface.
+
+A surface converted from a rational analytic one (a sphere, cylinder or torus
+as OpenCascade writes it: rational quadratic arcs) is parametrized only C1 at
+its interior knot lines: the pcurve's second derivative, taken along the
+curve, jumps there by some ``J`` (model units, the parameter-space part scaled
+to model units as in :mod:`.sampling`). The C2 cubic interpolant of
+:mod:`.sampling` cannot follow the jump: near the crossing its error falls only
+as ``h^2`` (measured for ``f = max(x, 0)^2 / 2``: ``0.0067 J h^2`` with the
+kink in the middle of a span, ``0.025 J h^2`` with a sample on it, decaying by
+``2 - sqrt(3) = 0.27`` per span away from it), where elsewhere it falls as
+``h^4``. The verification rounds then split the spans at the crossing over and
+over (4-12 rounds at 1e-10).
+
+:func:`crossing_positions` places the samples there at once: a span of width
+``h_c = 0.8 sqrt(target / (0.0067 J))`` centred on the crossing, then spans
+growing by ``_GROWTH`` per span outwards until they reach the regular
+spacing; the regular positions inside that zone are dropped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..surface import NurbsSurface
+
+__all__ = ["c1_knots", "crossing_positions"]
+
+#: C2 cubic error next to a jump J in the second derivative, kink mid-span: K J h^2
+_KINK_CONSTANT = 0.0067
+#: the centre span is this share of what the constant allows
+_MARGIN = 0.8
+#: graded spans grow by this factor per span away from the crossing (the error decays
+#: by 0.27 per span, so sqrt(1 / 0.27) = 1.9 would just hold)
+_GROWTH = 1.7
+#: graded spans per side at most
+_MAX_STEPS = 40
+#: a uv step longer than this share of the domain is a seam jump, not a crossing
+_SEAM_SHARE = 0.25
+
+
+def c1_knots(surface: NurbsSurface) -> tuple[NDArray, NDArray]:
+    """Interior knots ``(u_knots, v_knots)`` where the surface is at most C1 in that
+    direction (multiplicity at least ``degree - 1``); empty for a bicubic with simple
+    knots."""
+    out = []
+    for knots, degree, lo, hi in ((surface.knots_u, surface.degree_u, *surface.domain[:2]),
+                                  (surface.knots_v, surface.degree_v, *surface.domain[2:])):
+        values, counts = np.unique(np.asarray(knots), return_counts=True)
+        inner = (values > lo) & (values < hi) & (counts >= max(degree - 1, 1))
+        out.append(values[inner])
+    return out[0], out[1]
+
+
+def _second_difference(values: NDArray, t: NDArray) -> NDArray:
+    """``2 f[t0, t1, t2]`` of rows ``values (k, 3, d)`` at ``t (k, 3)``: ``(k, d)``."""
+    d1 = (values[:, 1:] - values[:, :-1]) / (t[:, 1:] - t[:, :-1])[..., None]
+    return 2.0 * (d1[:, 1] - d1[:, 0]) / (t[:, 2] - t[:, 0])[:, None]
+
+
+def _crossings(uv: NDArray, t: NDArray, knots: tuple[NDArray, NDArray], domain,
+               closed: bool) -> tuple[NDArray, NDArray]:
+    """Dense chords ``i (k,)`` whose ``uv`` crosses a knot line, and the crossing's
+    parameter ``t* (k,)`` (linear in the chord)."""
+    n = uv.shape[0]
+    nxt = np.roll(uv, -1, axis=0) if closed else uv[1:]
+    here = uv if closed else uv[:-1]
+    chords, where = [], []
+    for q, values in enumerate(knots):
+        if values.size == 0:
+            continue
+        extent = domain[2 * q + 1] - domain[2 * q]
+        a, b = here[:, q], nxt[:, q]
+        ok = np.abs(b - a) <= _SEAM_SHARE * extent
+        # chord i crosses knot c: (a - c) and (b - c) of opposite signs (or b on it)
+        side_a = np.searchsorted(values, a, side="right")
+        side_b = np.searchsorted(values, b, side="right")
+        hit = np.flatnonzero(ok & (side_a != side_b))
+        for i in hit:
+            lo, hi = sorted((side_a[i], side_b[i]))
+            for c in values[lo:hi]:
+                s = (c - a[i]) / (b[i] - a[i]) if b[i] != a[i] else 0.5
+                chords.append(i)
+                where.append(t[i] + float(np.clip(s, 0.0, 1.0)) * (t[i + 1] - t[i]))
+    if not chords or n < 6:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    return np.array(chords, dtype=np.int64), np.array(where)
+
+
+def _jumps(stacked: NDArray, t: NDArray, chords: NDArray, closed: bool) -> NDArray:
+    """Jump ``J (k,)`` of the second derivative across dense chords ``chords``: second
+    differences of the three samples on each side (``stacked (n, d)`` already in model
+    units); NaN where a side runs off an open curve."""
+    n = stacked.shape[0]
+    if closed:
+        ext = np.vstack([stacked, stacked[:1]])
+        period = t[-1]
+        left = (chords[:, None] + np.arange(-2, 1)[None, :])
+        right = (chords[:, None] + np.arange(1, 4)[None, :])
+        idx = np.concatenate([left, right], axis=1)
+        wraps = np.floor_divide(idx, n)
+        idx = np.mod(idx, n)
+        tt = t[idx] + wraps * period
+        vals = ext[idx]
+    else:
+        idx = np.concatenate([chords[:, None] + np.arange(-2, 1)[None, :],
+                              chords[:, None] + np.arange(1, 4)[None, :]], axis=1)
+        bad = (idx[:, 0] < 0) | (idx[:, -1] >= n)
+        idx = np.clip(idx, 0, n - 1)
+        tt, vals = t[idx], stacked[idx]
+    with np.errstate(divide="ignore", invalid="ignore"):     # the clipped rows: NaN below
+        left = _second_difference(vals[:, :3], tt[:, :3])
+        right = _second_difference(vals[:, 3:], tt[:, 3:])
+    jump = np.linalg.norm(right - left, axis=1)
+    if not closed:
+        jump[bad] = np.nan
+    return jump
+
+
+def crossing_positions(positions: NDArray, t: NDArray, regular: NDArray, stacked: NDArray,
+                       uv_a: NDArray, uv_b: NDArray, knots_a, knots_b, domain_a, domain_b,
+                       closed: bool, target: float) -> NDArray:
+    """Sample positions with graded zones at the C1 knot-line crossings (module docstring).
+
+    Parameters
+    ----------
+    positions : (p,) float
+        Regular interior positions (chord-length parameters) of the first subset.
+    t : (n,) float, or (n + 1,) when closed
+        Chord-length parameters of the dense samples.
+    regular : (chords,) float
+        Regular spacing at each dense chord (model units).
+    stacked : (n, 7) float
+        Dense ``points | uv_a | uv_b``, the parameter-space parts scaled to model units.
+    uv_a, uv_b : (n, 2) float
+        Dense parameters (unscaled), to find the crossings.
+    knots_a, knots_b : (u_knots, v_knots)
+        :func:`c1_knots` of each surface.
+    target : float
+        Model units: the interpolants' error allowed at the check points.
+
+    Returns
+    -------
+    (p',) float, sorted, strictly inside ``(0, t[-1])``.
+    """
+    found = [_crossings(uv, t, knots, domain, closed)
+             for uv, knots, domain in ((uv_a, knots_a, domain_a), (uv_b, knots_b, domain_b))]
+    chords = np.concatenate([f[0] for f in found])
+    if chords.size == 0:
+        return positions
+    where = np.concatenate([f[1] for f in found])
+    jump = _jumps(stacked, t, chords, closed)
+    keep = np.isfinite(jump) & (jump > 0)
+    chords, where, jump = chords[keep], where[keep], jump[keep]
+    if chords.size == 0:
+        return positions
+    centre = _MARGIN * np.sqrt(target / (_KINK_CONSTANT * jump))
+    reach = regular[chords]
+    period = t[-1]
+    extra, zones = [], []
+    for x, h, r in zip(where, centre, reach):
+        if h >= r:                              # the regular spacing is fine enough
+            continue
+        steps = [0.5 * h]
+        while h * _GROWTH ** len(steps) < r and len(steps) < _MAX_STEPS:
+            steps.append(steps[-1] + h * _GROWTH ** len(steps))
+        half = np.array(steps)
+        extra.append(np.concatenate([x - half[::-1], x + half]))
+        zones.append((x, half[-1] + 0.5 * r))
+    if not extra:
+        return positions
+    extra = np.concatenate(extra)
+    inside = np.zeros(positions.size, dtype=bool)
+    for x, width in zones:
+        d = np.abs(positions - x)
+        if closed:
+            d = np.minimum(d, period - d)
+        inside |= d < width
+    out = np.concatenate([positions[~inside], extra])
+    if closed:
+        out = np.mod(out, period)
+    lo, hi = 1e-9 * period, period * (1 - 1e-9)
+    out = np.sort(out[(out > lo) & (out < hi)])
+    small = 1e-3 * float(centre.min())
+    return out[np.concatenate([[True], np.diff(out) > small])]
