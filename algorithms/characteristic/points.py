@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
+from . import newton_kernel
 from .distance import DistanceField, DistanceJet
 from .projection import ProjectionStatus
 
@@ -149,7 +150,8 @@ def _newton_steps(h: NDArray, g: NDArray, flat: float) -> tuple[NDArray, NDArray
 
 def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = None, *,
                     max_iter: int = 16, dedupe: float = 1e-7,
-                    hess_scale: float = 0.0) -> DistanceJet | None:
+                    hess_scale: float = 0.0, compiled: bool | None = None
+                    ) -> DistanceJet | None:
     """Newton on ``grad phi = 0`` (eq. 9) from ``seeds (k, 2)``, batched.
 
     Steps are limited to a tenth of the domain diagonal; a seed whose iterate
@@ -160,7 +162,8 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
     (:func:`_newton_steps`): Newton then converges onto a curve of critical
     points (a surface of revolution cut normal to its axis: ``det H = 0`` all
     along it) instead of giving up; ``H`` below ``1e-9 hess_scale`` (``phi``
-    flat) still stops the seed.
+    flat) still stops the seed. ``compiled`` (default: when numba is there) runs
+    the same iterations by :mod:`.newton_kernel`; False: the batched numpy form.
 
     Returns
     -------
@@ -171,6 +174,16 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
     diag = field.diagonal
     uv = np.array(seeds, dtype=float).reshape(-1, 2)
     st = None if st0 is None else np.array(st0, dtype=float).reshape(-1, 2)
+    if compiled is None:
+        compiled = newton_kernel.AVAILABLE
+    if compiled:
+        if st is None:
+            st = (np.zeros_like(uv) if field.projector.is_affine
+                  else field.projector.seeds(field.evaluator.evaluate(uv[:, 0], uv[:, 1])))
+        uv, st, done = newton_kernel.newton_compiled(
+            field, uv, st, max_iter=max_iter, flat=1e-9 * hess_scale,
+            degenerate=DEGENERATE_SHARE, pseudo=hess_scale > 0)
+        return _distinct(field, uv, st, done, dedupe)
     alive = np.ones(uv.shape[0], dtype=bool)
     done = np.zeros(uv.shape[0], dtype=bool)
     for _ in range(max_iter):
@@ -196,7 +209,14 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
         bad = ~ok | (jet.status != ProjectionStatus.UNIQUE) | ~field.inside(uv[todo], 1e-9)
         alive[todo[bad]] = False
         done[todo[~bad & (length <= 1e-13 * diag)]] = True
-    keep = np.flatnonzero(done & alive)
+    return _distinct(field, uv, st, done & alive, dedupe)
+
+
+def _distinct(field: DistanceField, uv: NDArray, st: NDArray, done: NDArray, dedupe: float
+              ) -> DistanceJet | None:
+    """The jet at the converged ``uv[done]`` with a unique foot, merged within ``dedupe``."""
+    diag = field.diagonal
+    keep = np.flatnonzero(done)
     if keep.size == 0:
         return None
     jet = field.jet(uv[keep], st[keep])

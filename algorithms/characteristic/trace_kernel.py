@@ -188,14 +188,8 @@ def _trace_one(rq, pp, o, w, k, comp, uv0, st0, direction, r_lo, r_hi, diag, h0,
 
 
 @_jit
-def _trace_all(rq, pp, comps, uv0, st0, direction, h0, r_lo, r_hi, diag, h_max, h_min,
-               max_steps, ctol, max_turn, relative_ctol):
-    m = uv0.shape[0]
-    n = max_steps + 1
-    uv, st, grad = np.empty((m, n, 2)), np.empty((m, n, 2)), np.empty((m, n, 2))
-    phi, det = np.empty((m, n)), np.empty((m, n))
-    count = np.empty(m, dtype=np.int64)
-    reason = np.empty(m, dtype=np.int64)
+def buffers(rq):
+    """``(o, w)``: one-row jet outputs and the scratch arrays :func:`_jet` takes."""
     o = (np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty(1),
          np.empty((1, 2)), np.empty((1, 2, 2)), np.empty((1, 2, 2)), np.empty(1, dtype=np.int8),
          np.empty(1))
@@ -204,6 +198,30 @@ def _trace_all(rq, pp, comps, uv0, st0, direction, h0, r_lo, r_hi, diag, h_max, 
     w = (np.empty((3, width)), np.empty((3, height)), np.empty((3, 3, 4)), np.empty((3, 3, 3)),
          np.empty((3, 3, 3)), np.empty((3, 3, 3)), np.empty(3), np.empty(3), np.empty(3),
          np.empty(3), np.empty(3), np.empty((1, 2)), np.empty((1, 2)))
+    return o, w
+
+
+def kernel_arguments(field) -> tuple[tuple, tuple]:
+    """``(rq, pp)``: both surfaces' compiled data and the projector's settings for :func:`_jet`."""
+    projector = field.projector
+    lo, hi, quarter = projector.newton_bounds()
+    r, q = field.evaluator.compiled, projector.evaluator.compiled
+    rq = (r[0], r[1], r[2], bool(r[3]), q[0], q[1], q[2], bool(q[3]))
+    pp = (lo, hi, quarter, float(projector.tol), int(projector.max_iter), projector.lower,
+          projector.upper, projector.kernel_frame())
+    return rq, pp
+
+
+@_jit
+def _trace_all(rq, pp, comps, uv0, st0, direction, h0, r_lo, r_hi, diag, h_max, h_min,
+               max_steps, ctol, max_turn, relative_ctol):
+    m = uv0.shape[0]
+    n = max_steps + 1
+    uv, st, grad = np.empty((m, n, 2)), np.empty((m, n, 2)), np.empty((m, n, 2))
+    phi, det = np.empty((m, n)), np.empty((m, n))
+    count = np.empty(m, dtype=np.int64)
+    reason = np.empty(m, dtype=np.int64)
+    o, w = buffers(rq)
     for k in range(m):
         count[k], reason[k] = _trace_one(rq, pp, o, w, k, comps[k], uv0, st0, direction, r_lo,
                                          r_hi, diag, h0[k], h_max, h_min, max_steps, ctol,
@@ -228,12 +246,7 @@ def trace_compiled(field, comps: NDArray, uv0: NDArray, st0: NDArray, direction:
     reason : (m,) int
         Index into :data:`REASONS`.
     """
-    projector = field.projector
-    lo, hi, quarter = projector.newton_bounds()
-    r, q = field.evaluator.compiled, projector.evaluator.compiled
-    rq = (r[0], r[1], r[2], bool(r[3]), q[0], q[1], q[2], bool(q[3]))
-    pp = (lo, hi, quarter, float(projector.tol), int(projector.max_iter), projector.lower,
-          projector.upper, projector.kernel_frame())
+    rq, pp = kernel_arguments(field)
     c = np.ascontiguousarray
     return _trace_all(rq, pp, c(comps, dtype=np.int64), c(uv0, dtype=float),
                       c(st0, dtype=float), c(direction, dtype=float), c(h0, dtype=float),

@@ -150,3 +150,30 @@ def test_saddle_on_the_intersection_is_a_double_point():
         np.testing.assert_allclose(p[:, 2], 0.0, atol=1e-9)
         np.testing.assert_allclose(np.abs(p[:, 0] - 0.5), np.abs(p[:, 1] - 0.5), atol=1e-9)
         assert c.parameters[-1] == pytest.approx(np.sqrt(2) / 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("pair", ["degree six", "torus ridge"])
+def test_compiled_critical_newton_matches_the_numpy_form(pair):
+    """newton_kernel runs critical_points' Newton seed by seed: the same points (plain
+    step on the degree-6 pair; pseudo-inverse steps onto the torus's ridge of
+    critical points, where det H = 0 all along the top circle)."""
+    from char_surfaces import degree_six_pair, torus_and_plane
+
+    from surfprep.algorithms.characteristic import newton_kernel
+    from surfprep.algorithms.characteristic.algorithm import _grid, choose_field
+    from surfprep.algorithms.characteristic.points import grid_seeds
+
+    if not newton_kernel.AVAILABLE:
+        pytest.skip("numba not installed")
+    a, b = degree_six_pair() if pair == "degree six" else torus_and_plane(1e-3)
+    field = choose_field(a, b, tol=1e-9)
+    grid, shape = _grid(field)
+    seeds = grid_seeds(grid, shape)
+    scale = float(np.abs(grid.hess).max()) if pair == "torus ridge" else 0.0
+    ref = critical_points(field, seeds, hess_scale=scale, compiled=False)
+    new = critical_points(field, seeds, hess_scale=scale, compiled=True)
+    assert ref is not None and new is not None
+    assert ref.uv.shape[0] >= (3 if pair == "degree six" else 2)
+    np.testing.assert_allclose(new.uv, ref.uv, atol=1e-9 * field.diagonal)
+    np.testing.assert_allclose(new.phi, ref.phi, atol=1e-12)
+    assert np.abs(new.grad).max() <= 1e-9 * max(np.abs(new.hess).max(), 1.0)
