@@ -118,6 +118,28 @@ def _jumps(stacked: NDArray, t: NDArray, chords: NDArray, closed: bool) -> NDArr
     return jump
 
 
+def _merged(where: NDArray, jump: NDArray, target: float) -> tuple[NDArray, NDArray]:
+    """Crossings closer than two centre spans merged into one (both surfaces crossing a
+    knot line at about the same point: two interleaved zones would leave spans far
+    shorter than their neighbours, which the rounds then grade one by one): the mean
+    position and the larger jump."""
+    order = np.argsort(where)
+    where, jump = where[order], jump[order]
+    width = 2.0 * _MARGIN * np.sqrt(target / (_KINK_CONSTANT * jump))
+    xs, js = [where[0]], [jump[0]]
+    members = 1
+    for x, j, w in zip(where[1:], jump[1:], width[1:]):
+        if x - xs[-1] <= max(w, 2.0 * _MARGIN * np.sqrt(target / (_KINK_CONSTANT * js[-1]))):
+            xs[-1] = (xs[-1] * members + x) / (members + 1)
+            js[-1] = max(js[-1], j)
+            members += 1
+        else:
+            xs.append(x)
+            js.append(j)
+            members = 1
+    return np.array(xs), np.array(js)
+
+
 def crossing_positions(positions: NDArray, t: NDArray, regular: NDArray, stacked: NDArray,
                        uv_a: NDArray, uv_b: NDArray, knots_a, knots_b, domain_a, domain_b,
                        closed: bool, target: float) -> NDArray:
@@ -155,7 +177,9 @@ def crossing_positions(positions: NDArray, t: NDArray, regular: NDArray, stacked
     chords, where, jump = chords[keep], where[keep], jump[keep]
     if chords.size == 0:
         return positions
+    where, jump = _merged(where, jump, target)
     centre = _MARGIN * np.sqrt(target / (_KINK_CONSTANT * jump))
+    chords = np.clip(np.searchsorted(t, where, side="right") - 1, 0, regular.size - 1)
     reach = regular[chords]
     period = t[-1]
     extra, zones = [], []

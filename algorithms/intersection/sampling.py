@@ -198,6 +198,9 @@ def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
     goal = phase[-1] * np.arange(1, spans) / spans if phase[-1] > 0 else \
         t[-1] * np.arange(1, spans) / spans
     positions = np.interp(goal, phase, t) if phase[-1] > 0 else goal
+    if not curve.closed and positions.size:     # the end spans' error is ~10x the interior's
+        ends = np.array([0.5 * positions[0], 0.5 * (positions[-1] + t[-1])])
+        positions = np.sort(np.concatenate([positions, ends]))
     if knots is not None and phase[-1] > 0:
         ds, dphase = np.diff(t), np.diff(phase)
         regular = np.minimum(ds / np.maximum(dphase, 1e-300), t[-1] / spans)
