@@ -9,24 +9,33 @@ fit error instead of being left to the sewing tolerance.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..algorithms.healing import Network
 from ..algorithms.healing.connectivity import Side, _corner_number, side_points
-from ..algorithms.healing.continuity import fit_side_to_curve
+from ..algorithms.healing.continuity import covered_samples, fit_side_to_curve
 from ..algorithms.healing.measure_joins import measure_join
 from ..algorithms.projection import project_to_curve
 from .heal_topology import EDGE_SAMPLES, FaceEdge, dense_edge, polyline_distance
 
-__all__ = ["MAX_SNAP_SPANS", "SNAP_CHECK_SAMPLES", "snap_to_originals"]
+__all__ = ["MAX_SNAP_SPANS", "SNAP_CHECK_SAMPLES", "PartialTarget", "snap_to_originals"]
 
 #: knot spans along a snapped side at most
 MAX_SNAP_SPANS = 64
 #: samples along a snapped side where its gap to the edge is checked
 SNAP_CHECK_SAMPLES = 257
+
+@dataclass(frozen=True, eq=False)
+class PartialTarget:
+    """Edges lying along PART of a side, the rest of the side meeting nothing: only the
+    samples along them are fitted (:func:`fit_side_to_curve` with ``cover_tol``)."""
+
+    curves: list
+    cover_tol: float
+
 
 def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], gap_tol: float):
     """What ``side`` is fitted to: the edge lying closest along the whole side, within
@@ -58,7 +67,26 @@ def _matching_edge(side: NDArray, dense_side: NDArray, edges: list[FaceEdge], ga
         cover = np.min([polyline_distance(side, _dense(c)) for c in curves], axis=0)
         if cover.max() <= gap_tol:
             return curves[0] if len(curves) == 1 else curves
-    return None
+    ended = [e for e in near if polyline_distance(e.ends, dense_side).max() <= gap_tol
+             and polyline_distance(e.samples, dense_side).max() <= gap_tol]
+    by_face = [[e.curve for e in ended if e.face == face] for face in {e.face for e in ended}]
+    return _partial(side, by_face, gap_tol)
+
+
+def _partial(side: NDArray, groups: list[list], gap_tol: float) -> PartialTarget | None:
+    """The edges of the one face lying along part of the side with both ends on it, when
+    the part they cover is one stretch from one of the side's ends (a kept face meets
+    the side there, the rest is free); else None. Edges with an end off the side are
+    left out: an edge leaving a side at a shallow angle near its end lies within
+    ``gap_tol`` of it over a short stretch without meeting it."""
+    if len(groups) != 1 or not groups[0]:
+        return None
+    curves = groups[0]
+    near = np.min([polyline_distance(side, _dense(c)) for c in curves], axis=0) <= gap_tol
+    changes = np.count_nonzero(np.diff(near.astype(int)))
+    if changes != 1:
+        return None
+    return PartialTarget(curves, gap_tol)
 
 
 def _dense(curve, n: int = 129) -> NDArray:
@@ -106,15 +134,24 @@ def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float)
     curves = _curves(target)
     spans = min(MAX_SNAP_SPANS, sum(2 * (np.unique(c.knots).size - 1) for c in curves) + 8)
     while True:
-        fitted = fit_side_to_curve(surface, side, target, min_spans=spans, free_corners=free)
+        partial = isinstance(target, PartialTarget)
+        fitted = fit_side_to_curve(surface, side, curves, min_spans=spans, free_corners=free,
+                                   cover_tol=target.cover_tol if partial else None)
         pts = side_points(fitted, side, SNAP_CHECK_SAMPLES)
-        gap = np.min([project_to_curve(c, pts).distance for c in curves], axis=0).max()
+        found = [project_to_curve(c, pts) for c in curves]
+        nearest = np.argmin(np.stack([f.distance for f in found]), axis=0)
+        gap = np.stack([f.distance for f in found])[nearest, np.arange(pts.shape[0])]
+        if partial:
+            gap = gap[covered_samples(curves, found, nearest, target.cover_tol)]
+        gap = gap.max(initial=0.0)
         if spans >= MAX_SNAP_SPANS or gap <= tight:
             return fitted
         spans = min(MAX_SNAP_SPANS, 2 * spans)
 
 
 def _curves(target) -> list:
+    if isinstance(target, PartialTarget):
+        return target.curves
     return target if isinstance(target, list) else [target]
 
 
@@ -172,7 +209,8 @@ def _targets(patches: list, skip: set, edges: list[FaceEdge], gap_tol: float,
             target = _matching_edge(pts, side_points(patches[p], side, 129), candidates,
                                     gap_tol)
             if target is None or (part_only and (
-                    isinstance(target, list) or any(target is e.curve for e in candidates))):
+                    isinstance(target, (list, PartialTarget))
+                    or any(target is e.curve for e in candidates))):
                 continue
             out.append((p, side, target))
     return out
@@ -199,13 +237,24 @@ def _apply(patches: list, targets: list, clusters, tight: float) -> None:
     _pin_corners(patches, targets, clusters, tight)
     in_clusters = {(m[0], m[1], m[2]) for c in clusters for m in c.members}
     for p, side, target in targets:
-        free = tuple(not _in_cluster(p, side, end, in_clusters) for end in (0, 1))
+        free = tuple(not _in_cluster(p, side, end, in_clusters)
+                     and _near_an_end(patches[p], side, end, target) for end in (0, 1))
         patches[p] = _snapped(patches[p], side, target, free, tight)
 
 
 def _corner_index(surface, number: int) -> tuple[int, int]:
     nu, nv = surface.n_control
     return (0 if number % 2 == 0 else nu - 1), (0 if number // 2 == 0 else nv - 1)
+
+
+def _near_an_end(surface, side: Side, end: int, target) -> bool:
+    """Whether the corner may move onto an end of ``target``: always for a target along
+    the whole side; for a :class:`PartialTarget` only a corner within its ``cover_tol``."""
+    if not isinstance(target, PartialTarget):
+        return True
+    corner = side_points(surface, side, 2)[end]
+    ends = np.concatenate([c.evaluate(np.array(c.domain)) for c in target.curves])
+    return bool(np.linalg.norm(ends - corner, axis=1).min() <= target.cover_tol)
 
 
 def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
@@ -223,7 +272,8 @@ def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
             i, j = _corner_index(patches[p], number)
             corner = patches[p].control_points[i, j]
             goal = ends[int(np.argmin(np.linalg.norm(ends - corner, axis=1)))]
-            if np.linalg.norm(goal - corner) <= tight:
+            reach = target.cover_tol if isinstance(target, PartialTarget) else np.inf
+            if not tight < np.linalg.norm(goal - corner) <= reach:
                 continue
             for q in {m[0] for m in cluster.members}:
                 numbers = {_corner_number(m[1], m[2]) for m in cluster.members if m[0] == q}

@@ -58,7 +58,8 @@ from .connectivity import (
     side_indices,
 )
 
-__all__ = ["PointClasses", "enforce_g0", "enforce_g1", "fit_side_to_curve", "point_classes"]
+__all__ = ["PointClasses", "covered_samples", "enforce_g0", "enforce_g1", "fit_side_to_curve",
+           "point_classes"]
 
 
 @dataclass(frozen=True)
@@ -306,6 +307,8 @@ def _solve(cons: _Constraints, points: NDArray, free: NDArray) -> NDArray:
 # ------------------------------------------------ joining a fixed neighbour
 #: samples per knot span of the side for :func:`fit_side_to_curve`
 FIT_SAMPLES_PER_SPAN = 8
+#: least-squares weight of the samples along a partial target (against 1 for the rest)
+_COVERED_WEIGHT = 1e3
 
 
 def _refined_along(surface: NurbsSurface, side, min_spans: int) -> NurbsSurface:
@@ -324,8 +327,8 @@ def _refined_along(surface: NurbsSurface, side, min_spans: int) -> NurbsSurface:
 
 
 def fit_side_to_curve(surface: NurbsSurface, side, target, *,
-                      min_spans: int = 0, free_corners: tuple[bool, bool] = (False, False)
-                      ) -> NurbsSurface:
+                      min_spans: int = 0, free_corners: tuple[bool, bool] = (False, False),
+                      cover_tol: float | None = None) -> NurbsSurface:
     """``surface`` with the boundary row of ``side`` fitted to ``target`` (corners kept).
 
     For a side that meets a face which is not re-approximated (its edge is
@@ -348,6 +351,11 @@ def fit_side_to_curve(surface: NurbsSurface, side, target, *,
     free_corners : (bool, bool)
         Move the corner at the start / end of the side onto the nearer end of
         ``target`` (for corners no other patch shares).
+    cover_tol : float, optional
+        Model units. A side only partly along ``target`` (the kept edge meets part
+        of it, the rest is free): only samples within ``cover_tol`` of ``target``
+        whose foot is not at an outer end of it (one no other target curve
+        continues) go to their foot; the others keep their place.
 
     Returns
     -------
@@ -366,6 +374,12 @@ def fit_side_to_curve(surface: NurbsSurface, side, target, *,
     found = [project_to_curve(c, samples) for c in curves]
     nearest = np.argmin(np.stack([f.distance for f in found]), axis=0)
     feet = np.stack([f.points for f in found])[nearest, np.arange(samples.shape[0])]
+    weight = np.ones(samples.shape[0])
+    if cover_tol is not None:
+        covered = covered_samples(curves, found, nearest, cover_tol)
+        feet = np.where(covered[:, None], feet, samples)
+        # the step between foot and own place at the stretch's end goes to the free part
+        weight[covered] = _COVERED_WEIGHT
     basis = collocation_matrix(knots, degree, t)                  # (m, n)
     i, j = side_indices(surface.n_control, side)
     row = surface.control_points[i, j].copy()                     # (n, 3)
@@ -374,9 +388,30 @@ def fit_side_to_curve(surface: NurbsSurface, side, target, *,
         if free:
             row[k] = ends[int(np.argmin(np.linalg.norm(ends - row[k], axis=1)))]
     rhs = feet - basis[:, [0]] * row[0] - basis[:, [-1]] * row[-1]
-    inner, *_ = np.linalg.lstsq(basis[:, 1:-1], rhs, rcond=None)
+    inner, *_ = np.linalg.lstsq(weight[:, None] * basis[:, 1:-1], weight[:, None] * rhs,
+                                rcond=None)
     net = surface.control_points.copy()
     net[i[1:-1], j[1:-1]] = inner
     net[i[[0, -1]], j[[0, -1]]] = row[[0, -1]]
     return NurbsSurface(net, surface.knots_u, surface.knots_v, surface.degree_u,
                         surface.degree_v, surface.weights)
+
+
+def covered_samples(curves: list[NurbsCurve], found: list, nearest: NDArray,
+                    cover_tol: float) -> NDArray:
+    """(m,) bool: samples within ``cover_tol`` of the nearest target curve whose foot is
+    not at an outer end of the targets (an end no other curve continues within
+    ``cover_tol``). ``found`` holds each curve's :func:`project_to_curve` result."""
+    m = nearest.size
+    distance = np.stack([f.distance for f in found])[nearest, np.arange(m)]
+    t = np.stack([f.t for f in found])[nearest, np.arange(m)]
+    ends = [c.evaluate(np.array(c.domain)) for c in curves]
+    at_outer = np.zeros(m, bool)
+    for k, (c, e) in enumerate(zip(curves, ends)):
+        others = [x for n, x in enumerate(ends) if n != k]
+        span = c.domain[1] - c.domain[0]
+        for end, value in zip(e, c.domain):
+            continued = any(np.linalg.norm(o - end, axis=1).min() <= cover_tol for o in others)
+            if not continued:
+                at_outer |= (nearest == k) & (np.abs(t - value) <= 1e-9 * span)
+    return (distance <= cover_tol) & ~at_outer

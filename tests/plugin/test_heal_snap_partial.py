@@ -105,3 +105,23 @@ def test_t_junction_between_approximants_closed_on_the_longer_side():
         assert project_to_curve(top, side_points(p, Side.V0, 401)).distance.max() < 1e-7
     assert np.array_equal(snapped.patches[2].control_points, below.control_points)
     assert snapped.joins[0].max_gap < 1e-12
+
+
+def test_side_partly_along_a_kept_edge_fitted_there_only():
+    # the kept edge meets the right half (x in [1, 2]) of the patch's bottom side, 2e-3
+    # off it; the left half meets nothing and stays where it was
+    net = connect([_sheet(0.0, 2.0, 0.0, 1.0)], continuity="G0", gap_tol=1e-2)
+    x = np.linspace(1.0, 2.0, 17)
+    edge = interpolate_curve(np.stack([x, 2e-3 * np.sin(np.pi * (x - 1)) - 1e-3 * (x - 1),
+                                       np.zeros_like(x)], axis=1))
+    snapped, count = snap_to_originals(net, [_edge(edge)], 1e-2, 1e-9)
+    assert count == 1
+    old, new = side_points(net.patches[0], Side.V0, 801), side_points(snapped.patches[0],
+                                                                       Side.V0, 801)
+    right = old[:, 0] >= 1.0 + 1e-3
+    assert project_to_curve(edge, new[right]).distance.max() < 1e-7
+    # the free half moves only next to the junction (the edge leaves at a slight angle)
+    near, far = (old[:, 0] < 1.0) & (old[:, 0] > 0.8), old[:, 0] <= 0.8
+    assert np.abs(new[far] - old[far]).max() < 1e-5
+    assert np.abs(new[near] - old[near]).max() < 1e-4
+    assert np.allclose(new[0], old[0], atol=1e-12)      # the free far corner stays
