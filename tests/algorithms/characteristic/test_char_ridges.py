@@ -79,3 +79,27 @@ def test_plane_above_the_torus_meets_nothing():
     a, b = torus_and_plane(-1e-3, MAJOR, MINOR)
     rec = certify(a, b, [], tol=TOL)
     assert rec.curves == () and rec.isolated_points == ()
+
+
+@pytest.mark.slow
+def test_triangle_fragments_along_the_top_circle_are_replaced_by_it():
+    """The triangle method leaves fragments along the tangential top circle; the
+    certificate drops every one of them (each lies along the circle) and reports the
+    circle once."""
+    from surfprep.algorithms.intersection import StrayCurves, intersect_surfaces
+
+    a, b = torus_and_plane(0.0, MAJOR, MINOR)
+    mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP)
+    assert len(mesh) > 1
+    rec = certify(a, b, mesh, tol=TOL)
+    assert rec.dropped == len(mesh)
+    assert len(rec.curves) == 1 and rec.found_by == (FoundBy.CHARACTERISTIC,)
+    rho, z = radii_and_heights(rec.curves[0])
+    np.testing.assert_allclose(z, MINOR, atol=TOL)
+    assert np.abs(rho - MAJOR).max() <= np.sqrt(2 * MINOR * TOL) * 1.5
+    # a curve of the triangle method away from the circle is kept: the plane lowered
+    # a little cuts two circles, neither along a tangential curve
+    a, b = torus_and_plane(1e-3, MAJOR, MINOR)
+    mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP)
+    rec = certify(a, b, mesh, tol=TOL)
+    assert rec.dropped == 0 and len(rec.curves) >= len(mesh) > 0
