@@ -61,8 +61,16 @@ def _interior_samples(curve: NurbsCurve) -> NDArray:
     return curve.evaluate(np.linspace(t0, t1, _SAMPLES + 2)[1:-1])
 
 
-def _distance_to_curves(points: NDArray, curves: list[NurbsCurve]) -> NDArray:
-    return np.min([project_to_curve(c, points).distance for c in curves], axis=0)
+def _near_curves(points: NDArray, curves: list[NurbsCurve], tol: float) -> bool:
+    """Whether a point lies within ``tol`` of a curve (curves whose control-point box,
+    grown by ``tol``, holds no point are not projected onto)."""
+    for c in curves:
+        box = c.control_points
+        inside = np.all((points >= box.min(axis=0) - tol) & (points <= box.max(axis=0) + tol),
+                        axis=1)
+        if inside.any() and project_to_curve(c, points[inside]).distance.min() <= tol:
+            return True
+    return False
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,7 +121,7 @@ def _inside_sides(a: TrimmedFace, b: TrimmedFace, gap_tol: float,
                                         + gap_tol)
         if not np.all(np.isfinite(near)):
             continue                          # a sample far from every grid point of b
-        if _distance_to_curves(pts, sides_b).min() <= gap_tol:
+        if _near_curves(pts, sides_b, gap_tol):
             continue
         if _on_surface(b, pts, grid.uv[nearest] if grid.uv is not None else None, gap_tol):
             out.append(k)
