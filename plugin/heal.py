@@ -392,7 +392,7 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 # ---------------------------------------------------------------------- heal
 def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
-         overlap: OverlapRepair | str = "trim", split_faces: bool = False) -> HealResult:
+         overlap: OverlapRepair | str = "trim", split_faces: bool = True) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -417,9 +417,10 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     split_faces : bool
         Faces that are not four-sided are split into four-sided sub-patches on the
         face (:func:`.heal_nsided.quad_boundaries`) and replaced when every
-        sub-patch fits (sides checked against the edges too). Off by default: a
-        sub-patch side meeting part of a kept neighbour's edge is not yet fitted
-        to it, which can leave more open edges on some models.
+        sub-patch fits (sides checked against the edges too); their sides are
+        fitted to the parts of kept neighbours' edges and of longer approximant
+        sides they meet (:mod:`.heal_snap`). On by default; False keeps every face
+        that is not four-sided as it is (faster: its sub-patches are not built).
 
     Returns
     -------

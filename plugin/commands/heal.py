@@ -62,9 +62,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="a strip overlap of two four-sided faces: trim the later face "
                              "back (default) or replace both by one approximant over their "
                              "union when it is four-sided")
-    parser.add_argument("--split-faces", action="store_true", dest="split_faces",
+    parser.add_argument("--split-faces", action=argparse.BooleanOptionalAction, default=True,
+                        dest="split_faces",
                         help="also replace faces that are not four-sided, split into "
-                             "four-sided sub-patches on the face")
+                             "four-sided sub-patches on the face (default; "
+                             "--no-split-faces keeps them as they are)")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")

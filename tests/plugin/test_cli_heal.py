@@ -109,12 +109,13 @@ def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
 
 
 def test_heal_split_faces_option(tmp_path, capsys):
-    # a three-sided face: kept as it is by default, three sub-patches with --split-faces
+    # a three-sided face: three sub-patches by default (--split-faces), kept as it is
+    # with --no-split-faces
     from test_heal_nsided import _occ_triangle_face
     src = tmp_path / "triangle.step"
     surfprep.write([_occ_triangle_face()], src)
-    for flags, faces_out in (((), 1), (("--split-faces",), 3)):
-        out = tmp_path / f"out{len(flags)}.step"
+    for flags, faces_out in (((), 3), (("--split-faces",), 3), (("--no-split-faces",), 1)):
+        out = tmp_path / f"out{'_'.join(flags)}.step"
         code, _, err = run(capsys, "heal", src, "-o", out, *flags)
         assert code == 0, err
         assert surfprep.read(out).n_faces == faces_out

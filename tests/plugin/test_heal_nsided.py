@@ -13,14 +13,15 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "algorithms" / "healing"))
 from decompose_cases import (
     disc,
-    line,
     edge_from_uv,
+    line,
     pentagon,
     polygon_loop,
     six_edges_two_smooth,
     triangle,
     wavy_surface,
 )
+
 from surfprep.algorithms.healing import connect, local_approximant
 from surfprep.algorithms.healing.decompose import reverse_curve
 from surfprep.algorithms.projection import distance_to_surface
@@ -112,13 +113,14 @@ def _occ_triangle_face():
 def test_heal_split_faces_replaces_a_triangle_by_three_patches():
     # surfprep.heal(split_faces=True): the three-sided face becomes three sub-patches
     # that follow it (dense check against the surface), keep its area and outline, and
-    # are joined G0 into one valid face set; without the option the face is kept
+    # are joined G0 into one valid face set (the default); with split_faces=False the
+    # face is kept
     from surfprep.plugin.heal import heal
     from surfprep.plugin.heal_topology import face_edges, polyline_distance
     shape = _occ_triangle_face()
-    kept = heal(shape)
+    kept = heal(shape, split_faces=False)
     assert kept.patches == () and kept.model.n_faces == 1
-    r = heal(shape, split_faces=True)
+    r = heal(shape)
     assert [p.origin.kind for p in r.patches] == ["face"] * 3
     assert {p.origin.faces for p in r.patches} == {(0,)}
     assert r.valid_after and r.model.n_faces == 3
