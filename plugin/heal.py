@@ -20,14 +20,17 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    original faces (trimmed faces as the part inside their loops,
    :func:`face_source`; the face itself preferred over other faces crossing
    the segments; a face whose approximant misses ``tol`` at the largest
-   resolution is kept as it is, and the report says so); every hole one over
-   its four free edges (a loop whose patch lands on faces, e.g. the mouth of
+   resolution is kept as it is, and the report says so); a face that is not
+   four-sided is split into four-sided sub-patches (``split_faces``, default) and
+   replaced when all of them fit; every hole one over its four free edges (a loop whose patch lands on faces, e.g. the mouth of
    a slot, is no hole and stays open);
 4. the approximants are joined by :func:`connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
-   as it was (not re-approximated) is fitted to that face's edge or edges
-   (with the shared corners moved onto the edge's ends), so the gap to it
-   closes up to the fit error too;
+   as it was (not re-approximated) is fitted to that face's edge or edges, or
+   to the part of an edge it meets (with the shared corners moved onto the
+   ends), and a side along part of a longer approximant side (a T-junction
+   :func:`connect` does not join) to that part, so those gaps close up to the
+   fit error too (:mod:`.heal_snap`);
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
    shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
    untouched faces keep their names (a replaced face passes its name to its
