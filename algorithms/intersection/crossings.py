@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
 
-__all__ = ["c1_knots", "crossing_positions"]
+__all__ = ["c1_knots", "crossing_chords", "crossing_positions"]
 
 #: C2 cubic error next to a jump J in the second derivative, kink mid-span: K J h^2
 _KINK_CONSTANT = 0.0067
@@ -51,6 +51,13 @@ def c1_knots(surface: NurbsSurface) -> tuple[NDArray, NDArray]:
         inner = (values > lo) & (values < hi) & (counts >= max(degree - 1, 1))
         out.append(values[inner])
     return out[0], out[1]
+
+
+def crossing_chords(uv_a: NDArray, uv_b: NDArray, t: NDArray, knots_a, knots_b, domain_a,
+                    domain_b, closed: bool) -> NDArray:
+    """Dense chords ``(k,)`` crossing a C1 knot line of either surface (:func:`c1_knots`)."""
+    return np.concatenate([_crossings(uv, t, knots, domain, closed)[0] for uv, knots, domain
+                           in ((uv_a, knots_a, domain_a), (uv_b, knots_b, domain_b))])
 
 
 def _second_difference(values: NDArray, t: NDArray) -> NDArray:
