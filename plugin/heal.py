@@ -329,8 +329,10 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
                  skipped: list[str]) -> list[tuple[_Job, LocalApproximant]]:
     """One approximant per job; a face's own surface is its preferred source (other
     faces only where it is missed), so long segments do not pick far-away faces."""
-    out = []
+    out, failed = [], set()
     for job in jobs:
+        if job.split and job.origin.index in failed:
+            continue              # the face is kept whole: its other sub-patches are moot
         own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
         try:
             la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
@@ -338,11 +340,13 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
         except (SurfprepError, np.linalg.LinAlgError) as exc:
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
                            f"({type(exc).__name__}: {exc}); left as it was")
+            failed |= {job.origin.index} if job.split else set()
             continue
         if job.origin.kind in ("face", "union") and not la.converged:
             skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
                            f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
                            "kept as it was")
+            failed |= {job.origin.index} if job.split else set()
             continue
         if job.origin.kind == "hole" and not la.converged:
             # the error is measured only where segments land on the originals: over a real
@@ -354,16 +358,21 @@ def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_
                            "left open")
             continue
         out.append((job, la))
-    return _whole_faces_only(jobs, out, skipped)
+    return _whole_faces_only(jobs, out, skipped, failed)
 
 
-def _whole_faces_only(jobs: list[_Job], out: list, skipped: list[str]) -> list:
-    """A face split into sub-patches is replaced only when every sub-patch fits."""
+def _whole_faces_only(jobs: list[_Job], out: list, skipped: list[str],
+                      failed: set[int] = frozenset()) -> list:
+    """A face split into sub-patches is replaced only when every sub-patch fits (the
+    sub-patches after the first that does not fit, of a face in ``failed``, are not
+    built)."""
     want = Counter(j.origin.index for j in jobs if j.origin.kind == "face")
     got = Counter(j.origin.index for j, _ in out if j.origin.kind == "face")
-    partial = {i for i, k in want.items() if got[i] not in (0, k)}
-    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit; kept as it was"
-                for i in sorted(partial)]
+    partial = {i for i, k in want.items() if got[i] not in (0, k)} | \
+        {i for i in failed if got[i]}
+    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit"
+                f"{' (the rest not tried after one failed)' if i in failed else ''}; "
+                "kept as it was" for i in sorted(partial)]
     return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
 
 
