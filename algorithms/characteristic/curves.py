@@ -116,6 +116,17 @@ class TracedCurve:
         return TracedCurve(self.kind, self.uv[::-1], self.st[::-1], self.phi[::-1],
                            self.grad[::-1], self.det_k[::-1], self.end_reason, self.start_reason)
 
+    def after(self, backward: TracedCurve) -> TracedCurve:
+        """``backward`` (traced the other way from the same start) reversed, then this
+        curve: the two halves of one curve, their common start once."""
+        b = backward.reversed()
+        return TracedCurve(self.kind, np.vstack([b.uv[:-1], self.uv]),
+                           np.vstack([b.st[:-1], self.st]),
+                           np.concatenate([b.phi[:-1], self.phi]),
+                           np.vstack([b.grad[:-1], self.grad]),
+                           np.concatenate([b.det_k[:-1], self.det_k]),
+                           b.start_reason, self.end_reason)
+
 
 def _component(kind: CurveKind) -> int:
     return {CurveKind.U_CHARACTERISTIC: 0, CurveKind.V_CHARACTERISTIC: 1,

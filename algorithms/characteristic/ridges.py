@@ -65,16 +65,6 @@ class Ridge:
         return bool(np.abs(self.curve.phi).max() <= tol)
 
 
-def _join(forward: TracedCurve, backward: TracedCurve) -> TracedCurve:
-    b = backward.reversed()
-    return TracedCurve(forward.kind, np.vstack([b.uv[:-1], forward.uv]),
-                       np.vstack([b.st[:-1], forward.st]),
-                       np.concatenate([b.phi[:-1], forward.phi]),
-                       np.vstack([b.grad[:-1], forward.grad]),
-                       np.concatenate([b.det_k[:-1], forward.det_k]),
-                       b.start_reason, forward.end_reason)
-
-
 def _on_curve(uv: NDArray, curve: TracedCurve, reach: float) -> NDArray:
     """``(m,) bool``: ``uv (m, 2)`` within ``reach`` of the curve's polyline."""
     p = curve.uv
@@ -115,7 +105,7 @@ def trace_ridges(field: DistanceField, crit: DistanceJet, kinds: list[PointKind]
         both = trace_curves(field, [kind, kind], np.stack([uv, uv]), np.stack([crit.st[i]] * 2),
                             np.stack([along, -along]), h0=0.05 * h_max, h_max=h_max,
                             max_steps=400, ctol=1e-9 * field.diagonal, max_turn=0.3)
-        curve = both[0] if both[0].end_reason is EndReason.CLOSED else _join(both[0], both[1])
+        curve = both[0] if both[0].end_reason is EndReason.CLOSED else both[0].after(both[1])
         if np.abs(curve.grad).max() > noise or curve.uv.shape[0] < 3:
             continue                          # an isolated degenerate point, not a ridge
         ridges.append(Ridge(curve, float(curve.phi.mean()), float(lam[live])))

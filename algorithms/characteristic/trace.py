@@ -51,17 +51,6 @@ MAX_STEPS = 4000
 _SPLIT_ROUNDS = 8
 
 
-def _join(forward: TracedCurve, backward: TracedCurve) -> TracedCurve:
-    """``backward`` reversed, then ``forward`` (their common start once)."""
-    b = backward.reversed()
-    return TracedCurve(forward.kind, np.vstack([b.uv[:-1], forward.uv]),
-                       np.vstack([b.st[:-1], forward.st]),
-                       np.concatenate([b.phi[:-1], forward.phi]),
-                       np.vstack([b.grad[:-1], forward.grad]),
-                       np.concatenate([b.det_k[:-1], forward.det_k]),
-                       b.start_reason, forward.end_reason)
-
-
 def trace_intersections(field: DistanceField, uv: NDArray, st: NDArray, scale: NDArray, *,
                         tol: float, h_max: float | None = None, branches: bool = False
                         ) -> list[TracedCurve]:
@@ -97,7 +86,7 @@ def trace_intersections(field: DistanceField, uv: NDArray, st: NDArray, scale: N
                             ctol=ctol)
     out = list(forward)
     for i, b in zip(again, backward):
-        out[i] = _join(forward[i], b)
+        out[i] = forward[i].after(b)
     if not branches:
         return out
     from .singular import continue_at_singular_points  # it imports MAX_STEPS from here

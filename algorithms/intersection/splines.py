@@ -22,14 +22,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..basis import basis_derivatives, find_span
 from ..basis_kernels import AVAILABLE, _ders_one, _jit
 from ..curve import NurbsCurve
-from ..fitting import _bessel_tangent, averaged_knots, knots_from_breakpoints
+from ..fitting import _bessel_tangent, _solve_banded_rows, averaged_knots, knots_from_breakpoints
 from .interpolants import interpolate_samples
 
 __all__ = ["SplineSet", "interpolate_many"]
@@ -206,17 +205,4 @@ def interpolate_many(values: Sequence[NDArray], parameters: Sequence[NDArray],
 
 def _solve_blocks(cols: list[NDArray], values: list[NDArray], rhs: list[NDArray]) -> NDArray:
     """One banded solve of the block-diagonal system of all curves' rows."""
-    cols, values, rhs = np.concatenate(cols), np.concatenate(values), np.concatenate(rhs)
-    n = cols.shape[0]
-    rows = np.broadcast_to(np.arange(n)[:, None], cols.shape)
-    lower = int(max(np.max(rows - cols), 0))
-    upper = int(max(np.max(cols - rows), 0))
-    ab = np.zeros((lower + upper + 1, n))
-    ab[upper + rows - cols, cols] = values
-    try:
-        x = scipy.linalg.solve_banded((lower, upper), ab, rhs, check_finite=False)
-    except np.linalg.LinAlgError as exc:
-        raise DegenerateGeometryError("singular collocation matrix") from exc
-    if not np.all(np.isfinite(x)):
-        raise DegenerateGeometryError("interpolation gave non-finite control points")
-    return x
+    return _solve_banded_rows(np.concatenate(cols), np.concatenate(values), np.concatenate(rhs))
