@@ -1,6 +1,10 @@
 """Compiled inner loops of the adaptive tessellation (numba): per rectangle, a few
 hundred multiply-adds that numpy spends in temporaries and per-call overhead.
 
+* :func:`grid_points`: the surface on the test grid of every rectangle, the basis
+  functions once per grid line instead of once per point (the sums of
+  :func:`..basis_kernels.surface_derivatives_compiled` in the same order, so the
+  points are bitwise those of :meth:`NurbsSurface.evaluate`);
 * :func:`chord_errors_from_grid`: the chord errors of :func:`.tessellation._chord_errors`
   from the evaluated test grid (both two-triangle interpolants, the u- and v-line
   chords), the same formulas in the same order;
@@ -19,10 +23,76 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import AVAILABLE, _jit
+from ..basis_kernels import AVAILABLE, _ders_one, _jit
 
 __all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "chord_errors_from_grid",
-           "query_pairs", "restricted_boxes"]
+           "grid_points", "query_pairs", "restricted_boxes"]
+
+
+@_jit
+def _line_basis(knots, p, t, span, out):
+    """Basis functions ``out (n, p + 1)`` at ``t (n,)`` with spans ``span (n,)`` (A2.2)."""
+    ndu = np.empty((p + 1, p + 1))
+    a = np.zeros((2, p + 1))
+    left, right = np.empty(p + 1), np.empty(p + 1)
+    one = np.zeros((1, p + 1))
+    for i in range(t.size):
+        one[0, :] = 0.0
+        _ders_one(knots, p, t[i], span[i], 0, ndu, a, left, right, one)
+        for j in range(p + 1):
+            out[i, j] = one[0, j]
+
+
+@_jit
+def _grid_points(knots_u, knots_v, p, q, net, u, v, su, sv, rational, out):
+    k, n = u.shape
+    c = net.shape[2]
+    bu, bv = np.empty((n, p + 1)), np.empty((n, q + 1))
+    tmp = np.empty((q + 1, c))
+    hom = np.empty(c)
+    for r in range(k):
+        _line_basis(knots_u, p, u[r], su[r], bu)
+        _line_basis(knots_v, q, v[r], sv[r], bv)
+        for i in range(n):
+            iu0 = su[r, i] - p
+            done = -1                              # the u sums of column block `done`
+            for j in range(n):
+                iv0 = sv[r, j] - q
+                if iv0 != done:
+                    done = iv0
+                    for jj in range(q + 1):        # the u sums, then the v sums
+                        for cc in range(c):
+                            s = 0.0
+                            for ii in range(p + 1):
+                                s += bu[i, ii] * net[iu0 + ii, iv0 + jj, cc]
+                            tmp[jj, cc] = s
+                for cc in range(c):
+                    s = 0.0
+                    for jj in range(q + 1):
+                        s += bv[j, jj] * tmp[jj, cc]
+                    hom[cc] = s
+                inv_w = 1.0 / hom[c - 1] if rational else 1.0
+                for cc in range(c - 1):
+                    out[r, i, j, cc] = hom[cc] * inv_w if rational else hom[cc]
+
+
+def grid_points(knots_u: NDArray, knots_v: NDArray, p: int, q: int, net: NDArray, u: NDArray,
+                v: NDArray, su: NDArray, sv: NDArray, rational: bool) -> NDArray:
+    """Surface points ``(k, n, n, d)`` on the tensor grids ``u (k, n) x v (k, n)``.
+
+    ``net (n_u, n_v, d + 1)`` the homogeneous control net, ``su, sv (k, n)`` the knot
+    spans of ``u, v``; bitwise equal to the scattered evaluation at every grid point.
+    """
+    k, n = u.shape
+    out = np.empty((k, n, n, net.shape[2] - 1))
+    _grid_points(np.ascontiguousarray(knots_u, dtype=np.float64),
+                 np.ascontiguousarray(knots_v, dtype=np.float64), int(p), int(q),
+                 np.ascontiguousarray(net, dtype=np.float64),
+                 np.ascontiguousarray(u, dtype=np.float64),
+                 np.ascontiguousarray(v, dtype=np.float64),
+                 np.ascontiguousarray(su, dtype=np.int64),
+                 np.ascontiguousarray(sv, dtype=np.int64), bool(rational), out)
+    return out
 
 
 @_jit

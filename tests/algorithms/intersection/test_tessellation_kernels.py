@@ -97,3 +97,26 @@ def test_region_patch_boxes_equal_subpatch_boxes(surface):
     region = np.repeat(np.arange(regions.shape[0]), 5)
     boxes = region_patches(surface, regions).boxes(rects, region)
     np.testing.assert_array_equal(boxes, subpatch_boxes(surface, rects))
+
+
+@pytest.mark.parametrize("surface", [sphere_band(1.5), _bumpy()], ids=["rational", "bicubic"])
+def test_grid_points_bitwise_equal_to_scattered_evaluation(surface):
+    """The test grids of the tessellation, basis functions once per grid line, are
+    bitwise the points of NurbsSurface.evaluate (so the tessellation is unchanged),
+    also for rectangles across knot lines."""
+    from surfprep.algorithms.basis import find_span
+
+    rng = np.random.default_rng(5)
+    a, b, c, d = surface.domain
+    lo = rng.uniform(0, 0.7, (400, 2))
+    span = rng.uniform(1e-6, 0.3, (400, 2))
+    s = np.linspace(0.0, 1.0, 5)
+    u = a + (b - a) * (lo[:, :1] + s * span[:, :1])
+    v = c + (d - c) * (lo[:, 1:] + s * span[:, 1:])
+    su = find_span(surface.knots_u, surface.degree_u, u.ravel()).reshape(u.shape)
+    sv = find_span(surface.knots_v, surface.degree_v, v.ravel()).reshape(v.shape)
+    assert np.any((su[:, 0] != su[:, -1]) | (sv[:, 0] != sv[:, -1]))
+    grid = tessellation_kernels.grid_points(
+        surface.knots_u, surface.knots_v, surface.degree_u, surface.degree_v,
+        surface.homogeneous_points(), u, v, su, sv, surface.weights is not None)
+    np.testing.assert_array_equal(grid, surface.evaluate(u[:, :, None], v[:, None, :]))
