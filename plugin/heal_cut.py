@@ -47,7 +47,7 @@ from ..algorithms.projection import project_to_surface
 from ..errors import OpenCascadeError, SurfprepError
 from .faces import TrimmedFace, face_to_nurbs, make_face
 from .heal_topology import EDGE_SAMPLES, FaceEdge, is_valid, polyline_distance, sew
-from .step_iges import _all_faces
+from .step_iges import _all_faces, _compound
 
 __all__ = ["CutModel", "FaceCut", "boundary_on_faces", "cut_faces", "cut_under_patches",
            "face_area", "inner_edges", "outline", "read_faces", "rebuilt_model",
@@ -308,13 +308,7 @@ class CutModel:
 
 
 def rebuilt_model(model, faces: list[TopoDS_Face], names: list, colors: list):
-    from OCP.BRep import BRep_Builder
-    from OCP.TopoDS import TopoDS_Compound
-    compound, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(compound)
-    for f in faces:
-        builder.Add(compound, f)
-    return replace(model, shape=compound, faces=tuple(faces), face_names=tuple(names),
+    return replace(model, shape=_compound(faces), faces=tuple(faces), face_names=tuple(names),
                    face_colors=tuple(colors))
 
 

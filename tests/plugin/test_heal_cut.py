@@ -10,11 +10,9 @@ import json
 
 import numpy as np
 import pytest
-from OCP.BRep import BRep_Builder
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS_Compound
 
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
@@ -23,6 +21,7 @@ from surfprep.plugin.faces import make_face
 from surfprep.plugin.heal import heal
 from surfprep.plugin.heal_cut import face_area, outline
 from surfprep.plugin.heal_topology import polyline_distance
+from surfprep.plugin.io import to_shape
 
 X_CROSS = 1.0          # the sheets cross along x = 1
 SLOPE = 0.4            # B rises with this slope beyond the crossing
@@ -45,11 +44,7 @@ def sheet(x0, x1, slope):
 
 
 def compound(shapes):
-    out, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(out)
-    for f in shapes:
-        builder.Add(out, f)
-    return out
+    return to_shape(list(shapes))          # a compound of the faces
 
 
 @pytest.fixture(scope="module")

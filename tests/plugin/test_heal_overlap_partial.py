@@ -9,8 +9,6 @@ import json
 
 import numpy as np
 import pytest
-from OCP.BRep import BRep_Builder
-from OCP.TopoDS import TopoDS_Compound
 
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.healing.connectivity import Side
@@ -20,6 +18,7 @@ from surfprep.plugin.faces import make_face
 from surfprep.plugin.heal import heal
 from surfprep.plugin.heal_cut import face_area
 from surfprep.plugin.heal_overlap_trim import overlap_share
+from surfprep.plugin.io import to_shape
 
 
 def graph(x, y):
@@ -34,11 +33,7 @@ def big():
 
 
 def compound(shapes):
-    out, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(out)
-    for f in shapes:
-        builder.Add(out, f)
-    return out
+    return to_shape(list(shapes))          # a compound of the faces
 
 
 def piece(big, u0, u1, v0, v1):
