@@ -9,16 +9,17 @@ is clipped to both faces' trimmed domains:
   ``(u, v)`` (every edge's pcurve at ``EDGE_SAMPLES`` points, more for edges
   that are long in the parameter plane) into one set of polygon segments; a
   (u, v) point is inside when a ray in +u crosses them an odd number of times
-  (even-odd rule: outer loop and holes at once), vectorized over points x
-  segments. A face without loops is its whole parameter rectangle. Everything
-  the test needs is built once per face and cached (:class:`surfprep.plugin.trim_loops.LoopIndex`: the
-  segments bucketed by v, a k-d tree of them in (u, v); a k-d tree of the
-  trimming edges in space for the tolerance band), so the 30 bisection rounds
-  of the splitting cost little.
+  (even-odd rule: outer loop and holes at once), counted by a compiled kernel
+  over the segments of the point's v-bucket. A face without loops is its whole
+  parameter rectangle. Everything the test needs is built once per face and
+  cached (:class:`surfprep.plugin.trim_loops.LoopIndex`: the segments bucketed
+  by v, a k-d tree of them in (u, v); a k-d tree of the trimming edges in space
+  for the tolerance band).
 * **Splitting**: a curve is cut into the runs of samples inside both faces.
   Where a run leaves a face, the crossing is located on the interpolants
-  (``curve3d``, ``pcurve_a``, ``pcurve_b`` share one parameter) by 30
-  bisection steps batched over all crossings against the loop polygons, then
+  (``curve3d``, ``pcurve_a``, ``pcurve_b`` share one parameter) to 2^-30 of
+  a classification step against the loop polygons, 31 points per bracket and
+  round batched over all crossings (six rounds), then
   moved onto the exact trimming pcurve by Newton on ``pcurve(t) =
   edge.pcurve(s)`` (kept on the polygon where that fails or the crossing is
   near-tangential), and becomes the run's end (:attr:`EndKind.BOUNDARY`). The pieces are new :class:`IntersectionCurve`
@@ -113,7 +114,10 @@ __all__ = [
 DEFAULT_TOL_FACTOR = 1e-6
 #: smallest accepted ``tol``: this times that diagonal
 MIN_TOL_FACTOR = 1e-9
+#: a crossing's bracket is narrowed to 2^-_BISECTIONS of a classification step
 _BISECTIONS = 30
+#: points classified per bracket and round (:func:`_bracket_crossings`)
+_BRACKET_POINTS = 31
 #: the clipping classifies the interpolants at this many points per span
 CLASSIFY_PER_SPAN = 8
 
@@ -122,6 +126,33 @@ def _inside_both(fa: FaceOperand, fb: FaceOperand, curve: IntersectionCurve, t: 
                  tol: float) -> NDArray:
     uva, uvb = curve.pcurve_a.evaluate(t), curve.pcurve_b.evaluate(t)
     return inside_face(fa, uva, tol) & inside_face(fb, uvb, tol)
+
+
+def _bracket_crossings(fa: FaceOperand, fb: FaceOperand, curve: IntersectionCurve, lo: NDArray,
+                       hi: NDArray, lo_in: NDArray, tol: float) -> tuple[NDArray, NDArray]:
+    """Brackets ``(lo, hi)`` of every crossing narrowed ``2^-_BISECTIONS`` times at once.
+
+    Each round classifies ``_BRACKET_POINTS`` evenly spaced points inside every
+    bracket in one call and keeps the sub-interval where the classification first
+    differs from ``lo``'s (``lo_in``): ``log2(_BRACKET_POINTS + 1)`` bisections'
+    worth per round, so the per-call cost of the classification is paid about five
+    times instead of thirty.
+    """
+    period = curve.parameters[-1]
+    share = np.arange(1, _BRACKET_POINTS + 1) / (_BRACKET_POINTS + 1)
+    rounds = int(np.ceil(_BISECTIONS / np.log2(_BRACKET_POINTS + 1)))
+    for _ in range(rounds):
+        mid = lo[:, None] + share[None, :] * (hi - lo)[:, None]            # (c, k)
+        at = np.mod(mid, period) if curve.closed else mid
+        ok = _inside_both(fa, fb, curve, at.ravel(), tol).reshape(mid.shape)
+        differ = ok != lo_in[:, None]
+        first = np.where(differ.any(axis=1), differ.argmax(axis=1), _BRACKET_POINTS)
+        rows = np.arange(lo.size)
+        new_lo = np.where(first > 0, mid[rows, np.maximum(first - 1, 0)], lo)
+        hi = np.where(first < _BRACKET_POINTS, mid[rows, np.minimum(first, _BRACKET_POINTS - 1)],
+                      hi)
+        lo = new_lo
+    return lo, hi
 
 
 def _refine_crossing(curve_pcurve, face: FaceOperand, t0: float, bracket: float
@@ -201,12 +232,7 @@ def clip_curve(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand, tol: 
     change = np.flatnonzero(flags[1:] != flags[:-1])       # crossing between k and k + 1
     lo, hi = tt[change].copy(), tt[change + 1].copy()
     lo_in = flags[change]
-    for _ in range(_BISECTIONS):                           # all crossings at once
-        mid = 0.5 * (lo + hi)
-        ok = _inside_both(fa, fb, curve, np.mod(mid, period) if curve.closed else mid, tol)
-        same = ok == lo_in
-        lo = np.where(same, mid, lo)
-        hi = np.where(same, hi, mid)
+    lo, hi = _bracket_crossings(fa, fb, curve, lo, hi, lo_in, tol)
     cross_t = np.where(lo_in, lo, hi)                      # the inside end of each bracket
     # onto the exact trimming pcurve of the face the curve leaves (per crossing, few)
     # Newton may move a crossing by the polygon's error along the curve: allow a few

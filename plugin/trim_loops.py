@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..algorithms.loop_kernels import ray_crossings
 from .faces import TrimmedFace
 
 __all__ = ["EDGE_SAMPLES", "LoopIndex", "SegmentTree", "is_rectangle", "loop_segments"]
@@ -115,7 +116,7 @@ class LoopIndex:
 
     @classmethod
     def build(cls, seg: NDArray) -> LoopIndex:
-        a, b = seg[:, 0], seg[:, 1]
+        a, b = np.ascontiguousarray(seg[:, 0]), np.ascontiguousarray(seg[:, 1])
         bins = int(max(1, min(4096, 2 * np.sqrt(seg.shape[0]))))
         vlo, vhi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
         lo, hi = float(vlo.min()), float(vhi.max())
@@ -133,18 +134,7 @@ class LoopIndex:
 
     def crossings(self, uv: NDArray) -> NDArray:
         """Crossings ``(n,) int`` of a ray in +u from each point with the segments,
-        testing only the segments of the point's v-bucket."""
-        a, b = self.a, self.b
-        pbin = np.clip(((uv[:, 1] - self.lo) / self.width).astype(np.int64), 0, self.bins - 1)
-        inside_range = (uv[:, 1] >= self.lo) & (uv[:, 1] <= self.hi)
-        per_point = np.where(inside_range, self.indptr[pbin + 1] - self.indptr[pbin], 0)
-        point_of = np.repeat(np.arange(uv.shape[0]), per_point)
-        offs = np.arange(per_point.sum()) - np.repeat(np.cumsum(per_point) - per_point,
-                                                      per_point)
-        cand = self.seg_sorted[self.indptr[pbin[point_of]] + offs]
-        pa, pb, p = a[cand], b[cand], uv[point_of]
-        straddle = (pa[:, 1] > p[:, 1]) != (pb[:, 1] > p[:, 1])
-        dv = np.where(pb[:, 1] != pa[:, 1], pb[:, 1] - pa[:, 1], 1.0)
-        u_cross = pa[:, 0] + (p[:, 1] - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / dv
-        hit = straddle & (u_cross > p[:, 0])
-        return np.bincount(point_of[hit], minlength=uv.shape[0])
+        testing only the segments of the point's v-bucket
+        (:func:`surfprep.algorithms.loop_kernels.ray_crossings`, compiled)."""
+        return ray_crossings(uv, self.a, self.b, self.lo, self.hi, self.width, self.bins,
+                             self.seg_sorted, self.indptr)
