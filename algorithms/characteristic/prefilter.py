@@ -44,6 +44,7 @@ import numpy as np
 
 from ..bezier import bezier_patches
 from ..intersection import IntersectionCurve
+from ..intersection.culling import exact_patch_boxes, span_hull_boxes, surface_tree, tree_pairs
 from ..surface import NurbsSurface
 from .algorithm import CharacteristicRecord, FoundBy
 from .poles import collapsed_sides
@@ -64,15 +65,19 @@ class NoLoopReason(str, enum.Enum):
     MONOTONE_HEIGHT = "monotone height over a plane"
 
 
-def _patch_boxes(s: NurbsSurface) -> np.ndarray:
-    boxes, _, _ = s.patch_bounding_boxes()
-    return np.asarray(boxes, dtype=float).reshape(-1, 2, s.dimension)
-
-
 def _apart(a: NurbsSurface, b: NurbsSurface, tol: float) -> bool:
-    ba, bb = _patch_boxes(a), _patch_boxes(b)
-    touch = np.all((ba[:, None, 0] <= bb[None, :, 1] + tol)
-                   & (bb[None, :, 0] <= ba[:, None, 1] + tol), axis=-1)
+    """No Bézier-patch box of ``a`` within ``tol`` of one of ``b``'s. The span hull
+    boxes (sliding min/max over the nets, which hold the Bézier boxes) are descended
+    as grid trees first; exact Bézier boxes are extracted only for the candidate
+    pairs, so a large surface far from most of the other costs little."""
+    pairs = tree_pairs(surface_tree(a), surface_tree(b), pad=tol)
+    if pairs.shape[0] == 0:
+        return True
+    patches_a, inv_a = np.unique(pairs[:, 0], return_inverse=True)
+    patches_b, inv_b = np.unique(pairs[:, 1], return_inverse=True)
+    ba = exact_patch_boxes(a, patches_a)[inv_a.ravel()]
+    bb = exact_patch_boxes(b, patches_b)[inv_b.ravel()]
+    touch = np.all((ba[:, 0] <= bb[:, 1] + tol) & (bb[:, 0] <= ba[:, 1] + tol), axis=-1)
     return not bool(touch.any())
 
 
@@ -133,6 +138,9 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     halved (up to ``REFINEMENTS`` times: the control net closes in on the surface)."""
     if s.dimension != 3 or (s.is_rational and not _separable_weights(s.weights)):
         return False
+    s = _near_part(s, centre, normal, tol)
+    if s is None:                                      # no span comes near the plane
+        return True
     for level in range(REFINEMENTS + 1):
         if _monotone_patches(s, centre, normal, tol):
             return True
@@ -140,6 +148,32 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
             return False
         s = _halved(s)
     return False
+
+
+def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
+               ) -> NurbsSurface | None:
+    """``s`` restricted (exactly, at knots) to the index rectangle of the knot spans
+    whose span hull comes within ``tol`` of the plane, or None when none does.
+
+    The Bézier patches near the plane lie in those spans (a Bézier box is inside
+    its span's hull), and so does, in every row, the stretch from the first to the
+    last near patch: the rule's answer on the restriction is its answer on ``s``,
+    at the cost of the patches near the plane (a waterline across a hull face with
+    100 x 100 poles touches a few rows)."""
+    hull = span_hull_boxes(s)                                  # (ku, kv, 2, 3)
+    offset = float(centre @ normal)
+    low = np.where(normal >= 0, hull[:, :, 0], hull[:, :, 1]) @ normal - offset
+    high = np.where(normal >= 0, hull[:, :, 1], hull[:, :, 0]) @ normal - offset
+    near = (low <= tol) & (high >= -tol)
+    if not near.any():
+        return None
+    rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+    u_breaks = np.unique(s.knots_u[s.degree_u:s.knots_u.size - s.degree_u])
+    v_breaks = np.unique(s.knots_v[s.degree_v:s.knots_v.size - s.degree_v])
+    i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    if (i0, i1, j0, j1) == (0, u_breaks.size - 1, 0, v_breaks.size - 1):
+        return s
+    return s.restrict(u_breaks[i0], u_breaks[i1], v_breaks[j0], v_breaks[j1])
 
 
 def _monotone_patches(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,

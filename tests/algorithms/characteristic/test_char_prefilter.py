@@ -155,3 +155,44 @@ def test_rational_weights_that_do_not_separate_are_not_used():
     bent = NurbsSurface(band.control_points, band.knots_u, band.knots_v, 2, 2, w)
     plane = plane_patch([0.0, 0.0, 0.3], [0.0, 0.0, 1.0], half=2.0)
     assert no_loop_reason(bent, plane, tol=TOL) is None
+
+
+# ------------------------------------------------------------ the cheap forms agree
+def _many_span_sheet(n: int = 30, seed: int = 3) -> NurbsSurface:
+    """A bicubic height field with n x n poles: a slope in u plus noise, so that some
+    rows near a plane are monotone and some turn."""
+    rng = np.random.default_rng(seed)
+    x = np.linspace(0, 1, n)
+    u, v = np.meshgrid(x, x, indexing="ij")
+    z = u + 0.02 * rng.standard_normal((n, n)) * (v > 0.5)
+    knots = np.concatenate([[0] * 4, np.linspace(0, 1, n - 2)[1:-1], [1] * 4])
+    return NurbsSurface(np.stack([u, v, z], -1), knots, knots, 3, 3)
+
+
+@pytest.mark.parametrize("z", [-0.5, 0.02, 0.3, 0.5, 0.77, 1.5])
+def test_monotone_rule_on_the_near_part_equals_the_whole_surface(z):
+    """The rule runs on the spans near the plane only (prefilter._near_part); its
+    answer must be the rule's answer on the whole surface's Bézier patches."""
+    from surfprep.algorithms.characteristic import prefilter
+    sheet, (centre, normal) = _many_span_sheet(), (np.array([0.0, 0.0, z]), np.array([0, 0, 1.0]))
+    part = prefilter._near_part(sheet, centre, normal, TOL)
+    whole = prefilter._monotone_patches(sheet, centre, normal, TOL)
+    assert (part is None) == (z < -0.2 or z > 1.2)
+    assert (True if part is None else prefilter._monotone_patches(part, centre, normal, TOL)) \
+        == whole
+    if part is not None and 0.2 < z < 0.8:
+        assert part.n_control[0] < sheet.n_control[0]          # only a band of rows
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.3, 1.0 + 2e-7, 1.0 + 5e-7, 3.0])
+def test_apart_equals_all_pairs_of_bezier_boxes(shift):
+    """The tree-culled test (span hulls, then Bézier boxes of candidates only) against
+    every pair of Bézier boxes."""
+    from surfprep.algorithms.characteristic import prefilter
+    a = _many_span_sheet(12)
+    b = NurbsSurface(a.control_points + [0, 0, shift], a.knots_u, a.knots_v, 3, 3)
+    ba = a.patch_bounding_boxes()[0].reshape(-1, 2, 3)
+    bb = b.patch_bounding_boxes()[0].reshape(-1, 2, 3)
+    touch = np.all((ba[:, None, 0] <= bb[None, :, 1] + TOL)
+                   & (bb[None, :, 0] <= ba[:, None, 1] + TOL), axis=-1).any()
+    assert prefilter._apart(a, b, TOL) == (not touch)
