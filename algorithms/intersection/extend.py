@@ -197,6 +197,8 @@ def extend_open_ends(curves: list[RefinedCurve], open_ends: list[tuple[bool, boo
 _SIN_CANDIDATE = 0.1
 #: at most this many such samples per call are tried as starts
 _MAX_SAMPLE_STARTS = 16
+#: a local minimum of the normals' sine is a start only when it dips by this share (:func:`_dips`)
+_DIP_SHARE = 0.25
 #: the ball cut around a singular point: this times the farthest end that led to it
 _BALL_MARGIN = 1.25
 #: a piece end is joined to the half-branch it points along within this angle
@@ -216,6 +218,22 @@ def _normal_sines(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray,
     den = np.maximum(np.linalg.norm(na, axis=1) * np.linalg.norm(nb, axis=1),
                      np.finfo(float).tiny)
     return np.linalg.norm(np.cross(na, nb), axis=1) / den
+
+
+def _dips(sines: NDArray, minima: NDArray) -> NDArray:
+    """Mask of the local minima ``minima`` of a curve's ``sines`` that dip: across the
+    five samples around one the sine varies by at least ``_DIP_SHARE`` of its value.
+
+    Near a double point ``|N_a x N_b|`` falls linearly to zero along the curve, as
+    ``c |x - x0|``: with samples ``h`` apart the nearest has ``c d`` (``d <= h / 2``)
+    and the one two samples beyond ``c (2h - d)``, a variation of at least ``c h >= 2
+    c d``. Where the surfaces meet at a small but steady angle (near-tangential
+    pairs: a plane just below a torus's top circle, near-coincident sheets) every
+    sample is a flat minimum, and none of them is near a singular point."""
+    n = sines.size
+    window = np.clip(minima[:, None] + np.arange(-2, 3)[None, :], 0, n - 1)
+    values = sines[window]
+    return np.ptp(values, axis=1) >= _DIP_SHARE * sines[minima]
 
 
 def _singular_starts(curves: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
@@ -246,7 +264,7 @@ def _singular_starts(curves: list[RefinedCurve], kinds: list, surface_a: NurbsSu
             if n >= 3:
                 inner = np.flatnonzero((s[1:-1] <= s[:-2]) & (s[1:-1] <= s[2:])
                                        & (s[1:-1] < _SIN_CANDIDATE)) + 1
-                minima.extend(start + inner)
+                minima.extend(start + inner[_dips(s, inner)])
             start += n
         minima = np.array(minima, dtype=int)
         minima = minima[np.argsort(sines[minima])[:_MAX_SAMPLE_STARTS]]

@@ -248,3 +248,44 @@ def test_characteristic_tracer_equal_cylinders_traced_whole():
     assert len(bif) == 8
     for p in ([0, 1, 0], [0, -1, 0]):
         assert sum(np.linalg.norm(q - p) <= 1e-9 for q in bif) == 4
+
+
+# ---------------------------------------------------------------- which samples are starts
+def test_dips_tell_a_vanishing_sine_from_a_steady_small_one():
+    """|N_a x N_b| falling linearly to zero (a double point between samples, whatever
+    its offset) is a start; a steady small angle, or one that varies only by a few
+    per cent, is not (extend._dips)."""
+    from surfprep.algorithms.intersection.extend import _dips
+    x = np.linspace(0, 1, 41)
+    for x0 in (0.5, 0.5 + 0.25 / 40, 0.5 + 0.49 / 40):
+        s = 0.3 * np.abs(x - x0)
+        i = int(np.argmin(s))
+        assert _dips(s, np.array([i]))[0]
+    steady = np.full(41, 2.6e-3) * (1 + 0.01 * np.cos(7 * x))
+    minima = np.flatnonzero((steady[1:-1] <= steady[:-2]) & (steady[1:-1] <= steady[2:])) + 1
+    assert minima.size and not _dips(steady, minima).any()
+
+
+def test_near_tangential_circles_give_no_sample_starts():
+    """A plane 1e-6 below a torus's top circle: the normals are 2.6e-3 rad apart all
+    along both circles (every sample a flat minimum); no Gauss-Newton start is made
+    from the samples, and the circles come out whole."""
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).parents[1] / "characteristic"))
+    from char_surfaces import torus_and_plane
+
+    from surfprep.algorithms.intersection import StrayCurves
+    from surfprep.algorithms.intersection.extend import _singular_starts
+    from surfprep.algorithms.intersection.refine import RefinedCurve
+    torus, plane = torus_and_plane(1e-6)
+    curves = intersect_surfaces(torus, plane, tol=1e-9, stray=StrayCurves.DROP)
+    assert len(curves) == 2
+    radii = sorted(float(np.linalg.norm(c.points[0, :2])) for c in curves)
+    np.testing.assert_allclose(radii, 1 + np.array([-1, 1]) * np.sqrt(0.3 ** 2 - (0.3 - 1e-6) ** 2),
+                               atol=1e-9)
+    dense = [RefinedCurve(c.points, c.uv_a, c.uv_b, c.closed, np.ones(len(c.points), bool),
+                          np.zeros(len(c.points), bool)) for c in curves]
+    kinds = [(c.start_kind, c.end_kind) for c in curves]
+    pts, _, _, is_end = _singular_starts(dense, kinds, torus, plane)
+    assert pts.shape[0] == int(is_end.sum())
