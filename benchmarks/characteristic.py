@@ -7,11 +7,13 @@ Per pair, in one run:
   split into the characteristic stage (grid, side roots, characteristic curves,
   critical and turning points) and the intersection-curve stage (tracing eq. 33
   and refining to tol); the paper reports the first at 10-200 % of the second;
-* ``auto``: the triangle method plus the certificate
-  (:func:`surfprep.algorithms.characteristic.certify`), what ``surfprep.intersect``
-  does by default (the triangles are skipped when the characteristic stage finds
-  the surfaces coincident over the whole grid, as there); the certificate alone
-  is its own column, and auto's cost is given as a ratio to ``mesh``;
+* ``auto``: what ``surfprep.intersect`` does by default (:func:`auto_intersection`):
+  the characteristic stage, the triangle method (skipped when the stage finds the
+  surfaces coincident over the whole grid; told the tangential curves the stage
+  traced, so their fragments are left out), then the certificate
+  (:func:`surfprep.algorithms.characteristic.certify`); the certificate's share
+  (stage and finish) is its own column, and auto's cost is given as a ratio to
+  ``mesh``;
 * ``occ``: ``GeomAPI_IntSS(a, b, tol)``.
 
 Branches found are counted against the truth of each construction (curves whose
@@ -47,6 +49,7 @@ from surfprep.algorithms.characteristic import (
     certify,
     characteristic_analysis,
     characteristic_intersection,
+    tangential_curves,
 )
 from surfprep.algorithms.intersection import (
     StrayCurves,
@@ -121,17 +124,30 @@ def branches(curves) -> int | str:
     return connected_branches(list(curves), 1e-6) if curves else 0
 
 
+def auto_intersection(a, b):
+    """What ``surfprep.intersect`` does by default on one pair (plugin.intersect_methods):
+    the characteristic stage, the triangle method (skipped when the surfaces coincide over
+    the whole grid; the fragments along traced tangential curves left out), the
+    certificate. Returns ``(record, seconds of the certificate: stage + finish)``."""
+    start = time.perf_counter()
+    analysis = characteristic_analysis(a, b, tol=TOL, trace_critical=False, borders=False)
+    whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
+    tangential = [] if whole else tangential_curves(analysis, TOL)
+    staged = time.perf_counter() - start
+    mesh = [] if whole else intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP,
+                                               tangential=tangential)
+    middle = time.perf_counter()
+    record = certify(a, b, mesh, tol=TOL, analysis=analysis, tangential=tangential)
+    return record, staged + time.perf_counter() - middle
+
+
 def run_case(name, a, b, truth, contacts):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         mesh, t_mesh = best(lambda: intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP))
         char, _t_char = best(lambda: characteristic_intersection(a, b, tol=TOL))
-        mesh_curves = [] if isinstance(mesh, Exception) else mesh
-        whole = any(r.share >= FULL_COINCIDENCE for r in characteristic_analysis(
-            a, b, tol=TOL, trace_critical=False, borders=False).coincident)
-        # as surfprep.intersect's auto: the stage first; the triangles skipped when
-        # the surfaces coincide over the whole grid
-        cert, t_cert = best(lambda: certify(a, b, [] if whole else mesh_curves, tol=TOL))
+        auto, t_auto = best(lambda: auto_intersection(a, b))
+        cert, t_cert = auto[0], auto[1]
         occ, t_occ = best(lambda: intersect_surfaces_occ(a, b, TOL))
     row = {
         "case": name, "truth": truth, "contacts": contacts,
@@ -140,7 +156,7 @@ def run_case(name, a, b, truth, contacts):
         "coincident": bool(char.coincident),
         "t_char_stage": char.characteristic_time_s, "t_curve_stage": char.intersection_time_s,
         "auto": branches(cert.curves), "auto_added": len(cert.added),
-        "auto_contacts": len(cert.isolated_points), "t_auto": t_cert + (0 if whole else t_mesh),
+        "auto_contacts": len(cert.isolated_points), "t_auto": t_auto,
         "t_cert": t_cert,
         "occ": branches(occ), "t_occ": t_occ,
     }

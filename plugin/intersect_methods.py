@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import enum
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -25,6 +26,7 @@ from ..algorithms.characteristic import (
     characteristic_analysis,
     characteristic_intersection,
     no_loop_reason,
+    tangential_curves,
     uncertified_record,
 )
 from ..algorithms.intersection import IntersectionCurve, StrayCurves, intersect_surfaces
@@ -127,11 +129,11 @@ class IntersectionResult(list):
 FULL_COINCIDENCE = 0.95
 
 
-def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None
-                 ) -> list[IntersectionCurve]:
+def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
+                 tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
     try:
         return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                  stray=StrayCurves.DROP)
+                                  stray=StrayCurves.DROP, tangential=tangential)
     except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
             FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
@@ -165,8 +167,11 @@ def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | 
             analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False,
                                                borders=False)
             whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
-            mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol)
-            record = certify(a, b, mesh, tol=tol, analysis=analysis)
+            # fragments along a tangential contact the analysis already traced are left
+            # out of the triangle method (their marching and retries cost seconds)
+            tangential = [] if whole else tangential_curves(analysis, tol)
+            mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol, tangential)
+            record = certify(a, b, mesh, tol=tol, analysis=analysis, tangential=tangential)
     except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
                       stacklevel=3)

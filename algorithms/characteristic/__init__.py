@@ -29,6 +29,7 @@ from .algorithm import (
                         characteristic_analysis,
                         characteristic_intersection,
                         choose_field,
+                        tangential_curves,
 )
 from .curves import CurveKind, EndReason, TracedCurve, trace_curves
 from .distance import DistanceField, DistanceJet, distance_jet
@@ -65,6 +66,7 @@ __all__ = [
                         "critical_points",
                         "distance_jet",
                         "no_loop_reason",
+                        "tangential_curves",
                         "to_intersection_curve",
                         "trace_curves",
                         "trace_intersections",

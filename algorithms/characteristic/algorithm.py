@@ -81,6 +81,7 @@ __all__ = [
     "characteristic_analysis",
     "characteristic_intersection",
     "choose_field",
+    "tangential_curves",
 ]
 
 #: grid samples per direction of r's domain for the critical-point seeds
@@ -462,8 +463,8 @@ def characteristic_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float 
 
 def certify(a: NurbsSurface, b: NurbsSurface, curves: Sequence[IntersectionCurve], *,
             tol: float = 1e-7, phi_on: str | None = None,
-            analysis: CharacteristicAnalysis | None = None, open_curves: bool = False
-            ) -> CharacteristicRecord:
+            analysis: CharacteristicAnalysis | None = None, open_curves: bool = False,
+            tangential: Sequence[IntersectionCurve] | None = None) -> CharacteristicRecord:
     """The ``auto`` certificate: check ``curves`` (the triangle method's) against the
     characteristic points; trace and add the loops they miss (module docstring).
 
@@ -476,11 +477,16 @@ def certify(a: NurbsSurface, b: NurbsSurface, curves: Sequence[IntersectionCurve
         Also check the border points (open curves); by default only the loops
         the critical points imply (the triangle method does not miss curves
         that cross the boundary unless they are tiny).
+    tangential : sequence of IntersectionCurve, optional
+        :func:`tangential_curves` of ``analysis``, when already made (e.g. to
+        leave their fragments out of the triangle method,
+        ``intersect_surfaces(tangential=...)``).
     """
     if analysis is None:
         analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on, trace_critical=False,
                                            borders=open_curves)
-    return _finish(analysis, list(curves), tol, a, b, borders=open_curves)
+    return _finish(analysis, list(curves), tol, a, b, borders=open_curves,
+                   tangential=tangential)
 
 
 def _near_isolated(curve: IntersectionCurve, isolated: Sequence[CharacteristicPoint],
@@ -502,7 +508,7 @@ def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]
     return False
 
 
-def _tangential_curves(analysis: CharacteristicAnalysis, tol: float) -> list[IntersectionCurve]:
+def tangential_curves(analysis: CharacteristicAnalysis, tol: float) -> list[IntersectionCurve]:
     """The ridges with ``|phi| <= tol`` all along (tangential contact along a curve,
     :mod:`.ridges`) as intersection curves."""
     out = []
@@ -534,14 +540,15 @@ def _along(curves: Sequence[IntersectionCurve], tangential: Sequence[Intersectio
 
 
 def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], tol: float,
-            a: NurbsSurface, b: NurbsSurface, borders: bool = True) -> CharacteristicRecord:
+            a: NurbsSurface, b: NurbsSurface, borders: bool = True,
+            tangential: Sequence[IntersectionCurve] | None = None) -> CharacteristicRecord:
     start = time.perf_counter()
     fld = analysis.field
     size = _size(a, b)
     isolated = analysis.of_kind(PointKind.ISOLATED)
     # a tangential contact is a point: tiny curves around it are not curves
     radius = max(1e3 * tol, 1e-4 * size)
-    tangential = _tangential_curves(analysis, tol)
+    tangential = tangential_curves(analysis, tol) if tangential is None else list(tangential)
     along = _along(known, tangential, radius)
     kept = [c for c, on in zip(known, along) if not on
             and not _near_isolated(c, isolated, radius)

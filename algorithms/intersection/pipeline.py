@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import enum
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,6 +40,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from .compare import polyline_distance
 from .extend import extend_open_ends, join_at_singular_points
 from .mesh import TriangleMesh
 from .refine import RefinedCurve
@@ -92,6 +94,9 @@ _SEAM_CLOSURE = 64.0
 _MARCH_STEP = 0.25
 #: singular points are looked for within this times the mesh tolerance of curve ends
 _SINGULAR_REACH = 64.0
+#: a refined chain within this times tol (or ``_TANGENTIAL_SHARE`` times the size) of a
+#: known tangential curve all along is a fragment of it (as the certificate's test)
+_TANGENTIAL_REACH, _TANGENTIAL_SHARE = 1e3, 1e-4
 #: consecutive chords of refined samples turning by more than this: a fold
 _FOLD_ANGLE = np.radians(120.0)
 
@@ -380,7 +385,8 @@ def _stray_policy(curves: list, worst: NDArray, tol: float, stray: StrayCurves) 
 
 def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
                        mesh_tol: float | None = None, max_depth: int = 24,
-                       stray: StrayCurves = StrayCurves.RAISE) -> list[IntersectionCurve]:
+                       stray: StrayCurves = StrayCurves.RAISE,
+                       tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
     """Intersection curves of two surfaces and/or triangle meshes (000 §29.4, steps 1-6).
 
     Parameters
@@ -406,6 +412,14 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         A NURBS x NURBS curve whose interpolants stray from the surfaces by more
         than ``tol`` (near-tangential or overlapping surfaces, where the
         refinement does not converge) raises (``RAISE``) or is left out (``DROP``).
+    tangential : sequence of IntersectionCurve
+        Known curves of tangential contact (e.g. the characteristic method's
+        ridges, :mod:`..characteristic.ridges`). Along such a curve the
+        tessellations only graze each other and give fragments, whose marching
+        and refinement are ill-conditioned (seconds, then retries); traced chains
+        whose refined samples all lie within ``_TANGENTIAL_REACH`` of one are
+        left out right after the refinement. The tangential curves themselves
+        are not returned.
 
     Returns
     -------
@@ -436,6 +450,10 @@ def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
         mesh_tol = max(MESH_TOL_FACTOR * size, tol)
     mesh_tol = check_tolerance(mesh_tol, "mesh_tol", low=tol,
                                high=max(MAX_MESH_TOL_FACTOR * size, tol))
+    if tangential:
+        reach = max(_TANGENTIAL_REACH * tol, _TANGENTIAL_SHARE * size)
+        return _intersect(a, b, tol, mesh_tol, max_depth, stray, scale, _RETRIES,
+                          (tuple(tangential), reach))
     return _intersect(a, b, tol, mesh_tol, max_depth, stray, scale, _RETRIES)
 
 
@@ -457,8 +475,23 @@ def _folded(curve: RefinedCurve) -> bool:
     return bool(np.any((cos < np.cos(_FOLD_ANGLE)) & ~middle))
 
 
+def _off_tangential(chains: list[Chain], dense: list[RefinedCurve],
+                    tangential: tuple[IntersectionCurve, ...], reach: float
+                    ) -> tuple[list[Chain], list[RefinedCurve]]:
+    """The chains and refined curves that do not lie wholly within ``reach`` of a known
+    tangential curve (``intersect_surfaces(tangential=...)``)."""
+    if not dense:
+        return chains, dense
+    points = np.concatenate([c.points for c in dense])
+    owner = np.repeat(np.arange(len(dense)), [c.points.shape[0] for c in dense])
+    far = polyline_distance(points, list(tangential)) > reach
+    keep = np.bincount(owner[far], minlength=len(dense)) > 0
+    return ([c for c, k in zip(chains, keep) if k], [c for c, k in zip(dense, keep) if k])
+
+
 def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: int,
-               stray: StrayCurves, scale: float, retries: int) -> list[IntersectionCurve]:
+               stray: StrayCurves, scale: float, retries: int,
+               tangential: tuple | None = None) -> list[IntersectionCurve]:
     """:func:`intersect_surfaces` at one ``mesh_tol``; a NURBS x NURBS result with a
     folded or straying curve is computed again at ``mesh_tol / _RETRY_FACTOR``
     (``retries`` more times at most, not below ``_RETRY_FLOOR tol``): the
@@ -482,8 +515,12 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
     if surface_a is None or surface_b is None:
         return intersection_curves(topology, surface_a, surface_b, tol=tol)
     chains, dense = refine_chains(topology, surface_a, surface_b, tol=tol)
+    if tangential is not None:
+        chains, dense = _off_tangential(chains, dense, *tangential)
+        if not dense:
+            return []
     if can_retry and any(_folded(c) for c in dense):
-        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1)
+        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1, tangential)
     ends = [((topology.uv_a[c.point_ids[0]], topology.uv_b[c.point_ids[0]]),
              (topology.uv_a[c.point_ids[-1]], topology.uv_b[c.point_ids[-1]])) for c in chains]
     dense = _close_boundary_gaps(dense, chains, ends, surface_a, surface_b, tol,
@@ -493,5 +530,5 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
     dense, kinds = _along_sides(dense, kinds, topology, chains, surface_a, surface_b, tol)
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
     if can_retry and np.any(worst > tol):
-        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1)
+        return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1, tangential)
     return _stray_policy(curves, worst, tol, stray)

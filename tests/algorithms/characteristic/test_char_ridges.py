@@ -103,3 +103,28 @@ def test_triangle_fragments_along_the_top_circle_are_replaced_by_it():
     mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP)
     rec = certify(a, b, mesh, tol=TOL)
     assert rec.dropped == 0 and len(rec.curves) >= len(mesh) > 0
+
+
+def test_triangle_method_told_the_tangential_curve_leaves_out_its_fragments():
+    """intersect_surfaces(tangential=...): given the traced top circle (the analysis's
+    tangential ridge), the triangle method returns none of its fragments along it (so
+    no marching and no retries on them), and the certificate then reports the circle;
+    curves away from a given tangential curve are kept (the plane 1e-2 lower, told the
+    top circle, still gives its two circles)."""
+    from surfprep.algorithms.characteristic import characteristic_analysis, tangential_curves
+    from surfprep.algorithms.intersection import StrayCurves, intersect_surfaces
+
+    a, b = torus_and_plane(0.0, MAJOR, MINOR)
+    analysis = characteristic_analysis(a, b, tol=TOL, trace_critical=False, borders=False)
+    top = tangential_curves(analysis, TOL)
+    assert len(top) == 1
+    mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP, tangential=top)
+    assert mesh == []
+    rec = certify(a, b, mesh, tol=TOL, analysis=analysis, tangential=top)
+    assert len(rec.curves) == 1 and rec.found_by == (FoundBy.CHARACTERISTIC,)
+    lower, plane = torus_and_plane(1e-2, MAJOR, MINOR)
+    kept = intersect_surfaces(lower, plane, tol=TOL, stray=StrayCurves.DROP, tangential=top)
+    assert len(kept) == 2
+    half = np.sqrt(MINOR ** 2 - (MINOR - 1e-2) ** 2)
+    np.testing.assert_allclose(sorted(radii_and_heights(c)[0].mean() for c in kept),
+                               [MAJOR - half, MAJOR + half], atol=1e-6)
