@@ -76,6 +76,7 @@ from ..algorithms.intersection import (
     IntersectionCurve,
     closed_in_space,
 )
+from ..algorithms.projection import project_to_surface
 from ..errors import InvalidGeometryError, InvalidToleranceError
 from .edges import make_edge
 from .intersect_methods import (
@@ -92,6 +93,7 @@ from .intersect_operands import (
     face_operands,
     inside_face,
 )
+from .trim_loops import SegmentTree
 
 __all__ = [
     "DEFAULT_TOL_FACTOR",
@@ -382,7 +384,48 @@ def _along_a_boundary(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand
                 for p in lines)
         if face.edge_distance(curve.points).max() <= near + face._cache["sag"]:
             return True
+    return _on_a_tangent_join(curve, fa, fb, near)
+
+
+#: points on the way from a piece's sample to the nearest trimming loop (shares of the way)
+_JOIN_STEPS = np.array([0.25, 0.5, 0.75, 1.0])
+
+
+def _on_a_tangent_join(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperand,
+                       near: float) -> bool:
+    """True when one face lies within ``near`` of the other's surface all the way from
+    every sample of the piece to its trimming loops.
+
+    Where two faces of one shape meet tangentially (a G1 seam, as along every join
+    of the fuselage's faces), their surfaces are within the tolerance of each
+    other over a strip beside the common edge and cross there along curves that
+    wander tens of millimetres from it: not a self-intersection, the two faces
+    coincide between that curve and their edge. Each sample's (u, v) on a face is
+    joined to the nearest point of the face's loop polygon; points along that
+    way are measured against the other surface (closest points).
+    """
+    for face, uv, other in ((fa, curve.uv_a, fb), (fb, curve.uv_b, fa)):
+        if uv is None:
+            continue
+        tree = _loop_tree(face)
+        if tree is None:
+            continue
+        _, foot = tree.nearest(uv)
+        way = uv[:, None] + _JOIN_STEPS[None, :, None] * (foot - uv)[:, None]     # (n, s, 2)
+        way = way.reshape(-1, 2)
+        points = face.surface.evaluate(way[:, 0], way[:, 1])
+        if project_to_surface(other.surface, points).distance.max() <= near:
+            return True
     return False
+
+
+def _loop_tree(face: FaceOperand):
+    """Segment tree of the face's loop polygon in (u, v) (cached; None without loops)."""
+    if "loop_tree" not in face._cache:
+        seg = face.boundary_segments()
+        face._cache["loop_tree"] = SegmentTree.from_segments(
+            seg[:, 0], seg[:, 1] - seg[:, 0]) if seg.shape[0] else None
+    return face._cache["loop_tree"]
 
 
 def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOperand,

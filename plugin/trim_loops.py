@@ -87,8 +87,13 @@ class SegmentTree:
     def distance(self, x: NDArray, k: int = 8) -> NDArray:
         """Distance ``(n,)`` from each point ``x (n, dim)`` to the nearest of the ``k``
         segments whose midpoints are nearest (the segments are short and even)."""
+        return self.nearest(x, k)[0]
+
+    def nearest(self, x: NDArray, k: int = 8) -> tuple[NDArray, NDArray]:
+        """Distance ``(n,)`` and foot point ``(n, dim)`` on the nearest of the ``k``
+        segments whose midpoints are nearest each point ``x (n, dim)``."""
         if x.shape[0] == 0:
-            return np.zeros(0)
+            return np.zeros(0), np.zeros((0, x.shape[1]))
         k = min(k, self.start.shape[0])
         _, idx = self.tree.query(x, k=k)
         idx = idx.reshape(x.shape[0], k)
@@ -96,7 +101,11 @@ class SegmentTree:
         dd = np.einsum("nkc,nkc->nk", pd, pd)
         t = np.clip(np.einsum("nkc,nkc->nk", x[:, None] - pa, pd) / np.where(dd > 0, dd, 1.0),
                     0, 1)
-        return np.linalg.norm(pa + t[..., None] * pd - x[:, None], axis=-1).min(axis=1)
+        foot = pa + t[..., None] * pd                                   # (n, k, dim)
+        dist = np.linalg.norm(foot - x[:, None], axis=-1)
+        best = dist.argmin(axis=1)
+        rows = np.arange(x.shape[0])
+        return dist[rows, best], foot[rows, best]
 
 
 @dataclass(frozen=True, eq=False)

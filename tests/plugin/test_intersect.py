@@ -220,3 +220,41 @@ def test_bad_operand():
 
 def test_public_name():
     assert surfprep.intersect is intersect
+
+
+# ------------------------------------------------------------------ tangent joins
+def _flat_crossing_faces(slope):
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).parents[1] / "algorithms" / "characteristic"))
+    from char_surfaces import flat_crossing
+    a, b = flat_crossing(slope)
+    return surfprep.make_face(a), surfprep.make_face(b)
+
+
+def test_faces_of_one_shape_overlapping_within_tolerance_do_not_self_intersect():
+    """Two faces of one shape overlapping over a strip 0.1 wide, their surfaces within
+    7e-5 of each other there (crossing at 1e-3 rad), tol 1e-5: among the faces of one
+    shape that is a tangent join, not a self-intersection (each face lies within 10 tol
+    of the other all the way from the crossing to its edge); across two operands the
+    crossing is an answer. At 2e-3 rad (1.4e-4 apart at the strip's edge) the faces
+    truly cut through each other, and the crossing is reported within one shape too."""
+    fa, fb = _flat_crossing_faces(1e-3)
+    assert intersect([fa, fb], tol=1e-5) == []
+    (across,) = intersect(fa, fb, tol=1e-5)
+    assert across.length == pytest.approx(1.02, abs=0.01)
+    fa, fb = _flat_crossing_faces(2e-3)
+    (within,) = intersect([fa, fb], tol=1e-5)
+    assert within.length == pytest.approx(1.02, abs=0.01)
+
+
+@pytest.mark.slow
+def test_bundled_fuselage_does_not_self_intersect():
+    """step_samples/occt_fuselage.stp: its faces meet tangentially along their seams
+    and overlap a little there (the surfaces' crossings wander up to 44 mm from the
+    common edges, within 10 tol of each other); intersected among themselves they
+    gave 38 remnant curves before the tangent-join test, now none."""
+    from pathlib import Path
+    model = surfprep.read(Path(__file__).parents[2] / "step_samples" / "occt_fuselage.stp")
+    result = intersect(model)
+    assert list(result) == []
