@@ -37,6 +37,7 @@ sys.path.insert(0, str(ROOT / "tests" / "algorithms" / "characteristic"))
 
 from char_surfaces import (
     degree_six_pair,
+    flat_crossing,
     horizontal_plane,
     near_coincident,
     several_bumps,
@@ -46,17 +47,15 @@ from char_surfaces import (
 )
 
 from surfprep.algorithms.characteristic import (
-    certify,
-    characteristic_analysis,
+    auto_intersection,
     characteristic_intersection,
-    tangential_curves,
 )
 from surfprep.algorithms.intersection import (
     StrayCurves,
     connected_branches,
     intersect_surfaces,
 )
-from surfprep.plugin.intersect_methods import FULL_COINCIDENCE
+from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
 
 TOL = 1e-9
@@ -103,6 +102,9 @@ def cases():
     out.append(("torus x plane normal to its axis, 1e-6 below the top", a, b, 2, 0))
     a, b = torus_and_plane(0.0)
     out.append(("torus x plane touching its top circle", a, b, 1, 0))
+    for slope in (5e-4, 5e-3):
+        a, b = flat_crossing(slope)
+        out.append((f"sheets crossing at {slope:g} rad (wavy line)", a, b, 1, 0))
     return out
 
 
@@ -124,21 +126,20 @@ def branches(curves) -> int | str:
     return connected_branches(list(curves), 1e-6) if curves else 0
 
 
-def auto_intersection(a, b):
-    """What ``surfprep.intersect`` does by default on one pair (plugin.intersect_methods):
-    the characteristic stage, the triangle method (skipped when the surfaces coincide over
-    the whole grid; the fragments along traced tangential curves left out), the
-    certificate. Returns ``(record, seconds of the certificate: stage + finish)``."""
+def auto_run(a, b):
+    """``surfprep.intersect``'s default on one pair (``auto_intersection``), with the time
+    its triangle method took inside: ``(record, seconds outside the triangles)``."""
+    inside = [0.0]
+
+    def triangles(tangential):
+        start = time.perf_counter()
+        curves = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP, tangential=tangential)
+        inside[0] += time.perf_counter() - start
+        return curves
+
     start = time.perf_counter()
-    analysis = characteristic_analysis(a, b, tol=TOL, trace_critical=False, borders=False)
-    whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
-    tangential = [] if whole else tangential_curves(analysis, TOL)
-    staged = time.perf_counter() - start
-    mesh = [] if whole else intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP,
-                                               tangential=tangential)
-    middle = time.perf_counter()
-    record = certify(a, b, mesh, tol=TOL, analysis=analysis, tangential=tangential)
-    return record, staged + time.perf_counter() - middle
+    record = auto_intersection(a, b, tol=TOL, triangles=triangles)
+    return record, time.perf_counter() - start - inside[0]
 
 
 def run_case(name, a, b, truth, contacts):
@@ -146,8 +147,8 @@ def run_case(name, a, b, truth, contacts):
         warnings.simplefilter("ignore")
         mesh, t_mesh = best(lambda: intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP))
         char, _t_char = best(lambda: characteristic_intersection(a, b, tol=TOL))
-        auto, t_auto = best(lambda: auto_intersection(a, b))
-        cert, t_cert = auto[0], auto[1]
+        auto, t_auto = best(lambda: auto_run(a, b))
+        cert, t_cert = auto
         occ, t_occ = best(lambda: intersect_surfaces_occ(a, b, TOL))
     row = {
         "case": name, "truth": truth, "contacts": contacts,
@@ -157,16 +158,27 @@ def run_case(name, a, b, truth, contacts):
         "t_char_stage": char.characteristic_time_s, "t_curve_stage": char.intersection_time_s,
         "auto": branches(cert.curves), "auto_added": len(cert.added),
         "auto_contacts": len(cert.isolated_points), "t_auto": t_auto,
+        "route": cert.extra.get("route", "-"),
         "t_cert": t_cert,
         "occ": branches(occ), "t_occ": t_occ,
+        "occ_dev": occ_deviation(occ, a, b),
     }
     return row
 
 
+def occ_deviation(curves, a, b) -> float:
+    """Largest distance of OpenCascade's curve samples from either surface (by us)."""
+    if isinstance(curves, Exception) or not curves:
+        return float("nan")
+    points = np.concatenate([c.points for c in curves])
+    return float(max(distance_to_surface(a, points).max(), distance_to_surface(b, points).max()))
+
+
 def table(rows) -> str:
-    head = ("| pair | truth | mesh | char | auto (added) | OCC IntSS | char stage / curve stage "
-            "| mesh s | certificate s | auto s (x mesh) | char s | OCC s |")
-    lines = [head, "|" + "---|" * 12]
+    head = ("| pair | truth | mesh | char | auto (added) | auto route | OCC IntSS | OCC dev "
+            "| char stage / curve stage | mesh s | certificate s | auto s (x mesh) | char s "
+            "| OCC s |")
+    lines = [head, "|" + "---|" * 14]
     for r in rows:
         truth = f"{r['truth']}" + (f" + {r['contacts']} pt" if r["contacts"] else "")
         char = f"{r['char']}" + (f" + {r['char_contacts']} pt" if r["char_contacts"] else "") \
@@ -176,7 +188,8 @@ def table(rows) -> str:
         stage = (f"{100 * r['t_char_stage'] / r['t_curve_stage']:.0f} %"
                  if r["char"] not in (0, "0") and r["t_curve_stage"] > 0 else "- (no curve)")
         lines.append(
-            f"| {r['case']} | {truth} | {r['mesh']} | {char} | {auto} | {r['occ']} | {stage} "
+            f"| {r['case']} | {truth} | {r['mesh']} | {char} | {auto} | {r['route']} "
+            f"| {r['occ']} | {r['occ_dev']:.1e} | {stage} "
             f"| {r['t_mesh']:.3f} | {r['t_cert']:.3f} "
             f"| {r['t_auto']:.3f} ({r['t_auto'] / max(r['t_mesh'], 1e-9):.1f}x) "
             f"| {r['t_char_stage'] + r['t_curve_stage']:.3f} | {r['t_occ']:.3f} |")

@@ -21,13 +21,8 @@ from ..algorithms.characteristic import (
     CharacteristicRecord,
     CoincidentRegion,
     FoundBy,
-    NoLoopReason,
-    certify,
-    characteristic_analysis,
+    auto_intersection,
     characteristic_intersection,
-    no_loop_reason,
-    tangential_curves,
-    uncertified_record,
 )
 from ..algorithms.intersection import IntersectionCurve, StrayCurves, intersect_surfaces
 from ..errors import InvalidGeometryError, InvalidToleranceError
@@ -36,7 +31,6 @@ if TYPE_CHECKING:
     from .intersect_operands import FaceOperand
 
 __all__ = [
-    "FULL_COINCIDENCE",
     "CoincidentFaces",
     "ContactPoint",
     "FoundBy",
@@ -125,10 +119,6 @@ class IntersectionResult(list):
         self.method = Method(method)
 
 
-#: a coincident region with this share of the grid: the triangle method is not run
-FULL_COINCIDENCE = 0.95
-
-
 def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
                  tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
     try:
@@ -137,41 +127,32 @@ def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float |
     except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
             FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
-                      stacklevel=3)
+                      stacklevel=4)
         return []
 
 
 def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                 method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
-                                          CharacteristicRecord | None]:
+                method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
+                                         CharacteristicRecord | None]:
     """Untrimmed curves of one face pair by ``method``, how each was found, the record.
 
-    With ``"auto"``, a pair the prefilter clears
-    (:func:`surfprep.algorithms.characteristic.no_loop_reason`: boxes apart, or a
-    plane against a plane or a surface with a straight parameter direction) gets the
-    triangle method alone (nothing at all when apart) and a record saying so
-    (``record.extra["skipped"]``).
+    ``"auto"`` is :func:`surfprep.algorithms.characteristic.auto_intersection`
+    (prefilter, characteristic stage, the characteristic method alone where the
+    surfaces cross at a small angle, else the triangle method and the
+    certificate; ``record.extra["route"]`` says which), with the triangle
+    method's failures turned into warnings.
     """
     if method is Method.MESH:
         curves = _mesh_curves(fa, fb, tol, mesh_tol)
         return curves, [FoundBy.MESH] * len(curves), None
     a, b = fa.surface, fb.surface
-    reason = no_loop_reason(a, b, tol=tol) if method is Method.AUTO else None
-    if reason is not None:              # nothing for the certificate to find (prefilter)
-        curves = [] if reason is NoLoopReason.APART else _mesh_curves(fa, fb, tol, mesh_tol)
-        return curves, [FoundBy.MESH] * len(curves), uncertified_record(curves, reason)
     try:
         if method is Method.CHARACTERISTIC:
             record = characteristic_intersection(a, b, tol=tol)
         else:
-            analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False,
-                                               borders=False)
-            whole = any(r.share >= FULL_COINCIDENCE for r in analysis.coincident)
-            # fragments along a tangential contact the analysis already traced are left
-            # out of the triangle method (their marching and retries cost seconds)
-            tangential = [] if whole else tangential_curves(analysis, tol)
-            mesh = [] if whole else _mesh_curves(fa, fb, tol, mesh_tol, tangential)
-            record = certify(a, b, mesh, tol=tol, analysis=analysis, tangential=tangential)
+            record = auto_intersection(
+                a, b, tol=tol, mesh_tol=mesh_tol,
+                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential))
     except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
                       stacklevel=3)

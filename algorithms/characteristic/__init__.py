@@ -17,7 +17,9 @@ distance function, characteristic points and characteristic curves
   to their axis): tangential curves, and starts beside maximum/minimum ridges;
 * :mod:`.evaluator`: fast power-basis evaluation for the tracers;
 * :mod:`.kernels`: the distance jet and the projection as numba kernels;
-* :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them).
+* :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them);
+* :mod:`.crossing`: the flattest crossing angle on the stage's grid;
+* :mod:`.auto`: the default ``auto`` method per pair (:func:`auto_intersection`).
 """
 
 from .algorithm import (
@@ -31,6 +33,8 @@ from .algorithm import (
                         choose_field,
                         tangential_curves,
 )
+from .auto import FULL_COINCIDENCE, Route, auto_intersection, small_angle
+from .crossing import grid_crossing_sine
 from .curves import CurveKind, EndReason, TracedCurve, trace_curves
 from .distance import DistanceField, DistanceJet, distance_jet
 from .evaluator import PatchEvaluator
@@ -41,6 +45,7 @@ from .ridges import Ridge
 from .trace import to_intersection_curve, trace_intersections
 
 __all__ = [
+                        "FULL_COINCIDENCE",
                         "CharacteristicAnalysis",
                         "CharacteristicPoint",
                         "CharacteristicRecord",
@@ -57,7 +62,9 @@ __all__ = [
                         "ProjectionStatus",
                         "Projector",
                         "Ridge",
+                        "Route",
                         "TracedCurve",
+                        "auto_intersection",
                         "certify",
                         "characteristic_analysis",
                         "characteristic_intersection",
@@ -65,7 +72,9 @@ __all__ = [
                         "classify_critical",
                         "critical_points",
                         "distance_jet",
+                        "grid_crossing_sine",
                         "no_loop_reason",
+                        "small_angle",
                         "tangential_curves",
                         "to_intersection_curve",
                         "trace_curves",

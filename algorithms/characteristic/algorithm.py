@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from .crossing import grid_crossing_sine
 from .curves import CurveKind, TracedCurve, curve_value
 from .distance import DistanceField, DistanceJet
 from .points import (
@@ -133,6 +134,9 @@ class CharacteristicAnalysis:
     coincident: tuple[CoincidentRegion, ...]
     time_s: float
     ridges: tuple[Ridge, ...] = ()
+    #: smallest sine of the angle between the normals beside a sign change of phi on
+    #: the grid (:func:`.crossing.grid_crossing_sine`; inf: phi changes sign nowhere)
+    crossing_sine: float = float("inf")
 
     def of_kind(self, *kinds: PointKind) -> tuple[CharacteristicPoint, ...]:
         return tuple(p for p in self.points if p.kind in kinds)
@@ -332,9 +336,11 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         points += make_points(fld, PointKind.BORDER, uv_r, st_q, bp, np.zeros(bp.shape[0]))
         border_start = Start(uv_r, st_q, np.full(bp.shape[0], 0.1 * fld.diagonal),
                              np.arange(bp.shape[0]))
+    crossing = grid_crossing_sine(fld, grid, shape)
     if coincident:
         return CharacteristicAnalysis(fld, tuple(points), (), border_keys(border_start),
-                                      coincident, time.perf_counter() - start_time)
+                                      coincident, time.perf_counter() - start_time,
+                                      crossing_sine=crossing)
     # step 2: roots of phi_u (phi_v) on the sides; step 3: characteristic curves,
     # complete to the grid (sweep.py)
     side_points, swept = sweep(fld, grid, shape, noise, h_max, both=trace_critical)
@@ -402,7 +408,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     start = Start.stack([Start(start.uv, start.st, start.scale, loop_keys(fld, grid, shape, start)),
                          border_keys(border_start)])
     return CharacteristicAnalysis(fld, tuple(points), tuple(curves), start, (),
-                                  time.perf_counter() - start_time, tuple(ridges))
+                                  time.perf_counter() - start_time, tuple(ridges), crossing)
 
 
 def _pole_points(fld: DistanceField, a: NurbsSurface, b: NurbsSurface, tol: float,

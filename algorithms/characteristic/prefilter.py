@@ -141,6 +141,8 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     s = _near_part(s, centre, normal, tol)
     if s is None:                                      # no span comes near the plane
         return True
+    if _turns_both_ways(s, centre, normal):
+        return False
     for level in range(REFINEMENTS + 1):
         if _monotone_patches(s, centre, normal, tol):
             return True
@@ -148,6 +150,28 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
             return False
         s = _halved(s)
     return False
+
+
+#: samples per knot span of the necessary-condition check (:func:`_turns_both_ways`)
+_TURN_SAMPLES = 4
+
+
+def _turns_both_ways(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray) -> bool:
+    """True when the rule cannot hold in either direction, whatever the refinement: some
+    sampled line ``v = const`` crosses the plane twice (a height monotone along it
+    crosses once at most), and so does some line ``u = const``. A closed loop, as
+    around a bump, is crossed twice both ways: the halvings are not tried."""
+    grids = []
+    for knots, degree in ((s.knots_u, s.degree_u), (s.knots_v, s.degree_v)):
+        breaks = np.unique(knots[degree:knots.size - degree])
+        share = np.arange(_TURN_SAMPLES) / _TURN_SAMPLES
+        grids.append(np.append((breaks[:-1, None] + share * np.diff(breaks)[:, None]).ravel(),
+                               breaks[-1]))
+    h = s.evaluate_grid(*grids) @ normal - float(centre @ normal)          # (nu, nv)
+    sign = np.sign(h)
+    twice = [np.any(np.count_nonzero(sign[1:] * sign[:-1] < 0, axis=0) >= 2),
+             np.any(np.count_nonzero(sign[:, 1:] * sign[:, :-1] < 0, axis=1) >= 2)]
+    return bool(twice[0] and twice[1])
 
 
 def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float

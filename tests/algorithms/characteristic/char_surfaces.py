@@ -141,3 +141,18 @@ def torus_and_plane(gap: float, major: float = 1.0, minor: float = 0.3
     half = 1.5 * (major + minor)
     cp = np.array([[[-half, -half, z], [-half, half, z]], [[half, -half, z], [half, half, z]]])
     return torus(major, minor), NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+
+def flat_crossing(slope: float, n: int = 8) -> tuple[NurbsSurface, NurbsSurface]:
+    """Two bicubic sheets over overlapping strips, ``[0, 0.55]`` and ``[0.45, 1]`` in x,
+    of the graph ``0.2 sin(2x) cos(1.5y)``, the second tilted by ``slope (x - 1/2 -
+    0.02 sin 6y)``: they cross at the angle ``slope`` along the wavy curve ``x = 1/2 +
+    0.02 sin 6y`` (y in [0, 1]), one branch of length about 1.02."""
+    from surfprep.algorithms.fitting import interpolate_surface
+
+    def sheet(x0: float, x1: float, tilt: float) -> NurbsSurface:
+        x, y = np.meshgrid(np.linspace(x0, x1, n), np.linspace(0, 1, n), indexing="ij")
+        z = 0.2 * np.sin(2 * x) * np.cos(1.5 * y) + tilt * (x - 0.5 - 0.02 * np.sin(6 * y))
+        return interpolate_surface(np.stack([x, y, z], axis=-1))
+
+    return sheet(0.0, 0.55, 0.0), sheet(0.45, 1.0, slope)

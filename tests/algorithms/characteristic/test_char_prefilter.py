@@ -196,3 +196,16 @@ def test_apart_equals_all_pairs_of_bezier_boxes(shift):
     touch = np.all((ba[:, None, 0] <= bb[None, :, 1] + TOL)
                    & (bb[None, :, 0] <= ba[:, None, 1] + TOL), axis=-1).any()
     assert prefilter._apart(a, b, TOL) == (not touch)
+
+
+def test_loops_refuse_the_monotone_rule_without_halving():
+    """A plane through bumps cuts closed loops, each crossed twice by lines of both
+    directions: prefilter._turns_both_ways says so from one sample grid (no span
+    halvings); a sloped sheet, crossed once per line, is not refused that way."""
+    from surfprep.algorithms.characteristic import prefilter
+    up = np.array([0.0, 0.0, 1.0])
+    bumps = several_bumps()
+    top = bumps.evaluate(0.5, 0.72)[2]
+    assert prefilter._turns_both_ways(bumps, np.array([0, 0, top - 0.01]), up)
+    assert no_loop_reason(bumps, horizontal_plane(top - 0.01), tol=TOL) is None
+    assert not prefilter._turns_both_ways(sloped_sheet(), np.array([0, 0, 0.3]), up)
