@@ -205,8 +205,8 @@ def table(rows) -> str:
     full = [r for r in rows if r["occ"] == r["truth"] and r["truth"] and not r["contacts"]]
     if full:
         lines.append("where OCC finds every branch: " + "; ".join(
-            f"{r['case']}: auto {r['t_auto']:.3f} s = mesh {r['t_mesh']:.3f} + certificate "
-            f"{r['t_cert']:.3f} vs OCC {r['t_occ']:.3f} ({r['t_auto'] / max(r['t_occ'], 1e-9):.1f}x)"
+            f"{r['case']}: auto {r['t_auto']:.3f} s ({r['route']}) vs OCC {r['t_occ']:.3f} "
+            f"({r['t_auto'] / max(r['t_occ'], 1e-9):.1f}x)"
             for r in full))
     return "\n".join(lines)
 

@@ -18,7 +18,8 @@ distance function, characteristic points and characteristic curves
 * :mod:`.evaluator`: fast power-basis evaluation for the tracers;
 * :mod:`.kernels`: the distance jet and the projection as numba kernels;
 * :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them);
-* :mod:`.crossing`: the flattest crossing angle on the stage's grid;
+* :mod:`.grid`: the roles of the two surfaces and the stage's sample grid;
+* :mod:`.crossing`: the flattest crossing angle on that grid;
 * :mod:`.auto`: the default ``auto`` method per pair (:func:`auto_intersection`).
 """
 
@@ -38,6 +39,7 @@ from .crossing import grid_crossing_sine
 from .curves import CurveKind, EndReason, TracedCurve, trace_curves
 from .distance import DistanceField, DistanceJet, distance_jet
 from .evaluator import PatchEvaluator
+from .grid import StageGrid, stage_grid
 from .points import CharacteristicPoint, PointKind, classify_critical, critical_points
 from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
 from .projection import Projection, ProjectionStatus, Projector
@@ -63,6 +65,7 @@ __all__ = [
                         "Projector",
                         "Ridge",
                         "Route",
+                        "StageGrid",
                         "TracedCurve",
                         "auto_intersection",
                         "certify",
@@ -75,6 +78,7 @@ __all__ = [
                         "grid_crossing_sine",
                         "no_loop_reason",
                         "small_angle",
+                        "stage_grid",
                         "tangential_curves",
                         "to_intersection_curve",
                         "trace_curves",

@@ -44,9 +44,9 @@ from numpy.typing import NDArray
 from ..intersection import IntersectionCurve
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .crossing import grid_crossing_sine
 from .curves import CurveKind, TracedCurve, curve_value
 from .distance import DistanceField, DistanceJet
+from .grid import GRID_MAX, GRID_MIN, StageGrid, choose_field, stage_grid
 from .points import (
     DEGENERATE_SHARE,
     CharacteristicPoint,
@@ -85,8 +85,6 @@ __all__ = [
     "tangential_curves",
 ]
 
-#: grid samples per direction of r's domain for the critical-point seeds
-GRID_MIN, GRID_MAX = 33, 129
 #: derivatives of phi below this share of its largest gradient on the grid are rounding
 NOISE_SHARE = 1e-9
 #: rounds of "trace through new critical points" at most
@@ -193,61 +191,6 @@ class CharacteristicRecord:
         return tuple(c for c, f in zip(self.curves, self.found_by) if f is FoundBy.CHARACTERISTIC)
 
 
-# ------------------------------------------------------------------ roles
-def _normal_spread(surface: NurbsSurface, n: int = 9) -> float:
-    """Largest angle (radians) between the normals on an ``n x n`` grid and their mean."""
-    d = surface.domain
-    g = surface.derivatives_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n), 1)
-    normal = np.cross(g[:, :, 1, 0], g[:, :, 0, 1]).reshape(-1, 3)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-    mean = normal.mean(axis=0)
-    mean /= max(np.linalg.norm(mean), 1e-300)
-    return float(np.arccos(np.clip(normal @ mean, -1, 1)).max())
-
-
-def _coverage(r: NurbsSurface, projector: Projector, n: int = 9) -> float:
-    d = r.domain
-    pts = r.evaluate_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)).reshape(-1, 3)
-    return float(np.mean(projector.project(pts).status != ProjectionStatus.NONE))
-
-
-def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | None = None
-                 ) -> DistanceField:
-    """The role of each surface: ``phi`` on the domain of ``r``, projection onto ``q``.
-
-    ``q`` should be the surface onto which more of the other projects (coverage
-    of a coarse grid) and, between near ties, the flatter one (smaller spread
-    of normals: projections onto it are unique farther out). ``phi_on`` forces
-    the choice (``"a"`` or ``"b"``).
-    """
-    if phi_on not in (None, "a", "b"):
-        raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
-    proj_b, proj_a = Projector(b, tol=tol * 1e-3), Projector(a, tol=tol * 1e-3)
-    if phi_on is None:
-        cover_ab, cover_ba = _coverage(a, proj_b), _coverage(b, proj_a)
-        if abs(cover_ab - cover_ba) > 0.1:
-            phi_on = "a" if cover_ab > cover_ba else "b"
-        else:
-            phi_on = "a" if _normal_spread(b) <= _normal_spread(a) else "b"
-    field = DistanceField(a, proj_b, False) if phi_on == "a" else DistanceField(b, proj_a, True)
-    # the other role (border points) reuses the other projector instead of building it again
-    field._cache["other_projector"] = proj_a if phi_on == "a" else proj_b
-    field._cache["evaluator"] = field._cache["other_projector"].evaluator   # r's, built once
-    return field
-
-
-# ------------------------------------------------------------------ stage helpers
-def _grid(field: DistanceField) -> tuple[DistanceJet, tuple[int, int]]:
-    counts = []
-    for knots, degree in ((field.r.knots_u, field.r.degree_u), (field.r.knots_v, field.r.degree_v)):
-        spans = np.unique(knots[degree:knots.size - degree]).size - 1
-        counts.append(int(np.clip(4 * spans + 1, GRID_MIN, GRID_MAX)))
-    u = np.linspace(field.lower[0], field.upper[0], counts[0])
-    v = np.linspace(field.lower[1], field.upper[1], counts[1])
-    uv = np.stack(np.meshgrid(u, v, indexing="ij"), -1).reshape(-1, 2)
-    return field.jet(uv), (counts[0], counts[1])
-
-
 def _coincident(field: DistanceField, jet: DistanceJet, shape: tuple[int, int], tol: float
                 ) -> tuple[CoincidentRegion, ...]:
     """The grid cells whose four corners all have a regular projection and ``|phi| <= tol``:
@@ -306,22 +249,25 @@ def _turning_points(field: DistanceField, uv: NDArray, st: NDArray, kind: CurveK
 # ------------------------------------------------------------------ the stage
 def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
                             phi_on: str | None = None, trace_critical: bool = True,
-                            borders: bool = True) -> CharacteristicAnalysis:
+                            borders: bool = True, grid: StageGrid | None = None
+                            ) -> CharacteristicAnalysis:
     """The characteristic stage (module docstring, steps 0-5).
 
     ``trace_critical`` False is the ``auto`` certificate's lighter stage: only
     the u-characteristic curves from the sides are traced (a critical point on
     them shows as a sign change of ``phi_v``), none through the critical points
     (those from the seed grid are known already). ``borders`` False skips the
-    border points (the certificate checks closed loops).
+    border points (the certificate checks closed loops). ``grid``: the stage's
+    grid when already made (:func:`.grid.stage_grid` with the same ``tol`` and
+    ``phi_on``).
     """
     start_time = time.perf_counter()
     tol = check_tolerance(tol)
-    fld = choose_field(a, b, tol=tol, phi_on=phi_on)
+    staged = grid if grid is not None else stage_grid(a, b, tol=tol, phi_on=phi_on)
+    fld, grid, shape = staged.field, staged.jet, staged.shape
     other = DistanceField(fld.q, fld._cache.get("other_projector")
                           or Projector(fld.r, tol=fld.projector.tol), not fld.swapped)
     h_max = 0.15 * fld.diagonal
-    grid, shape = _grid(fld)
     coincident = _coincident(fld, grid, shape, tol)
     regular = grid.status == ProjectionStatus.UNIQUE
     noise = NOISE_SHARE * float(np.abs(grid.grad[regular]).max()) if regular.any() else 0.0
@@ -336,7 +282,7 @@ def characteristic_analysis(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         points += make_points(fld, PointKind.BORDER, uv_r, st_q, bp, np.zeros(bp.shape[0]))
         border_start = Start(uv_r, st_q, np.full(bp.shape[0], 0.1 * fld.diagonal),
                              np.arange(bp.shape[0]))
-    crossing = grid_crossing_sine(fld, grid, shape)
+    crossing = staged.crossing_sine
     if coincident:
         return CharacteristicAnalysis(fld, tuple(points), (), border_keys(border_start),
                                       coincident, time.perf_counter() - start_time,
@@ -454,7 +400,8 @@ def _size(a: NurbsSurface, b: NurbsSurface) -> float:
 
 
 def characteristic_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float = 1e-7,
-                                phi_on: str | None = None) -> CharacteristicRecord:
+                                phi_on: str | None = None, grid: StageGrid | None = None
+                                ) -> CharacteristicRecord:
     """Intersection of two surfaces by the characteristic method alone (§6.3 steps 1-4).
 
     Returns
@@ -462,8 +409,9 @@ def characteristic_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float 
     CharacteristicRecord
         Curves (all ``FoundBy.CHARACTERISTIC``) within ``tol`` of both surfaces,
         isolated (tangential contact) points, coincident regions and the record.
+        ``grid`` as in :func:`characteristic_analysis`.
     """
-    analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on)
+    analysis = characteristic_analysis(a, b, tol=tol, phi_on=phi_on, grid=grid)
     return _finish(analysis, [], tol, a, b)
 
 

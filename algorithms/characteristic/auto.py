@@ -6,17 +6,18 @@ characteristic stage (002), on one pair of surfaces.
 1. **prefilter** (:func:`.prefilter.no_loop_reason`): boxes apart (nothing to do), or
    a plane against a ruled surface or a monotone height (no loop, no contact
    possible): the triangle method alone;
-2. the **characteristic stage** (:func:`.algorithm.characteristic_analysis`, the
-   light form: u-characteristic curves from the sides, no border points);
-3. surfaces **coinciding** over the whole grid: no triangles (they would give
-   only debris), the coincident region is the answer;
-4. surfaces that cross **at a small angle** somewhere (the stage's
-   ``crossing_sine`` below :func:`small_angle`): the characteristic method
-   alone (:func:`.algorithm.characteristic_intersection`), whose tracing by eq.
-   33 with a corrector does not depend on an angle, where the triangles'
+2. ``phi`` on the stage's grid (:func:`.grid.stage_grid`); surfaces that cross
+   **at a small angle** somewhere on it (``crossing_sine`` below
+   :func:`small_angle`): the characteristic method alone
+   (:func:`.algorithm.characteristic_intersection`, on that grid), whose tracing
+   by eq. 33 with a corrector does not depend on an angle, where the triangles'
    segments stop chaining into one curve (:mod:`.crossing`: fragments,
    zigzags, or a curve dropped as stray);
-5. otherwise the triangle method, told the **tangential curves** the stage
+3. the **characteristic stage** (:func:`.algorithm.characteristic_analysis`, the
+   light form: u-characteristic curves from the sides, no border points);
+   surfaces **coinciding** over the whole grid: no triangles (they would give
+   only debris), the coincident region is the answer;
+4. otherwise the triangle method, told the **tangential curves** the stage
    traced (their fragments left out), then the certificate
    (:func:`.algorithm.certify`): loops it missed are traced and added.
 
@@ -40,6 +41,7 @@ from .algorithm import (
     characteristic_intersection,
     tangential_curves,
 )
+from .grid import stage_grid
 from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
 
 __all__ = ["FULL_COINCIDENCE", "SMALL_ANGLE_SHARE", "Route", "auto_intersection", "small_angle"]
@@ -113,11 +115,15 @@ def auto_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float,
     if reason is not None:
         curves = [] if reason is NoLoopReason.APART else run(())
         return _routed(uncertified_record(curves, reason), Route.PREFILTER)
-    analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False, borders=False)
+    grid = stage_grid(a, b, tol=tol)
+    if grid.crossing_sine < small_angle(a, b, mesh_tol):
+        record = characteristic_intersection(a, b, tol=tol, grid=grid)
+        whole = any(r.share >= FULL_COINCIDENCE for r in record.coincident)
+        return _routed(record, Route.COINCIDENT if whole else Route.SMALL_ANGLE)
+    analysis = characteristic_analysis(a, b, tol=tol, trace_critical=False, borders=False,
+                                       grid=grid)
     if any(r.share >= FULL_COINCIDENCE for r in analysis.coincident):
         return _routed(certify(a, b, [], tol=tol, analysis=analysis), Route.COINCIDENT)
-    if analysis.crossing_sine < small_angle(a, b, mesh_tol):
-        return _routed(characteristic_intersection(a, b, tol=tol), Route.SMALL_ANGLE)
     tangential = tangential_curves(analysis, tol)
     curves = run(tangential)
     record = certify(a, b, curves, tol=tol, analysis=analysis, tangential=tangential)

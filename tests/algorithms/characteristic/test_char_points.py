@@ -160,13 +160,13 @@ def test_compiled_critical_newton_matches_the_numpy_form(pair):
     from char_surfaces import degree_six_pair, torus_and_plane
 
     from surfprep.algorithms.characteristic import newton_kernel
-    from surfprep.algorithms.characteristic.algorithm import _grid, choose_field
+    from surfprep.algorithms.characteristic.grid import choose_field, field_grid
     from surfprep.algorithms.characteristic.points import grid_seeds
 
     assert newton_kernel.AVAILABLE                # numba is a declared dependency
     a, b = degree_six_pair() if pair == "degree six" else torus_and_plane(1e-3)
     field = choose_field(a, b, tol=1e-9)
-    grid, shape = _grid(field)
+    grid, shape = field_grid(field)
     seeds = grid_seeds(grid, shape)
     scale = float(np.abs(grid.hess).max()) if pair == "torus ridge" else 0.0
     ref = critical_points(field, seeds, hess_scale=scale, compiled=False)

@@ -15,7 +15,7 @@ from surfprep.algorithms.characteristic import (
     Projector,
     critical_points,
 )
-from surfprep.algorithms.characteristic.algorithm import _grid
+from surfprep.algorithms.characteristic.grid import field_grid
 from surfprep.algorithms.characteristic.points import edge_roots
 from surfprep.algorithms.characteristic.sweep import sweep, unvisited_seeds
 
@@ -29,7 +29,7 @@ def small_plane_field():
 
 def test_components_without_side_roots_are_traced_from_the_grid():
     field = small_plane_field()
-    grid, shape = _grid(field)
+    grid, shape = field_grid(field)
     noise = 1e-9 * np.abs(grid.grad).max()
     uv, _, _ = edge_roots(field, 0, noise=noise)
     assert uv.shape[0] == 0                       # the paper's side roots see nothing
