@@ -10,6 +10,9 @@ failures into exit codes:
 * 2 a usage error (argparse) or an expected failure
   (:class:`~surfprep.errors.SurfprepError`: bad input file, refused output...),
   printed as one line ``surfprep: error: <message>`` on stderr.
+
+Warnings (e.g. intersection curves left out because they stray from the
+surfaces) are printed as one line ``surfprep: warning: <message>`` each.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import argparse
 import sys
 import textwrap
 import traceback
+import warnings
 from collections.abc import Sequence
 
 from ..errors import SurfprepError
@@ -100,6 +104,11 @@ def _one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on stderr (``--debug`` keeps Python's form, with the place)."""
+    print(f"{PROG}: warning: {_one_line(message)}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit code.
 
@@ -119,7 +128,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_ERROR
     console = Console.for_streams(progress=True if args.progress else None)
     try:
-        return int(run(args, console))
+        with warnings.catch_warnings():
+            if not args.debug:
+                warnings.showwarning = _show_warning      # restored when the block ends
+            return int(run(args, console))
     except SurfprepError as exc:
         if args.debug:
             traceback.print_exc(file=err)

@@ -337,3 +337,24 @@ def test_parametrization_figure_of_occ_converted_cylinder_and_sphere():
     face = describe_face(sphere.faces[0], 0)
     # the poles collapse u-chords to zero: skipped, so the figure stays finite
     assert 1.0 < face.param_quality_u < 1.2 and 1.0 < face.param_quality_v < 1.2
+
+
+def test_warnings_are_one_line_each(capsys, monkeypatch):
+    """A warning raised while a command runs is printed as ``surfprep: warning: ...`` (no
+    file, line or source echo); with --debug it stays a Python warning."""
+    import dataclasses
+    import warnings
+
+    def noisy(args, console):
+        warnings.warn("3 of 7 intersection curves left out:\n  they stray", UserWarning)
+        return 0
+
+    fake = dataclasses.replace(COMMANDS[0], name="noisy", run=noisy,
+                               add_arguments=lambda parser: None)
+    monkeypatch.setattr(cli, "COMMANDS", (fake,))
+    code, out, err = run(capsys, "noisy")
+    assert code == 0
+    assert err.strip() == "surfprep: warning: 3 of 7 intersection curves left out: they stray"
+    with pytest.warns(UserWarning, match="left out"):       # --debug: Python's warning
+        code, out, err = run(capsys, "noisy", "--debug")
+    assert code == 0 and "surfprep: warning" not in err
