@@ -29,9 +29,9 @@ from __future__ import annotations
 import enum
 from collections.abc import Callable, Sequence
 
-import numpy as np
 
 from ..intersection import IntersectionCurve, StrayCurves, intersect_surfaces
+from ..intersection.angles import small_crossing_sine
 from ..intersection.pipeline import MESH_TOL_FACTOR, operand_size
 from ..surface import NurbsSurface
 from .algorithm import (
@@ -44,15 +44,10 @@ from .algorithm import (
 from .grid import stage_grid
 from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
 
-__all__ = ["FULL_COINCIDENCE", "SMALL_ANGLE_SHARE", "Route", "auto_intersection", "small_angle"]
+__all__ = ["FULL_COINCIDENCE", "Route", "auto_intersection", "small_angle"]
 
 #: a coincident region with this share of the grid: the triangle method is not run
 FULL_COINCIDENCE = 0.95
-#: crossings flatter than this times ``sqrt(mesh_tol / size)`` (radians) go to the
-#: characteristic method (measured on a wavy crossing of two sheets at mesh_tol =
-#: 1e-3 size: triangles fail at slopes 1e-3 and 5e-3, hold from 1e-2 on; the limit,
-#: 0.019 at the default, sits between)
-SMALL_ANGLE_SHARE = 0.6
 
 Triangles = Callable[[Sequence[IntersectionCurve]], list[IntersectionCurve]]
 
@@ -68,10 +63,10 @@ class Route(str, enum.Enum):
 
 def small_angle(a: NurbsSurface, b: NurbsSurface, mesh_tol: float | None = None) -> float:
     """Sine below which a crossing is too flat for the triangle method at ``mesh_tol``
-    (default: the pipeline's, ``MESH_TOL_FACTOR`` times the pair's size)."""
+    (default: the pipeline's, ``MESH_TOL_FACTOR`` times the pair's size;
+    :func:`..intersection.angles.small_crossing_sine`)."""
     size = operand_size(a, b)[0]
-    share = MESH_TOL_FACTOR if mesh_tol is None else mesh_tol / max(size, np.finfo(float).tiny)
-    return SMALL_ANGLE_SHARE * float(np.sqrt(share))
+    return small_crossing_sine(size, MESH_TOL_FACTOR * size if mesh_tol is None else mesh_tol)
 
 
 def _default_triangles(a: NurbsSurface, b: NurbsSurface, tol: float, mesh_tol: float | None

@@ -23,8 +23,8 @@ from .culling import (BoxTree, PatchOverlap, build_tree, candidate_pairs, overla
                       overlap_patches, patch_rectangles, subpatch_boxes, surface_patch_boxes,
                       tree_pairs)
 from .mesh import TriangleMesh, collinear_mask
-from .pipeline import (StrayCurves, StrayCurveWarning, closed_in_space, default_mesh_tolerance,
-                       intersect_surfaces, operand_size)
+from .pipeline import (SmallAngleWarning, StrayCurves, StrayCurveWarning, closed_in_space,
+                       default_mesh_tolerance, intersect_surfaces, operand_size)
 from .refine import (RefinedCurve, RefinedPoints, project_points, refine_curves, refine_points,
                      segment_distance)
 from .result import CurveDeviation, IntersectionCurve, interpolate_samples, intersection_curves
@@ -35,7 +35,8 @@ from .topology import Chain, EndKind, SegmentTopology, build_topology, topology_
 from .triangles import TriangleHits, intersect_triangles
 
 __all__ = [
-    "intersect_surfaces", "StrayCurves", "StrayCurveWarning", "closed_in_space", "default_mesh_tolerance", "operand_size",
+    "intersect_surfaces", "SmallAngleWarning", "StrayCurves", "StrayCurveWarning",
+    "closed_in_space", "default_mesh_tolerance", "operand_size",
     "IntersectionCurve", "CurveDeviation", "intersection_curves", "interpolate_samples",
     "cubic_samples", "SampledCurve",
     "EndKind", "Chain", "SegmentTopology", "build_topology", "topology_from_soup",

@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
+from .angles import FLAT_SHARE, flat_share, small_crossing_sine, soup_crossing_sine
 from .compare import polyline_distance
 from .extend import extend_open_ends, join_at_singular_points
 from .mesh import TriangleMesh
@@ -60,6 +61,7 @@ __all__ = [
     "MAX_TOL_FACTOR",
     "MESH_TOL_FACTOR",
     "MIN_TOL_FACTOR",
+    "SmallAngleWarning",
     "StrayCurves",
     "closed_in_space",
     "default_mesh_tolerance",
@@ -357,6 +359,27 @@ class StrayCurveWarning(UserWarning):
     """Curves were left out because they stray from the surfaces by more than tol."""
 
 
+class SmallAngleWarning(UserWarning):
+    """The surfaces cross at an angle too small for the triangle method at its mesh
+    tolerance (:mod:`.angles`): curves there may come out in fragments or be missed."""
+
+
+def _warn_if_flat(soup, a: NurbsSurface, b: NurbsSurface, mesh_tol: float) -> None:
+    """:class:`SmallAngleWarning` when the exact normals at ``FLAT_SHARE`` or more of the
+    soup's segment ends are closer to parallel than :func:`.angles.small_crossing_sine`
+    allows (the median of those angles is named)."""
+    limit = small_crossing_sine(operand_size(a, b)[0], mesh_tol)
+    sines = soup_crossing_sine(a, b, soup.uv_a.reshape(-1, 2), soup.uv_b.reshape(-1, 2))
+    if flat_share(sines, limit) >= FLAT_SHARE:
+        sine = float(np.median(sines[sines < limit]))
+        warnings.warn(
+            f"the surfaces cross at angles about {np.arcsin(min(sine, 1.0)):.2g} rad, below "
+            f"{np.arcsin(limit):.2g} for mesh_tol={mesh_tol:g}: the triangle method may give "
+            "fragments or miss the curve there (surfprep.intersect's default method 'auto' "
+            "traces such pairs by the characteristic method; or pass a smaller mesh_tol)",
+            SmallAngleWarning, stacklevel=4)
+
+
 class StrayCurves(enum.Enum):
     """What :func:`intersect_surfaces` does with curves that break ``tol``."""
 
@@ -510,6 +533,8 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
                                   domain_a=domain_a, domain_b=domain_b)
     surface_a = a if isinstance(a, NurbsSurface) else None
     surface_b = b if isinstance(b, NurbsSurface) else None
+    if retries == _RETRIES and surface_a is not None and surface_b is not None:
+        _warn_if_flat(soup, surface_a, surface_b, mesh_tol)
     closure = min(_JOIN_FACTOR * mesh_tol, max(_SEAM_CLOSURE * tol, merge))
     topology = cut_at_seams(topology, surface_a, surface_b, closure)
     if surface_a is None or surface_b is None:

@@ -1,0 +1,57 @@
+"""The triangle method's small-angle limit (algorithms.intersection.angles) and its warning."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms.intersection import SmallAngleWarning, StrayCurves, intersect_surfaces
+from surfprep.algorithms.intersection.angles import small_crossing_sine, soup_crossing_sine
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "characteristic"))
+from char_surfaces import flat_crossing  # noqa: E402
+
+
+def plane(angle: float) -> NurbsSurface:
+    c, s = np.cos(angle), np.sin(angle)
+    cp = np.array([[[x, y * c, y * s] for y in (-1.0, 1.0)] for x in (-1.0, 1.0)])
+    return NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+
+def test_limit_follows_the_square_root_of_the_mesh_tolerance():
+    assert small_crossing_sine(2.0, 2e-3) == pytest.approx(0.6 * np.sqrt(1e-3))
+    assert small_crossing_sine(2.0, 2e-5) == pytest.approx(0.06 * np.sqrt(1e-3))
+
+
+@pytest.mark.parametrize("angle", [1e-3, 0.1, 1.0])
+def test_soup_sine_of_two_planes(angle):
+    uv = np.random.default_rng(0).uniform(0, 1, (20, 2))
+    np.testing.assert_allclose(soup_crossing_sine(plane(angle), plane(0.0), uv, uv),
+                               np.sin(angle), rtol=1e-12)
+
+
+def _small_angle_warnings(a, b) -> list:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        intersect_surfaces(a, b, tol=1e-8, stray=StrayCurves.DROP)
+    return [w for w in caught if issubclass(w.category, SmallAngleWarning)]
+
+
+def test_a_flat_crossing_is_warned_about_a_steep_one_not():
+    """Sheets crossing at 5e-3 rad (the triangle method returns nothing there at tol
+    1e-8) give a SmallAngleWarning naming the angle; at 0.1 rad none."""
+    (w,) = _small_angle_warnings(*flat_crossing(5e-3))
+    assert "about 0.0048 rad" in str(w.message) and "auto" in str(w.message)
+    assert _small_angle_warnings(*flat_crossing(0.1)) == []
+
+
+def test_a_double_point_is_not_a_flat_crossing():
+    """Equal-radius cylinders cross with parallel normals at their two double points, but
+    only over a short stretch round them: no warning."""
+    from test_ssi_pipeline import cylinder
+    assert _small_angle_warnings(cylinder(1.0, 1.5), cylinder(1.0, 2.0, normal=(1, 0, 0))) == []
