@@ -65,11 +65,27 @@ class NoLoopReason(str, enum.Enum):
     MONOTONE_HEIGHT = "monotone height over a plane"
 
 
+#: below this many patch pairs the Bézier boxes are compared all at once (no trees)
+_DIRECT_PAIRS = 4096
+
+
+def _patch_count(s: NurbsSurface) -> int:
+    spans = [np.unique(k[d:k.size - d]).size - 1 for k, d in
+             ((s.knots_u, s.degree_u), (s.knots_v, s.degree_v))]
+    return int(spans[0] * spans[1])
+
+
 def _apart(a: NurbsSurface, b: NurbsSurface, tol: float) -> bool:
-    """No Bézier-patch box of ``a`` within ``tol`` of one of ``b``'s. The span hull
-    boxes (sliding min/max over the nets, which hold the Bézier boxes) are descended
-    as grid trees first; exact Bézier boxes are extracted only for the candidate
-    pairs, so a large surface far from most of the other costs little."""
+    """No Bézier-patch box of ``a`` within ``tol`` of one of ``b``'s. Few patches: all
+    pairs at once. Otherwise the span hull boxes (sliding min/max over the nets, which
+    hold the Bézier boxes) are descended as grid trees first and exact Bézier boxes
+    extracted only for the candidate pairs, so a large surface far from most of the
+    other costs little."""
+    if _patch_count(a) * _patch_count(b) <= _DIRECT_PAIRS:     # small nets: all pairs at once
+        ba = a.patch_bounding_boxes()[0].reshape(-1, 2, a.dimension)
+        bb = b.patch_bounding_boxes()[0].reshape(-1, 2, b.dimension)
+        return not bool(np.all((ba[:, None, 0] <= bb[None, :, 1] + tol)
+                               & (bb[None, :, 0] <= ba[:, None, 1] + tol), axis=-1).any())
     pairs = tree_pairs(surface_tree(a), surface_tree(b), pad=tol)
     if pairs.shape[0] == 0:
         return True

@@ -184,12 +184,13 @@ def test_monotone_rule_on_the_near_part_equals_the_whole_surface(z):
         assert part.n_control[0] < sheet.n_control[0]          # only a band of rows
 
 
+@pytest.mark.parametrize("poles", [6, 12])
 @pytest.mark.parametrize("shift", [0.0, 0.3, 1.0 + 2e-7, 1.0 + 5e-7, 3.0])
-def test_apart_equals_all_pairs_of_bezier_boxes(shift):
-    """The tree-culled test (span hulls, then Bézier boxes of candidates only) against
-    every pair of Bézier boxes."""
+def test_apart_equals_all_pairs_of_bezier_boxes(shift, poles):
+    """The test (all pairs for 3 x 3 patches; for 9 x 9 span hulls in trees, then
+    Bézier boxes of candidates only) against every pair of Bézier boxes."""
     from surfprep.algorithms.characteristic import prefilter
-    a = _many_span_sheet(12)
+    a = _many_span_sheet(poles)
     b = NurbsSurface(a.control_points + [0, 0, shift], a.knots_u, a.knots_v, 3, 3)
     ba = a.patch_bounding_boxes()[0].reshape(-1, 2, 3)
     bb = b.patch_bounding_boxes()[0].reshape(-1, 2, 3)
