@@ -24,7 +24,12 @@ from ..algorithms.characteristic import (
     auto_intersection,
     characteristic_intersection,
 )
-from ..algorithms.intersection import IntersectionCurve, StrayCurves, intersect_surfaces
+from ..algorithms.intersection import (
+    IntersectionCurve,
+    SmallAngleWarning,
+    StrayCurves,
+    intersect_surfaces,
+)
 from ..errors import InvalidGeometryError, InvalidToleranceError
 
 if TYPE_CHECKING:
@@ -120,10 +125,17 @@ class IntersectionResult(list):
 
 
 def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                 tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
+                 tangential: Sequence[IntersectionCurve] = (), routed: bool = False
+                 ) -> list[IntersectionCurve]:
+    """The triangle method on a face pair, its failures as warnings. ``routed``: called by
+    ``auto`` after it weighed the crossing angle, so the triangle method's own
+    SmallAngleWarning (which points to ``auto``) is not repeated."""
     try:
-        return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                  stray=StrayCurves.DROP, tangential=tangential)
+        with warnings.catch_warnings():
+            if routed:
+                warnings.simplefilter("ignore", SmallAngleWarning)
+            return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
+                                      stray=StrayCurves.DROP, tangential=tangential)
     except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
             FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
@@ -152,7 +164,8 @@ def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | 
         else:
             record = auto_intersection(
                 a, b, tol=tol, mesh_tol=mesh_tol,
-                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential))
+                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential,
+                                                           routed=True))
     except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
                       stacklevel=3)

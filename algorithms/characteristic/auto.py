@@ -27,10 +27,10 @@ characteristic stage (002), on one pair of surfaces.
 from __future__ import annotations
 
 import enum
+import warnings
 from collections.abc import Callable, Sequence
 
-
-from ..intersection import IntersectionCurve, StrayCurves, intersect_surfaces
+from ..intersection import IntersectionCurve, SmallAngleWarning, StrayCurves, intersect_surfaces
 from ..intersection.angles import small_crossing_sine
 from ..intersection.pipeline import MESH_TOL_FACTOR, operand_size
 from ..surface import NurbsSurface
@@ -71,8 +71,12 @@ def small_angle(a: NurbsSurface, b: NurbsSurface, mesh_tol: float | None = None)
 
 def _default_triangles(a: NurbsSurface, b: NurbsSurface, tol: float, mesh_tol: float | None
                        ) -> Triangles:
-    return lambda tangential: intersect_surfaces(a, b, tol=tol, mesh_tol=mesh_tol,
-                                                 stray=StrayCurves.DROP, tangential=tangential)
+    def run(tangential: Sequence[IntersectionCurve]) -> list[IntersectionCurve]:
+        with warnings.catch_warnings():      # the angle was weighed already (the route)
+            warnings.simplefilter("ignore", SmallAngleWarning)
+            return intersect_surfaces(a, b, tol=tol, mesh_tol=mesh_tol, stray=StrayCurves.DROP,
+                                      tangential=tangential)
+    return run
 
 
 def _routed(record: CharacteristicRecord, route: Route) -> CharacteristicRecord:

@@ -17,16 +17,37 @@ public too, module by module:
 * :mod:`.compare`: distances between two answers (Hausdorff, per-branch).
 """
 
-from .compare import (CurveSetDistance, connected_branches, curve_set_distance, hausdorff,
-                      polyline_distance)
-from .culling import (BoxTree, PatchOverlap, build_tree, candidate_pairs, overlap_boxes,
-                      overlap_patches, patch_rectangles, subpatch_boxes, surface_patch_boxes,
-                      tree_pairs)
+from .compare import CurveSetDistance, connected_branches, curve_set_distance, hausdorff, polyline_distance
+from .culling import (
+                      BoxTree,
+                      PatchOverlap,
+                      build_tree,
+                      candidate_pairs,
+                      overlap_boxes,
+                      overlap_patches,
+                      patch_rectangles,
+                      subpatch_boxes,
+                      surface_patch_boxes,
+                      tree_pairs,
+)
 from .mesh import TriangleMesh, collinear_mask
-from .pipeline import (SmallAngleWarning, StrayCurves, StrayCurveWarning, closed_in_space,
-                       default_mesh_tolerance, intersect_surfaces, operand_size)
-from .refine import (RefinedCurve, RefinedPoints, project_points, refine_curves, refine_points,
-                     segment_distance)
+from .pipeline import (
+                      SmallAngleWarning,
+                      StrayCurves,
+                      StrayCurveWarning,
+                      closed_in_space,
+                      default_mesh_tolerance,
+                      intersect_surfaces,
+                      operand_size,
+)
+from .refine import (
+                      RefinedCurve,
+                      RefinedPoints,
+                      project_points,
+                      refine_curves,
+                      refine_points,
+                      segment_distance,
+)
 from .result import CurveDeviation, IntersectionCurve, interpolate_samples, intersection_curves
 from .sampling import SampledCurve, cubic_samples
 from .segments import SegmentSoup, SoupStats, mesh_segments
