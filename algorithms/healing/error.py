@@ -33,6 +33,7 @@ from scipy.spatial import cKDTree
 from ..intersection.mesh import TriangleMesh
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
+from . import triangle_kernels
 from .clipping import ClippedTriangles, SurfaceSource
 
 __all__ = [
@@ -193,7 +194,9 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
     that source's triangles only: a plane cut into a few large triangles is not
     crowded out by a finely triangulated neighbour) give the closest point of
     the triangulation; on a parametric source its barycentric ``(u, v)``
-    (eq. 10) starts Newton point inversion on the exact surface.
+    (eq. 10) starts Newton point inversion on the exact surface (whose foot may
+    leave the triangulated part of a trimmed source: so every source is
+    inverted, none is ruled out by its triangles' distance).
 
     Parameters
     ----------
@@ -210,33 +213,45 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
     if points.shape[0] == 0 or clipped.n_triangles == 0:
         return best
     for s_id in np.unique(clipped.source):
-        ids = np.flatnonzero(clipped.source == s_id)
-        np.minimum(best, _source_triangles_distance(points, clipped, s_id, ids, tol), out=best)
+        dist, uv = _source_triangles(points, clipped, np.flatnonzero(clipped.source == s_id))
+        surface = clipped.sources[s_id].surface
+        exact = np.all(np.isfinite(uv), axis=1)
+        if surface is not None and np.any(exact):
+            # chords, not the surface, where the surface is known
+            dist[exact] = project_to_surface(surface, points[exact], tol=tol,
+                                             guess=uv[exact]).distance
+        np.minimum(best, dist, out=best)
     return best
 
 
-def _source_triangles_distance(points: NDArray, clipped: ClippedTriangles, s_id: int,
-                               ids: NDArray, tol: float) -> NDArray:
-    """Distance of each point to one source through its clipped triangles ``ids``."""
+def _source_triangles(points: NDArray, clipped: ClippedTriangles, ids: NDArray
+                      ) -> tuple[NDArray, NDArray]:
+    """``(distance (k,), (u, v) (k, 2))``: each point's distance to one source's clipped
+    triangles ``ids`` and the barycentric ``(u, v)`` of the foot (NaN without
+    parameters)."""
     k_pts = points.shape[0]
     k = min(_CANDIDATE_TRIANGLES, ids.size)
     _, cand = cKDTree(clipped.points[ids].mean(axis=1)).query(points, k=k)
-    cand = ids[cand.reshape(k_pts, k)].ravel()
+    cand = ids[cand.reshape(k_pts, k)]
+    if triangle_kernels.AVAILABLE:
+        dist, pick, bary = triangle_kernels.nearest_on_candidates(points, clipped.points, cand)
+    else:                               # pragma: no cover - numba is installed in CI
+        dist, pick, bary = _nearest_numpy(points, clipped.points, cand)
+    chosen = cand[np.arange(k_pts), pick]
+    uv = np.einsum("pk,pkc->pc", bary, clipped.uv[chosen])
+    return dist, uv
+
+
+def _nearest_numpy(points: NDArray, tri: NDArray, cand: NDArray
+                   ) -> tuple[NDArray, NDArray, NDArray]:
+    """:func:`.triangle_kernels.nearest_on_candidates` by :func:`closest_on_triangles`."""
+    k_pts, k = cand.shape
     rows = np.repeat(np.arange(k_pts), k)
-    foot, bary = closest_on_triangles(points[rows], clipped.points[cand])
+    foot, bary = closest_on_triangles(points[rows], tri[cand.ravel()])
     dist = np.linalg.norm(points[rows] - foot, axis=1).reshape(k_pts, k)
     pick = np.argmin(dist, axis=1)
     flat = np.arange(k_pts) * k + pick
-    out = dist[np.arange(k_pts), pick]
-    uv = np.einsum("pk,pkc->pc", bary[flat], clipped.uv[cand[flat]])
-    surface = clipped.sources[s_id].surface
-    exact_uv = np.all(np.isfinite(uv), axis=1)
-    if surface is None or not np.any(exact_uv):
-        return out
-    # chords, not the surface, where the surface is known
-    out[exact_uv] = project_to_surface(surface, points[exact_uv], tol=tol,
-                                       guess=uv[exact_uv]).distance
-    return out
+    return dist[np.arange(k_pts), pick], pick, bary[flat]
 
 
 def measure_error(surface: NurbsSurface, found: NDArray, clipped: ClippedTriangles,

@@ -97,6 +97,23 @@ def test_distance_through_triangles_matches_global_inversion():
     np.testing.assert_allclose(local, glob, atol=1e-10)       # exact, not the chords
 
 
+def test_distance_through_triangles_with_many_sources():
+    """Four sources, two of them copies of the surface lifted by 0.05 and 0.3: the
+    nearest triangles per source (compiled kernel) seed the inversions, and the
+    distances equal the global inversion onto every source."""
+    s = smooth_surface()
+    lifted = [NurbsSurface(s.control_points + [0, 0, dz], s.knots_u, s.knots_v, s.degree_u,
+                           s.degree_v) for dz in (0.05, 0.3)]
+    sources = as_sources([s.restrict(None, 0.5, None, None), s.restrict(0.5, None, None, None),
+                          *lifted])
+    clipped = clip_sources(sources, np.array([[0.1, 0.1, -1.0], [0.9, 0.9, 2.0]]), mesh_tol=0.01)
+    uv = RNG.uniform(0.2, 0.8, (400, 2))
+    pts = s.evaluate(uv[:, 0], uv[:, 1]) + RNG.normal(scale=0.05, size=(400, 3))
+    local = distance_to_triangles(pts, clipped, tol=1e-12)
+    glob = distance_to_sources(pts, sources, tol=1e-12)
+    np.testing.assert_allclose(local, glob, atol=1e-10)
+
+
 def _plane(z: float, lo: float = -1.0, hi: float = 2.0) -> NurbsSurface:
     c = np.array([[[lo, lo, z], [lo, hi, z]], [[hi, lo, z], [hi, hi, z]]], float)
     return NurbsSurface(c, np.array([0, 0, 1, 1.0]), np.array([0, 0, 1, 1.0]), 1, 1)
