@@ -41,6 +41,9 @@ SIDE_SAMPLES_PER_SPAN = 16
 _MIN_SAMPLES = 64
 #: a run must hold this many consecutive samples on the other surface
 _MIN_RUN = 3
+#: samples added between the neighbours of a stretch of near samples shorter than a run,
+#: and the least number of samples of a run's curve
+_DENSE = 16
 #: bisection steps locating a run's ends along the side
 _BISECTIONS = 40
 #: seed grid of the projections onto the other surface, per knot span and direction
@@ -169,13 +172,36 @@ def _bisect_ends(own, other, side, inside: NDArray, outside: NDArray, guess: NDA
     return a
 
 
+def _densified(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDArray,
+               dist: NDArray, foot: NDArray, tol: float
+               ) -> tuple[NDArray, NDArray, NDArray]:
+    """The side samples with ``_DENSE`` more between the neighbours of every stretch of
+    near samples shorter than ``_MIN_RUN``: a run shorter than two sample spacings (the
+    other surface a narrow strip across the side, as a 3 mm plane under a 19 mm arc)
+    holds only one or two of the regular samples. Returns ``(t, distance, foot uv)``."""
+    near = dist <= _SHARE * tol
+    edges = np.diff(np.concatenate([[0], near.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    short = (stops - starts + 1) < _MIN_RUN
+    if not np.any(short):
+        return t, dist, foot
+    lo = t[np.maximum(starts[short] - 1, 0)]
+    hi = t[np.minimum(stops[short] + 1, t.size - 1)]
+    extra = (lo[:, None] + np.linspace(0, 1, _DENSE + 2)[None, 1:-1] * (hi - lo)[:, None]).ravel()
+    found = _gap(own, other, side, extra, tol)[2]
+    t_all = np.concatenate([t, extra])
+    order = np.argsort(t_all, kind="stable")
+    return (t_all[order], np.concatenate([dist, found.distance])[order],
+            np.concatenate([foot, found.uv])[order])
+
+
 def _side_runs(own: NurbsSurface, other: NurbsSurface, side: DomainSide, tol: float
                ) -> list[SideRun]:
     t = _side_samples(own, side.coord)
     found = _gap(own, other, side, t, tol)[2]
     limit = _SHARE * tol
-    near = found.distance <= limit
-    runs = _runs(near)
+    t, dist, foot = _densified(own, other, side, t, found.distance, found.uv, tol)
+    runs = _runs(dist <= limit)
     if not runs:
         return []
     lo_i = np.array([r[0] for r in runs])
@@ -185,11 +211,11 @@ def _side_runs(own: NurbsSurface, other: NurbsSurface, side: DomainSide, tol: fl
     low = lo_i > 0
     if low.any():
         t0[low] = _bisect_ends(own, other, side, t[lo_i[low]], t[lo_i[low] - 1],
-                               found.uv[lo_i[low]], limit, tol)
+                               foot[lo_i[low]], limit, tol)
     high = hi_i < t.size - 1
     if high.any():
         t1[high] = _bisect_ends(own, other, side, t[hi_i[high]], t[hi_i[high] + 1],
-                                found.uv[hi_i[high]], limit, tol)
+                                foot[hi_i[high]], limit, tol)
     return [SideRun(side, float(a), float(b)) for a, b in zip(t0, t1) if b > a]
 
 
@@ -199,9 +225,10 @@ def _run_curve(own: NurbsSurface, other: NurbsSurface, run: SideRun, tol: float
     that closes in space stays an open curve whose ends coincide (the convention
     of a loop through a seam, :func:`.pipeline.closed_in_space`): its own
     parameter jumps there."""
-    t_all = _side_samples(own, run.side.coord)
-    inner = t_all[(t_all > run.t0) & (t_all < run.t1)]
-    t = np.concatenate([[run.t0], inner, [run.t1]])
+    t_all = np.concatenate([_side_samples(own, run.side.coord),
+                            np.linspace(run.t0, run.t1, _DENSE + 2)])    # a short run too
+    t = np.unique(np.concatenate([[run.t0], t_all[(t_all > run.t0) & (t_all < run.t1)],
+                                  [run.t1]]))
     uv, p, found = _gap(own, other, run.side, t, tol)
     if np.any(found.distance > _SHARE * tol):
         return None
