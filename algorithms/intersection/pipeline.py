@@ -99,6 +99,9 @@ _SINGULAR_REACH = 64.0
 #: a refined chain within this times tol (or ``_TANGENTIAL_SHARE`` times the size) of a
 #: known tangential curve all along is a fragment of it (as the certificate's test)
 _TANGENTIAL_REACH, _TANGENTIAL_SHARE = 1e3, 1e-4
+#: traced points this share of the domain from a side count as on it (candidates only:
+#: the side is then probed, :func:`.sides.may_run_along_many`)
+_SIDE_SLACK = 1e-4
 #: consecutive chords of refined samples turning by more than this: a fold
 _FOLD_ANGLE = np.radians(120.0)
 
@@ -283,10 +286,13 @@ def _extend(dense: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
 
 
 def _domain_sides(domain) -> list[tuple[int, float, float]]:
-    """``(coord, value, slack)`` of the four sides of a domain (slack 1e-9 of its extent)."""
+    """``(coord, value, slack)`` of the four sides of a domain: a traced point this close
+    to a side (``_SIDE_SLACK`` of the extent) may be on a stretch along it (a chain of
+    one segment ending 2e-5 of the extent inside the side it runs along, b1_euclid
+    faces 28 x 37, had the side left unexamined at 1e-9)."""
     extent = (domain[1] - domain[0], domain[3] - domain[2])
-    return [(0, domain[0], 1e-9 * extent[0]), (0, domain[1], 1e-9 * extent[0]),
-            (1, domain[2], 1e-9 * extent[1]), (1, domain[3], 1e-9 * extent[1])]
+    return [(0, domain[0], _SIDE_SLACK * extent[0]), (0, domain[1], _SIDE_SLACK * extent[0]),
+            (1, domain[2], _SIDE_SLACK * extent[1]), (1, domain[3], _SIDE_SLACK * extent[1])]
 
 
 def _traced_sides(topology: SegmentTopology, chains: list[Chain], surface_a: NurbsSurface,

@@ -23,10 +23,10 @@ from numpy.typing import NDArray
 from ..surface import NurbsSurface
 from .topology import Chain, EndKind, SegmentTopology
 
-__all__ = ["cut_at_seams"]
+__all__ = ["cut_at_seams", "other_side", "seam_jumps"]
 
 
-def _jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
+def seam_jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
            closure_tol: float) -> NDArray:
     """Steps ``(s,) bool`` of a chain that cross a seam of ``surface``.
 
@@ -50,7 +50,7 @@ def _jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
     if steps.size:
         ends = np.concatenate([here[steps], nxt[steps]])              # (2c, 2)
         toward = np.concatenate([nxt[steps], here[steps]])
-        moved = np.stack([_other_side(e, t, domain) for e, t in zip(ends, toward)])
+        moved = np.stack([other_side(e, t, domain) for e, t in zip(ends, toward)])
         gap = np.linalg.norm(surface.evaluate(moved[:, 0], moved[:, 1])
                              - surface.evaluate(ends[:, 0], ends[:, 1]), axis=1)
         seam = np.minimum(gap[: steps.size], gap[steps.size:]) <= closure_tol
@@ -58,7 +58,7 @@ def _jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
     return jump
 
 
-def _other_side(uv: NDArray, toward: NDArray, domain) -> NDArray:
+def other_side(uv: NDArray, toward: NDArray, domain) -> NDArray:
     """``uv (2,)`` moved to the domain end nearer to ``toward`` in each coordinate
     whose difference exceeds half the domain (the seam's other parameter line)."""
     lo = np.array([domain[0], domain[2]])
@@ -105,8 +105,8 @@ def cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
         ids = chain.point_ids
         ca = None if uv_a is None else topology.uv_a[ids]
         cb = None if uv_b is None else topology.uv_b[ids]
-        jump_a = _jumps(ca, surface_a, chain.closed, closure_tol)
-        jump_b = _jumps(cb, surface_b, chain.closed, closure_tol)
+        jump_a = seam_jumps(ca, surface_a, chain.closed, closure_tol)
+        jump_b = seam_jumps(cb, surface_b, chain.closed, closure_tol)
         jump = jump_a | jump_b
         if not jump.any():
             chains.append(chain)
@@ -156,9 +156,9 @@ def cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
                 # only the surface that jumps there is moved to its seam's other side
                 # (the other's (u, v) may change by much between two sparse samples)
                 if domain is not None and starts[k] is not None and jumps[starts[k]]:
-                    part[0] = _other_side(part[0], part[1], domain)
+                    part[0] = other_side(part[0], part[1], domain)
                 if domain is not None and stops[k] is not None and jumps[stops[k]]:
-                    part[-1] = _other_side(part[-1], part[-2], domain)
+                    part[-1] = other_side(part[-1], part[-2], domain)
                 piece_uv.append(part)
             fresh = np.arange(count, count + local.size)
             count += local.size

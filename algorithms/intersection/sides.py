@@ -10,8 +10,8 @@ only scattered pieces with gaps (000 §29.4.3 handles crossings, not contact).
 
 Such a stretch is found here directly on the side: the side curve is sampled
 densely (``SIDE_SAMPLES_PER_SPAN`` per knot span), every sample projected onto
-the other surface, and runs of consecutive samples within ``tol / 16`` of it
-become curves. Each run's ends are located by bisection along the side
+the other surface, and runs of consecutive samples within ``tol / 8`` of it
+become curves (their points halfway to the feet: within ``tol / 16`` of both). Each run's ends are located by bisection along the side
 (where the side leaves the other surface), and every sample keeps its side
 parameter exactly: the side curve is the intersection there, so no refinement
 is needed (nor possible: the auxiliary-plane step would slide the points into
@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
 from .refine import RefinedCurve
+from .seams import other_side, seam_jumps
 
 __all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "may_run_along",
            "may_run_along_many", "side_curves"]
@@ -49,8 +50,11 @@ _BISECTIONS = 40
 #: seed grid of the projections onto the other surface, per knot span and direction
 #: (the default grid of project_to_surface cost 2/3 of the whole pair here)
 _SEED_PER_SPAN = 6
-#: share of tol within which side samples lie on the other surface (as dense samples)
-_SHARE = 1.0 / 16
+#: share of tol within which side samples count as lying on the other surface; a curve's
+#: points are the midpoints of a side point and its foot, within half that of both
+#: surfaces (tol / 16, as dense samples). (With tol / 16 here, a side 1e-5..3e-5 from
+#: the other surface, tol 3e-4, b1_euclid faces 28 x 37, stopped its run half-way.)
+_SHARE = 1.0 / 8
 
 
 @dataclass(frozen=True)
@@ -233,7 +237,7 @@ def _run_curve(own: NurbsSurface, other: NurbsSurface, run: SideRun, tol: float
     if np.any(found.distance > _SHARE * tol):
         return None
     points = 0.5 * (p + found.points)
-    found_uv = found.uv
+    found_uv = _ends_off_the_seam(other, found.uv, tol)
     keep = np.concatenate([[True], np.linalg.norm(np.diff(points, axis=0), axis=1) > 0])
     uv, points, found_uv = uv[keep], points[keep], found_uv[keep]
     if points.shape[0] < 2:
@@ -241,6 +245,21 @@ def _run_curve(own: NurbsSurface, other: NurbsSurface, run: SideRun, tol: float
     uv_a, uv_b = (uv, found_uv) if run.side.owner == 0 else (found_uv, uv)
     n = points.shape[0]
     return RefinedCurve(points, uv_a, uv_b, False, np.ones(n, bool), np.zeros(n, bool))
+
+
+def _ends_off_the_seam(surface: NurbsSurface, uv: NDArray, tol: float) -> NDArray:
+    """``uv (n, 2)`` with an end moved across a seam of ``surface`` where its projection
+    landed on the seam's far parameter line (a side running into the seam of a closed
+    surface: both lines are the end's foot, and the projection may pick either; the
+    jump of the whole period to the next sample wrecks the pcurve's interpolant)."""
+    if uv.shape[0] < 2:
+        return uv
+    uv = uv.copy()
+    jumps = seam_jumps(uv, surface, False, tol)
+    for end, nxt, step in ((0, 1, 0), (-1, -2, -1)):
+        if jumps[step]:
+            uv[end] = other_side(uv[end], uv[nxt], surface.domain)
+    return uv
 
 
 def _side_rows(surface: NurbsSurface, coord: int, high: bool) -> NDArray:
