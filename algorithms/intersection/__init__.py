@@ -14,6 +14,9 @@ public too, module by module:
 * :mod:`.interpolants`: the cubic interpolants of samples and their deviation;
 * :mod:`.sampling`: the samples the cubic interpolants need (:func:`cubic_samples`);
 * :mod:`.result`: :class:`IntersectionCurve` and its interpolants;
+* :mod:`.sides`, :mod:`.seams`, :mod:`.extend`, :mod:`.singular_join`: curves along
+  domain sides, cuts at seams, hanging ends marched, curves joined at double points;
+* :mod:`.angles`: how flat a crossing the triangles can follow;
 * :mod:`.compare`: distances between two answers (Hausdorff, per-branch).
 """
 

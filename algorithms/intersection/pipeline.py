@@ -42,7 +42,7 @@ from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 from .angles import FLAT_SHARE, flat_share, small_crossing_sine, soup_crossing_sine
 from .compare import polyline_distance
-from .extend import extend_open_ends, join_at_singular_points
+from .extend import extend_open_ends
 from .mesh import TriangleMesh
 from .refine import RefinedCurve
 from .result import (
@@ -54,6 +54,7 @@ from .result import (
 from .seams import cut_at_seams
 from .segments import mesh_segments
 from .sides import DomainSide, box_sides, covered_by_sides, may_run_along_many, side_curves
+from .singular_join import join_at_singular_points
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
 __all__ = [
@@ -274,7 +275,7 @@ def _extend(dense: list[RefinedCurve], kinds: list, surface_a: NurbsSurface,
     """OPEN (hanging) ends continued on the exact surfaces (:mod:`.extend`); an end
     that reaches a domain side becomes BOUNDARY; then curves meeting at singular
     points (double points) are made to end exactly there (BIFURCATION,
-    :func:`.extend.join_at_singular_points`)."""
+    :func:`.singular_join.join_at_singular_points`)."""
     open_ends = [(s is EndKind.OPEN, e is EndKind.OPEN) for s, e in kinds]
     if any(a or b for a, b in open_ends):
         dense, reached = extend_open_ends(dense, open_ends, surface_a, surface_b, tol=tol,

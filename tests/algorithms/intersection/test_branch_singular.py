@@ -1,6 +1,6 @@
 """Singular points of intersection curves: second-order branch directions
 (algorithms.intersection.branches) and curves joined exactly at double points
-(algorithms.intersection.extend.join_at_singular_points).
+(algorithms.intersection.singular_join.join_at_singular_points).
 
 Exact answers: two cylinders of equal radius with perpendicular axes,
 ``x^2 + y^2 = 1`` and ``y^2 + z^2 = 1``, meet along the ellipses ``x = +-z``,
@@ -24,7 +24,7 @@ from surfprep.algorithms.intersection.branches import (
     locate_singular_points,
     singular_branches,
 )
-from surfprep.algorithms.intersection.extend import join_at_singular_points
+from surfprep.algorithms.intersection.singular_join import join_at_singular_points
 
 
 def hook(monkeypatch):
@@ -254,8 +254,8 @@ def test_characteristic_tracer_equal_cylinders_traced_whole():
 def test_dips_tell_a_vanishing_sine_from_a_steady_small_one():
     """|N_a x N_b| falling linearly to zero (a double point between samples, whatever
     its offset) is a start; a steady small angle, or one that varies only by a few
-    per cent, is not (extend._dips)."""
-    from surfprep.algorithms.intersection.extend import _dips
+    per cent, is not (singular_join._dips)."""
+    from surfprep.algorithms.intersection.singular_join import _dips
     x = np.linspace(0, 1, 41)
     for x0 in (0.5, 0.5 + 0.25 / 40, 0.5 + 0.49 / 40):
         s = 0.3 * np.abs(x - x0)
@@ -276,8 +276,8 @@ def test_near_tangential_circles_give_no_sample_starts():
     from char_surfaces import torus_and_plane
 
     from surfprep.algorithms.intersection import SmallAngleWarning, StrayCurves
-    from surfprep.algorithms.intersection.extend import _singular_starts
     from surfprep.algorithms.intersection.refine import RefinedCurve
+    from surfprep.algorithms.intersection.singular_join import _singular_starts
     torus, plane = torus_and_plane(1e-6)
     with pytest.warns(SmallAngleWarning):          # 2.6e-3 rad: flat for the triangles
         curves = intersect_surfaces(torus, plane, tol=1e-9, stray=StrayCurves.DROP)
