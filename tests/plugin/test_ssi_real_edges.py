@@ -287,6 +287,7 @@ def test_narrow_strip_across_a_side(s1_ideas):
 @pytest.mark.parametrize("file, faces, why", [
     ("occt_b1_euclid.stp", (28, 37), "side 1e-5..3e-5 from the plane: run stopped half-way"),
     ("occt_k1_alias.stp", (20, 23), "side into the other surface's seam: foot on its far line"),
+    ("occt_cornetta.stp", (3, 39), "end met the side away from the corner the curve runs into"),
 ])
 def test_side_runs_that_ended_early(data_dir, file, faces, why):
     """Edges along a domain side that only IntSS reproduced at the start of the 2026-12
@@ -296,7 +297,10 @@ def test_side_runs_that_ended_early(data_dir, file, faces, why):
     run ended where the gap passed tol / 16. k1_alias 20 x 23: a side ending in the
     seam of a closed surface, whose first foot landed on the seam's far line; the
     pcurve's jump of the whole period made the curve stray by 9e5 and it was dropped.
-    Both now match the stored edge, as IntSS."""
+    cornetta 3 x 39: the curve runs into a corner of one domain; the traced end met
+    the side 0.05 mm from it, beyond the reach of the end's solve on the side, and
+    stayed there; such ends are now marched to the side. All match the stored edge,
+    as IntSS."""
     real = RealFile(data_dir / file)
     (edge,) = real.edges_between(*faces)[:1]
     m = real.match(edge)
