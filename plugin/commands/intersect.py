@@ -73,6 +73,8 @@ def characteristic_report(results) -> dict:
             })
             if "skipped" in r.extra:
                 entry["certificate_skipped"] = r.extra["skipped"]
+            if "route" in r.extra:
+                entry["route"] = r.extra["route"]
         pairs.append(entry)
     return {
         "method": method.value,
@@ -233,8 +235,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also run OpenCascade's BRepAlgoAPI_Section and report both")
     parser.add_argument("--method", choices=METHODS, default="auto",
                         help="auto (default): triangles, then characteristic points as a "
-                             "certificate (missed loops traced and added); mesh: triangles "
-                             "only; characteristic: the characteristic-curve method only")
+                             "certificate (missed loops traced and added), and the "
+                             "characteristic method for pairs that cross at a small angle; "
+                             "mesh: triangles only; characteristic: the characteristic-curve "
+                             "method only")
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:

@@ -100,6 +100,7 @@ def test_cli_method_found_by_and_plot(sphere, tmp_path, capsys):
     assert r["curves"][0]["found_by"] == "characteristic"
     (pair,) = r["pairs"]
     assert pair["found_by_characteristic"] == 1
+    assert pair["route"] == "small crossing angle"       # a tiny loop near the pole: flat
     assert pair["characteristic_points"].get("minimum", 0) + \
         pair["characteristic_points"].get("maximum", 0) == 1
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
