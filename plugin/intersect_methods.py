@@ -26,7 +26,6 @@ from ..algorithms.characteristic import (
 )
 from ..algorithms.intersection import (
     IntersectionCurve,
-    SmallAngleWarning,
     StrayCurves,
     intersect_surfaces,
 )
@@ -125,17 +124,11 @@ class IntersectionResult(list):
 
 
 def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                 tangential: Sequence[IntersectionCurve] = (), routed: bool = False
-                 ) -> list[IntersectionCurve]:
-    """The triangle method on a face pair, its failures as warnings. ``routed``: called by
-    ``auto`` after it weighed the crossing angle, so the triangle method's own
-    SmallAngleWarning (which points to ``auto``) is not repeated."""
+                 tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
+    """The triangle method on a face pair, its failures as warnings."""
     try:
-        with warnings.catch_warnings():
-            if routed:
-                warnings.simplefilter("ignore", SmallAngleWarning)
-            return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                      stray=StrayCurves.DROP, tangential=tangential)
+        return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
+                                  stray=StrayCurves.DROP, tangential=tangential)
     except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
             FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
@@ -164,8 +157,7 @@ def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | 
         else:
             record = auto_intersection(
                 a, b, tol=tol, mesh_tol=mesh_tol,
-                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential,
-                                                           routed=True))
+                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential))
     except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
                       stacklevel=3)

@@ -71,12 +71,18 @@ def small_angle(a: NurbsSurface, b: NurbsSurface, mesh_tol: float | None = None)
 
 def _default_triangles(a: NurbsSurface, b: NurbsSurface, tol: float, mesh_tol: float | None
                        ) -> Triangles:
-    def run(tangential: Sequence[IntersectionCurve]) -> list[IntersectionCurve]:
-        with warnings.catch_warnings():      # the angle was weighed already (the route)
+    return lambda tangential: intersect_surfaces(a, b, tol=tol, mesh_tol=mesh_tol,
+                                                 stray=StrayCurves.DROP, tangential=tangential)
+
+
+def _quiet(run: Triangles) -> Triangles:
+    """``run`` without the triangle method's SmallAngleWarning: ``auto`` weighed the
+    angle for its route, and the warning points users to ``auto``."""
+    def quiet(tangential: Sequence[IntersectionCurve]) -> list[IntersectionCurve]:
+        with warnings.catch_warnings():
             warnings.simplefilter("ignore", SmallAngleWarning)
-            return intersect_surfaces(a, b, tol=tol, mesh_tol=mesh_tol, stray=StrayCurves.DROP,
-                                      tangential=tangential)
-    return run
+            return run(tangential)
+    return quiet
 
 
 def _routed(record: CharacteristicRecord, route: Route) -> CharacteristicRecord:
@@ -109,7 +115,7 @@ def auto_intersection(a: NurbsSurface, b: NurbsSurface, *, tol: float,
         Curves with how each was found, isolated contact points, coincident
         regions; ``extra["route"]`` the :class:`Route` taken.
     """
-    run = triangles or _default_triangles(a, b, tol, mesh_tol)
+    run = _quiet(triangles or _default_triangles(a, b, tol, mesh_tol))
     reason = no_loop_reason(a, b, tol=tol)
     if reason is not None:
         curves = [] if reason is NoLoopReason.APART else run(())

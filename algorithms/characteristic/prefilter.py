@@ -44,7 +44,13 @@ import numpy as np
 
 from ..bezier import bezier_patches
 from ..intersection import IntersectionCurve
-from ..intersection.culling import exact_patch_boxes, span_hull_boxes, surface_tree, tree_pairs
+from ..intersection.culling import (
+    exact_patch_boxes,
+    patch_rectangles,
+    span_hull_boxes,
+    surface_tree,
+    tree_pairs,
+)
 from ..surface import NurbsSurface
 from .algorithm import CharacteristicRecord, FoundBy
 from .poles import collapsed_sides
@@ -69,19 +75,13 @@ class NoLoopReason(str, enum.Enum):
 _DIRECT_PAIRS = 4096
 
 
-def _patch_count(s: NurbsSurface) -> int:
-    spans = [np.unique(k[d:k.size - d]).size - 1 for k, d in
-             ((s.knots_u, s.degree_u), (s.knots_v, s.degree_v))]
-    return int(spans[0] * spans[1])
-
-
 def _apart(a: NurbsSurface, b: NurbsSurface, tol: float) -> bool:
     """No Bézier-patch box of ``a`` within ``tol`` of one of ``b``'s. Few patches: all
     pairs at once. Otherwise the span hull boxes (sliding min/max over the nets, which
     hold the Bézier boxes) are descended as grid trees first and exact Bézier boxes
     extracted only for the candidate pairs, so a large surface far from most of the
     other costs little."""
-    if _patch_count(a) * _patch_count(b) <= _DIRECT_PAIRS:     # small nets: all pairs at once
+    if patch_rectangles(a).shape[0] * patch_rectangles(b).shape[0] <= _DIRECT_PAIRS:     # small nets: all pairs at once
         ba = a.patch_bounding_boxes()[0].reshape(-1, 2, a.dimension)
         bb = b.patch_bounding_boxes()[0].reshape(-1, 2, b.dimension)
         return not bool(np.all((ba[:, None, 0] <= bb[None, :, 1] + tol)

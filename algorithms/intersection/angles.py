@@ -12,9 +12,10 @@ at ``mesh_tol = 1e-3`` of the size: fragments or nothing at slopes 1e-3 and
 
 * :func:`small_crossing_sine`: the limit, ``SMALL_ANGLE_SHARE sqrt(mesh_tol /
   size)`` (0.019 at the default mesh tolerance);
-* :func:`soup_crossing_sine`: the sine of the angle between the exact normals
-  at the segment ends of a triangle soup, and :func:`flat_share`, the share of
-  them below the limit (``FLAT_SHARE`` or more: a flat crossing, not the short
+* :func:`normal_sines`: the sine of the angle between the exact normals at
+  parameters of both surfaces (the segment ends of a triangle soup; the samples
+  of :mod:`.singular_join`), and :func:`flat_share`, the share of them below the
+  limit (``FLAT_SHARE`` or more: a flat crossing, not the short
   stretch round a double point).
 """
 
@@ -25,8 +26,8 @@ import numpy as np
 from ..surface import NurbsSurface
 from . import vectors
 
-__all__ = ["FLAT_SHARE", "SMALL_ANGLE_SHARE", "flat_share", "small_crossing_sine",
-           "soup_crossing_sine"]
+__all__ = ["FLAT_SHARE", "SMALL_ANGLE_SHARE", "flat_share", "normal_sines",
+           "small_crossing_sine"]
 
 #: the limit of the module docstring, times ``sqrt(mesh_tol / size)``
 SMALL_ANGLE_SHARE = 0.6
@@ -40,19 +41,19 @@ def small_crossing_sine(size: float, mesh_tol: float) -> float:
     return SMALL_ANGLE_SHARE * float(np.sqrt(mesh_tol / max(size, np.finfo(float).tiny)))
 
 
-def soup_crossing_sine(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: np.ndarray,
-                       uv_b: np.ndarray) -> np.ndarray:
-    """``|N_a x N_b|`` ``(k,)`` at the parameters ``uv_a, uv_b (k, 2)`` of segment ends;
-    points where a normal vanishes (poles) are left out."""
+def normal_sines(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: np.ndarray,
+                 uv_b: np.ndarray) -> np.ndarray:
+    """``|N_a x N_b|`` ``(k,)`` at the parameters ``uv_a, uv_b (k, 2)`` (0 where a normal
+    vanishes, as at a pole)."""
     if uv_a.shape[0] == 0:
         return np.zeros(0)
     da = surface_a.derivatives(uv_a[:, 0], uv_a[:, 1], 1)
     db = surface_b.derivatives(uv_b[:, 0], uv_b[:, 1], 1)
     na = vectors.cross(da[:, 1, 0], da[:, 0, 1])
     nb = vectors.cross(db[:, 1, 0], db[:, 0, 1])
-    la, lb = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
-    ok = (la > 0) & (lb > 0)
-    return np.linalg.norm(vectors.cross(na[ok], nb[ok]), axis=1) / (la[ok] * lb[ok])
+    den = np.maximum(np.linalg.norm(na, axis=1) * np.linalg.norm(nb, axis=1),
+                     np.finfo(float).tiny)
+    return np.linalg.norm(vectors.cross(na, nb), axis=1) / den
 
 
 def flat_share(sines: np.ndarray, limit: float) -> float:

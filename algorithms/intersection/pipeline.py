@@ -40,7 +40,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from .angles import FLAT_SHARE, flat_share, small_crossing_sine, soup_crossing_sine
+from .angles import FLAT_SHARE, flat_share, normal_sines, small_crossing_sine
 from .compare import polyline_distance
 from .extend import extend_open_ends
 from .mesh import TriangleMesh
@@ -385,7 +385,7 @@ def _warn_if_flat(soup, a: NurbsSurface, b: NurbsSurface, mesh_tol: float) -> No
     soup's segment ends are closer to parallel than :func:`.angles.small_crossing_sine`
     allows (the median of those angles is named)."""
     limit = small_crossing_sine(operand_size(a, b)[0], mesh_tol)
-    sines = soup_crossing_sine(a, b, soup.uv_a.reshape(-1, 2), soup.uv_b.reshape(-1, 2))
+    sines = normal_sines(a, b, soup.uv_a.reshape(-1, 2), soup.uv_b.reshape(-1, 2))
     if flat_share(sines, limit) >= FLAT_SHARE:
         sine = float(np.median(sines[sines < limit]))
         warnings.warn(

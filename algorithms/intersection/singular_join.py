@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
+from .angles import normal_sines
 from .branches import SingularKind, locate_singular_points, singular_branches
 from .refine import RefinedCurve
 from .topology import EndKind
@@ -38,18 +39,6 @@ _JOIN_COS = np.cos(np.radians(35.0))
 #: a cut end whose (u, v) differ from the singular point's by more than this share of
 #: the domain's extent (either surface) lies across a seam from it
 _SAME_SIDE = 0.25
-
-
-def _normal_sines(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray,
-                  ub: NDArray) -> NDArray:
-    """``|N_a x N_b| (n,)`` at samples ``ua, ub (n, 2)``."""
-    da = surface_a.derivatives(ua[:, 0], ua[:, 1], 1)
-    db = surface_b.derivatives(ub[:, 0], ub[:, 1], 1)
-    na = np.cross(da[:, 1, 0], da[:, 0, 1])
-    nb = np.cross(db[:, 1, 0], db[:, 0, 1])
-    den = np.maximum(np.linalg.norm(na, axis=1) * np.linalg.norm(nb, axis=1),
-                     np.finfo(float).tiny)
-    return np.linalg.norm(np.cross(na, nb), axis=1) / den
 
 
 def _dips(sines: NDArray, minima: NDArray) -> NDArray:
@@ -88,7 +77,7 @@ def _singular_starts(curves: list[RefinedCurve], kinds: list, surface_a: NurbsSu
     if sum(sizes):
         all_a = np.concatenate([c.uv_a for c in curves])
         all_b = np.concatenate([c.uv_b for c in curves])
-        sines = _normal_sines(surface_a, surface_b, all_a, all_b)
+        sines = normal_sines(surface_a, surface_b, all_a, all_b)
         minima = []
         start = 0
         for n in sizes:

@@ -11,7 +11,7 @@ import pytest
 
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import SmallAngleWarning, StrayCurves, intersect_surfaces
-from surfprep.algorithms.intersection.angles import small_crossing_sine, soup_crossing_sine
+from surfprep.algorithms.intersection.angles import normal_sines, small_crossing_sine
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "characteristic"))
 from char_surfaces import flat_crossing  # noqa: E402
@@ -31,7 +31,7 @@ def test_limit_follows_the_square_root_of_the_mesh_tolerance():
 @pytest.mark.parametrize("angle", [1e-3, 0.1, 1.0])
 def test_soup_sine_of_two_planes(angle):
     uv = np.random.default_rng(0).uniform(0, 1, (20, 2))
-    np.testing.assert_allclose(soup_crossing_sine(plane(angle), plane(0.0), uv, uv),
+    np.testing.assert_allclose(normal_sines(plane(angle), plane(0.0), uv, uv),
                                np.sin(angle), rtol=1e-12)
 
 
