@@ -93,7 +93,6 @@ from .intersect_operands import (
     face_operands,
     inside_face,
 )
-from .trim_loops import SegmentTree
 
 __all__ = [
     "DEFAULT_TOL_FACTOR",
@@ -407,7 +406,7 @@ def _on_a_tangent_join(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperan
     for face, uv, other in ((fa, curve.uv_a, fb), (fb, curve.uv_b, fa)):
         if uv is None:
             continue
-        tree = _loop_tree(face)
+        tree = face.loop_tree()
         if tree is None:
             continue
         _, foot = tree.nearest(uv)
@@ -417,15 +416,6 @@ def _on_a_tangent_join(curve: IntersectionCurve, fa: FaceOperand, fb: FaceOperan
         if project_to_surface(other.surface, points).distance.max() <= near:
             return True
     return False
-
-
-def _loop_tree(face: FaceOperand):
-    """Segment tree of the face's loop polygon in (u, v) (cached; None without loops)."""
-    if "loop_tree" not in face._cache:
-        seg = face.boundary_segments()
-        face._cache["loop_tree"] = SegmentTree.from_segments(
-            seg[:, 0], seg[:, 1] - seg[:, 0]) if seg.shape[0] else None
-    return face._cache["loop_tree"]
 
 
 def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOperand,

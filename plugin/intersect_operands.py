@@ -114,6 +114,18 @@ class FaceOperand:
             self._cache["loop_index"] = None if rect else LoopIndex.build(seg)
         return self._cache["loop_index"]
 
+    def loop_tree(self) -> SegmentTree | None:
+        """Segment tree of the loop polygon in ``(u, v)`` (the loop index's own when the
+        face has one, else built once; None without loops)."""
+        index = self.loop_index()
+        if index is not None:
+            return index.uv_tree
+        if "loop_tree" not in self._cache:
+            seg = self.boundary_segments()
+            self._cache["loop_tree"] = SegmentTree.from_segments(
+                seg[:, 0], seg[:, 1] - seg[:, 0]) if seg.shape[0] else None
+        return self._cache["loop_tree"]
+
     def edge_distance(self, points: NDArray) -> NDArray:
         """Distance ``(n,)`` of ``points (n, 3)`` to the sampled trimming edges in space
         (:meth:`boundary_polylines`; k-d tree built once per face)."""
