@@ -156,10 +156,15 @@ def may_run_along_many(own: NurbsSurface, other: NurbsSurface, sides: list[Domai
     return answer
 
 
+def _stretches(near: NDArray) -> tuple[NDArray, NDArray]:
+    """First and last indices ``(k,), (k,)`` of every stretch of consecutive True entries."""
+    edges = np.diff(np.concatenate([[0], near.astype(np.int8), [0]]))
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+
+
 def _runs(near: NDArray) -> list[tuple[int, int]]:
     """``[(first, last)]`` index ranges of consecutive True entries, ``_MIN_RUN`` long at least."""
-    edges = np.diff(np.concatenate([[0], near.astype(np.int8), [0]]))
-    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    starts, stops = _stretches(near)
     return [(int(a), int(b)) for a, b in zip(starts, stops) if b - a + 1 >= _MIN_RUN]
 
 
@@ -183,9 +188,7 @@ def _densified(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDAr
     near samples shorter than ``_MIN_RUN``: a run shorter than two sample spacings (the
     other surface a narrow strip across the side, as a 3 mm plane under a 19 mm arc)
     holds only one or two of the regular samples. Returns ``(t, distance, foot uv)``."""
-    near = dist <= _SHARE * tol
-    edges = np.diff(np.concatenate([[0], near.astype(np.int8), [0]]))
-    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    starts, stops = _stretches(dist <= _SHARE * tol)
     short = (stops - starts + 1) < _MIN_RUN
     if not np.any(short):
         return t, dist, foot
