@@ -405,21 +405,26 @@ class StrayCurves(enum.Enum):
     DROP = "drop"
 
 
-def _stray_policy(curves: list, worst: NDArray, tol: float, stray: StrayCurves) -> list:
-    """Curves straying beyond ``tol`` dropped with a warning or raised (``stray``)."""
+def _stray_policy(curves: list, worst: NDArray, tol: float, stray: StrayCurves,
+                  folded: NDArray | None = None) -> list:
+    """Curves straying beyond ``tol`` or ``folded (c,) bool`` (turning back on
+    themselves) dropped with a warning or raised (``stray``)."""
+    folded = np.zeros(worst.shape, dtype=bool) if folded is None else folded
+    bad = (worst > tol) | folded
+    if not np.any(bad):
+        return curves
+    how = (f"stray from the surfaces by up to {worst.max():.3g} > tol={tol:g}"
+           if np.any(worst > tol) else "")
+    if folded.any():
+        how += (" or " if how else "") + f"fold back on themselves ({folded.sum()})"
     if stray is StrayCurves.DROP:
-        if np.any(worst > tol):
-            warnings.warn(
-                f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves left out: "
-                f"they stray from the surfaces by up to {worst.max():.3g} > tol={tol:g} "
-                "(near-tangential or overlapping surfaces)", StrayCurveWarning, stacklevel=3)
-        return [c for c, w in zip(curves, worst) if w <= tol]
-    if np.any(worst > tol):
-        raise InvalidGeometryError(
-            f"{np.count_nonzero(worst > tol)} of {len(curves)} intersection curves stray from "
-            f"the surfaces by up to {worst.max():.3g} > tol={tol:g}: the surfaces are "
-            "near-tangential or overlap there")
-    return curves
+        warnings.warn(f"{bad.sum()} of {len(curves)} intersection curves left out: they "
+                      f"{how} (near-tangential or overlapping surfaces)", StrayCurveWarning,
+                      stacklevel=3)
+        return [c for c, b in zip(curves, bad) if not b]
+    raise InvalidGeometryError(
+        f"{bad.sum()} of {len(curves)} intersection curves {how}: the surfaces are "
+        "near-tangential or overlap there")
 
 
 def intersect_surfaces(a: Operand, b: Operand, *, tol: float = 1e-7,
@@ -571,6 +576,9 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
     dense, kinds = _extend(dense, kinds, surface_a, surface_b, tol, mesh_tol)
     dense, kinds = _along_sides(dense, kinds, topology, chains, surface_a, surface_b, tol)
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
-    if can_retry and np.any(worst > tol):
+    # a curve whose kept samples still turn back on themselves runs over one stretch
+    # twice: within tol of both surfaces, but not the intersection curve
+    folded = np.array([_folded(c) for c in curves], dtype=bool)
+    if can_retry and (np.any(worst > tol) or folded.any()):
         return _intersect(a, b, tol, finer, max_depth, stray, scale, retries - 1, tangential)
-    return _stray_policy(curves, worst, tol, stray)
+    return _stray_policy(curves, worst, tol, stray, folded)

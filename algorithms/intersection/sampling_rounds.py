@@ -30,8 +30,11 @@ _POINT_SHARE = 1.0 / 16.0
 _PROJECTION_STEPS = 4
 #: a projection onto curve3d stops once its steps move the foot by this share of the target
 _SETTLED = 1e-2
-#: a span longer than this times a neighbour is split (graded sampling)
+#: a span longer than this times a neighbour is split (graded sampling), into at most
+#: _MAX_GRADED pieces per round, by a closure of at most _GRADE_PASSES passes
 _MAX_RATIO = 4.0
+_MAX_GRADED = 8
+_GRADE_PASSES = 32
 #: a failing span takes a dense sample within this fraction of its middle, else a new one
 _MIDDLE = 0.25
 #: a new sample must project onto its span's chord this far from both ends
@@ -74,8 +77,8 @@ class _Work:
 
 
 def _project_on_curve(curves: SplineSet, index: NDArray, x: NDArray, t0: NDArray, lo: NDArray,
-                      hi: NDArray, settled: float = 0.0) -> NDArray:
-    """Distances ``(m,)`` of points ``x (m, 3)`` to the first three coordinates of
+                      hi: NDArray, settled: float = 0.0) -> tuple[NDArray, NDArray]:
+    """Distances ``(m,)`` of points ``x (m, 3)``, and their feet ``(m,)``, to the first three coordinates of
     curves ``index (m,)`` of ``curves`` near ``t0`` (Newton within ``[lo, hi]``,
     ``_PROJECTION_STEPS`` at most; stopped once every step moves the foot by
     ``settled`` model units or less: the distance is stationary at the foot, so its
@@ -93,7 +96,7 @@ def _project_on_curve(curves: SplineSet, index: NDArray, x: NDArray, t0: NDArray
         t = moved
         if np.all(step <= settled):
             break
-    return np.linalg.norm(curves.evaluate(index, t)[:, :3] - x, axis=1)
+    return np.linalg.norm(curves.evaluate(index, t)[:, :3] - x, axis=1), t
 
 
 @dataclass
@@ -185,16 +188,21 @@ def _checks(works: list[_Work], tol: float) -> list[_Check]:
     return out
 
 
+def _stacked_errors(at: NDArray, surface_a, surface_b) -> NDArray:
+    """``(m,)``: the largest of ``|S_a(pcurve_a) - curve3d|``, ``|S_b(pcurve_b) - curve3d|``,
+    ``|S_a - S_b|`` at stacked interpolant values ``at (m, 7)``."""
+    on_a = surface_a.evaluate(at[:, 3], at[:, 4])
+    on_b = surface_b.evaluate(at[:, 5], at[:, 6])
+    return np.maximum.reduce([np.linalg.norm(on_a - at[:, :3], axis=1),
+                              np.linalg.norm(on_b - at[:, :3], axis=1),
+                              np.linalg.norm(on_a - on_b, axis=1)])
+
+
 def _check_errors(checks: list[_Check], surface_a, surface_b) -> list[NDArray]:
     """Per curve ``(spans,)``: the largest of ``|S_a(pcurve_a) - curve3d|``,
     ``|S_b(pcurve_b) - curve3d|``, ``|S_a - S_b|`` at the check points; one
     evaluation per surface for all curves."""
-    at = np.concatenate([c.at for c in checks])
-    on_a = surface_a.evaluate(at[:, 3], at[:, 4])
-    on_b = surface_b.evaluate(at[:, 5], at[:, 6])
-    err = np.maximum.reduce([np.linalg.norm(on_a - at[:, :3], axis=1),
-                             np.linalg.norm(on_b - at[:, :3], axis=1),
-                             np.linalg.norm(on_a - on_b, axis=1)])
+    err = _stacked_errors(np.concatenate([c.at for c in checks]), surface_a, surface_b)
     split = np.cumsum([c.at.shape[0] for c in checks])[:-1]
     return [e.reshape(-1, len(CHECK_FRACTIONS)).max(axis=1) for e in np.split(err, split)]
 
@@ -209,11 +217,12 @@ def _span_errors_now(w: _Work, check: _Check, dirty_error: NDArray) -> NDArray:
     return w.span_error[check.kept[:spans]]
 
 
-def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float):
-    """Spans (by index into the kept samples) over ``target`` at their check points or
-    too long beside a neighbour, their errors, the dense samples farther than
-    ``target`` from ``curve3d`` (the worst per span; those spans take them), and what
-    the insertion needs."""
+def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float,
+                   surface_a, surface_b):
+    """Spans (by index into the kept samples) over ``target`` at their check points, their
+    errors, the dense samples farther than ``target`` from ``curve3d`` where the
+    interpolants at their feet are over ``target`` too (the worst per span; those spans
+    take them), what the insertion needs and which spans may be split."""
     k, t = check.kept, check.t
     dt = np.diff(t)
     error = np.nan_to_num(error)
@@ -233,20 +242,20 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
         j = span_of[idx]
         a0, a1 = arc[ends[j]], arc[ends[j + 1]]
         frac = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
-        dist = _project_on_curve(check.curves, np.full(idx.size, check.index), w.points[idx],
-                                 t[j] + frac * dt[j], t[j], t[j + 1], settled=_SETTLED * target)
+        dist, foot = _project_on_curve(check.curves, np.full(idx.size, check.index),
+                                       w.points[idx], t[j] + frac * dt[j], t[j], t[j + 1],
+                                       settled=_SETTLED * target)
         far = dist > target
+        if np.any(far):         # a miss only where the interpolants leave the surfaces there:
+            # near-tangential dense samples scatter along the surfaces by gap / sin(angle),
+            # which is no error (and keeping them puts kinks into the interpolants)
+            far[far] = _stacked_errors(check.evaluate(foot[far]), surface_a, surface_b) > target
         if np.any(far):                          # the worst of each span
             order = np.lexsort((-dist[far], j[far]))
             first = np.concatenate([[True], np.diff(j[far][order]) != 0])
             off = idx[far][order][first]
-    # graded spans: one over _MAX_RATIO times a neighbour is split too (a C2 cubic
-    # swings between the check points of a long span next to a short one)
-    ring = np.concatenate([dt[-1:], dt, dt[:1]]) if w.closed else \
-        np.concatenate([[np.inf], dt, [np.inf]])
-    steep = dt > _MAX_RATIO * np.minimum(ring[:-2], ring[2:])
     can = (dt > tol) & ~w.stuck[k[: dt.size]]
-    bad = ((error > target) | steep) & can
+    bad = (error > target) & can
     # spans next to a failing one and nearly failing themselves are split with it: a
     # C2 cubic spreads a split to its neighbours, which would otherwise fail one
     # after another over as many rounds (a front moving a few spans per round)
@@ -260,7 +269,37 @@ def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: 
     bad |= near & (error > _NEAR_SHARE * target) & can
     bad[span_of[off]] = False                    # those get their dense sample instead
     bad = np.flatnonzero(bad)
-    return bad, error[bad], off, ends, span_of, arc
+    return bad, error[bad], off, ends, span_of, arc, can
+
+
+def _graded(dt: NDArray, pieces: NDArray, cut: NDArray, closed: bool, can: NDArray) -> NDArray:
+    """Pieces per span ``(spans,) int`` after grading: no piece longer than
+    ``_MAX_RATIO`` times the piece beside it across a span end (a C2 cubic swings
+    between the check points of a long span next to a short one).
+
+    ``pieces (spans,) int``: the equal pieces planned for each span (1: not split);
+    ``cut (spans,) float``: where a kept dense sample splits a span (fraction of it;
+    NaN: none), such spans are left as they are; ``can (spans,) bool``: spans that
+    may be split. The grading is closed in one go (a front of halvings moving a span
+    per round would cost a round per span); at most ``_MAX_GRADED`` pieces.
+    """
+    n = pieces.astype(np.float64)
+    has_cut = ~np.isnan(cut)
+    fixed = has_cut | ~can
+    cut = np.where(has_cut, cut, 0.5)
+    for _ in range(_GRADE_PASSES):
+        first = np.where(has_cut, cut * dt, dt / n)
+        last = np.where(has_cut, (1 - cut) * dt, dt / n)
+        before = np.roll(last, 1)
+        after = np.roll(first, -1)
+        if not closed:
+            before[0] = after[-1] = np.inf
+        need = np.minimum(np.ceil(dt / (_MAX_RATIO * np.minimum(before, after))), _MAX_GRADED)
+        grow = ~fixed & (need > n)
+        if not grow.any():
+            break
+        n[grow] = need[grow]
+    return n.astype(np.int64)
 
 
 def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
@@ -380,31 +419,40 @@ def verification_round(works: list[_Work], surface_a, surface_b, target: float, 
     for w, check, error in zip(todo, checks, errors):
         error = _span_errors_now(w, check, error)
         w.error = float(np.nanmax(error)) if error.size else 0.0
-        bad, error, off, ends, span_of, arc = _failing_spans(w, check, error, target, tol)
+        bad, error, off, ends, span_of, arc, can = _failing_spans(w, check, error, target, tol,
+                                                             surface_a, surface_b)
         w.history.append((w.error, bad.size + off.size))
         if _stalled(w.history, target):         # near-tangential: splitting does not help
             w.done = True
             if w.error <= tol:                  # within the contract all the same
                 w.result = check
             continue
-        if bad.size == 0 and off.size == 0:
+        pieces = _pieces(error, target)
+        taken, covered = _middle_samples(w, bad, pieces, span_of, ends, arc)
+        t = check.t
+        dt = np.diff(t)
+        planned = np.ones(dt.size, dtype=np.int64)
+        planned[bad[~covered]] = pieces[~covered]
+        cut = np.full(dt.size, np.nan)
+        for idx in (off, taken):                 # spans split at a kept dense sample
+            j = span_of[idx]
+            a0, a1 = arc[ends[j]], arc[ends[j + 1]]
+            cut[j] = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
+        split = _graded(dt, planned, cut, w.closed, can)
+        if off.size == 0 and taken.size == 0 and not np.any(split > 1):
             w.done = True
             w.result = check
             continue
         w.kept[off] = True
         w.fresh[off] = True
-        t = check.t
-        pieces = _pieces(error, target)
-        taken, covered = _middle_samples(w, bad, pieces, span_of, ends, arc)
         w.kept[taken] = True
         w.fresh[taken] = True
-        fresh = [(j, n) for j, n, c in zip(bad, pieces, covered) if not c]
-        if fresh:
-            span = np.repeat([j for j, _ in fresh], [n - 1 for _, n in fresh])
-            count = np.repeat([n for _, n in fresh], [n - 1 for _, n in fresh])
-            local = np.concatenate([np.arange(1, n) for _, n in fresh])
-            jobs.append((w, ends[span], ends[span + 1],
-                         t[span] + local / count * np.diff(t)[span]))
+        span = np.flatnonzero(split > 1)
+        if span.size:
+            count = np.repeat(split[span], split[span] - 1)
+            local = np.concatenate([np.arange(1, n) for n in split[span]])
+            span = np.repeat(span, split[span] - 1)
+            jobs.append((w, ends[span], ends[span + 1], t[span] + local / count * dt[span]))
             curves.append(check)
     if not jobs:
         return

@@ -55,3 +55,26 @@ def test_a_double_point_is_not_a_flat_crossing():
     only over a short stretch round them: no warning."""
     from test_ssi_pipeline import cylinder
     assert _small_angle_warnings(cylinder(1.0, 1.5), cylinder(1.0, 2.0, normal=(1, 0, 0))) == []
+
+
+def test_a_curve_running_over_itself_is_not_returned():
+    """At 5e-3 rad the triangle method's refined samples land on one stretch of the
+    curve twice (a fold): every point within tol of both surfaces, but the curve 20 %
+    longer than the intersection (1.21-1.26 against 1.0189). Such a curve is left out
+    with a StrayCurveWarning (or raised), never returned."""
+    from surfprep.algorithms.characteristic import auto_intersection
+    from surfprep.algorithms.intersection import StrayCurveWarning
+    from surfprep.errors import InvalidGeometryError
+    a, b = flat_crossing(5e-3)
+    (exact,) = auto_intersection(a, b, tol=1e-8).curves
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        curves = intersect_surfaces(a, b, tol=1e-8, stray=StrayCurves.DROP)
+    assert sum(c.length for c in curves) <= exact.length * (1 + 1e-4)
+    if not curves:
+        assert any(issubclass(w.category, StrayCurveWarning) and "fold" in str(w.message)
+                   for w in caught)
+        with pytest.raises(InvalidGeometryError, match="fold back"):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", SmallAngleWarning)
+                intersect_surfaces(a, b, tol=1e-8)

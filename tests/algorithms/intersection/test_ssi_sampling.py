@@ -99,3 +99,31 @@ def test_closed_curve_and_collapsed_curve():
     assert out[0].curve.points.shape[0] >= 2
     assert exact_distance(out[0].interpolants[0].evaluate(
         np.linspace(0, out[0].parameters[-1], 5001)), c).max() <= tol
+
+
+def test_grading_is_closed_in_one_call():
+    """_graded: after one call no piece is over _MAX_RATIO times the piece beside it
+    across a span end, unless the span got the most pieces a round allows; spans cut
+    at a kept dense sample and spans that may not be split keep their pieces."""
+    from surfprep.algorithms.intersection.sampling_rounds import _MAX_GRADED, _MAX_RATIO, _graded
+    rng = np.random.default_rng(5)
+    for closed in (False, True):
+        for _ in range(20):
+            n = 30
+            dt = rng.uniform(0.5, 2.0, n)
+            planned = np.where(rng.uniform(size=n) < 0.2, rng.integers(2, 5, n), 1)
+            cut = np.where(rng.uniform(size=n) < 0.15, rng.uniform(0.01, 0.99, n), np.nan)
+            can = rng.uniform(size=n) < 0.9
+            pieces = _graded(dt, planned, cut, closed, can)
+            fixed = ~np.isnan(cut) | ~can
+            assert np.all(pieces[fixed] == planned[fixed])
+            assert np.all(pieces >= planned) and pieces.max() <= max(_MAX_GRADED, planned.max())
+            has = ~np.isnan(cut)
+            first = np.where(has, np.nan_to_num(cut) * dt, dt / pieces)
+            last = np.where(has, (1 - np.nan_to_num(cut)) * dt, dt / pieces)
+            pairs = range(n) if closed else range(n - 1)
+            for i in pairs:
+                j = (i + 1) % n
+                for long_, short, span in ((last[i], first[j], i), (first[j], last[i], j)):
+                    if long_ > _MAX_RATIO * short * (1 + 1e-12):
+                        assert fixed[span] or pieces[span] == _MAX_GRADED
