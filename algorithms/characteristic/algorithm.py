@@ -69,7 +69,7 @@ from .starts import (
     trace_uncovered,
 )
 from .sweep import from_critical, sweep
-from .trace import dense_polyline, polyline_gap, to_intersection_curve
+from .trace import dense_polyline, polyline_gap, to_intersection_curves
 
 __all__ = [
     "GRID_MAX",
@@ -465,13 +465,8 @@ def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]
 def tangential_curves(analysis: CharacteristicAnalysis, tol: float) -> list[IntersectionCurve]:
     """The ridges with ``|phi| <= tol`` all along (tangential contact along a curve,
     :mod:`.ridges`) as intersection curves."""
-    out = []
-    for ridge in analysis.ridges:
-        if ridge.is_tangential(tol):
-            curve = to_intersection_curve(analysis.field, ridge.curve, tol)
-            if curve is not None:
-                out.append(curve)
-    return out
+    traced = [ridge.curve for ridge in analysis.ridges if ridge.is_tangential(tol)]
+    return [c for c in to_intersection_curves(analysis.field, traced, tol) if c is not None]
 
 
 def _along(curves: Sequence[IntersectionCurve], tangential: Sequence[IntersectionCurve],

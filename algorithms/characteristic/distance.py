@@ -241,6 +241,10 @@ class DistanceField:
         """:func:`distance_jet` at ``uv (n, 2)``."""
         return distance_jet(self.evaluator, self.projector, uv, st0)
 
+    def pair(self) -> tuple[NurbsSurface, NurbsSurface]:
+        """``(a, b)``: the two surfaces in the pair's order."""
+        return (self.q, self.r) if self.swapped else (self.r, self.q)
+
     def ab(self, uv: NDArray, st: NDArray) -> tuple[NDArray, NDArray]:
         """``(uv_a, uv_b)``: parameters on ``r`` and ``q`` in the pair's order."""
         return (st, uv) if self.swapped else (uv, st)

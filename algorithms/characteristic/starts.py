@@ -27,7 +27,7 @@ from .curves import TracedCurve
 from .distance import DistanceField, DistanceJet
 from .points import CharacteristicPoint, PointKind
 from .projection import ProjectionStatus
-from .trace import curve_gap, to_intersection_curve, trace_intersections
+from .trace import curve_gap, to_intersection_curves, trace_intersections
 
 __all__ = [
     "MAX_TRACE_ROUNDS",
@@ -187,16 +187,28 @@ def settle(field: DistanceField, start: Start) -> tuple[Start, NDArray]:
 
 
 def _on_trace(uv: NDArray, trace: TracedCurve) -> bool:
-    """True when ``uv (2,)`` lies on the traced polyline in the parameter plane: closer to
-    one of its chords than a tenth of that chord (the chords of a trace sag by about
-    ``MAX_TURN / 8`` of their length)."""
+    """True when ``uv (2,)`` lies on the traced polyline in the parameter plane: within
+    the sag of one of its chords, ``length * turn / 4`` (twice the sag of an arc
+    turning by ``turn``, the larger of the chord's angles with its neighbours),
+    plus ``1e-6`` of the chord for rounding. Two curves close side by side (the
+    circles of a torus just below a plane, 1e-3 of a chord apart) stay apart."""
     p = trace.uv
     q = np.vstack([p, p[:1]]) if trace.closed else p
     a, d = q[:-1], np.diff(q, axis=0)
     dd = np.einsum("sc,sc->s", d, d)
+    length = np.sqrt(dd)
+    unit = d / np.where(length > 0, length, 1.0)[:, None]
+    cos = np.einsum("sc,sc->s", unit[:-1], unit[1:])
+    turn = np.arccos(np.clip(cos, -1.0, 1.0))                       # at inner vertices
+    if trace.closed:
+        at_vertex = np.append(np.arccos(np.clip(unit[-1] @ unit[0], -1.0, 1.0)), turn)
+        bend = np.maximum(at_vertex, np.roll(at_vertex, -1))
+    else:
+        bend = np.maximum(np.append(turn[:1], turn), np.append(turn, turn[-1:])) \
+            if turn.size else np.zeros(length.size)
     t = np.clip(np.einsum("sc,sc->s", uv - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
     gap = np.linalg.norm(a + t[:, None] * d - uv, axis=1)
-    return bool(np.any(gap <= 0.1 * np.sqrt(dd) + 1e-14))
+    return bool(np.any(gap <= length * (0.25 * bend + 1e-6) + 1e-14))
 
 
 def _sine(field: DistanceField, uv: NDArray, st: NDArray) -> NDArray:
@@ -214,40 +226,34 @@ def _points_3d(field: DistanceField, uv: NDArray) -> NDArray:
 
 def trace_uncovered(field: DistanceField, starts: Start, known: list[IntersectionCurve],
                      tol: float, size: float) -> list[IntersectionCurve]:
-    """Trace the starts that lie on none of the ``known`` curves (3D), in rounds."""
+    """Trace the starts that lie on none of the ``known`` curves (3D) nor on a trace of an
+    earlier round (parameter plane), in rounds; all traces sampled in one batch."""
     settled, ok = settle(field, starts)
     uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
     pts = _points_3d(field, uv)
     # a curve within tol of both surfaces may sit tol / sin(angle) off the exact point
     # along the surfaces where they meet at a small angle
     cover = 10 * tol / np.maximum(_sine(field, uv, st), 1e-6) + 1e-9 * size
-    curves = list(known)
-    out: list[IntersectionCurve] = []
     todo = np.arange(uv.shape[0])
+    if known and todo.size:
+        todo = todo[curve_gap(pts, list(known), within=cover) > cover]
+    traces: list[TracedCurve] = []
     for _ in range(MAX_TRACE_ROUNDS):
+        todo = todo[[not any(_on_trace(uv[i], t) for t in traces) for i in todo]] \
+            if traces else todo
         if todo.size == 0:
             break
-        gap = curve_gap(pts[todo], curves, within=cover[todo])
-        todo = todo[gap > cover[todo]]
-        if todo.size == 0:
-            break
-        # one start per group and round (several starts of one loop trace once)
+        # one start per group and round (several starts of one loop trace once; the
+        # others are traced in a later round if no trace passes through them)
         _, first = np.unique(group[todo], return_index=True)
         batch = todo[np.sort(first)]
-        traced = trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol,
-                                     branches=True)
-        kept_traces: list[TracedCurve] = []
-        for t in traced:
-            if any(_on_trace(t.uv[t.uv.shape[0] // 2], k) for k in kept_traces):
-                continue                                  # a loop traced twice in one round
-            curve = to_intersection_curve(field, t, tol)
-            if curve is None:
-                continue
-            kept_traces.append(t)
-            out.append(curve)
-            curves.append(curve)
+        for t in trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol,
+                                     branches=True):
+            if not any(_on_trace(t.uv[t.uv.shape[0] // 2], k) for k in traces):
+                traces.append(t)                          # (a loop traced twice: once)
         todo = np.setdiff1d(todo, batch)
-    return out
+    # all traces sampled in one batch
+    return [c for c in to_intersection_curves(field, traces, tol) if c is not None]
 
 
 def away_from(starts: Start, isolated: Sequence[CharacteristicPoint], field: DistanceField

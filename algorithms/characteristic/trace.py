@@ -6,12 +6,11 @@ the other way too, and the two halves are joined. A trace ends where the curve
 closes, on a side of ``r``'s domain, or where its image leaves ``q``'s domain
 (a border point of ``q``'s boundary curve, §6.2).
 
-The traced samples then go through the refinement of the triangle method
-(:func:`surfprep.algorithms.intersection.refine_curves`: auxiliary-plane
-refinement to ``tol``, chord-midpoint insertion, redundant samples dropped);
-every end on a domain side is solved again with that side's parameter held
-(:func:`.points.solve_held`), and spans whose interpolants stray by more than
-``tol`` get refined midpoints (:func:`refine_points`), so the result is an
+Every end on a domain side is solved again with that side's parameter held
+(:func:`.points.solve_held`); the traced samples then go through the cubic
+sampling of the triangle method (:func:`..intersection.result.checked_curves`,
+all curves of a round in one batch), and spans whose interpolants still stray
+by more than ``tol`` get refined midpoints (:func:`refine_points`), so the result is an
 :class:`~surfprep.algorithms.intersection.IntersectionCurve` with the same
 contract as the triangle method's.
 
@@ -29,7 +28,6 @@ from ..intersection import (
     EndKind,
     IntersectionCurve,
     RefinedCurve,
-    refine_curves,
     refine_points,
 )
 from ..intersection import result as _result
@@ -42,6 +40,7 @@ __all__ = [
     "dense_polyline",
     "polyline_gap",
     "to_intersection_curve",
+    "to_intersection_curves",
     "trace_intersections",
 ]
 
@@ -297,25 +296,22 @@ def _end_kind(reason: EndReason) -> EndKind:
     return EndKind.OPEN
 
 
-def to_intersection_curve(field: DistanceField, traced: TracedCurve, tol: float
-                          ) -> IntersectionCurve | None:
-    """A traced ``phi = 0`` curve refined to ``tol`` (module docstring); None when too short."""
+def _dense_trace(field: DistanceField, traced: TracedCurve, tol: float
+                 ) -> tuple[RefinedCurve, tuple[EndKind, EndKind]] | None:
+    """A traced ``phi = 0`` curve as dense samples on both surfaces (closing overlap and
+    repeated points dropped, ends on sides solved again) with its end kinds; None
+    when too short."""
     uv_a, uv_b = field.ab(traced.uv, traced.st)
     closed = traced.closed
     if closed:                  # the trace ends back near its start: drop the overlap
         n = _closing_count(traced.uv)
         uv_a, uv_b = uv_a[:n], uv_b[:n]
-    a, b = (field.q, field.r) if field.swapped else (field.r, field.q)
+    a, b = field.pair()
     pts = a.evaluate(uv_a[:, 0], uv_a[:, 1])
     keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-3 * tol])
-    uv_a, uv_b = uv_a[keep], uv_b[keep]
-    if uv_a.shape[0] < 2 + closed:
+    ua, ub = uv_a[keep], uv_b[keep]
+    if ua.shape[0] < 2 + closed:
         return None
-    sampled = getattr(_result, "sampled_curves", None)      # the cubic sampling, when there
-    ua, ub = uv_a, uv_b
-    if sampled is None:          # older intersection package: polyline refinement
-        refined = refine_curves(a, b, [uv_a], [uv_b], [closed], tol=tol)[0]
-        ua, ub = refined.uv_a, refined.uv_b
     if not closed:
         ua, ub = _fix_ends(field, traced, ua, ub, tol)
     pts = 0.5 * (a.evaluate(ua[:, 0], ua[:, 1]) + b.evaluate(ub[:, 0], ub[:, 1]))
@@ -324,22 +320,50 @@ def to_intersection_curve(field: DistanceField, traced: TracedCurve, tol: float
     if not closed and not keep[-1]:          # keep the solved end, drop its neighbour
         keep[-1], keep[-2] = True, pts.shape[0] <= 2
     pts, ua, ub = pts[keep], ua[keep], ub[keep]
-    kinds = ((EndKind.CLOSED, EndKind.CLOSED) if closed else
-             (_end_kind(traced.start_reason), _end_kind(traced.end_reason)))
     if pts.shape[0] < 2 + closed:
         return None
+    kinds = ((EndKind.CLOSED, EndKind.CLOSED) if closed else
+             (_end_kind(traced.start_reason), _end_kind(traced.end_reason)))
+    flags = np.ones(pts.shape[0], dtype=bool)
+    return RefinedCurve(pts, ua, ub, closed, flags, ~flags), kinds
+
+
+def _sampled(dense: list, a, b, tol: float) -> list:
+    """``(curve or None, largest check error)`` per dense curve: all sampled in one
+    batch (:func:`..intersection.result.checked_curves`); a batch that fails is
+    sampled curve by curve, so one bad curve costs only itself."""
     try:
-        if sampled is not None:
-            dense = RefinedCurve(pts, ua, ub, closed, np.ones(pts.shape[0], dtype=bool),
-                                 np.zeros(pts.shape[0], dtype=bool))
-            curve = sampled([dense], [kinds], a, b, tol=tol)[0]
-        else:
-            curve = IntersectionCurve.from_samples(pts, ua, ub, closed, *kinds)
+        curves, worst = _result.checked_curves([d for d, _ in dense], [k for _, k in dense],
+                                               a, b, tol=tol, aligned=True)
+        return list(zip(curves, worst))
     except InvalidGeometryError:
-        return None
-    for _ in range(_SPLIT_ROUNDS):
-        split = _split_failing(curve, a, b, tol)
-        if split is None:
-            break
-        curve = split
-    return curve
+        if len(dense) == 1:
+            return [(None, float("nan"))]
+    return [_sampled([d], a, b, tol)[0] for d in dense]
+
+
+def to_intersection_curves(field: DistanceField, traced: list[TracedCurve], tol: float
+                           ) -> list[IntersectionCurve | None]:
+    """Traced ``phi = 0`` curves refined to ``tol`` (module docstring), sampled in one
+    batch; None for a curve too short. A curve whose check found a span over ``tol``
+    gets refined midpoints there (a few rounds)."""
+    a, b = field.pair()
+    dense = [_dense_trace(field, t, tol) for t in traced]
+    live = [i for i, d in enumerate(dense) if d is not None]
+    out: list[IntersectionCurve | None] = [None] * len(traced)
+    for i, (curve, worst) in zip(live, _sampled([dense[i] for i in live], a, b, tol)
+                                 if live else []):
+        if curve is not None and not worst <= tol:     # NaN: not verified as sampled
+            for _ in range(_SPLIT_ROUNDS):
+                split = _split_failing(curve, a, b, tol)
+                if split is None:
+                    break
+                curve = split
+        out[i] = curve
+    return out
+
+
+def to_intersection_curve(field: DistanceField, traced: TracedCurve, tol: float
+                          ) -> IntersectionCurve | None:
+    """One traced ``phi = 0`` curve refined to ``tol`` (:func:`to_intersection_curves`)."""
+    return to_intersection_curves(field, [traced], tol)[0]
