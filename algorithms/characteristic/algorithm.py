@@ -511,7 +511,7 @@ def _finish(analysis: CharacteristicAnalysis, known: list[IntersectionCurve], to
         starts = Start(starts.uv[loop], starts.st[loop], starts.scale[loop], starts.group[loop])
     if not analysis.coincident:
         traced = trace_uncovered(fld, starts, kept, tol, size)
-        added += [c for c in traced if c.max_deviation(a, b).max <= tol]
+        added += traced                   # within tol (trace_uncovered's check)
     kept = kept[:len(kept) - len(tangential)]
     curves = tuple(kept) + tuple(added)
     found = (FoundBy.MESH,) * len(kept) + (FoundBy.CHARACTERISTIC,) * len(added)

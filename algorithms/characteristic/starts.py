@@ -227,7 +227,8 @@ def _points_3d(field: DistanceField, uv: NDArray) -> NDArray:
 def trace_uncovered(field: DistanceField, starts: Start, known: list[IntersectionCurve],
                      tol: float, size: float) -> list[IntersectionCurve]:
     """Trace the starts that lie on none of the ``known`` curves (3D) nor on a trace of an
-    earlier round (parameter plane), in rounds; all traces sampled in one batch."""
+    earlier round (parameter plane), in rounds; all traces sampled in one batch, the
+    curves within ``tol`` returned."""
     settled, ok = settle(field, starts)
     uv, st, scale, group = (settled.uv[ok], settled.st[ok], settled.scale[ok], settled.group[ok])
     pts = _points_3d(field, uv)
@@ -253,7 +254,8 @@ def trace_uncovered(field: DistanceField, starts: Start, known: list[Intersectio
                 traces.append(t)                          # (a loop traced twice: once)
         todo = np.setdiff1d(todo, batch)
     # all traces sampled in one batch
-    return [c for c in to_intersection_curves(field, traces, tol) if c is not None]
+    return [c for c in to_intersection_curves(field, traces, tol, within_tol=True)
+            if c is not None]
 
 
 def away_from(starts: Start, isolated: Sequence[CharacteristicPoint], field: DistanceField

@@ -342,11 +342,13 @@ def _sampled(dense: list, a, b, tol: float) -> list:
     return [_sampled([d], a, b, tol)[0] for d in dense]
 
 
-def to_intersection_curves(field: DistanceField, traced: list[TracedCurve], tol: float
-                           ) -> list[IntersectionCurve | None]:
+def to_intersection_curves(field: DistanceField, traced: list[TracedCurve], tol: float, *,
+                           within_tol: bool = False) -> list[IntersectionCurve | None]:
     """Traced ``phi = 0`` curves refined to ``tol`` (module docstring), sampled in one
-    batch; None for a curve too short. A curve whose check found a span over ``tol``
-    gets refined midpoints there (a few rounds)."""
+    batch; None for a curve too short, and with ``within_tol`` for one whose
+    interpolants stray beyond ``tol`` (measured only where the sampling's own check did
+    not pass). A curve whose check found a span over ``tol`` gets refined midpoints
+    there (a few rounds)."""
     a, b = field.pair()
     dense = [_dense_trace(field, t, tol) for t in traced]
     live = [i for i, d in enumerate(dense) if d is not None]
@@ -359,6 +361,8 @@ def to_intersection_curves(field: DistanceField, traced: list[TracedCurve], tol:
                 if split is None:
                     break
                 curve = split
+            if within_tol and not curve.max_deviation(a, b).max <= tol:
+                curve = None
         out[i] = curve
     return out
 
