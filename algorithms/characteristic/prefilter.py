@@ -157,7 +157,9 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     s = _near_part(s, centre, normal, tol)
     if s is None:                                      # no span comes near the plane
         return True
-    if _turns_both_ways(s, centre, normal):
+    hopeless = [t or f for t, f in zip(_crossed_twice(s, centre, normal),
+                                       _flat_directions(s, centre, normal, tol))]
+    if all(hopeless):
         return False
     for level in range(REFINEMENTS + 1):
         if _monotone_patches(s, centre, normal, tol):
@@ -172,11 +174,11 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
 _TURN_SAMPLES = 4
 
 
-def _turns_both_ways(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray) -> bool:
-    """True when the rule cannot hold in either direction, whatever the refinement: some
-    sampled line ``v = const`` crosses the plane twice (a height monotone along it
-    crosses once at most), and so does some line ``u = const``. A closed loop, as
-    around a bump, is crossed twice both ways: the halvings are not tried."""
+def _crossed_twice(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray
+                   ) -> tuple[bool, bool]:
+    """Per direction (u, v): some sampled line along it crosses the plane twice (a
+    height monotone along it crosses once at most), so the rule cannot hold in that
+    direction whatever the refinement."""
     grids = []
     for knots, degree in ((s.knots_u, s.degree_u), (s.knots_v, s.degree_v)):
         breaks = np.unique(knots[degree:knots.size - degree])
@@ -185,9 +187,33 @@ def _turns_both_ways(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray) ->
                                breaks[-1]))
     h = s.evaluate_grid(*grids) @ normal - float(centre @ normal)          # (nu, nv)
     sign = np.sign(h)
-    twice = [np.any(np.count_nonzero(sign[1:] * sign[:-1] < 0, axis=0) >= 2),
-             np.any(np.count_nonzero(sign[:, 1:] * sign[:, :-1] < 0, axis=1) >= 2)]
-    return bool(twice[0] and twice[1])
+    return (bool(np.any(np.count_nonzero(sign[1:] * sign[:-1] < 0, axis=0) >= 2)),
+            bool(np.any(np.count_nonzero(sign[:, 1:] * sign[:, :-1] < 0, axis=1) >= 2)))
+
+
+def _turns_both_ways(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray) -> bool:
+    """True when some sampled line ``v = const`` crosses the plane twice, and so does
+    some line ``u = const`` (:func:`_crossed_twice`). A closed loop, as around a bump,
+    is crossed twice both ways: the halvings are not tried."""
+    return all(_crossed_twice(s, centre, normal))
+
+
+def _flat_directions(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
+                     ) -> tuple[bool, bool]:
+    """Per direction (u, v): some Bézier patch near the plane has every control-height
+    difference along it within ``tol``. Halving a span halves such differences (the
+    new ones are halved convex combinations of the old) and one half stays near the
+    plane, so the rule, which needs every difference over ``tol``, cannot hold in
+    that direction whatever the refinement (the circles of a torus cut normal to
+    its axis: its heights do not change along them at all)."""
+    patches, _, _ = bezier_patches(s)                      # (ku, kv, p+1, q+1, 4)
+    h = (patches[..., :3] / patches[..., 3:]) @ normal - float(centre @ normal)
+    near = (h.min(axis=(2, 3)) <= tol) & (h.max(axis=(2, 3)) >= -tol)
+    out = []
+    for axis in (2, 3):
+        d = np.abs(np.diff(h, axis=axis))
+        out.append(bool(d.shape[axis] > 0 and np.any(near & (d <= tol).all(axis=(2, 3)))))
+    return out[0], out[1]
 
 
 def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float

@@ -210,3 +210,25 @@ def test_loops_refuse_the_monotone_rule_without_halving():
     assert prefilter._turns_both_ways(bumps, np.array([0, 0, top - 0.01]), up)
     assert no_loop_reason(bumps, horizontal_plane(top - 0.01), tol=TOL) is None
     assert not prefilter._turns_both_ways(sloped_sheet(), np.array([0, 0, 0.3]), up)
+
+
+def test_a_torus_cut_normal_to_its_axis_is_refused_without_halving(monkeypatch):
+    """A torus cut just below its top by a plane normal to its axis: its heights do
+    not change along the circles (a near patch flat along u within tol: halvings only
+    halve those differences) and lines across the tube cross the plane twice, so the
+    monotone rule is refused from the net as it is (it used to be tried on three
+    halvings first); the answer is None (the certificate looks) as before."""
+    from char_surfaces import torus_and_plane
+    from surfprep.algorithms.characteristic import prefilter
+    torus, plane = torus_and_plane(1e-6)
+    centre, normal = plane.evaluate(0.5, 0.5), np.array([0.0, 0.0, 1.0])
+    flat = prefilter._flat_directions(torus, centre, normal, TOL)
+    twice = prefilter._crossed_twice(torus, centre, normal)
+    assert all(f or t for f, t in zip(flat, twice)) and any(flat)
+    halvings = []
+    monkeypatch.setattr(prefilter, "_halved", lambda s: halvings.append(s) or s)
+    assert no_loop_reason(torus, plane, tol=TOL) is None
+    assert halvings == []
+    # a sloped sheet is flat in no direction (its heights rise by more than tol)
+    assert prefilter._flat_directions(sloped_sheet(), np.array([0, 0, 0.3]), normal, TOL) \
+        == (False, False)
