@@ -131,6 +131,14 @@ def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, to
             det = 1e-300
         step0 = (k11 * f0 - k01 * f1) / det
         step1 = (k00 * f1 - k01 * f0) / det
+        # a coordinate held at a side of the clip box while the step pushes it out:
+        # Newton in the other one alone (the coupled step, clipped, converges slowly)
+        hold_s = (s0 >= hi[0] and step0 > 0) or (s0 <= lo[0] and step0 < 0)
+        hold_t = (t0 >= hi[1] and step1 > 0) or (t0 <= lo[1] and step1 < 0)
+        if hold_s:
+            step0, step1 = 0.0, (0.0 if hold_t else f1 / max(k11, 1e-300))
+        elif hold_t:
+            step0, step1 = f0 / max(k00, 1e-300), 0.0
         scale = max(abs(step0) / quarter[0], abs(step1) / quarter[1], 1.0)
         n0 = min(max(s0 + step0 / scale, lo[0]), hi[0])
         n1 = min(max(t0 + step1 / scale, lo[1]), hi[1])

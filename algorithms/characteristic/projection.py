@@ -275,6 +275,12 @@ class Projector:
             mdet = m00 * m11 - m01 ** 2
             mdet = np.where(np.abs(mdet) > 1e-300, mdet, 1e-300)
             step = np.stack([m11 * f0 - m01 * f1, m00 * f1 - m01 * f0], -1) / mdet[:, None]
+            # a coordinate held at a side of the clip box while the step pushes it out:
+            # Newton in the other one alone (as the compiled kernel)
+            held = ((sa >= hi) & (step > 0)) | ((sa <= lo) & (step < 0))
+            alone = np.stack([f0 / np.maximum(m00, 1e-300), f1 / np.maximum(m11, 1e-300)], -1)
+            step = np.where(held[:, ::-1] & ~held, alone, step)
+            step[held] = 0.0
             # limit a step to a quarter of the domain (far seeds must not jump around)
             scale = np.max(np.abs(step) / quarter, axis=1)
             step /= np.maximum(scale, 1.0)[:, None]

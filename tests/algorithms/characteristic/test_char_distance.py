@@ -194,3 +194,26 @@ def test_parallelogram_projection_in_closed_form_matches_newton():
     n = np.array([1.0, 2.0, 2.0]) / 3.0
     off = (pts - closed.foot)[closed.regular]
     np.testing.assert_allclose(np.linalg.norm(np.cross(off, n), axis=1), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_a_foot_held_at_the_clip_box_is_the_closest_point_along_it(compiled, monkeypatch):
+    """Points far beyond q's side: Newton holds s at the side of the clip box (domain
+    and extension) and moves t alone, so the foot is the closest point of that line,
+    ``(r - q) . q_t = 0`` (the coupled step, clipped, crept to another point and ran
+    its 30 steps: 897 of 1089 grid points of the sheets crossing at 5e-3 rad); ten
+    steps from the domain's middle reach it, compiled and numpy alike."""
+    from char_surfaces import flat_crossing
+    from surfprep.algorithms.characteristic import kernels
+    from surfprep.algorithms.characteristic.projection import EXTENSION
+    if not compiled:
+        monkeypatch.setattr(kernels, "AVAILABLE", False)
+    a, b = flat_crossing(5e-3)
+    pts = b.evaluate(np.full(40, 0.5), np.linspace(0.05, 0.95, 40)) + [2.0, 0.0, 0.0]
+    for steps in (10, 30):
+        res = Projector(a, tol=1e-12, max_iter=steps).project(pts, np.tile([0.5, 0.5], (40, 1)))
+        held = np.isclose(res.st[:, 0], 1.0 + EXTENSION) | np.isclose(res.st[:, 0], -EXTENSION)
+        assert held.all() and (res.status == ProjectionStatus.NONE).all()
+        d = a.derivatives(res.st[:, 0], res.st[:, 1], 1)
+        along = np.einsum("ij,ij->i", pts - d[:, 0, 0], d[:, 0, 1])
+        assert np.abs(along).max() <= 1e-9 * np.linalg.norm(d[:, 0, 1], axis=1).max()
