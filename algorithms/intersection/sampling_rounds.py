@@ -286,19 +286,21 @@ def _graded(dt: NDArray, pieces: NDArray, cut: NDArray, closed: bool, can: NDArr
     n = pieces.astype(np.float64)
     has_cut = ~np.isnan(cut)
     fixed = has_cut | ~can
-    cut = np.where(has_cut, cut, 0.5)
+    any_cut = bool(has_cut.any())
+    head, tail = (np.where(has_cut, cut * dt, 0.0), np.where(has_cut, (1 - cut) * dt, 0.0)) \
+        if any_cut else (None, None)
+    wrap = np.inf
     for _ in range(_GRADE_PASSES):
-        first = np.where(has_cut, cut * dt, dt / n)
-        last = np.where(has_cut, (1 - cut) * dt, dt / n)
-        before = np.roll(last, 1)
-        after = np.roll(first, -1)
-        if not closed:
-            before[0] = after[-1] = np.inf
-        need = np.minimum(np.ceil(dt / (_MAX_RATIO * np.minimum(before, after))), _MAX_GRADED)
-        grow = ~fixed & (need > n)
+        first = last = dt / n
+        if any_cut:
+            first, last = np.where(has_cut, head, first), np.where(has_cut, tail, last)
+        before = np.concatenate(([last[-1] if closed else wrap], last[:-1]))
+        after = np.concatenate((first[1:], [first[0] if closed else wrap]))
+        need = np.ceil(dt / (_MAX_RATIO * np.minimum(before, after)))
+        grow = (need > n) & ~fixed
         if not grow.any():
             break
-        n[grow] = need[grow]
+        n[grow] = np.minimum(need[grow], _MAX_GRADED)
     return n.astype(np.int64)
 
 
@@ -427,31 +429,33 @@ def verification_round(works: list[_Work], surface_a, surface_b, target: float, 
             if w.error <= tol:                  # within the contract all the same
                 w.result = check
             continue
-        pieces = _pieces(error, target)
-        taken, covered = _middle_samples(w, bad, pieces, span_of, ends, arc)
         t = check.t
         dt = np.diff(t)
         planned = np.ones(dt.size, dtype=np.int64)
-        planned[bad[~covered]] = pieces[~covered]
         cut = np.full(dt.size, np.nan)
+        if bad.size == 0 and off.size == 0 and not np.any(_graded(dt, planned, cut, w.closed,
+                                                                  can) > 1):
+            w.done = True
+            w.result = check
+            continue
+        pieces = _pieces(error, target)
+        taken, covered = _middle_samples(w, bad, pieces, span_of, ends, arc)
+        planned[bad[~covered]] = pieces[~covered]
         for idx in (off, taken):                 # spans split at a kept dense sample
             j = span_of[idx]
             a0, a1 = arc[ends[j]], arc[ends[j + 1]]
             cut[j] = (arc[idx] - a0) / np.where(a1 > a0, a1 - a0, 1.0)
         split = _graded(dt, planned, cut, w.closed, can)
-        if off.size == 0 and taken.size == 0 and not np.any(split > 1):
-            w.done = True
-            w.result = check
-            continue
         w.kept[off] = True
         w.fresh[off] = True
         w.kept[taken] = True
         w.fresh[taken] = True
         span = np.flatnonzero(split > 1)
         if span.size:
-            count = np.repeat(split[span], split[span] - 1)
-            local = np.concatenate([np.arange(1, n) for n in split[span]])
-            span = np.repeat(span, split[span] - 1)
+            inner = split[span] - 1                     # new samples per span
+            count = np.repeat(split[span], inner)
+            local = np.arange(inner.sum()) - np.repeat(np.cumsum(inner) - inner, inner) + 1
+            span = np.repeat(span, inner)
             jobs.append((w, ends[span], ends[span + 1], t[span] + local / count * dt[span]))
             curves.append(check)
     if not jobs:
