@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
+from .creases import CreasePieces
 from .curve import NurbsCurve
 from .projection import (
     _MIN_SAMPLES,
@@ -25,7 +26,6 @@ from .projection import (
     _check_count,
     _check_points,
     _pick_seeds,
-    _Pieces,
     _sample_counts,
     _seed_grid,
     _solve,
@@ -87,7 +87,7 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
     max_iter = _check_count(max_iter, "max_iter", 1)
     n_seeds = _check_count(n_seeds, "n_seeds", 1)
     lo, hi = (np.array([x]) for x in curve.domain)
-    pieces = _Pieces([curve.knots], [curve.degree])
+    pieces = CreasePieces([curve.knots], [curve.degree])
     if guess is not None:
         x0 = np.asarray(guess, dtype=float)
         if x0.shape != shape or not np.all(np.isfinite(x0)):

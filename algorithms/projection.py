@@ -42,8 +42,10 @@ and Newton's step solves ``H delta = -grad f``. The method, for all points at on
    crease starts on both sides; a problem that stops on a crease with
    descent on the other side continues in the neighbouring piece; grid
    neighbours across a crease do not count in the local-minimum test of
-   the seeds. A foot exactly on a crease is reported ``1e-13`` of the
-   parameter range before it when reached from below.
+   the seeds; a foot within ``_CREASE_REACH`` of its piece's width from a
+   crease is sought again from the crease's other side (the basin there may
+   have no seed). A foot exactly on a crease is reported ``1e-13`` of the
+   parameter range before it when reached from below (:mod:`.creases`).
 5. The best result over the seeds of each query is returned.
 
 Curves are the same with one parameter (``r . C'`` and ``|C'|^2 + r . C''``).
@@ -66,6 +68,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import InvalidGeometryError
 from .basis import distinct_knots
+from .creases import CreasePieces
 from .surface import NurbsSurface
 from .tolerance import check_tolerance
 
@@ -85,7 +88,8 @@ _MAX_HALVINGS = 30
 _SAMPLE_BUDGET = 200_000
 _CANDIDATES = 24
 _MAX_CROSSINGS = 8
-_NUDGE = 1e-13
+#: a foot this share of its piece's width from a crease is sought across it too
+_CREASE_REACH = 0.02
 _MIN_SAMPLES = 256      # grid intervals per surface direction, at least
 
 
@@ -398,76 +402,7 @@ def _minimize(local: Callable, value: Callable, targets: NDArray, x0: NDArray, l
 
 
 # ------------------------------------------------------------------- creases
-class _Pieces:
-    """The domain cut along knot lines of multiplicity >= degree (where the first
-    derivatives may jump): per parameter, ``edges`` = domain ends and crease values.
-
-    Newton works inside one piece (its box); a piece's upper bound is moved
-    ``_NUDGE`` of the domain width below the crease, so that evaluation there
-    uses the piece's own polynomial (evaluation at a knot takes the right side).
-    """
-
-    def __init__(self, knot_vectors: list[NDArray], degrees: list[int]):
-        self.edges = []
-        for knots, p in zip(knot_vectors, degrees):
-            values, mult = distinct_knots(knots, p)
-            inner = values[1:-1][mult[1:-1] >= p]
-            self.edges.append(np.concatenate([values[:1], inner, values[-1:]]))
-        self.nudge = np.array([_NUDGE * (e[-1] - e[0]) for e in self.edges])
-
-    def index(self, x: NDArray) -> NDArray:
-        """Piece of each parameter: (m, k) int."""
-        return np.stack([np.clip(np.searchsorted(e, x[:, i], side="right") - 1, 0, e.size - 2)
-                         for i, e in enumerate(self.edges)], axis=1)
-
-    def bounds(self, piece: NDArray) -> tuple[NDArray, NDArray]:
-        lo = np.stack([e[piece[:, i]] for i, e in enumerate(self.edges)], axis=1)
-        hi = np.stack([np.where(piece[:, i] + 2 < e.size, e[piece[:, i] + 1] - self.nudge[i],
-                                e[piece[:, i] + 1]) for i, e in enumerate(self.edges)], axis=1)
-        return lo, hi
-
-    def axis_index(self, axis: int, values: NDArray) -> NDArray:
-        """Piece of parameter values along one axis: (s,) int."""
-        e = self.edges[axis]
-        return np.clip(np.searchsorted(e, values, side="right") - 1, 0, e.size - 2)
-
-    def split_seeds(self, rows: NDArray, x0: NDArray) -> tuple[NDArray, NDArray]:
-        """Seeds on a crease start on both of its sides (a local minimum may hide on
-        either): duplicated rows and start points."""
-        for i, e in enumerate(self.edges):
-            on = np.isin(x0[:, i], e[1:-1])
-            extra = x0[on].copy()
-            extra[:, i] -= self.nudge[i]
-            rows, x0 = np.concatenate([rows, rows[on]]), np.concatenate([x0, extra])
-        return rows, x0
-
-    def crossings(self, local: Callable, x: NDArray, targets: NDArray, piece: NDArray
-                  ) -> tuple[NDArray, NDArray, NDArray]:
-        """Problems stopped on a crease with descent on its other side.
-
-        Returns the mask (m,), their new pieces (m, k) and start points (m, k).
-        """
-        lo, hi = self.bounds(piece)
-        count = np.array([e.size - 1 for e in self.edges])
-        up = (x >= hi) & (piece + 1 < count)
-        down = (x <= lo) & (piece > 0)
-        moved = np.where(up, piece + 1, np.where(down, piece - 1, piece))
-        new_lo, new_hi = self.bounds(moved)
-        start = np.where(up, new_lo, np.where(down, new_hi, x))
-        candidates = np.flatnonzero((up | down).any(axis=1))
-        if candidates.size == 0:          # surfaces cannot evaluate 0 points
-            return np.zeros(x.shape[0], dtype=bool), piece, x
-        f, jac, _ = local(start[candidates])
-        gradient = np.einsum("md,mdk->mk", f - targets[candidates], jac)
-        descend = (up[candidates] & (gradient < 0)) | (down[candidates] & (gradient > 0))
-        cross = np.zeros(x.shape[0], dtype=bool)
-        cross[candidates] = descend.any(axis=1)
-        keep = np.zeros_like(up)
-        keep[candidates] = descend
-        return cross, np.where(keep, moved, piece), np.where(keep, start, x)
-
-
-def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, pieces: _Pieces,
+def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, pieces: CreasePieces,
            tol: float, max_iter: int):
     """:func:`_minimize` piece by piece: a problem that ends on a crease with descent
     beyond it continues in the neighbouring piece (up to ``_MAX_CROSSINGS`` times)."""
@@ -486,6 +421,16 @@ def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, piec
         todo = todo[better]
         x[todo], points[todo], distance[todo] = xr[better], pr[better], dr[better]
         converged[todo], piece[todo] = cr[better], moved[better]
+    # a foot in a valley just beside a crease may hide a lower one just across it
+    # (the seeds' grid can miss that basin): started from the crease's other side too
+    todo, moved, start = pieces.beside(x, piece, _CREASE_REACH)
+    if todo.size:
+        xr, pr, dr, cr = _minimize(local, value, targets[todo], start, *pieces.bounds(moved),
+                                   tol, max_iter)
+        better = dr < distance[todo]
+        todo = todo[better]
+        x[todo], points[todo], distance[todo] = xr[better], pr[better], dr[better]
+        converged[todo] = cr[better]
     return x, points, distance, converged
 
 
@@ -545,7 +490,7 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
     n_seeds = _check_count(n_seeds, "n_seeds", 1)
     u0, u1, v0, v1 = surface.domain
     lo, hi = np.array([u0, v0]), np.array([u1, v1])
-    pieces = _Pieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
+    pieces = CreasePieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
     if guess is not None:
         x0 = np.asarray(guess, dtype=float)
         if x0.shape != shape + (2,) or not np.all(np.isfinite(x0)):
@@ -566,7 +511,7 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
 
 
 def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
-                   samples_per_span: int | None, pieces: _Pieces) -> tuple[NDArray, NDArray]:
+                   samples_per_span: int | None, pieces: CreasePieces) -> tuple[NDArray, NDArray]:
     def build():
         net = surface.control_points
         extents = [_span_extents(net, surface.knots_u, surface.degree_u),
