@@ -59,7 +59,7 @@ from .points import (
 )
 from .poles import pole_contacts
 from .projection import ProjectionStatus, Projector
-from .ridges import Ridge, ridge_starts, trace_ridges
+from .ridges import Ridge, ridge_refiner, ridge_starts, trace_ridges
 from .starts import (
     Start,
     away_from,
@@ -465,8 +465,14 @@ def _inside_region(curve: IntersectionCurve, regions: Sequence[CoincidentRegion]
 def tangential_curves(analysis: CharacteristicAnalysis, tol: float) -> list[IntersectionCurve]:
     """The ridges with ``|phi| <= tol`` all along (tangential contact along a curve,
     :mod:`.ridges`) as intersection curves."""
-    traced = [ridge.curve for ridge in analysis.ridges if ridge.is_tangential(tol)]
-    return [c for c in to_intersection_curves(analysis.field, traced, tol) if c is not None]
+    out = []
+    ridges = [r for r in analysis.ridges if r.is_tangential(tol)]
+    for kind in dict.fromkeys(r.curve.kind for r in ridges):       # new samples on the ridge
+        traced = [r.curve for r in ridges if r.curve.kind is kind]
+        out += [c for c in to_intersection_curves(analysis.field, traced, tol,
+                                                  refiner=ridge_refiner(analysis.field, kind))
+                if c is not None]
+    return out
 
 
 def _along(curves: Sequence[IntersectionCurve], tangential: Sequence[IntersectionCurve],

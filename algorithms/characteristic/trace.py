@@ -328,32 +328,34 @@ def _dense_trace(field: DistanceField, traced: TracedCurve, tol: float
     return RefinedCurve(pts, ua, ub, closed, flags, ~flags), kinds
 
 
-def _sampled(dense: list, a, b, tol: float) -> list:
+def _sampled(dense: list, a, b, tol: float, refiner=None) -> list:
     """``(curve or None, largest check error)`` per dense curve: all sampled in one
     batch (:func:`..intersection.result.checked_curves`); a batch that fails is
     sampled curve by curve, so one bad curve costs only itself."""
     try:
         curves, worst = _result.checked_curves([d for d, _ in dense], [k for _, k in dense],
-                                               a, b, tol=tol, aligned=True)
+                                               a, b, tol=tol, aligned=True, refiner=refiner)
         return list(zip(curves, worst))
     except InvalidGeometryError:
         if len(dense) == 1:
             return [(None, float("nan"))]
-    return [_sampled([d], a, b, tol)[0] for d in dense]
+    return [_sampled([d], a, b, tol, refiner)[0] for d in dense]
 
 
 def to_intersection_curves(field: DistanceField, traced: list[TracedCurve], tol: float, *,
-                           within_tol: bool = False) -> list[IntersectionCurve | None]:
+                           within_tol: bool = False, refiner=None
+                           ) -> list[IntersectionCurve | None]:
     """Traced ``phi = 0`` curves refined to ``tol`` (module docstring), sampled in one
     batch; None for a curve too short, and with ``within_tol`` for one whose
     interpolants stray beyond ``tol`` (measured only where the sampling's own check did
     not pass). A curve whose check found a span over ``tol`` gets refined midpoints
-    there (a few rounds)."""
+    there (a few rounds). ``refiner``: how new samples are put on the curve
+    (:func:`..intersection.sampling.cubic_samples`; e.g. :func:`.ridges.ridge_refiner`)."""
     a, b = field.pair()
     dense = [_dense_trace(field, t, tol) for t in traced]
     live = [i for i, d in enumerate(dense) if d is not None]
     out: list[IntersectionCurve | None] = [None] * len(traced)
-    for i, (curve, worst) in zip(live, _sampled([dense[i] for i in live], a, b, tol)
+    for i, (curve, worst) in zip(live, _sampled([dense[i] for i in live], a, b, tol, refiner)
                                  if live else []):
         if curve is not None and not worst <= tol:     # NaN: not verified as sampled
             for _ in range(_SPLIT_ROUNDS):

@@ -36,6 +36,7 @@ from .interpolants import (
 )
 from .refine import RefinedCurve, project_points, refine_curves
 from .sampling import cubic_samples
+from .sampling_rounds import Refiner
 from .topology import Chain, EndKind, SegmentTopology
 
 __all__ = [
@@ -229,18 +230,19 @@ def sampled_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKin
 
 def checked_curves(refined: Sequence[RefinedCurve], kinds: Sequence[tuple[EndKind, EndKind]],
                    surface_a: NurbsSurface, surface_b: NurbsSurface, *, tol: float,
-                   simplify: bool = True, max_rounds: int = 40, aligned: bool = False
-                   ) -> tuple[list[IntersectionCurve], NDArray]:
+                   simplify: bool = True, max_rounds: int = 40, aligned: bool = False,
+                   refiner: Refiner | None = None) -> tuple[list[IntersectionCurve], NDArray]:
     """:func:`sampled_curves` and each curve's largest deviation ``(c,) float`` (as
     :meth:`IntersectionCurve.max_deviation` measures it: at a quarter, the midpoint
     and three quarters of every span), taken from the sampling's last check
     where it passed, measured otherwise. A curve collapsed onto a point is left
     out, or, with ``aligned``, given as None (deviation NaN), so that the output
-    lines up with ``refined``."""
+    lines up with ``refined``. ``refiner``: as in :func:`.sampling.cubic_samples`."""
     out, worst = [], []
+    extra = {} if refiner is None else {"refiner": refiner}
     for sampled, (start, end) in zip(cubic_samples(surface_a, surface_b, refined, tol=tol,
-                                                   simplify=simplify, max_rounds=max_rounds),
-                                     kinds):
+                                                   simplify=simplify, max_rounds=max_rounds,
+                                                   **extra), kinds):
         if sampled is None:                    # collapsed onto a point
             if aligned:
                 out.append(None)

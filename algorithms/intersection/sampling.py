@@ -56,6 +56,7 @@ from .sampling_rounds import (
     _MIDDLE,
     _POINT_SHARE,
     CHECK_FRACTIONS,
+    Refiner,
     _Work,
     verification_round,
 )
@@ -289,7 +290,8 @@ class SampledCurve:
 def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
                   curves: Sequence[RefinedCurve], *, tol: float, share: float = CUBIC_SHARE,
                   simplify: bool = True, max_rounds: int = 40,
-                  tangent_sin: float = 1e-6) -> list[RefinedCurve]:
+                  tangent_sin: float = 1e-6, refiner: Refiner = refine_points
+                  ) -> list[RefinedCurve]:
     """The samples the cubic interpolants of refined curves need (module docstring).
 
     Parameters
@@ -309,6 +311,11 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         Verification rounds at most.
     tangent_sin : float
         As in :func:`.refine.refine_points`.
+    refiner : callable
+        Puts new samples on the curve: ``refiner(surface_a, surface_b, uv_a, uv_b,
+        tol=, anchors=, tangent_sin=) -> RefinedPoints``, by default
+        :func:`.refine.refine_points` (a tangential curve, where the surfaces
+        touch and points within tol of both form a band, needs its own).
 
     Returns
     -------
@@ -334,8 +341,8 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
                             np.concatenate([p for _, (_, p) in planned]))
         anchors = at[:, :3]
-        new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
-                            anchors=anchors, tangent_sin=tangent_sin)
+        new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
+                      anchors=anchors, tangent_sin=tangent_sin)
         # a sample that slid along the curve (near-tangential surfaces) is left out
         moved = np.linalg.norm(new.points - anchors, axis=1)
     works, offset = [], 0
@@ -355,7 +362,7 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
                              new.singular[sl][ok])
         works.append(_merged_work(c, t, pos[ok], part))
     for _ in range(max_rounds):
-        verification_round(works, surface_a, surface_b, target, tol, tangent_sin)
+        verification_round(works, surface_a, surface_b, target, tol, tangent_sin, refiner)
         if all(w.done for w in works):
             break
     out = []

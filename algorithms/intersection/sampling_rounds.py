@@ -10,6 +10,7 @@ dense sample nearest their middle or new refined samples (all curves in one
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,10 +18,14 @@ from numpy.typing import NDArray
 
 from ..curve import NurbsCurve
 from .interpolants import sample_parameters
-from .refine import refine_points
+from .refine import RefinedPoints, refine_points
 from .splines import SplineSet, interpolate_many
 
-__all__ = ["CHECK_FRACTIONS", "verification_round"]
+__all__ = ["CHECK_FRACTIONS", "Refiner", "verification_round"]
+
+#: ``refiner(surface_a, surface_b, uv_a, uv_b, *, tol, anchors, tangent_sin)``: new
+#: samples put on the curve (:func:`.refine.refine_points` or a tangential curve's own)
+Refiner = Callable[..., RefinedPoints]
 
 #: where every span is checked (fractions of the span)
 CHECK_FRACTIONS = (0.25, 0.5, 0.75)
@@ -404,7 +409,7 @@ def _middle_samples(w: _Work, bad: NDArray, pieces: NDArray, span_of: NDArray, e
 
 
 def verification_round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
-           tangent_sin: float) -> None:
+                       tangent_sin: float, refiner: Refiner = refine_points) -> None:
     """One verification round over all unfinished curves (module docstring, step 2)."""
     todo = [w for w in works if not w.done]
     checks = _checks(todo, tol)
@@ -463,8 +468,8 @@ def verification_round(works: list[_Work], surface_a, surface_b, target: float, 
     at = curves[0].curves.evaluate(np.concatenate([np.full(j[3].size, c.index)
                                                    for j, c in zip(jobs, curves)]),
                                    np.concatenate([j[3] for j in jobs]))
-    new = refine_points(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
-                        anchors=at[:, :3], tangent_sin=tangent_sin)
+    new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
+                  anchors=at[:, :3], tangent_sin=tangent_sin)
     offset = 0
     for w, start, stop, _ in jobs:
         sl = slice(offset, offset + start.size)
