@@ -331,6 +331,12 @@ def span_patches(surface: NurbsSurface, span_u: ArrayLike, span_v: ArrayLike) ->
     net = pw[rows[:, :, None], cols[:, None, :]]                      # (k, p+1, q+1, d+1)
     ku = surface.knots_u[iu[:, None] - p + np.arange(2 * p + 2)]
     kv = surface.knots_v[iv[:, None] - q + np.arange(2 * q + 2)]
+    if tessellation_kernels.AVAILABLE:          # the same de Boor triangles, compiled
+        net = tessellation_kernels.blossom_spans(np.ascontiguousarray(net, dtype=float),
+                                                 np.ascontiguousarray(ku, dtype=float), p)
+        net = tessellation_kernels.blossom_spans(np.ascontiguousarray(np.swapaxes(net, 1, 2)),
+                                                 np.ascontiguousarray(kv, dtype=float), q)
+        return np.swapaxes(net, 1, 2)
     net = _blossom_spans(net, ku, p)
     return np.swapaxes(_blossom_spans(np.swapaxes(net, 1, 2), kv, q), 1, 2)
 

@@ -10,6 +10,8 @@ hundred multiply-adds that numpy spends in temporaries and per-call overhead.
   chords), the same formulas in the same order;
 * :func:`restricted_boxes`: the control-net boxes of Bézier patches restricted to
   sub-rectangles (the blossoms of :func:`.culling._blossom_restrict` in u, then v);
+* :func:`blossom_spans`: the Bernstein coefficients of single knot spans (the de Boor
+  triangles of :func:`.culling._blossom_spans`, the same steps in the same order);
 * :func:`any_overlap`: which boxes come near any leaf of a box tree (the pruning test
   of :func:`.tessellation._near`, without listing the pairs);
 * :func:`query_pairs`: the overlapping pairs of :func:`.culling.candidate_pairs` with a
@@ -25,8 +27,8 @@ from numpy.typing import NDArray
 
 from ..basis_kernels import AVAILABLE, _ders_one, _jit
 
-__all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "chord_errors_from_grid",
-           "grid_points", "query_pairs", "restricted_boxes"]
+__all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "blossom_spans",
+           "chord_errors_from_grid", "grid_points", "query_pairs", "restricted_boxes"]
 
 
 @_jit
@@ -321,3 +323,28 @@ def query_pairs(tree, boxes: NDArray, pad: float) -> NDArray:
                             np.ascontiguousarray(boxes, dtype=float), float(pad), 2 * tree.depth + 4)
     pairs = pairs[:k]
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+
+
+@_jit
+def blossom_spans(net, knots, p):
+    """``(k, p + 1, m, c)``: the Bernstein coefficients along axis 1 of the knot spans
+    ``[knots[s, p], knots[s, p + 1]]`` from their poles ``net (k, p + 1, m, c)``;
+    coefficient ``i`` is the blossom ``f(a^{p-i}, b^i)`` (:func:`.culling._blossom_spans`)."""
+    k, _, m, c = net.shape
+    out = np.empty((k, p + 1, m, c))
+    work = np.empty(p + 1)
+    for s in range(k):
+        a, b = knots[s, p], knots[s, p + 1]
+        for i in range(p + 1):
+            for j in range(m):
+                for ch in range(c):
+                    for t in range(p + 1):
+                        work[t] = net[s, t, j, ch]
+                    for r in range(1, p + 1):
+                        x = a if r <= p - i else b
+                        for t in range(p + 1 - r):
+                            lo, hi = knots[s, r + t], knots[s, p + 1 + t]
+                            alpha = (x - lo) / (hi - lo)
+                            work[t] = (1.0 - alpha) * work[t] + alpha * work[t + 1]
+                    out[s, i, j, ch] = work[0]
+    return out

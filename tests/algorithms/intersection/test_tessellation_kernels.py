@@ -124,3 +124,21 @@ def test_grid_points_bitwise_equal_to_scattered_evaluation(surface):
         surface.knots_u, surface.knots_v, surface.degree_u, surface.degree_v,
         surface.homogeneous_points(), u, v, su, sv, surface.weights is not None)
     np.testing.assert_array_equal(grid, surface.evaluate(u[:, :, None], v[:, None, :]))
+
+
+@pytest.mark.parametrize("surface", [sphere_band(1.5), _bumpy()], ids=["rational", "bicubic"])
+def test_compiled_span_patches_are_the_bezier_patches(monkeypatch, surface):
+    """culling.span_patches by the compiled blossoms equals its numpy form bitwise and
+    the global Bézier decomposition (bezier_patches) to rounding."""
+    from surfprep.algorithms.bezier import bezier_patches
+    from surfprep.algorithms.intersection.culling import _spans, span_patches
+    p, q = surface.degree_u, surface.degree_v
+    su = _spans(surface.knots_u, p, surface.n_control[0])
+    sv = _spans(surface.knots_v, q, surface.n_control[1])
+    flat = np.random.default_rng(3).permutation(su.size * sv.size)
+    compiled = span_patches(surface, su[flat // sv.size], sv[flat % sv.size])
+    monkeypatch.setattr(tessellation_kernels, "AVAILABLE", False)
+    reference = span_patches(surface, su[flat // sv.size], sv[flat % sv.size])
+    np.testing.assert_array_equal(compiled, reference)
+    whole = bezier_patches(surface)[0].reshape(-1, p + 1, q + 1, 4)[flat]
+    np.testing.assert_allclose(compiled, whole, rtol=0, atol=1e-13 * np.abs(whole).max())
