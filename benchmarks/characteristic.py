@@ -18,7 +18,7 @@ Per pair, in one run:
 
 Branches found are counted against the truth of each construction (curves whose
 ends meet count as one branch; an isolated contact point is reported apart).
-Times are the best of ``REPEAT`` runs.
+Times are the best of ``REPEAT`` runs, the four methods interleaved.
 
 Run:  python benchmarks/characteristic.py        (prints a markdown table)
 """
@@ -59,7 +59,7 @@ from surfprep.algorithms.projection import distance_to_surface
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
 
 TOL = 1e-9
-REPEAT = 3
+REPEAT = 5
 
 
 def bumps_level() -> float:
@@ -108,16 +108,20 @@ def cases():
     return out
 
 
-def best(fn):
-    value, elapsed = None, np.inf
+def best(*fns):
+    """``[(value, best time)]`` of each function, the runs interleaved (one of each per
+    repetition, ``REPEAT`` times): this shared machine's speed drifts by tens of per
+    cent over seconds, and a ratio of two bests taken a minute apart drifts with it."""
+    values, elapsed = [None] * len(fns), [np.inf] * len(fns)
     for _ in range(REPEAT):
-        start = time.perf_counter()
-        try:
-            value = fn()
-        except Exception as exc:  # noqa: BLE001 - the row says what failed
-            value = exc
-        elapsed = min(elapsed, time.perf_counter() - start)
-    return value, elapsed
+        for i, fn in enumerate(fns):
+            start = time.perf_counter()
+            try:
+                values[i] = fn()
+            except Exception as exc:  # noqa: BLE001 - the row says what failed
+                values[i] = exc
+            elapsed[i] = min(elapsed[i], time.perf_counter() - start)
+    return list(zip(values, elapsed))
 
 
 def branches(curves) -> int | str:
@@ -145,11 +149,12 @@ def auto_run(a, b):
 def run_case(name, a, b, truth, contacts):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        mesh, t_mesh = best(lambda: intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP))
-        char, _t_char = best(lambda: characteristic_intersection(a, b, tol=TOL))
-        auto, t_auto = best(lambda: auto_run(a, b))
+        (mesh, t_mesh), (char, _t_char), (auto, t_auto), (occ, t_occ) = best(
+            lambda: intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP),
+            lambda: characteristic_intersection(a, b, tol=TOL),
+            lambda: auto_run(a, b),
+            lambda: intersect_surfaces_occ(a, b, TOL))
         cert, t_cert = auto
-        occ, t_occ = best(lambda: intersect_surfaces_occ(a, b, TOL))
     row = {
         "case": name, "truth": truth, "contacts": contacts,
         "mesh": branches(mesh), "t_mesh": t_mesh,
