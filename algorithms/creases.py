@@ -19,7 +19,6 @@ __all__ = ["NUDGE", "CreasePieces"]
 
 #: a piece's upper bound lies this share of the domain width below its crease
 NUDGE = 1e-13
-_NUDGE = NUDGE
 
 
 class CreasePieces:
@@ -27,7 +26,7 @@ class CreasePieces:
     derivatives may jump): per parameter, ``edges`` = domain ends and crease values.
 
     Newton works inside one piece (its box); a piece's upper bound is moved
-    ``_NUDGE`` of the domain width below the crease, so that evaluation there
+    ``NUDGE`` of the domain width below the crease, so that evaluation there
     uses the piece's own polynomial (evaluation at a knot takes the right side).
     """
 
@@ -37,7 +36,7 @@ class CreasePieces:
             values, mult = distinct_knots(knots, p)
             inner = values[1:-1][mult[1:-1] >= p]
             self.edges.append(np.concatenate([values[:1], inner, values[-1:]]))
-        self.nudge = np.array([_NUDGE * (e[-1] - e[0]) for e in self.edges])
+        self.nudge = np.array([NUDGE * (e[-1] - e[0]) for e in self.edges])
 
     def index(self, x: NDArray) -> NDArray:
         """Piece of each parameter: (m, k) int."""

@@ -150,7 +150,7 @@ def ridge_refiner(field: DistanceField, kind: CurveKind):
         x, jet, ok = _correct(field, kind, np.asarray(uv, dtype=float),
                               np.asarray(st, dtype=float), np.full(uv.shape[0], -1),
                               1e-12 * field.diagonal)
-        foot = field.q.evaluate(jet.st[:, 0], jet.st[:, 1])
+        foot = jet.projection.foot
         gap = np.linalg.norm(jet.point - foot, axis=1)
         ok &= (jet.status == ProjectionStatus.UNIQUE) & (gap <= tol)
         ua, ub = (jet.st, x) if field.swapped else (x, jet.st)

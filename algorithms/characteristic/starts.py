@@ -186,12 +186,13 @@ def settle(field: DistanceField, start: Start) -> tuple[Start, NDArray]:
     return Start(x, jet.st, start.scale, start.group), ok
 
 
-def _on_trace(uv: NDArray, trace: TracedCurve) -> bool:
-    """True when ``uv (2,)`` lies on the traced polyline in the parameter plane: within
-    the sag of one of its chords, ``length * turn / 4`` (twice the sag of an arc
-    turning by ``turn``, the larger of the chord's angles with its neighbours),
-    plus ``1e-6`` of the chord for rounding. Two curves close side by side (the
-    circles of a torus just below a plane, 1e-3 of a chord apart) stay apart."""
+def _on_trace(uv: NDArray, trace: TracedCurve) -> NDArray:
+    """``(m,) bool``: which of ``uv (m, 2)`` lie on the traced polyline in the parameter
+    plane: within the sag of one of its chords, ``length * turn / 4`` (twice the sag
+    of an arc turning by ``turn``, the larger of the chord's angles with its
+    neighbours), plus ``1e-6`` of the chord for rounding. Two curves close side by
+    side (the circles of a torus just below a plane, 1e-3 of a chord apart) stay
+    apart."""
     p = trace.uv
     q = np.vstack([p, p[:1]]) if trace.closed else p
     a, d = q[:-1], np.diff(q, axis=0)
@@ -206,9 +207,11 @@ def _on_trace(uv: NDArray, trace: TracedCurve) -> bool:
     else:
         bend = np.maximum(np.append(turn[:1], turn), np.append(turn, turn[-1:])) \
             if turn.size else np.zeros(length.size)
-    t = np.clip(np.einsum("sc,sc->s", uv - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
-    gap = np.linalg.norm(a + t[:, None] * d - uv, axis=1)
-    return bool(np.any(gap <= length * (0.25 * bend + 1e-6) + 1e-14))
+    uv = np.atleast_2d(uv)
+    t = np.clip(np.einsum("msc,sc->ms", uv[:, None] - a[None], d) / np.where(dd > 0, dd, 1.0),
+                0.0, 1.0)                                          # (m, chords)
+    gap = np.linalg.norm(a[None] + t[..., None] * d[None] - uv[:, None], axis=-1)
+    return np.any(gap <= length * (0.25 * bend + 1e-6) + 1e-14, axis=1)
 
 
 def _sine(field: DistanceField, uv: NDArray, st: NDArray) -> NDArray:
@@ -240,8 +243,8 @@ def trace_uncovered(field: DistanceField, starts: Start, known: list[Intersectio
         todo = todo[curve_gap(pts, list(known), within=cover) > cover]
     traces: list[TracedCurve] = []
     for _ in range(MAX_TRACE_ROUNDS):
-        todo = todo[[not any(_on_trace(uv[i], t) for t in traces) for i in todo]] \
-            if traces else todo
+        for t in traces:                      # one test of all starts per trace
+            todo = todo[~_on_trace(uv[todo], t)] if todo.size else todo
         if todo.size == 0:
             break
         # one start per group and round (several starts of one loop trace once; the
@@ -250,7 +253,7 @@ def trace_uncovered(field: DistanceField, starts: Start, known: list[Intersectio
         batch = todo[np.sort(first)]
         for t in trace_intersections(field, uv[batch], st[batch], scale[batch], tol=tol,
                                      branches=True):
-            if not any(_on_trace(t.uv[t.uv.shape[0] // 2], k) for k in traces):
+            if not any(_on_trace(t.uv[t.uv.shape[0] // 2], k)[0] for k in traces):
                 traces.append(t)                          # (a loop traced twice: once)
         todo = np.setdiff1d(todo, batch)
     # all traces sampled in one batch
