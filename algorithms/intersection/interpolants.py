@@ -2,7 +2,7 @@
 the 3D curve and both pcurves (000 §29.4.6), and their deviation from the surfaces.
 
 :func:`interpolate_samples` is the C2 cubic (:func:`fitting.interpolate_curve`;
-a closed sequence gets a C1 Bessel closure); :func:`interpolate_stacked` builds
+a closed sequence gets a C1 closure); :func:`interpolate_stacked` builds
 several on one parametrization with one collocation solve; :func:`span_errors`
 measures ``|S_a(pcurve_a) - curve3d|``, ``|S_b(pcurve_b) - curve3d|`` and
 ``|S_a - S_b|`` at given parameters of every span.
@@ -37,7 +37,7 @@ def interpolate_samples(values: ArrayLike, parameters: ArrayLike, closed: bool) 
         A closed sequence does not repeat its first sample.
     parameters : (n,) float, or (n + 1,) float when closed
     closed : bool
-        Closed: the first sample is appended, with a C1 (Bessel) closure when
+        Closed: the first sample is appended, with a C1 closure when
         there are at least 4 samples.
 
     Returns

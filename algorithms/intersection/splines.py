@@ -3,7 +3,7 @@
 The sampling rounds of :mod:`.sampling` interpolate every unfinished curve
 (:func:`.interpolants.interpolate_samples`: the C2 cubic of
 :func:`fitting.interpolate_curve` on the chord-length parameters, a closed
-curve with its C1 Bessel closure) and evaluate the interpolants at check points
+curve with its C1 closure) and evaluate the interpolants at check points
 and in Newton projections. Per curve that is a collocation solve, a validated
 :class:`NurbsCurve` and several small evaluations, whose fixed costs dominate
 when curves have a few hundred samples. :func:`interpolate_many` builds the same
@@ -28,7 +28,7 @@ from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..basis import basis_derivatives, find_span
 from ..basis_kernels import AVAILABLE, _ders_one, _jit
 from ..curve import NurbsCurve
-from ..fitting import _bessel_tangent, _solve_banded_rows, averaged_knots, knots_from_breakpoints
+from ..fitting import _seam_tangent, _solve_banded_rows, averaged_knots, knots_from_breakpoints
 from .interpolants import interpolate_samples
 
 __all__ = ["SplineSet", "interpolate_many"]
@@ -115,8 +115,8 @@ def _evaluate_many(knots, knot_start, control, control_start, degree, index, t, 
 def _rows(q: NDArray, t: NDArray, closed: bool) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Collocation rows of one cubic interpolant (as :func:`fitting.interpolate_curve`
     builds them): ``cols, values (N, 4)``, ``rhs (N, d)`` and the knots."""
-    if closed:                  # C1 closure: D_0 = D_{n-1} by Bessel's rule (eqs. 9.19-9.21)
-        tangent = _bessel_tangent(q, t)
+    if closed:                  # C1 closure: D_0 = D_{n-1}, the seam tangent (eqs. 9.19-9.21)
+        tangent = _seam_tangent(q, t)
         knots = knots_from_breakpoints(t, 3, end_condition="clamped")
         span = find_span(knots, 3, t)
         values = basis_derivatives(knots, 3, t, 0, span)[0][:, 0]

@@ -170,6 +170,25 @@ def test_closed_points_close_and_smooth_closure_is_c1():
     assert np.abs(smooth.evaluate(t) - points).max() <= 1e-13
 
 
+
+def test_smooth_closure_is_as_accurate_at_the_seam_as_inside():
+    """The seam tangent of a closed interpolant is of the quartic through five samples
+    (fourth-order accurate): on an ellipse sampled evenly from a seam where its
+    curvature changes fastest, the spans at the seam are off the true curve by no
+    more than the worst interior span (measured 0.29 of it). Bessel's parabola
+    (second order) left them 7.3 times worse."""
+    angle = 0.7 + np.linspace(0.0, 2 * np.pi, 40)
+    points = np.c_[np.cos(angle), 0.6 * np.sin(angle)]
+    points[-1] = points[0]
+    t = chord_length_parameters(points)
+    curve = interpolate_curve(points, parameters=t, smooth_closure=True)
+    fine = np.linspace(0.0, 1.0, 40001)
+    x, y = curve.evaluate(fine).T          # distance to the ellipse, F / |grad F| (first order)
+    dist = np.abs(x ** 2 + (y / 0.6) ** 2 - 1) / np.hypot(2 * x, 2 * y / 0.36)
+    span = np.clip(np.searchsorted(t, fine, side="right") - 1, 0, t.size - 2)
+    seam = (span <= 1) | (span >= t.size - 3)
+    assert dist[seam].max() <= dist[~seam].max()
+
 # ------------------------------------------------------------------- surfaces
 @settings(max_examples=30, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(1, 5), st.integers(1, 5), st.integers(0, 4),
