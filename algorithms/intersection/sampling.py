@@ -17,7 +17,9 @@ of a curve (each within ``tol / 16`` of both surfaces):
 1. an initial subset spaced ``h(s) = (384 share tol / kappa^3)^(1/4)`` along
    the curve, ``kappa`` the discrete (Menger) curvature of the 3D samples and
    of both parameter-space polylines (scaled to model units), the ends always
-   kept (a closed curve keeps at least four samples);
+   kept (a closed curve keeps at least four samples), graded at the crossings of
+   C1 knot lines and with a sample on each crossing of a C2 knot line
+   (:mod:`.crossings`);
 2. rounds of verification: every span of the interpolants is checked at a
    quarter, the midpoint and three quarters on both exact surfaces
    (``|S_a(pcurve_a(t)) - curve3d(t)|``, ``|S_b(pcurve_b(t)) - curve3d(t)|``
@@ -44,7 +46,7 @@ from numpy.typing import NDArray
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from . import vectors
-from .crossings import c1_knots, crossing_chords, crossing_positions
+from .crossings import c1_knots, c2_knots, crossing_chords, crossing_positions, on_c2_crossings
 from .interpolants import (
     interpolate_samples,
     interpolate_stacked,
@@ -199,13 +201,14 @@ def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
     Returns ``(t, positions)``: the dense chord-length parameters ``t`` and the
     interior parameters where samples should go, equally many cubic spans apart (at
     least four spans on a closed curve), on the interpolant through all dense samples;
-    graded towards the crossings of C1 knot lines (:mod:`.crossings`) when ``knots``
-    gives ``(c1_knots(a), c1_knots(b), domain_a, domain_b)``.
+    graded towards the crossings of C1 knot lines and with a sample on those of C2
+    knot lines (:mod:`.crossings`) when ``knots`` gives ``(c1_knots(a), c1_knots(b),
+    domain_a, domain_b, c2_knots(a), c2_knots(b))``.
     """
     if knots is not None and fourth is not None and fourth.size:
         # the jump at a C1 knot line shows as a large fourth derivative on the chords
         # round it; the graded zone of :mod:`.crossings` takes care of those instead
-        near = crossing_chords(curve.uv_a, curve.uv_b, t, *knots, curve.closed)
+        near = crossing_chords(curve.uv_a, curve.uv_b, t, *knots[:4], curve.closed)
         if near.size:
             near = (near[:, None] + np.arange(-_KINK_REACH, _KINK_REACH + 1)[None, :]).ravel()
             near = np.mod(near, fourth.size) if curve.closed else \
@@ -229,6 +232,8 @@ def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
         positions = crossing_positions(positions, t, regular, stacked, curve.uv_a, curve.uv_b,
                                        knots[0], knots[1], knots[2], knots[3], curve.closed,
                                        target)
+        positions = on_c2_crossings(positions, t, curve.uv_a, curve.uv_b, knots[4], knots[5],
+                                    knots[2], knots[3], curve.closed)
     return t, positions
 
 
@@ -333,7 +338,8 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         dense = interpolate_many([np.hstack([curves[i].points, curves[i].uv_a, curves[i].uv_b])
                                   for i in live], [plans[i] for i in live],
                                  [curves[i].closed for i in live])
-        knots = (c1_knots(surface_a), c1_knots(surface_b), surface_a.domain, surface_b.domain)
+        knots = (c1_knots(surface_a), c1_knots(surface_b), surface_a.domain, surface_b.domain,
+                 c2_knots(surface_a), c2_knots(surface_b))
         for i in live:
             plans[i] = _resample_targets(curves[i], plans[i], target,
                                          _fourth_derivatives(curves[i], plans[i]), knots)
