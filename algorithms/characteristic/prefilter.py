@@ -48,6 +48,7 @@ from ..intersection.culling import (
     exact_patch_boxes,
     patch_rectangles,
     span_hull_boxes,
+    surface_patch_boxes,
     surface_tree,
     tree_pairs,
 )
@@ -82,8 +83,7 @@ def _apart(a: NurbsSurface, b: NurbsSurface, tol: float) -> bool:
     extracted only for the candidate pairs, so a large surface far from most of the
     other costs little."""
     if patch_rectangles(a).shape[0] * patch_rectangles(b).shape[0] <= _DIRECT_PAIRS:     # small nets: all pairs at once
-        ba = a.patch_bounding_boxes()[0].reshape(-1, 2, a.dimension)
-        bb = b.patch_bounding_boxes()[0].reshape(-1, 2, b.dimension)
+        ba, bb = surface_patch_boxes(a)[0], surface_patch_boxes(b)[0]
         return not bool(np.all((ba[:, None, 0] <= bb[None, :, 1] + tol)
                                & (bb[None, :, 0] <= ba[:, None, 1] + tol), axis=-1).any())
     pairs = tree_pairs(surface_tree(a), surface_tree(b), pad=tol)
@@ -157,9 +157,10 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     s = _near_part(s, centre, normal, tol)
     if s is None:                                      # no span comes near the plane
         return True
-    hopeless = [t or f for t, f in zip(_crossed_twice(s, centre, normal),
-                                       _flat_directions(s, centre, normal, tol))]
-    if all(hopeless):
+    crossed = _crossed_twice(s, centre, normal)
+    if all(crossed):                                   # a loop, as around a bump
+        return False
+    if all(c or f for c, f in zip(crossed, _flat_directions(s, centre, normal, tol))):
         return False
     for level in range(REFINEMENTS + 1):
         if _monotone_patches(s, centre, normal, tol):

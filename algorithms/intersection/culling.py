@@ -26,7 +26,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
-from ..bezier import patch_bounding_boxes
 from ..surface import NurbsSurface
 from . import tessellation_kernels
 
@@ -544,9 +543,13 @@ def surface_patch_boxes(surface: NurbsSurface) -> tuple[NDArray, NDArray]:
     boxes : (ku * kv, 2, 3) float
     rects : (ku * kv, 4) float
         Patch ``(i, j)`` at flat index ``i * kv + j``.
+
+    The same boxes as :func:`surfprep.algorithms.bezier.patch_bounding_boxes`, by
+    :func:`exact_patch_boxes` on every patch (its span extraction is compiled:
+    about half the time).
     """
-    boxes, _, _ = patch_bounding_boxes(surface)
-    return boxes.reshape(-1, 2, boxes.shape[-1]), patch_rectangles(surface)
+    rects = patch_rectangles(surface)
+    return exact_patch_boxes(surface, np.arange(rects.shape[0])), rects
 
 
 def overlap_boxes(boxes_a: ArrayLike, boxes_b: ArrayLike, *, pad: float = 0.0

@@ -182,10 +182,12 @@ def test_span_hulls_exact_boxes_and_grid_tree(seed, rational):
         grid_tree,
         span_hull_boxes,
     )
+    from surfprep.algorithms.bezier import patch_bounding_boxes
     s = random_bspline(np.random.default_rng(seed), 9, 7, rational)
-    exact, _ = surface_patch_boxes(s)                        # whole Bezier decomposition
+    exact = patch_bounding_boxes(s)[0].reshape(-1, 2, 3)     # whole Bezier decomposition
     np.testing.assert_allclose(exact_patch_boxes(s, np.arange(exact.shape[0])), exact,
                                atol=1e-12)
+    np.testing.assert_allclose(surface_patch_boxes(s)[0], exact, atol=1e-12)
     hull = span_hull_boxes(s).reshape(-1, 2, 3)
     assert hull.shape == exact.shape
     assert np.all(hull[:, 0] <= exact[:, 0] + 1e-12) and np.all(hull[:, 1] >= exact[:, 1] - 1e-12)
