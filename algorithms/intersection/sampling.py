@@ -15,8 +15,9 @@ tol)^(1/4)`` samples: 80 on the unit circle at 1e-7, 450 at 1e-10.
 of a curve (each within ``tol / 16`` of both surfaces):
 
 1. an initial subset spaced ``h(s) = (384 share tol / kappa^3)^(1/4)`` along
-   the curve, ``kappa`` the discrete (Menger) curvature of the 3D samples and
-   of both parameter-space polylines (scaled to model units), the ends always
+   the curve, ``kappa^3`` the larger of the discrete (Menger) curvature of the
+   3D samples cubed and the fourth derivative of the checked errors estimated
+   from the dense samples (through the surfaces' Jacobians), the ends always
    kept (a closed curve keeps at least four samples), graded at the crossings of
    C1 knot lines and with a sample on each crossing of a C2 knot line
    (:mod:`.crossings`);
@@ -85,7 +86,9 @@ _SPACING = 0.8
 #: weight of the measured fourth derivative against kappa^3 (a divided difference over
 #: five dense samples smooths the peaks of the true one; measured on the benchmark
 #: pairs: bumpy bicubic x plane 4 -> 2 rounds at 1e-7 and 7 -> 3 at 1e-10, with fewer
-#: samples, against 0.41; the rational surfaces' cuts take 20-35 % more samples)
+#: samples, against 0.41; the rational surfaces' cuts take 20-35 % more samples). With
+#: the checked errors' estimate through the Jacobians, 1.5 and 4 gave the same rounds
+#: on the 26 benchmark cuts within one either way (-8 % / +9 % samples)
 _FOURTH_WEIGHT = 2.5
 #: the fourth-derivative estimate is ignored this many dense chords round a C1 knot-line
 #: crossing (five-sample windows reach that far)
@@ -115,12 +118,10 @@ def _menger(points: NDArray, closed: bool) -> NDArray:
     return kappa
 
 
-def _scaled(uv: NDArray, points: NDArray) -> NDArray:
-    """``uv (n, 2)`` scaled to model units by the median ratio of 3D to uv chords."""
-    duv = np.linalg.norm(np.diff(uv, axis=0), axis=1)
-    dp = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    ok = duv > 0
-    return uv * (float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0)
+def pcurve_jacobians(surface: NurbsSurface, uv: NDArray) -> NDArray:
+    """``(n, 3, 2)``: ``[S_u, S_v]`` of ``surface`` at ``uv (n, 2)``."""
+    d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
+    return np.stack([d[:, 1, 0], d[:, 0, 1]], axis=-1)
 
 
 def _scale(uv: NDArray, points: NDArray) -> float:
@@ -131,18 +132,38 @@ def _scale(uv: NDArray, points: NDArray) -> float:
     return float(np.median(dp[ok] / duv[ok])) if np.any(ok) else 1.0
 
 
-def _fourth_derivatives(curve: RefinedCurve, t: NDArray) -> NDArray:
-    """Fourth derivative estimate ``(chords,)`` of the stacked curve
-    ``(points | uv_a | uv_b)`` per dense chord, in model units (the parameter-space
-    parts scaled by :func:`_scale`): 24 times the fourth divided difference over the
-    chord-length parameters ``t`` of every five consecutive dense samples (wrapping
-    round a closed curve; ``f[t_i, ..., t_i+4] = f^(4)(xi) / 24``), given to the two
-    middle chords of the five and the larger taken per chord.
+def _fourth_derivatives(curve: RefinedCurve, t: NDArray,
+                        jacobians: tuple[NDArray, NDArray]) -> NDArray:
+    """Fourth derivative estimate ``(chords,)`` of the checked errors per dense chord.
+
+    The checks (:mod:`.sampling_rounds`) measure ``S_a(pcurve_a) - curve3d``,
+    ``S_b(pcurve_b) - curve3d`` and ``S_a - S_b``. Interpolation is linear, so
+    with ``E`` the interpolation error of the C2 cubic and ``J`` a surface's
+    Jacobian (frozen over a few samples) the first is ``J E[uv] - E[C] =
+    -E[C - J uv]``, of order ``h^4`` times the fourth derivative of ``C - J uv``:
+    what the pcurve shares with ``curve3d`` cancels (on a plane ``C - J uv`` is
+    constant and the check error vanishes at any spacing), and what remains is
+    the 3D error the surface's curvature adds. Here ``d4 = 24 f[t_i..t_i+4]``
+    of every five consecutive dense samples (the divided difference is the
+    fourth derivative at some point over 24; wrapping round a closed curve) for
+    ``C`` and for both ``uv``; per window the largest of ``|d4 C - J_a d4
+    uv_a|``, ``|d4 C - J_b d4 uv_b|``, ``|J_a d4 uv_a - J_b d4 uv_b|`` (``J``
+    at the window's middle sample), given to the two middle chords of the
+    window and the larger taken per chord.
+
+    A scalar scale of the pcurves instead (the median ratio of 3D to
+    parameter chords) took every pcurve's own fourth derivative for error: on a
+    sphere, whose parametrization turns a small circle into a 4:1 ellipse, 2.3
+    times the samples the circle needs, every span at 1 % of its target.
 
     Where a surface's parametrization is only C1 (the knot lines of converted
     rational surfaces) the pcurve's second derivative jumps and this estimate is
     large on the chords next to the crossing, so the first subset is already
-    denser there instead of rounds of splitting finding it out."""
+    denser there instead of rounds of splitting finding it out.
+
+    ``jacobians``: ``(n, 3, 2)`` of each surface at the dense samples
+    (:func:`pcurve_jacobians`).
+    """
     pts, closed = curve.points, curve.closed
     chords = t.size - 1
     out = np.zeros(chords)
@@ -155,9 +176,11 @@ def _fourth_derivatives(curve: RefinedCurve, t: NDArray) -> NDArray:
     dd = values
     for k in range(1, 5):
         dd = np.diff(dd, axis=0) / (t[k:] - t[:-k])[:, None]
-    weights = (1.0, _scale(curve.uv_a, pts), _scale(curve.uv_b, pts))
-    f4 = 24.0 * np.maximum.reduce([w * np.linalg.norm(dd[:, a:b], axis=1)
-                                   for w, (a, b) in zip(weights, ((0, 3), (3, 5), (5, 7)))])
+    middle = (np.arange(dd.shape[0]) + 2) % pts.shape[0]
+    on_a = np.einsum("nij,nj->ni", jacobians[0][middle], dd[:, 3:5])
+    on_b = np.einsum("nij,nj->ni", jacobians[1][middle], dd[:, 5:7])
+    f4 = 24.0 * np.maximum.reduce([np.linalg.norm(d, axis=1) for d in
+                                   (dd[:, :3] - on_a, dd[:, :3] - on_b, on_a - on_b)])
     for shift in (1, 2):       # window i covers chords i .. i + 3: the middle ones
         idx = np.arange(f4.size) + shift
         np.maximum.at(out, idx % chords if closed else idx, f4)
@@ -170,11 +193,11 @@ def _spacing_phase(curve: RefinedCurve, t: NDArray, target: float,
                    fourth: NDArray | None = None) -> NDArray:
     """Cumulative number of cubic spans needed ``(len(t),)`` at the dense samples:
     the integral of ``(f4 / (384 target))^(1/4)`` along the chord lengths ``t``,
-    ``f4`` the larger of ``kappa^3`` (Menger curvature of the 3D and parameter-space
-    polylines) and ``fourth (chords,)`` (:func:`_fourth_derivatives`)."""
-    pts, closed = curve.points, curve.closed
-    kappa = np.maximum.reduce([_menger(pts, closed), _menger(_scaled(curve.uv_a, pts), closed),
-                               _menger(_scaled(curve.uv_b, pts), closed)])
+    ``f4`` the larger of ``kappa^3`` (Menger curvature of the 3D polyline: the
+    divided differences of five dense samples smooth a peak of the true fourth
+    derivative, the curvature of three does not) and ``fourth (chords,)``
+    (:func:`_fourth_derivatives`)."""
+    kappa = _menger(curve.points, curve.closed)
     ds = np.diff(t)
     k_chord = np.maximum(kappa, np.roll(kappa, -1))[: ds.size]
     f4 = np.maximum(k_chord, 0.0) ** 3
@@ -235,6 +258,18 @@ def _resample_targets(curve: RefinedCurve, t: NDArray, target: float,
         positions = on_c2_crossings(positions, t, curve.uv_a, curve.uv_b, knots[4], knots[5],
                                     knots[2], knots[3], curve.closed)
     return t, positions
+
+
+def _dense_jacobians(surface_a: NurbsSurface, surface_b: NurbsSurface,
+                     curves: Sequence[RefinedCurve]) -> list[tuple[NDArray, NDArray]]:
+    """Per curve ``(J_a, J_b)``, each ``(n, 3, 2)``, at its dense samples (one
+    evaluation per surface for all curves)."""
+    if not curves:
+        return []
+    split = np.cumsum([c.points.shape[0] for c in curves])[:-1]
+    jac_a = pcurve_jacobians(surface_a, np.concatenate([c.uv_a for c in curves]))
+    jac_b = pcurve_jacobians(surface_b, np.concatenate([c.uv_b for c in curves]))
+    return list(zip(np.split(jac_a, split), np.split(jac_b, split)))
 
 
 def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _Work:
@@ -340,9 +375,10 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
                                  [curves[i].closed for i in live])
         knots = (c1_knots(surface_a), c1_knots(surface_b), surface_a.domain, surface_b.domain,
                  c2_knots(surface_a), c2_knots(surface_b))
-        for i in live:
+        jacobians = _dense_jacobians(surface_a, surface_b, [curves[i] for i in live])
+        for i, jac in zip(live, jacobians):
             plans[i] = _resample_targets(curves[i], plans[i], target,
-                                         _fourth_derivatives(curves[i], plans[i]), knots)
+                                         _fourth_derivatives(curves[i], plans[i], jac), knots)
         planned = [(curves[i], plans[i]) for i in live]
         at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
                             np.concatenate([p for _, (_, p) in planned]))
