@@ -316,6 +316,17 @@ def _edge_count(surface: NurbsSurface) -> int:
     return max(EDGE_SAMPLES, 4 * spans + 1)
 
 
+def side_jets(field: DistanceField) -> tuple[list[tuple[int, float, NDArray]], DistanceJet]:
+    """The four sides of ``r``'s domain (:func:`edge_samples`, :func:`_edge_count` samples
+    each) and ``phi``'s jet at all of them, side after side: one batch, computed once
+    per field (the border points and the side roots of ``phi_u``, ``phi_v`` read the
+    same samples)."""
+    if "sides" not in field._cache:
+        sides = edge_samples(field.lower, field.upper, _edge_count(field.r))
+        field._cache["sides"] = (sides, field.jet(np.concatenate([uv for _, _, uv in sides])))
+    return field._cache["sides"]
+
+
 def edge_roots(field: DistanceField, component: int, iterations: int = 6, noise: float = 0.0
                ) -> tuple[NDArray, NDArray, NDArray]:
     """Roots of ``phi_u`` (``component`` 0) or ``phi_v`` (1) on the sides of ``r``'s domain.
@@ -333,10 +344,9 @@ def edge_roots(field: DistanceField, component: int, iterations: int = 6, noise:
     side : (k,) int
         The held coordinate of each root's side (0: a side ``u = const``).
     """
-    count = _edge_count(field.r)
     brackets = []
-    sides = edge_samples(field.lower, field.upper, count)
-    every = field.jet(np.concatenate([uv for _, _, uv in sides]))      # one batch, 4 sides
+    sides, every = side_jets(field)
+    count = sides[0][2].shape[0]
     for n, (coord, _, uv) in enumerate(sides):
         rows = slice(n * count, (n + 1) * count)
         g = every.grad[rows, component]
@@ -444,18 +454,20 @@ def border_points(fields: tuple[DistanceField, DistanceField], tol: float
     b = fields[0].q
     starts_a, starts_b, on_b, coords, values = [], [], [], [], []
     for field in fields:
-        count = _edge_count(field.r)
-        for coord, value, uv in edge_samples(field.lower, field.upper, count):
-            jet = field.jet(uv)
-            ok = jet.status != ProjectionStatus.NONE
-            f = jet.phi
+        sides, every = side_jets(field)
+        count = sides[0][2].shape[0]
+        for n, (coord, value, uv) in enumerate(sides):
+            rows = slice(n * count, (n + 1) * count)
+            st_side = every.st[rows]
+            ok = every.status[rows] != ProjectionStatus.NONE
+            f = every.phi[rows]
             k = np.flatnonzero(ok[:-1] & ok[1:] & ((np.sign(f[:-1]) != np.sign(f[1:]))
                                                    | (np.abs(f[:-1]) <= tol)))
             if k.size == 0:
                 continue
             w = f[k] / np.where(f[k] != f[k + 1], f[k] - f[k + 1], 1.0)
             uv0 = uv[k] + np.clip(w, 0, 1)[:, None] * (uv[k + 1] - uv[k])
-            ua, ub = field.ab(uv0, jet.st[k])
+            ua, ub = field.ab(uv0, st_side[k])
             starts_a.append(ua)
             starts_b.append(ub)
             on_b.append(np.full(k.size, field.swapped))
