@@ -83,12 +83,8 @@ def test_no_zone_on_a_c2_surface():
     np.testing.assert_array_equal(out, positions)
 
 
-@pytest.mark.parametrize("tol", [1e-7, 1e-10])
-def test_sphere_cut_needs_few_rounds_and_stays_within_half_tol_densely(tol, monkeypatch):
-    """A circle of latitude on the rational sphere crosses four C1 knot lines (a seam
-    among them): with the zones in place the first subset passes after at most two
-    verification rounds (a round that splits, one that checks), and the interpolants
-    lie within tol / 2 of both surfaces at 40 points per span."""
+def counted_rounds(monkeypatch) -> list:
+    """A list that gets one entry per verification round of the cubic sampling."""
     rounds = []
     original = sampling_module.verification_round
 
@@ -97,6 +93,16 @@ def test_sphere_cut_needs_few_rounds_and_stays_within_half_tol_densely(tol, monk
         return original(*args, **kwargs)
 
     monkeypatch.setattr(sampling_module, "verification_round", counted)
+    return rounds
+
+
+@pytest.mark.parametrize("tol", [1e-7, 1e-10])
+def test_sphere_cut_needs_few_rounds_and_stays_within_half_tol_densely(tol, monkeypatch):
+    """A circle of latitude on the rational sphere crosses four C1 knot lines (a seam
+    among them): with the zones in place the first subset passes after at most two
+    verification rounds (a round that splits, one that checks), and the interpolants
+    lie within tol / 2 of both surfaces at 40 points per span."""
+    rounds = counted_rounds(monkeypatch)
     plane, sphere = plane_z(0.3), sphere_band(1.0)
     (curve,) = intersect_surfaces(plane, sphere, tol=tol)
     assert len(rounds) <= 2
@@ -172,14 +178,7 @@ def test_bicubic_cut_has_samples_on_its_knot_lines_and_passes_in_few_rounds(tol,
     every crossing of pcurve_a has a kept sample within 1e-3 of a knot span from it,
     and the curves stay within tol densely."""
     from test_ssi_pipeline import bumpy, check_on_surfaces, flat
-    rounds = []
-    original = sampling_module.verification_round
-
-    def counted(*args, **kwargs):
-        rounds.append(1)
-        return original(*args, **kwargs)
-
-    monkeypatch.setattr(sampling_module, "verification_round", counted)
+    rounds = counted_rounds(monkeypatch)
     a, b = bumpy(20), flat(0.2)
     curves = intersect_surfaces(a, b, tol=tol)
     assert len(curves) == 4 and len(rounds) <= 2
