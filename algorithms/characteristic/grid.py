@@ -48,37 +48,42 @@ class StageGrid:
     crossing_sine: float
 
 
-def _normal_spread(surface: NurbsSurface, n: int = 9) -> float:
-    """Largest angle (radians) between the normals on an ``n x n`` grid and their mean."""
-    d = surface.domain
-    g = surface.derivatives_grid(np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n), 1)
-    normal = np.cross(g[:, :, 1, 0], g[:, :, 0, 1]).reshape(-1, 3)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
-    mean = normal.mean(axis=0)
-    mean /= max(np.linalg.norm(mean), 1e-300)
-    return float(np.arccos(np.clip(normal @ mean, -1, 1)).max())
+@dataclass(frozen=True, eq=False)
+class _Coarse:
+    """An ``n x n`` grid over a surface's domain: ``params (n*n, 2)``, ``points (n*n, 3)``
+    and unit ``normals (n*n, 3)`` (one evaluation for the field choice's two tests)."""
+
+    params: NDArray
+    points: NDArray
+    normals: NDArray
+
+    @classmethod
+    def of(cls, surface: NurbsSurface, n: int = 9) -> _Coarse:
+        d = surface.domain
+        u, v = np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)
+        g = surface.derivatives_grid(u, v, 1)
+        normal = np.cross(g[:, :, 1, 0], g[:, :, 0, 1]).reshape(-1, 3)
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        params = np.stack(np.meshgrid(u, v, indexing="ij"), -1).reshape(-1, 2)
+        return cls(params, g[:, :, 0, 0].reshape(-1, 3), normal)
+
+    def spread(self) -> float:
+        """Largest angle (radians) between the normals and their mean."""
+        mean = self.normals.mean(axis=0)
+        mean /= max(np.linalg.norm(mean), 1e-300)
+        return float(np.arccos(np.clip(self.normals @ mean, -1, 1)).max())
 
 
-def _coarse_grid(surface: NurbsSurface, n: int) -> tuple[NDArray, NDArray]:
-    """``(params (n*n, 2), points (n*n, 3))`` of an ``n x n`` grid over the domain."""
-    d = surface.domain
-    u, v = np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)
-    params = np.stack(np.meshgrid(u, v, indexing="ij"), -1).reshape(-1, 2)
-    return params, surface.evaluate_grid(u, v).reshape(-1, 3)
+def _coverage(points: NDArray, seeds: NDArray, projector: Projector) -> float:
+    """Share of ``points (m, 3)`` whose feet on ``q``, by Newton from ``seeds (m, 2)``,
+    lie in ``q``'s domain.
 
-
-def _coverage(r: NurbsSurface, projector: Projector, n: int = 9) -> float:
-    """Share of an ``n x n`` grid of ``r`` whose feet on ``q`` lie in ``q``'s domain.
-
-    Newton starts from the nearest node of an ``n x n`` grid of ``q`` (all pairs:
-    ``n^4`` distances), not from the projector's seed tree: in the certificate's
-    route the projector that is not chosen is never used again, and building its
-    tree of ``(4 spans + 1)^2`` nodes cost more than the whole estimate.
+    The seeds are the nearest nodes of a coarse grid of ``q`` (:class:`_Coarse`),
+    not the projector's seed tree: in the certificate's route the projector that
+    is not chosen is never used again, and building its tree of ``(4 spans + 1)^2``
+    nodes cost more than the whole estimate.
     """
-    _, pts = _coarse_grid(r, n)
-    params, nodes = _coarse_grid(projector.surface, n)
-    nearest = np.argmin(((pts[:, None] - nodes[None]) ** 2).sum(-1), axis=1)
-    return float(np.mean(projector.project(pts, params[nearest]).status != ProjectionStatus.NONE))
+    return float(np.mean(projector.project(points, seeds).status != ProjectionStatus.NONE))
 
 
 def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | None = None
@@ -94,11 +99,14 @@ def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | 
         raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
     proj_b, proj_a = Projector(b, tol=tol * 1e-3), Projector(a, tol=tol * 1e-3)
     if phi_on is None:
-        cover_ab, cover_ba = _coverage(a, proj_b), _coverage(b, proj_a)
+        grid_a, grid_b = _Coarse.of(a), _Coarse.of(b)
+        d2 = ((grid_a.points[:, None] - grid_b.points[None]) ** 2).sum(-1)   # both ways
+        cover_ab = _coverage(grid_a.points, grid_b.params[np.argmin(d2, axis=1)], proj_b)
+        cover_ba = _coverage(grid_b.points, grid_a.params[np.argmin(d2, axis=0)], proj_a)
         if abs(cover_ab - cover_ba) > 0.1:
             phi_on = "a" if cover_ab > cover_ba else "b"
         else:
-            phi_on = "a" if _normal_spread(b) <= _normal_spread(a) else "b"
+            phi_on = "a" if grid_b.spread() <= grid_a.spread() else "b"
     field = DistanceField(a, proj_b, False) if phi_on == "a" else DistanceField(b, proj_a, True)
     # the other role (border points) reuses the other projector instead of building it again
     field._cache["other_projector"] = proj_a if phi_on == "a" else proj_b
