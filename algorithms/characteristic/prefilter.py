@@ -171,7 +171,7 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     return False
 
 
-#: samples per knot span of the necessary-condition check (:func:`_turns_both_ways`)
+#: samples per knot span of the necessary-condition check (:func:`_crossed_twice`)
 _TURN_SAMPLES = 4
 
 
@@ -190,13 +190,6 @@ def _crossed_twice(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray
     sign = np.sign(h)
     return (bool(np.any(np.count_nonzero(sign[1:] * sign[:-1] < 0, axis=0) >= 2)),
             bool(np.any(np.count_nonzero(sign[:, 1:] * sign[:, :-1] < 0, axis=1) >= 2)))
-
-
-def _turns_both_ways(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray) -> bool:
-    """True when some sampled line ``v = const`` crosses the plane twice, and so does
-    some line ``u = const`` (:func:`_crossed_twice`). A closed loop, as around a bump,
-    is crossed twice both ways: the halvings are not tried."""
-    return all(_crossed_twice(s, centre, normal))
 
 
 def _flat_directions(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float

@@ -118,7 +118,7 @@ def _menger(points: NDArray, closed: bool) -> NDArray:
     return kappa
 
 
-def pcurve_jacobians(surface: NurbsSurface, uv: NDArray) -> NDArray:
+def _pcurve_jacobians(surface: NurbsSurface, uv: NDArray) -> NDArray:
     """``(n, 3, 2)``: ``[S_u, S_v]`` of ``surface`` at ``uv (n, 2)``."""
     d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
     return np.stack([d[:, 1, 0], d[:, 0, 1]], axis=-1)
@@ -162,7 +162,7 @@ def _fourth_derivatives(curve: RefinedCurve, t: NDArray,
     denser there instead of rounds of splitting finding it out.
 
     ``jacobians``: ``(n, 3, 2)`` of each surface at the dense samples
-    (:func:`pcurve_jacobians`).
+    (:func:`_pcurve_jacobians`).
     """
     pts, closed = curve.points, curve.closed
     chords = t.size - 1
@@ -267,8 +267,8 @@ def _dense_jacobians(surface_a: NurbsSurface, surface_b: NurbsSurface,
     if not curves:
         return []
     split = np.cumsum([c.points.shape[0] for c in curves])[:-1]
-    jac_a = pcurve_jacobians(surface_a, np.concatenate([c.uv_a for c in curves]))
-    jac_b = pcurve_jacobians(surface_b, np.concatenate([c.uv_b for c in curves]))
+    jac_a = _pcurve_jacobians(surface_a, np.concatenate([c.uv_a for c in curves]))
+    jac_b = _pcurve_jacobians(surface_b, np.concatenate([c.uv_b for c in curves]))
     return list(zip(np.split(jac_a, split), np.split(jac_b, split)))
 
 

@@ -201,15 +201,15 @@ def test_apart_equals_all_pairs_of_bezier_boxes(shift, poles):
 
 def test_loops_refuse_the_monotone_rule_without_halving():
     """A plane through bumps cuts closed loops, each crossed twice by lines of both
-    directions: prefilter._turns_both_ways says so from one sample grid (no span
+    directions: prefilter._crossed_twice says so, both ways, from one sample grid (no span
     halvings); a sloped sheet, crossed once per line, is not refused that way."""
     from surfprep.algorithms.characteristic import prefilter
     up = np.array([0.0, 0.0, 1.0])
     bumps = several_bumps()
     top = bumps.evaluate(0.5, 0.72)[2]
-    assert prefilter._turns_both_ways(bumps, np.array([0, 0, top - 0.01]), up)
+    assert all(prefilter._crossed_twice(bumps, np.array([0, 0, top - 0.01]), up))
     assert no_loop_reason(bumps, horizontal_plane(top - 0.01), tol=TOL) is None
-    assert not prefilter._turns_both_ways(sloped_sheet(), np.array([0, 0, 0.3]), up)
+    assert not all(prefilter._crossed_twice(sloped_sheet(), np.array([0, 0, 0.3]), up))
 
 
 def test_a_torus_cut_normal_to_its_axis_is_refused_without_halving(monkeypatch):
@@ -219,6 +219,7 @@ def test_a_torus_cut_normal_to_its_axis_is_refused_without_halving(monkeypatch):
     monotone rule is refused from the net as it is (it used to be tried on three
     halvings first); the answer is None (the certificate looks) as before."""
     from char_surfaces import torus_and_plane
+
     from surfprep.algorithms.characteristic import prefilter
     torus, plane = torus_and_plane(1e-6)
     centre, normal = plane.evaluate(0.5, 0.5), np.array([0.0, 0.0, 1.0])
