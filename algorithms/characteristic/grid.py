@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from ..surface import NurbsSurface
 from .crossing import grid_crossing_sine
 from .distance import DistanceField, DistanceJet
+from .evaluator import PatchEvaluator
 from .projection import ProjectionStatus, Projector
 
 __all__ = ["GRID_MAX", "GRID_MIN", "StageGrid", "choose_field", "field_grid", "stage_grid"]
@@ -51,27 +52,38 @@ class StageGrid:
 @dataclass(frozen=True, eq=False)
 class _Coarse:
     """An ``n x n`` grid over a surface's domain: ``params (n*n, 2)``, ``points (n*n, 3)``
-    and unit ``normals (n*n, 3)`` (one evaluation for the field choice's two tests)."""
+    and unit ``normals (n*n, 3)`` (one evaluation, by the projector's compiled patches,
+    for the field choice's two tests)."""
 
     params: NDArray
     points: NDArray
     normals: NDArray
 
     @classmethod
-    def of(cls, surface: NurbsSurface, n: int = 9) -> _Coarse:
-        d = surface.domain
+    def of(cls, evaluator: PatchEvaluator, n: int = 9) -> _Coarse:
+        d = evaluator.domain
         u, v = np.linspace(d[0], d[1], n), np.linspace(d[2], d[3], n)
-        g = surface.derivatives_grid(u, v, 1)
-        normal = np.cross(g[:, :, 1, 0], g[:, :, 0, 1]).reshape(-1, 3)
-        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
         params = np.stack(np.meshgrid(u, v, indexing="ij"), -1).reshape(-1, 2)
-        return cls(params, g[:, :, 0, 0].reshape(-1, 3), normal)
+        g = evaluator.derivatives(params[:, 0], params[:, 1], 1)
+        normal = np.cross(g[:, 1, 0], g[:, 0, 1])
+        normal /= np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        return cls(params, g[:, 0, 0], normal)
 
     def spread(self) -> float:
         """Largest angle (radians) between the normals and their mean."""
         mean = self.normals.mean(axis=0)
         mean /= max(np.linalg.norm(mean), 1e-300)
         return float(np.arccos(np.clip(self.normals @ mean, -1, 1)).max())
+
+
+def _nearest(x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
+    """Index of the nearest row of ``y (k, 3)`` to every row of ``x (m, 3)``, and of ``x``
+    to every row of ``y``: one matrix of squared distances, both ways (centred first:
+    the expanded form loses no digits to coordinates far from the origin)."""
+    centre = x.mean(axis=0)
+    x, y = x - centre, y - centre
+    d2 = (x * x).sum(1)[:, None] + (y * y).sum(1)[None, :] - 2.0 * (x @ y.T)
+    return np.argmin(d2, axis=1), np.argmin(d2, axis=0)
 
 
 def _coverage(points: NDArray, seeds: NDArray, projector: Projector) -> float:
@@ -91,18 +103,19 @@ def choose_field(a: NurbsSurface, b: NurbsSurface, *, tol: float, phi_on: str | 
     """The role of each surface: ``phi`` on the domain of ``r``, projection onto ``q``.
 
     ``q`` should be the surface onto which more of the other projects (coverage
-    of a coarse grid) and, between near ties, the flatter one (smaller spread
-    of normals: projections onto it are unique farther out). ``phi_on`` forces
-    the choice (``"a"`` or ``"b"``).
+    of a coarse grid: the share of its feet, by Newton from the nearest node of
+    the other coarse grid, inside ``q``'s domain) and, between near ties, the
+    flatter one (smaller spread of normals: projections onto it are unique
+    farther out). ``phi_on`` forces the choice (``"a"`` or ``"b"``).
     """
     if phi_on not in (None, "a", "b"):
         raise ValueError(f"phi_on must be 'a', 'b' or None, got {phi_on!r}")
     proj_b, proj_a = Projector(b, tol=tol * 1e-3), Projector(a, tol=tol * 1e-3)
     if phi_on is None:
-        grid_a, grid_b = _Coarse.of(a), _Coarse.of(b)
-        d2 = ((grid_a.points[:, None] - grid_b.points[None]) ** 2).sum(-1)   # both ways
-        cover_ab = _coverage(grid_a.points, grid_b.params[np.argmin(d2, axis=1)], proj_b)
-        cover_ba = _coverage(grid_b.points, grid_a.params[np.argmin(d2, axis=0)], proj_a)
+        grid_a, grid_b = _Coarse.of(proj_a.evaluator), _Coarse.of(proj_b.evaluator)
+        near_ab, near_ba = _nearest(grid_a.points, grid_b.points)
+        cover_ab = _coverage(grid_a.points, grid_b.params[near_ab], proj_b)
+        cover_ba = _coverage(grid_b.points, grid_a.params[near_ba], proj_a)
         if abs(cover_ab - cover_ba) > 0.1:
             phi_on = "a" if cover_ab > cover_ba else "b"
         else:
