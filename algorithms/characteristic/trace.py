@@ -31,6 +31,7 @@ from ..intersection import (
     refine_points,
 )
 from ..intersection import result as _result
+from ..intersection.splines import SplineSet
 from .curves import CurveKind, EndReason, TracedCurve, curve_value, trace_curves
 from .distance import DistanceField
 from .points import solve_held
@@ -165,30 +166,51 @@ def curve_gap(points: NDArray, curves: list[IntersectionCurve], per_span: int = 
     return best
 
 
+def _closest(derivatives, t: NDArray, p: NDArray, lo: NDArray, hi: NDArray,
+             iterations: int) -> NDArray:
+    """Newton on ``C'(t) . (C(t) - p) = 0`` from ``t (m,)`` for ``p (m, 3)``, clipped to
+    ``[lo, hi]``; ``derivatives(t) -> (m, 3, 3)`` gives ``C, C', C''``."""
+    for _ in range(iterations):
+        d = derivatives(t)
+        off = d[:, 0] - p
+        f = np.einsum("mc,mc->m", d[:, 1], off)
+        df = np.einsum("mc,mc->m", d[:, 2], off) + np.einsum("mc,mc->m", d[:, 1], d[:, 1])
+        t = np.clip(t - f / np.where(np.abs(df) > 1e-300, df, 1e-300), lo, hi)
+    return t
+
+
 def _newton_gap(points: NDArray, curves: list[IntersectionCurve], owner: NDArray,
                 sample: NDArray, iterations: int = 4) -> NDArray:
     """``(n,)`` distance from each of ``points (n, 3)`` to a point of its curve
     ``owner (n,)`` found by Newton on ``C'(t) . (C(t) - p) = 0`` from the parameter of
     its nearest sample ``sample (n,)``, kept within the two spans next to it (an
-    upper bound of the distance to the curve, equal to it once Newton converged)."""
-    best = np.full(points.shape[0], np.inf)
-    for i in np.unique(owner):
-        curve = curves[i]
+    upper bound of the distance to the curve, equal to it once Newton converged).
+    The polynomial interpolants of all curves are evaluated together
+    (:class:`..intersection.splines.SplineSet`: one compiled call per step)."""
+    offsets = np.concatenate([[0], np.cumsum([c.parameters.size for c in curves])])
+    params = np.concatenate([c.parameters for c in curves]).astype(float)
+    base = offsets[owner]
+    lo = params[base + np.maximum(sample - 1, 0)]
+    hi = params[base + np.minimum(sample + 1, offsets[owner + 1] - base - 1)]
+    t0 = params[base + sample]
+    best = np.empty(points.shape[0])
+    kind = np.array([0 if c.curve3d is None else 1 + c.curve3d.is_rational for c in curves])
+    for r in np.flatnonzero(kind[owner] == 0):           # no interpolant: the sample itself
+        best[r] = np.linalg.norm(curves[owner[r]].points[sample[r]] - points[r])
+    for i in np.flatnonzero(kind == 2):                  # rational: curve by curve
         rows = np.flatnonzero(owner == i)
-        t_all = curve.parameters
-        j = sample[rows]
-        if curve.curve3d is None:
-            best[rows] = np.linalg.norm(curve.points[j] - points[rows], axis=1)
-            continue
-        lo, hi = t_all[np.maximum(j - 1, 0)], t_all[np.minimum(j + 1, t_all.size - 1)]
-        t, p = t_all[j].astype(float), points[rows]
-        for _ in range(iterations):
-            d = curve.curve3d.derivatives(t, 2)                       # (m, 3, 3)
-            off = d[:, 0] - p
-            f = np.einsum("mc,mc->m", d[:, 1], off)
-            df = np.einsum("mc,mc->m", d[:, 2], off) + np.einsum("mc,mc->m", d[:, 1], d[:, 1])
-            t = np.clip(t - f / np.where(np.abs(df) > 1e-300, df, 1e-300), lo, hi)
-        best[rows] = np.linalg.norm(curve.curve3d.evaluate(t) - p, axis=1)
+        c = curves[i].curve3d
+        t = _closest(lambda x, c=c: c.derivatives(x, 2), t0[rows], points[rows], lo[rows],
+                     hi[rows], iterations)
+        best[rows] = np.linalg.norm(c.evaluate(t) - points[rows], axis=1)
+    rows = np.flatnonzero(kind[owner] == 1)
+    if rows.size:
+        index = np.flatnonzero(kind == 1)
+        splines = SplineSet.of([curves[i].curve3d for i in index])
+        which = np.searchsorted(index, owner[rows])
+        t = _closest(lambda x: splines.derivatives(which, x, 2), t0[rows], points[rows],
+                     lo[rows], hi[rows], iterations)
+        best[rows] = np.linalg.norm(splines.evaluate(which, t) - points[rows], axis=1)
     return best
 
 

@@ -54,6 +54,27 @@ class SplineSet:
     knot_start: NDArray
     control_start: NDArray
 
+    @classmethod
+    def of(cls, curves: Sequence[NurbsCurve]) -> SplineSet:
+        """The flat arrays of non-rational ``curves`` of one dimension (at least one).
+
+        Raises
+        ------
+        InvalidGeometryError
+            A rational curve, or curves of different dimensions.
+        """
+        if not curves:
+            raise InvalidGeometryError("a SplineSet needs at least one curve")
+        if any(c.is_rational for c in curves) or len({c.dimension for c in curves}) != 1:
+            raise InvalidGeometryError("a SplineSet holds non-rational curves of one dimension")
+        knots = [np.asarray(c.knots, dtype=float) for c in curves]
+        control = [np.asarray(c.control_points, dtype=float) for c in curves]
+        return cls(np.concatenate(knots), np.concatenate(control),
+                   np.array([c.degree for c in curves], dtype=np.int64),
+                   np.concatenate([[0], np.cumsum([k.size for k in knots])]).astype(np.int64),
+                   np.concatenate([[0], np.cumsum([c.shape[0] for c in control])]
+                                  ).astype(np.int64))
+
     def curve(self, i: int) -> NurbsCurve:
         """Curve ``i`` as a NurbsCurve."""
         k = self.knots[self.knot_start[i]:self.knot_start[i + 1]]
