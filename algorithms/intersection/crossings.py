@@ -109,15 +109,19 @@ def _crossings(uv: NDArray, t: NDArray, knots: tuple[NDArray, NDArray], domain,
         side_a = np.searchsorted(values, a, side="right")
         side_b = np.searchsorted(values, b, side="right")
         hit = np.flatnonzero(ok & (side_a != side_b))
-        for i in hit:
-            lo, hi = sorted((side_a[i], side_b[i]))
-            for c in values[lo:hi]:
-                s = (c - a[i]) / (b[i] - a[i]) if b[i] != a[i] else 0.5
-                chords.append(i)
-                where.append(t[i] + float(np.clip(s, 0.0, 1.0)) * (t[i + 1] - t[i]))
-    if not chords or n < 6:
+        lo = np.minimum(side_a[hit], side_b[hit])
+        count = np.abs(side_b[hit] - side_a[hit])          # knots values[lo:lo + count]
+        i = np.repeat(hit, count)
+        c = values[np.repeat(lo, count) + np.arange(count.sum())
+                   - np.repeat(np.cumsum(count) - count, count)]
+        da = b[i] - a[i]
+        frac = np.where(da != 0, (c - a[i]) / np.where(da != 0, da, 1.0), 0.5)
+        chords.append(i)
+        where.append(t[i] + np.clip(frac, 0.0, 1.0) * (t[i + 1] - t[i]))
+    chords = np.concatenate(chords) if chords else np.zeros(0, dtype=np.int64)
+    if chords.size == 0 or n < 6:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
-    return np.array(chords, dtype=np.int64), np.array(where)
+    return chords.astype(np.int64), np.concatenate(where)
 
 
 def _jumps(stacked: NDArray, t: NDArray, chords: NDArray, closed: bool) -> NDArray:
@@ -242,19 +246,15 @@ def crossing_positions(positions: NDArray, t: NDArray, regular: NDArray, stacked
     return out[np.concatenate([[True], np.diff(out) > small])]
 
 
-def _merged_crossings(where: NDArray, grid: NDArray) -> list[float]:
+def _merged_crossings(where: NDArray, grid: NDArray) -> NDArray:
     """Sorted crossings ``where`` with those closer than ``_C2_NEAR`` of the spacing of
     ``grid`` there merged into their mean (both surfaces, or a u and a v knot line,
     crossed at about one point: two samples there would leave a span far shorter
     than its neighbours, which the rounds then grade)."""
-    groups: list[list[float]] = []
-    for x in where:
-        i = int(np.clip(np.searchsorted(grid, x), 1, grid.size - 1))
-        if groups and x - groups[-1][-1] < _C2_NEAR * (grid[i] - grid[i - 1]):
-            groups[-1].append(float(x))
-        else:
-            groups.append([float(x)])
-    return [float(np.mean(g)) for g in groups]
+    i = np.clip(np.searchsorted(grid, where), 1, grid.size - 1)
+    near = np.diff(where) < _C2_NEAR * (grid[i] - grid[i - 1])[1:]
+    first = np.flatnonzero(np.concatenate([[True], ~near]))
+    return np.add.reduceat(where, first) / np.diff(np.append(first, where.size))
 
 
 def on_c2_crossings(positions: NDArray, t: NDArray, uv_a: NDArray, uv_b: NDArray,
@@ -278,17 +278,17 @@ def on_c2_crossings(positions: NDArray, t: NDArray, uv_a: NDArray, uv_b: NDArray
         return positions
     period = t[-1]
     grid = np.concatenate([[0.0], positions, [period]])
-    out, taken = grid.copy(), []
-    for x in _merged_crossings(np.sort(where), grid):
-        i = int(np.clip(np.searchsorted(grid, x), 1, grid.size - 1))   # grid[i-1] < x <= grid[i]
-        left, right = x - grid[i - 1], grid[i] - x
-        if min(left, right) < _C2_NEAR * (grid[i] - grid[i - 1]):
-            j, beyond = (i, i + 1) if right <= left else (i - 1, i - 2)
-            if j in (0, grid.size - 1):     # the curve's end sample stays: near enough
-                continue
-            out[j] = 0.5 * (x + grid[beyond])
-        taken.append(x)
-    out = np.concatenate([out[1:-1], np.asarray(taken, dtype=float)])
+    x = _merged_crossings(np.sort(where), grid)
+    i = np.clip(np.searchsorted(grid, x), 1, grid.size - 1)     # grid[i-1] < x <= grid[i]
+    left, right = x - grid[i - 1], grid[i] - x
+    near = np.minimum(left, right) < _C2_NEAR * (grid[i] - grid[i - 1])
+    j = np.where(right <= left, i, i - 1)                   # the position to move off
+    beyond = np.where(right <= left, i + 1, i - 2)          # and the next one past it
+    at_end = near & ((j == 0) | (j == grid.size - 1))       # the end sample stays: near enough
+    move = near & ~at_end
+    out = grid.copy()
+    out[j[move]] = 0.5 * (x[move] + grid[beyond[move]])
+    out = np.concatenate([out[1:-1], x[~at_end]])
     lo, hi = 1e-9 * period, period * (1 - 1e-9)
     out = np.sort(out[(out > lo) & (out < hi)])
     return out[np.concatenate([[True], np.diff(out) > 1e-9 * period])]
