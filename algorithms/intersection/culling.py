@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
-from . import tessellation_kernels
+from . import tessellation_kernels, vectors
 
 __all__ = [
     "BoxTree",
@@ -368,7 +368,7 @@ class RegionPatches:
         coeffs = _blossom_restrict(self.coeffs[region], s0, s1)
         coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), t0, t1)
         cartesian = coeffs[..., :-1] / coeffs[..., -1:]
-        return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
+        return np.stack([vectors.corner_min(cartesian), vectors.corner_max(cartesian)], axis=1)
 
 
 def _patch_spans(surface: NurbsSurface, rects: NDArray) -> tuple[NDArray, NDArray]:
@@ -440,7 +440,7 @@ def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
     coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), (rects[:, 2] - c) / (d - c),
                                (rects[:, 3] - c) / (d - c))
     cartesian = coeffs[..., :-1] / coeffs[..., -1:]
-    return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
+    return np.stack([vectors.corner_min(cartesian), vectors.corner_max(cartesian)], axis=1)
 
 
 # ------------------------------------------------------------ span grid trees
@@ -532,7 +532,7 @@ def exact_patch_boxes(surface: NurbsSurface, patches: ArrayLike) -> NDArray:
     patches = np.asarray(patches, dtype=np.int64)
     coeffs = span_patches(surface, su[patches // sv.size], sv[patches % sv.size])
     cartesian = coeffs[..., :-1] / coeffs[..., -1:]
-    return np.stack([cartesian.min(axis=(1, 2)), cartesian.max(axis=(1, 2))], axis=1)
+    return np.stack([vectors.corner_min(cartesian), vectors.corner_max(cartesian)], axis=1)
 
 
 def surface_patch_boxes(surface: NurbsSurface) -> tuple[NDArray, NDArray]:

@@ -212,7 +212,7 @@ class TriangleMesh:
     def triangle_boxes(self) -> NDArray:
         """Axis-aligned box of every triangle: (m, 2, 3) float, ``[t, min/max, xyz]``."""
         p = self.triangle_points()
-        return np.stack([p.min(axis=1), p.max(axis=1)], axis=1)
+        return np.stack([vectors.corner_min(p), vectors.corner_max(p)], axis=1)
 
     def bounding_box(self) -> NDArray:
         """Box of all vertices: (2, 3) float (zeros for an empty mesh)."""

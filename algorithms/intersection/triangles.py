@@ -268,12 +268,14 @@ def intersect_triangles(tri_a: ArrayLike, tri_b: ArrayLike) -> TriangleHits:
     nb = vectors.cross(b[:, 1] - b[:, 0], b[:, 2] - b[:, 0])
     da = _dot(nb[:, None], a - b[:, :1])                     # (k, 3), scaled by |nb|
     db = _dot(na[:, None], b - a[:, :1])
-    size = np.maximum(np.abs(a).max(axis=(1, 2)), np.abs(b).max(axis=(1, 2)))
-    span = np.maximum(np.ptp(a, axis=1).max(axis=1), np.ptp(b, axis=1).max(axis=1))
+    lo_a, hi_a = vectors.corner_min(a), vectors.corner_max(a)
+    lo_b, hi_b = vectors.corner_min(b), vectors.corner_max(b)
+    size = vectors.entry_max(np.abs(np.concatenate([lo_a, hi_a, lo_b, hi_b], axis=1)))
+    span = vectors.entry_max(np.concatenate([hi_a - lo_a, hi_b - lo_b], axis=1))
     limit = _COPLANAR * (size + span)
     len_a, len_b = np.linalg.norm(na, axis=1), np.linalg.norm(nb, axis=1)
-    coplanar = ((np.abs(da).max(axis=1) <= limit * len_b)
-                & (np.abs(db).max(axis=1) <= limit * len_a))
+    coplanar = ((vectors.entry_max(np.abs(da)) <= limit * len_b)
+                & (vectors.entry_max(np.abs(db)) <= limit * len_a))
     cop = np.flatnonzero(coplanar)
     cop = cop[_coplanar_overlap(a[cop], b[cop], na[cop])]
 
