@@ -86,15 +86,18 @@ def _cells_of(field: DistanceField, shape: tuple[int, int], curves: list[TracedC
     nu, nv = shape
     cell = (field.upper - field.lower) / (np.array(shape) - 1)
     hit = np.zeros((nu - 1, nv - 1), dtype=bool)
-    for c in curves:
-        p = c.uv
-        if p.shape[0] > 1:                    # chords cut at a quarter cell
-            d = np.diff(p, axis=0)
-            pieces = np.maximum(np.ceil(4 * np.abs(d / cell).max(axis=1)).astype(int), 1)
-            start = np.repeat(np.arange(d.shape[0]), pieces)
-            first = np.repeat(np.cumsum(pieces) - pieces, pieces)
-            w = (np.arange(start.size) - first) / pieces[start]
-            p = np.vstack([p[start] + w[:, None] * d[start], p[-1:]])
+    polylines = [c.uv for c in curves if c.uv.shape[0]]
+    if polylines:                             # chords cut at a quarter cell, all curves at once
+        p = np.concatenate(polylines)
+        last = np.cumsum([q.shape[0] for q in polylines]) - 1
+        d = np.diff(p, axis=0)
+        pieces = np.maximum(np.ceil(4 * np.abs(d / cell).max(axis=1)).astype(int), 1)
+        pieces[last[:-1]] = 1                 # no chord from one curve's end to the next
+        d[last[:-1]] = 0.0
+        start = np.repeat(np.arange(d.shape[0]), pieces)
+        first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+        w = (np.arange(start.size) - first) / pieces[start]
+        p = np.vstack([p[start] + w[:, None] * d[start], p[-1:]])
         ij = np.clip(((p - field.lower) / cell).astype(int), 0, np.array(shape) - 2)
         hit[ij[:, 0], ij[:, 1]] = True
     rows = hit.copy()
