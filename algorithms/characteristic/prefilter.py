@@ -154,9 +154,16 @@ def _monotone_height(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,
     halved (up to ``REFINEMENTS`` times: the control net closes in on the surface)."""
     if s.dimension != 3 or (s.is_rational and not _separable_weights(s.weights)):
         return False
-    s = _near_part(s, centre, normal, tol)
-    if s is None:                                      # no span comes near the plane
+    near = _near_spans(s, centre, normal, tol)
+    if near is None:                                   # no span comes near the plane
         return True
+    # every sign change of the sampled heights lies in the near spans' rectangle, so
+    # the whole surface answers _crossed_twice as its restriction does: where the
+    # rectangle is most of it, ask before restricting (a loop round a bump)
+    share = _share(s, near)
+    if 0.5 < share < 1 and all(_crossed_twice(s, centre, normal)):
+        return False
+    s = _restricted(s, near)
     crossed = _crossed_twice(s, centre, normal)
     if all(crossed):                                   # a loop, as around a bump
         return False
@@ -210,16 +217,11 @@ def _flat_directions(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, to
     return out[0], out[1]
 
 
-def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
-               ) -> NurbsSurface | None:
-    """``s`` restricted (exactly, at knots) to the index rectangle of the knot spans
-    whose span hull comes within ``tol`` of the plane, or None when none does.
-
-    The Bézier patches near the plane lie in those spans (a Bézier box is inside
-    its span's hull), and so does, in every row, the stretch from the first to the
-    last near patch: the rule's answer on the restriction is its answer on ``s``,
-    at the cost of the patches near the plane (a waterline across a hull face with
-    100 x 100 poles touches a few rows)."""
+def _near_spans(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
+                ) -> tuple[int, int, int, int] | None:
+    """``(i0, i1, j0, j1)``: the index rectangle (spans ``i0 <= i < i1`` along u, ``j0 <=
+    j < j1`` along v) of the knot spans whose span hull comes within ``tol`` of the
+    plane, or None when none does."""
     hull = span_hull_boxes(s)                                  # (ku, kv, 2, 3)
     offset = float(centre @ normal)
     low = np.where(normal >= 0, hull[:, :, 0], hull[:, :, 1]) @ normal - offset
@@ -228,12 +230,42 @@ def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: flo
     if not near.any():
         return None
     rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
-    u_breaks = np.unique(s.knots_u[s.degree_u:s.knots_u.size - s.degree_u])
-    v_breaks = np.unique(s.knots_v[s.degree_v:s.knots_v.size - s.degree_v])
-    i0, i1, j0, j1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    if (i0, i1, j0, j1) == (0, u_breaks.size - 1, 0, v_breaks.size - 1):
+    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+
+
+def _breaks(s: NurbsSurface) -> tuple[np.ndarray, np.ndarray]:
+    return (np.unique(s.knots_u[s.degree_u:s.knots_u.size - s.degree_u]),
+            np.unique(s.knots_v[s.degree_v:s.knots_v.size - s.degree_v]))
+
+
+def _share(s: NurbsSurface, near: tuple[int, int, int, int]) -> float:
+    """Share of the spans of ``s`` inside the rectangle ``near``."""
+    u, v = _breaks(s)
+    i0, i1, j0, j1 = near
+    return (i1 - i0) * (j1 - j0) / ((u.size - 1) * (v.size - 1))
+
+
+def _restricted(s: NurbsSurface, near: tuple[int, int, int, int]) -> NurbsSurface:
+    """``s`` restricted (exactly, at knots) to the span rectangle ``near``
+    (:func:`_near_spans`).
+
+    The Bézier patches near the plane lie in those spans (a Bézier box is inside
+    its span's hull), and so does, in every row, the stretch from the first to the
+    last near patch: the rule's answer on the restriction is its answer on ``s``,
+    at the cost of the patches near the plane (a waterline across a hull face with
+    100 x 100 poles touches a few rows)."""
+    if _share(s, near) == 1:
         return s
-    return s.restrict(u_breaks[i0], u_breaks[i1], v_breaks[j0], v_breaks[j1])
+    u, v = _breaks(s)
+    i0, i1, j0, j1 = near
+    return s.restrict(u[i0], u[i1], v[j0], v[j1])
+
+
+def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
+               ) -> NurbsSurface | None:
+    """:func:`_restricted` to :func:`_near_spans`, or None when no span comes near."""
+    near = _near_spans(s, centre, normal, tol)
+    return None if near is None else _restricted(s, near)
 
 
 def _monotone_patches(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,

@@ -184,6 +184,26 @@ def test_monotone_rule_on_the_near_part_equals_the_whole_surface(z):
         assert part.n_control[0] < sheet.n_control[0]          # only a band of rows
 
 
+@pytest.mark.parametrize("z", [0.02, 0.2, 0.4, 0.5])
+def test_crossed_twice_on_the_near_part_equals_the_whole_surface(z):
+    """_monotone_height asks _crossed_twice of the whole surface before restricting it
+    when the near spans are most of it: every sign change of the sampled heights lies
+    in the near spans, so both must answer alike (here on bumps that make rows cross
+    the plane twice and a slope that crosses once)."""
+    from surfprep.algorithms.characteristic import prefilter
+    x = np.linspace(0, 1, 14)
+    u, v = np.meshgrid(x, x, indexing="ij")
+    height = 0.5 * u + 0.3 * np.exp(-((u - 0.5) ** 2 + (v - 0.6) ** 2) / 0.02)
+    knots = np.concatenate([[0] * 4, np.linspace(0, 1, 12)[1:-1], [1] * 4])
+    sheet = NurbsSurface(np.stack([u, v, height], -1), knots, knots, 3, 3)
+    centre, normal = np.array([0.0, 0.0, z]), np.array([0, 0, 1.0])
+    near = prefilter._near_spans(sheet, centre, normal, TOL)
+    part = prefilter._restricted(sheet, near)
+    assert part.n_control[0] < sheet.n_control[0]              # a true restriction
+    assert prefilter._crossed_twice(sheet, centre, normal) == \
+        prefilter._crossed_twice(part, centre, normal)
+
+
 @pytest.mark.parametrize("poles", [6, 12])
 @pytest.mark.parametrize("shift", [0.0, 0.3, 1.0 + 2e-7, 1.0 + 5e-7, 3.0])
 def test_apart_equals_all_pairs_of_bezier_boxes(shift, poles):
