@@ -62,3 +62,35 @@ def test_coincident_samples_raise():
     q[:, 0] = [0, 1, 1, 2, 3]
     with pytest.raises(DegenerateGeometryError):
         interpolate_many([q], [sample_parameters(q[:, :3], False)], [False])
+
+
+def test_spline_set_of_curves_evaluates_each_as_its_own():
+    """SplineSet.of (the certificate's closest points on known curves) against each
+    NurbsCurve, derivatives to second order, with degrees mixed."""
+    from surfprep.algorithms.curve import NurbsCurve
+    from surfprep.algorithms.intersection.splines import SplineSet
+    rng = np.random.default_rng(3)
+    values = [_samples(rng, n)[:, :3] for n in (30, 12, 50)]
+    closed = [False, True, False]
+    params = [sample_parameters(q, c) for q, c in zip(values, closed)]
+    curves = [interpolate_samples(q, t, c) for q, t, c in zip(values, params, closed)]
+    curves.append(NurbsCurve(rng.normal(size=(5, 3)), [0, 0, 0, 0.3, 0.7, 1, 1, 1], 2))
+    splines = SplineSet.of(curves)
+    for i, c in enumerate(curves):
+        lo, hi = c.domain
+        t = np.linspace(lo, hi, 301)
+        ref = c.derivatives(t, 2)
+        np.testing.assert_allclose(splines.derivatives(np.full(t.size, i), t, 2), ref,
+                                   rtol=0, atol=1e-11 * np.abs(ref).max())
+
+
+def test_spline_set_of_refuses_rational_or_mixed_curves():
+    from surfprep.algorithms.curve import NurbsCurve
+    from surfprep.algorithms.intersection.splines import SplineSet
+    line = NurbsCurve(np.array([[0.0, 0, 0], [1, 0, 0]]), [0, 0, 1, 1], 1)
+    arc = NurbsCurve(np.array([[1.0, 0, 0], [1, 1, 0], [0, 1, 0]]), [0, 0, 0, 1, 1, 1], 2,
+                     np.array([1, np.sqrt(0.5), 1]))
+    flat = NurbsCurve(np.array([[0.0, 0], [1, 0]]), [0, 0, 1, 1], 1)
+    for bad in ([], [line, arc], [line, flat]):
+        with pytest.raises(InvalidGeometryError):
+            SplineSet.of(bad)
