@@ -470,5 +470,5 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
     uv, triangles, leaf_of = _triangulate_leaves(leaves, diag)
     xyz = surface.evaluate(uv[:, 0], uv[:, 1])
     solid = ~collinear_mask(xyz[triangles])
-    mesh = TriangleMesh(xyz, triangles[solid], uv, leaf_of[solid])
+    mesh = TriangleMesh.from_checked(xyz, triangles[solid], uv, leaf_of[solid])   # solid: checked
     return Tessellation(mesh, leaves, region, err, depth)

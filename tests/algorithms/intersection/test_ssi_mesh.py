@@ -99,3 +99,37 @@ def test_collinear_mask_scale_invariant():
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [1, 1e-17, 0], [2, 0, 0]]])
     for scale in (1e-6, 1.0, 1e6):
         np.testing.assert_array_equal(collinear_mask(tri * scale), [False, True])
+
+
+def test_collinear_mask_equals_the_reduction_form():
+    """collinear_mask sums and compares column by column; the same decisions as the
+    reductions it replaced, on random, sliver and coincident-corner triangles."""
+    rng = np.random.default_rng(5)
+    pts = rng.normal(size=(400, 3, 3))
+    pts[:100, 2] = 0.5 * (pts[:100, 0] + pts[:100, 1])              # collinear
+    pts[100:150, 2] = pts[100:150, 0] * (1 + 1e-14)                 # coincident to rounding
+    pts[150:200, 2] = pts[150:200, 1] + 1e-13 * rng.normal(size=(50, 3))   # near slivers
+    edges = pts[:, [1, 2, 0]] - pts
+    longest2 = np.max(np.sum(edges * edges, axis=2), axis=1)
+    cross = np.linalg.norm(np.cross(edges[:, 0], -edges[:, 2]), axis=1)
+    expected = cross <= 64 * np.finfo(float).eps * longest2
+    assert expected[:150].all() and not expected[200:].any()
+    np.testing.assert_array_equal(collinear_mask(pts), expected)
+
+
+def test_from_checked_mesh_is_the_validated_one():
+    """A tessellation's mesh comes through TriangleMesh.from_checked: the same arrays,
+    read-only, that full validation accepts."""
+    from surfprep.algorithms.intersection.tessellation import tessellate
+    from surfprep.algorithms.surface import NurbsSurface
+    x = np.linspace(0, 1, 5)
+    u, v = np.meshgrid(x, x, indexing="ij")
+    z = 0.3 * np.sin(3 * u) * np.cos(2 * v)
+    knots = [0, 0, 0, 0, 0.5, 1, 1, 1, 1]
+    mesh = tessellate(NurbsSurface(np.stack([u, v, z], -1), knots, knots, 3, 3), 1e-3).mesh
+    checked = TriangleMesh(mesh.vertices, mesh.triangles, mesh.uv, mesh.patch)
+    for name in ("vertices", "triangles", "uv", "patch"):
+        mine, full = getattr(mesh, name), getattr(checked, name)
+        np.testing.assert_array_equal(mine, full)
+        assert mine.dtype == full.dtype and not mine.flags.writeable
+    assert not mesh.degenerate_triangles().any()
