@@ -224,11 +224,21 @@ def _distinct(field: DistanceField, uv: NDArray, st: NDArray, done: NDArray, ded
     if keep.size == 0:
         return None
     pts = jet.uv[keep]
-    order = []
-    for i in range(pts.shape[0]):                      # few points: a plain pass
-        if all(np.linalg.norm(pts[i] - pts[j]) > dedupe * diag for j in order):
-            order.append(i)
+    order = _first_apart(pts, dedupe * diag)
     return field.jet(pts[order], jet.st[keep][order])
+
+
+def _first_apart(pts: NDArray, radius: float) -> list[int]:
+    """Indices of ``pts (k, d)``, in order, each farther than ``radius`` from every one
+    kept before it (one matrix of distances, then a greedy pass over its rows)."""
+    if pts.shape[0] == 0:
+        return []
+    far = (np.linalg.norm(pts[:, None] - pts[None], axis=-1) > radius).tolist()
+    keep: list[int] = []
+    for i, row in enumerate(far):
+        if all(row[j] for j in keep):
+            keep.append(i)
+    return keep
 
 
 def grid_seeds(jet: DistanceJet, shape: tuple[int, int], max_seeds: int = 400,
@@ -480,8 +490,5 @@ def border_points(fields: tuple[DistanceField, DistanceField], tol: float
                             np.concatenate(values), tol / 16)
     ua, ub = ua[ok], ub[ok]
     pts = 0.5 * (a.evaluate(ua[:, 0], ua[:, 1]) + b.evaluate(ub[:, 0], ub[:, 1]))
-    keep = []
-    for i in range(pts.shape[0]):
-        if all(np.linalg.norm(pts[i] - pts[j]) > tol for j in keep):
-            keep.append(i)
+    keep = _first_apart(pts, tol)
     return pts[keep], ua[keep], ub[keep]

@@ -176,3 +176,13 @@ def test_compiled_critical_newton_matches_the_numpy_form(pair):
     np.testing.assert_allclose(new.uv, ref.uv, atol=1e-9 * field.diagonal)
     np.testing.assert_allclose(new.phi, ref.phi, atol=1e-12)
     assert np.abs(new.grad).max() <= 1e-9 * max(np.abs(new.hess).max(), 1.0)
+
+
+def test_first_apart_keeps_the_earlier_of_close_points():
+    """The dedupe of critical and border points: greedy in order, a point kept when
+    farther than the radius from every one kept before it (not from dropped ones)."""
+    from surfprep.algorithms.characteristic.points import _first_apart
+    pts = np.array([[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [1.55, 0.0], [1.0, 0.61]])
+    assert _first_apart(pts, 0.6) == [0, 2, 4]
+    assert _first_apart(pts, 0.4) == [0, 1, 2, 3, 4]
+    assert _first_apart(np.zeros((0, 3)), 1.0) == []
