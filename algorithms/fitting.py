@@ -318,15 +318,23 @@ def _seam_tangent(q: NDArray, t: NDArray) -> NDArray:
         d0 = (q[0] - q[-2]) / h0
         d1 = (q[1] - q[0]) / h1
         return (h1 * d0 + h0 * d1) / (h0 + h1)
-    period = t[-1] - t[0]
-    x = np.array([t[-3] - period, t[-2] - period, t[0], t[1], t[2]]) - t[0]
-    rows = q[[n - 3, n - 2, 0, 1, 2]]
-    weights = np.empty(5)
+    period = float(t[-1] - t[0])
+    t0 = float(t[0])
+    x = [float(t[-3]) - period - t0, float(t[-2]) - period - t0, 0.0, float(t[1]) - t0,
+         float(t[2]) - t0]
+    weights = np.empty(5)              # five nodes: plain floats, no array call per product
     for j in range(5):
-        others = np.delete(x, j)
-        weights[j] = float(np.sum(-1.0 / others)) if j == 2 else \
-            float(np.prod(-np.delete(x, [j, 2])) / np.prod(x[j] - others))
-    return weights @ rows
+        if j == 2:
+            weights[j] = sum(-1.0 / x[m] for m in range(5) if m != 2)
+            continue
+        numerator, denominator = 1.0, 1.0
+        for m in range(5):
+            if m != j and m != 2:
+                numerator *= -x[m]
+            if m != j:
+                denominator *= x[j] - x[m]
+        weights[j] = numerator / denominator
+    return weights @ q[[n - 3, n - 2, 0, 1, 2]]
 
 
 def interpolate_curve(points: ArrayLike, *, degree: int = 3, parameters: ArrayLike | None = None,
