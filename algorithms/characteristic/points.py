@@ -230,7 +230,8 @@ def _distinct(field: DistanceField, uv: NDArray, st: NDArray, done: NDArray, ded
 
 def _first_apart(pts: NDArray, radius: float) -> list[int]:
     """Indices of ``pts (k, d)``, in order, each farther than ``radius`` from every one
-    kept before it (one matrix of distances, then a greedy pass over its rows)."""
+    kept before it (one matrix of distances, then a greedy pass over its rows; ``k``
+    is bounded by the side samples and the grid seeds, some hundreds at most)."""
     if pts.shape[0] == 0:
         return []
     far = (np.linalg.norm(pts[:, None] - pts[None], axis=-1) > radius).tolist()
