@@ -254,18 +254,11 @@ def _restricted(s: NurbsSurface, near: tuple[int, int, int, int]) -> NurbsSurfac
     last near patch: the rule's answer on the restriction is its answer on ``s``,
     at the cost of the patches near the plane (a waterline across a hull face with
     100 x 100 poles touches a few rows)."""
-    if _share(s, near) == 1:
-        return s
     u, v = _breaks(s)
     i0, i1, j0, j1 = near
+    if (i0, i1, j0, j1) == (0, u.size - 1, 0, v.size - 1):
+        return s
     return s.restrict(u[i0], u[i1], v[j0], v[j1])
-
-
-def _near_part(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray, tol: float
-               ) -> NurbsSurface | None:
-    """:func:`_restricted` to :func:`_near_spans`, or None when no span comes near."""
-    near = _near_spans(s, centre, normal, tol)
-    return None if near is None else _restricted(s, near)
 
 
 def _monotone_patches(s: NurbsSurface, centre: np.ndarray, normal: np.ndarray,

@@ -195,8 +195,12 @@ def _newton_gap(points: NDArray, curves: list[IntersectionCurve], owner: NDArray
     t0 = params[base + sample]
     best = np.empty(points.shape[0])
     kind = np.array([0 if c.curve3d is None else 1 + c.curve3d.is_rational for c in curves])
-    for r in np.flatnonzero(kind[owner] == 0):           # no interpolant: the sample itself
-        best[r] = np.linalg.norm(curves[owner[r]].points[sample[r]] - points[r])
+    rows = np.flatnonzero(kind[owner] == 0)              # no interpolant: the sample itself
+    if rows.size:
+        first = np.concatenate([[0], np.cumsum([c.points.shape[0] for c in curves])])
+        samples = np.concatenate([c.points for c in curves])
+        best[rows] = np.linalg.norm(samples[first[owner[rows]] + sample[rows]] - points[rows],
+                                    axis=1)
     for i in np.flatnonzero(kind == 2):                  # rational: curve by curve
         rows = np.flatnonzero(owner == i)
         c = curves[i].curve3d

@@ -171,11 +171,13 @@ def _many_span_sheet(n: int = 30, seed: int = 3) -> NurbsSurface:
 
 @pytest.mark.parametrize("z", [-0.5, 0.02, 0.3, 0.5, 0.77, 1.5])
 def test_monotone_rule_on_the_near_part_equals_the_whole_surface(z):
-    """The rule runs on the spans near the plane only (prefilter._near_part); its
-    answer must be the rule's answer on the whole surface's Bézier patches."""
+    """The rule runs on the spans near the plane only (prefilter._near_spans,
+    prefilter._restricted); its answer must be the rule's answer on the whole
+    surface's Bézier patches."""
     from surfprep.algorithms.characteristic import prefilter
     sheet, (centre, normal) = _many_span_sheet(), (np.array([0.0, 0.0, z]), np.array([0, 0, 1.0]))
-    part = prefilter._near_part(sheet, centre, normal, TOL)
+    near = prefilter._near_spans(sheet, centre, normal, TOL)
+    part = None if near is None else prefilter._restricted(sheet, near)
     whole = prefilter._monotone_patches(sheet, centre, normal, TOL)
     assert (part is None) == (z < -0.2 or z > 1.2)
     assert (True if part is None else prefilter._monotone_patches(part, centre, normal, TOL)) \
