@@ -26,6 +26,7 @@ __all__ = [
     "distinct_knots",
     "find_span",
     "greville_abscissae",
+    "span_range",
     "validate_knots",
 ]
 
@@ -86,16 +87,22 @@ def find_span(knots: NDArray, degree: int, t: ArrayLike) -> NDArray:
     (...) int, same shape as ``t``; values in ``[degree, n - 1]``.
     """
     t = np.asarray(t, dtype=float)
-    n = knots.size - degree - 1
     span = np.searchsorted(knots, t, side="right") - 1
-    # last non-empty span: largest i <= n-1 with knots[i] < knots[i+1]
-    last = n - 1
+    first, last = span_range(knots, degree)
+    return np.minimum(np.maximum(span, first), last)      # np.clip costs ~5 us a call
+
+
+def span_range(knots: NDArray, degree: int) -> tuple[int, int]:
+    """``(first, last)``: the indices of the first and the last non-empty knot span
+    (``knots[i] < knots[i + 1]``, ``degree <= i <= n - 1``), where :func:`find_span`
+    puts parameters before and after the domain."""
+    last = knots.size - degree - 2
     while knots[last] == knots[last + 1]:
         last -= 1
     first = degree
     while knots[first] == knots[first + 1]:
         first += 1
-    return np.minimum(np.maximum(span, first), last)      # np.clip costs ~5 us a call
+    return first, last
 
 
 def basis_functions(knots: NDArray, degree: int, t: ArrayLike,

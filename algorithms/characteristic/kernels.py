@@ -191,24 +191,6 @@ def project_points(coef, iu, iv, rational, x, st0, lo, hi, quarter, tol, max_ite
 
 
 @_jit
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
-
-
-@_jit
-def _normal_derivative(c1, c2, n, length, out):
-    """``out = ((c1 + c2) - n (n . (c1 + c2))) / length``: a derivative of the unit normal."""
-    dot = 0.0
-    for c in range(3):
-        out[c] = c1[c] + c2[c]
-        dot += n[c] * out[c]
-    for c in range(3):
-        out[c] = (out[c] - n[c] * dot) / length
-
-
-@_jit
 def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
     """The §6.2 case of one foot, as :meth:`.projection.Projector.status`:
     0 unique, 1 multiple (``K`` not positive definite), 2 none (outside ``q``'s

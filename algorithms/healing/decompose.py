@@ -149,14 +149,6 @@ def join_curves(curves: Sequence[NurbsCurve]) -> NurbsCurve:
     return NurbsCurve(pw[:, :-1], kv, degree)
 
 
-def _sample(edge: LoopEdge, n: int = _DENSE) -> tuple[NDArray, NDArray, NDArray]:
-    """Parameters (n,), 3D points (n, 3) and uv points (n, 2) of one edge."""
-    t = np.linspace(*edge.pcurve.domain, n)
-    uv = edge.pcurve.evaluate(t)
-    xyz = None if edge.curve is None else edge.curve.evaluate(t)
-    return t, xyz, uv
-
-
 def turning_angles(edges: Sequence[LoopEdge]) -> NDArray:
     """(m,) float: the angle (radians) between the end tangent of real edge ``k - 1``
     and the start tangent of real edge ``k`` (cyclic; a degenerated edge between them,

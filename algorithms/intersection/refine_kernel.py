@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ..basis import span_range
 from ..basis_kernels import AVAILABLE, _jit
 from ..basis_kernels import _ders_one as _basis_one
 from ..surface import NurbsSurface
@@ -199,20 +200,9 @@ def _refine_all(ka_u, ka_v, pa, qa, net_a, rat_a, spans_a, dom_a,
             iterations[i] += 1
 
 
-def _first_last(knots: NDArray, degree: int, n: int) -> tuple[int, int]:
-    last = n - 1
-    while knots[last] == knots[last + 1]:
-        last -= 1
-    first = degree
-    while knots[first] == knots[first + 1]:
-        first += 1
-    return first, last
-
-
 def _surface_args(surface: NurbsSurface) -> tuple:
-    nu, nv = surface.n_control
-    spans = np.array([*_first_last(surface.knots_u, surface.degree_u, nu),
-                      *_first_last(surface.knots_v, surface.degree_v, nv)], dtype=np.int64)
+    spans = np.array([*span_range(surface.knots_u, surface.degree_u),
+                      *span_range(surface.knots_v, surface.degree_v)], dtype=np.int64)
     return (np.ascontiguousarray(surface.knots_u, dtype=float),
             np.ascontiguousarray(surface.knots_v, dtype=float), int(surface.degree_u),
             int(surface.degree_v), np.ascontiguousarray(surface._homogeneous_net),

@@ -9,8 +9,13 @@ from nurbs_strategies import curve_samples, curves, make_curve, scale_of, surfac
 from scipy.interpolate import BSpline
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
-from surfprep.algorithms.basis import (basis_derivatives, collocation_matrix, find_span,
-                                       greville_abscissae)
+from surfprep.algorithms.basis import (
+    basis_derivatives,
+    collocation_matrix,
+    find_span,
+    greville_abscissae,
+    span_range,
+)
 from surfprep.errors import InvalidGeometryError
 
 SETTINGS = settings(max_examples=60, deadline=None)
@@ -120,6 +125,15 @@ def test_find_span_at_domain_ends_and_outside():
     knots = np.array([0, 0, 0, 1, 2, 2, 3, 3, 3], dtype=float)
     span = find_span(knots, 2, np.array([-1.0, 0.0, 0.5, 1.0, 2.0, 3.0, 4.0]))
     np.testing.assert_array_equal(span, [2, 2, 2, 3, 5, 5, 5])
+
+
+def test_span_range_skips_empty_end_spans():
+    # the domain's first span is empty when a knot at the start repeats degree + 2 times
+    assert span_range(np.array([0, 0, 0, 1, 2, 2, 3, 3, 3], dtype=float), 2) == (2, 5)
+    knots = np.array([0, 0, 0, 0, 1, 2, 2, 2], dtype=float)
+    assert span_range(knots, 2) == (3, 4)
+    np.testing.assert_array_equal(find_span(knots, 2, np.array([-1.0, 0.0, 1.5, 2.0, 9.0])),
+                                  [3, 3, 4, 4, 4])
 
 
 def test_greville_abscissae_reproduce_a_line():

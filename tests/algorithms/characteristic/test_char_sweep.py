@@ -84,6 +84,12 @@ def test_a_curve_past_the_cut_locus_is_traced_again_on_the_nearest_branch():
                         np.r_[near.phi, far.phi], np.vstack([near.grad, far.grad]),
                         np.r_[near.projection.det_k, far.projection.det_k],
                         EndReason.START, EndReason.DOMAIN)
+    # the centre is an umbilic focal point: both eigenvalues of K flip there, det K
+    # keeps its sign, and only the status (K not positive definite) tells the branch
+    assert curve.cut_locus_crossings == 0
+    flipped = TracedCurve(curve.kind, curve.uv, curve.st, curve.phi, curve.grad,
+                          np.array([1.0, -0.5]), EndReason.START, EndReason.DOMAIN)
+    assert flipped.cut_locus_crossings == 1             # one eigenvalue through zero
     again = other_branches(field, [curve], 0.15 * field.diagonal)
     assert len(again) == 2                                 # both ways from the fresh foot
     whole = 0
