@@ -58,8 +58,10 @@ _MAX_STEPS = 40
 #: a uv step longer than this share of the domain is a seam jump, not a crossing
 _SEAM_SHARE = 0.25
 #: a regular position nearer a C2 crossing than this share of its spacing is moved off
-#: it (no span shorter than a quarter of a neighbour: the rounds' grading ratio is 4)
-_C2_NEAR = 0.25
+#: it (no span shorter than a third of a neighbour: the rounds grade spans over 4 times
+#: a neighbour, and with a quarter the spacing's own variation left one 4.3 times its
+#: neighbour on the bumpy bicubic, a round for the grading alone)
+_C2_NEAR = 1.0 / 3.0
 
 
 def c1_knots(surface: NurbsSurface) -> tuple[NDArray, NDArray]:
@@ -312,7 +314,7 @@ def on_c2_crossings(positions: NDArray, t: NDArray, uv_a: NDArray, uv_b: NDArray
     spacing of a refined trace), and one sample per crossing costs little. A position
     nearer a crossing than ``_C2_NEAR`` of the spacing there is moved to the middle
     between the crossing and its next position beyond (no span gets longer, none
-    shorter than a quarter of its neighbour); a crossing that near an end sample of
+    shorter than a third of its neighbour); a crossing that near an end sample of
     the curve (which stays) takes no sample of its own. Returns ``(p',) float``,
     sorted, strictly inside ``(0, t[-1])``.
     """

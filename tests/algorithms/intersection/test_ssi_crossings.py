@@ -175,18 +175,21 @@ def test_a_c2_crossing_next_to_a_closed_curves_start_takes_no_sample():
     np.testing.assert_array_equal(out_near, positions)
 
 
-@pytest.mark.parametrize("tol", [1e-9, 1e-10])
-def test_bicubic_cut_has_samples_on_its_knot_lines_and_passes_in_few_rounds(tol, monkeypatch):
+@pytest.mark.parametrize("tol, most", [(1e-7, 1), (1e-9, 1), (1e-10, 2)])
+def test_bicubic_cut_has_samples_on_its_knot_lines_and_passes_in_few_rounds(tol, most,
+                                                                             monkeypatch):
     """The bumpy bicubic (20 x 20 poles) x a plane: four loops crossing about 60 simple
-    knot lines. With a sample on each crossing the first subset passes after at most
-    two verification rounds (it took four when the rounds had to find the crossings),
-    every crossing of pcurve_a has a kept sample within 1e-3 of a knot span from it,
-    and the curves stay within tol densely."""
+    knot lines. With a sample on each crossing the first subset passes the first
+    verification round at 1e-7 and 1e-9 and after two at 1e-10 (it took four when the
+    rounds had to find the crossings, and a second round at 1e-7 / 1e-9 while a
+    position moved off a crossing could leave a span 4.3 times its neighbour, over the
+    rounds' grading ratio), every crossing of pcurve_a has a kept sample within 1e-3
+    of a knot span from it, and the curves stay within tol densely."""
     from test_ssi_pipeline import bumpy, check_on_surfaces, flat
     rounds = counted_rounds(monkeypatch)
     a, b = bumpy(20), flat(0.2)
     curves = intersect_surfaces(a, b, tol=tol)
-    assert len(curves) == 4 and len(rounds) <= 2
+    assert len(curves) == 4 and len(rounds) <= most
     check_on_surfaces(curves, a, b, tol=tol)
     knots_u, knots_v = c2_knots(a)
     width = float(np.diff(knots_u[:2])[0])

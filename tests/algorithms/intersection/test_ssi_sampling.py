@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_ssi_refine import R_SPHERE, plane_z, sphere_patch, sphere_plane_start
+
 from surfprep.algorithms.intersection.refine import RefinedCurve, refine_curves
 from surfprep.algorithms.intersection.result import checked_curves
 from surfprep.algorithms.intersection.sampling import (
+    _NEIGHBOUR_SHARE,
+    _with_neighbours,
     cubic_samples,
     interpolate_samples,
     interpolate_stacked,
     sample_parameters,
 )
 from surfprep.algorithms.intersection.topology import EndKind
-from test_ssi_refine import R_SPHERE, plane_z, sphere_patch, sphere_plane_start
 
 
 def dense_arc(c: float, n: int, tol: float):
@@ -127,3 +130,17 @@ def test_grading_is_closed_in_one_call():
                 for long_, short, span in ((last[i], first[j], i), (first[j], last[i], j)):
                     if long_ > _MAX_RATIO * short * (1 + 1e-12):
                         assert fixed[span] or pieces[span] == _MAX_GRADED
+
+
+def test_a_dip_of_the_fourth_derivative_estimate_is_raised_to_its_neighbours():
+    """One chord far below its neighbours (the fourth derivative passing through zero)
+    takes _NEIGHBOUR_SHARE of the larger neighbour; smooth values and a peak stay; a
+    closed curve's first and last chords are neighbours."""
+    f4 = np.array([4.0, 4.2, 0.1, 8.0, 8.0, 7.9])
+    out = _with_neighbours(f4, closed=False)
+    assert out[2] == pytest.approx(_NEIGHBOUR_SHARE * 8.0)
+    np.testing.assert_array_equal(np.delete(out, 2), np.delete(f4, 2))
+    assert np.all(out >= f4)
+    ring = np.array([0.01, 1.0, 1.0, 1.0, 2.0])
+    assert _with_neighbours(ring, closed=True)[0] == pytest.approx(_NEIGHBOUR_SHARE * 2.0)
+    assert _with_neighbours(ring, closed=False)[0] == pytest.approx(_NEIGHBOUR_SHARE * 1.0)
