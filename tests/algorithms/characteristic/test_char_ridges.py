@@ -9,6 +9,8 @@ the top circle (gap = 0), misses it (gap < 0).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from char_surfaces import torus, torus_and_plane
@@ -86,11 +88,20 @@ def test_triangle_fragments_along_the_top_circle_are_replaced_by_it():
     """The triangle method leaves fragments along the tangential top circle; the
     certificate drops every one of them (each lies along the circle) and reports the
     circle once."""
-    from surfprep.algorithms.intersection import SmallAngleWarning, StrayCurves, intersect_surfaces
+    from surfprep.algorithms.intersection import (
+        SmallAngleWarning,
+        StrayCurves,
+        StrayCurveWarning,
+        intersect_surfaces,
+    )
 
     a, b = torus_and_plane(0.0, MAJOR, MINOR)
-    with pytest.warns(SmallAngleWarning):         # the triangle method says it may fail
-        mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP)
+    with warnings.catch_warnings():
+        # some fragments along the tangential circle stray or fold and are left out
+        # (what the triangle method can do here; the certificate replaces them all)
+        warnings.simplefilter("ignore", StrayCurveWarning)
+        with pytest.warns(SmallAngleWarning):     # the triangle method says it may fail
+            mesh = intersect_surfaces(a, b, tol=TOL, stray=StrayCurves.DROP)
     assert len(mesh) > 1
     rec = certify(a, b, mesh, tol=TOL)
     assert rec.dropped == len(mesh)
