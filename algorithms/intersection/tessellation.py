@@ -261,6 +261,8 @@ def _refine(surface: NurbsSurface, regions: NDArray, tol: float, max_depth: int,
         out_err.append(err[done])
         out_diag.append(diag[done])
         todo = ~done
+        if not todo.any():
+            break
         err, eu, ev = err[todo], eu[todo], ev[todo]
         worst = np.maximum(eu, ev)
         twist = worst <= 0.25 * err                 # neither direction explains the error
@@ -386,6 +388,16 @@ def _triangulate_leaves(leaves: NDArray, diagonal: NDArray
     return np.concatenate([uv, centres]), triangles, leaf_of
 
 
+def _one_leaf(leaf: NDArray, diagonal: int) -> tuple[NDArray, NDArray, NDArray]:
+    """:func:`_triangulate_leaves` of a single leaf (a plane's one patch: no neighbour
+    can hang on it), without the sorting and loop bookkeeping: the same corners in
+    the same (u, v) order and the same two triangles."""
+    u0, u1, v0, v1 = leaf
+    uv = np.array([[u0, v0], [u0, v1], [u1, v0], [u1, v1]])
+    triangles = np.array([[0, 2, 1], [2, 3, 1]] if diagonal == 1 else [[0, 2, 3], [0, 3, 1]])
+    return uv, triangles, np.zeros(2, dtype=np.int64)
+
+
 # ------------------------------------------------------------------- public
 def _check_regions(surface: NurbsSurface, regions: ArrayLike | None) -> NDArray:
     if regions is None:
@@ -467,7 +479,8 @@ def tessellate(surface: NurbsSurface, tol: float, regions: ArrayLike | None = No
         empty = TriangleMesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros((0, 2)),
                              np.zeros(0, np.int64))
         return Tessellation(empty, leaves, region, err, depth)
-    uv, triangles, leaf_of = _triangulate_leaves(leaves, diag)
+    uv, triangles, leaf_of = (_one_leaf(leaves[0], diag[0]) if leaves.shape[0] == 1
+                              else _triangulate_leaves(leaves, diag))
     xyz = surface.evaluate(uv[:, 0], uv[:, 1])
     solid = ~collinear_mask(xyz[triangles])
     mesh = TriangleMesh.from_checked(xyz, triangles[solid], uv, leaf_of[solid])   # solid: checked

@@ -246,3 +246,16 @@ def test_keep_boxes_per_region_prune_only_their_own_region():
             assert uv[:, 0].max() <= 0.5
     with pytest.raises(InvalidGeometryError):
         tessellate(plane, 1e-3, regions, keep_boxes=box, keep_region=[2])
+
+
+@pytest.mark.parametrize("diagonal", [0, 1])
+def test_one_leaf_is_triangulated_as_the_general_path_does(diagonal):
+    """A single leaf (a plane's one patch) skips the crack-free bookkeeping: the same
+    corners, order, triangles and leaf ids as _triangulate_leaves."""
+    from surfprep.algorithms.intersection.tessellation import _one_leaf, _triangulate_leaves
+    leaf = np.array([0.2, 0.7, -1.0, 3.0])
+    fast = _one_leaf(leaf, diagonal)
+    general = _triangulate_leaves(leaf[None], np.array([diagonal]))
+    for x, y in zip(fast, general):
+        np.testing.assert_array_equal(x, y)
+        assert x.dtype == y.dtype
