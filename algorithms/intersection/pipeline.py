@@ -93,6 +93,8 @@ _RETRY_FLOOR = 16.0
 #: times ``tol`` (not ``mesh_tol``: a face narrower than a few ``mesh_tol``, like
 #: the KCS hull's 20 mm transom at mesh_tol 9 mm, is not closed)
 _SEAM_CLOSURE = 64.0
+#: segment ends (every k-th) whose normals decide the SmallAngleWarning, at least
+_FLAT_SAMPLES = 256
 #: first marching step from a hanging end, times ``mesh_tol``
 _MARCH_STEP = 0.25
 #: singular points are looked for within this times the mesh tolerance of curve ends
@@ -383,9 +385,13 @@ class SmallAngleWarning(UserWarning):
 def _warn_if_flat(soup, a: NurbsSurface, b: NurbsSurface, mesh_tol: float) -> None:
     """:class:`SmallAngleWarning` when the exact normals at ``FLAT_SHARE`` or more of the
     soup's segment ends are closer to parallel than :func:`.angles.small_crossing_sine`
-    allows (the median of those angles is named)."""
+    allows (the median of those angles is named). Every k-th end is looked at, at
+    least ``_FLAT_SAMPLES`` of them: a share and a median need no more, and a cut of
+    four loops has a thousand ends."""
     limit = small_crossing_sine(operand_size(a, b)[0], mesh_tol)
-    sines = normal_sines(a, b, soup.uv_a.reshape(-1, 2), soup.uv_b.reshape(-1, 2))
+    uv_a, uv_b = soup.uv_a.reshape(-1, 2), soup.uv_b.reshape(-1, 2)
+    step = max(1, uv_a.shape[0] // _FLAT_SAMPLES)         # a share and a median: a sample
+    sines = normal_sines(a, b, uv_a[::step], uv_b[::step])
     if flat_share(sines, limit) >= FLAT_SHARE:
         sine = float(np.median(sines[sines < limit]))
         warnings.warn(

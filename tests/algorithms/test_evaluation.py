@@ -15,6 +15,7 @@ from surfprep.algorithms.basis import (
     find_span,
     greville_abscissae,
     span_range,
+    validate_knots,
 )
 from surfprep.errors import InvalidGeometryError
 
@@ -197,3 +198,15 @@ def test_from_homogeneous_round_trip():
     np.testing.assert_allclose(again.evaluate(t), curve.evaluate(t), rtol=1e-14, atol=1e-13)
     with pytest.raises(InvalidGeometryError, match="> 0"):
         NurbsCurve.from_homogeneous(-curve.homogeneous_points(), curve.knots, 3)
+
+
+def test_interior_knot_multiplicity_over_degree_plus_one_is_refused():
+    """degree + 1 equal interior knots (a break of the curve) pass; degree + 2 do not,
+    and the message gives the multiplicity."""
+    ok = np.array([0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1], dtype=float)
+    np.testing.assert_array_equal(validate_knots(ok, 2, 6), ok)
+    bad = np.array([0, 0, 0, 0.5, 0.5, 0.5, 0.5, 1, 1, 1], dtype=float)
+    with pytest.raises(InvalidGeometryError, match=r"multiplicity 4 > degree \+ 1 = 3"):
+        validate_knots(bad, 2, 7)
+    # clamped ends of multiplicity degree + 1 are not interior
+    validate_knots(np.array([0, 0, 0, 1, 1, 1], dtype=float), 2, 3)

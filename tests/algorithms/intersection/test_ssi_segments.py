@@ -184,3 +184,15 @@ def test_candidate_pairs_of_the_soup_are_the_brute_force_ones():
     assert soup.stats.candidate_pairs == int(hit.sum())
     # every segment's pair is a candidate
     assert np.all(hit[soup.tri_a, soup.tri_b])
+
+
+def test_touching_points_that_are_segment_ends_are_told_apart():
+    """_not_segment_ends: a touching point bitwise equal to a segment end (a signed
+    zero counts as zero) is one; one off by an ulp is not; empty inputs keep all."""
+    from surfprep.algorithms.intersection.segments import _not_segment_ends
+    ends = np.array([[0.0, 1.0, 2.0], [0.5, -0.25, 3.0], [1.0, 1.0, 1.0]])
+    touch = np.array([[0.5, -0.25, 3.0], [-0.0, 1.0, 2.0], [np.nextafter(1.0, 2.0), 1.0, 1.0],
+                      [7.0, 8.0, 9.0]])
+    np.testing.assert_array_equal(_not_segment_ends(touch, ends), [False, False, True, True])
+    np.testing.assert_array_equal(_not_segment_ends(touch, np.zeros((0, 3))), [True] * 4)
+    assert _not_segment_ends(np.zeros((0, 3)), ends).shape == (0,)
