@@ -1,22 +1,52 @@
 """Pure numpy/scipy geometry of surfprep: no OCP, cadquery or build123d here."""
 
-from .bezier import (bezier_curves, bezier_decompose_array, bezier_patches, bezier_segments,
-                     bezier_surfaces, patch_bounding_boxes)
+from .bezier import (
+                     bezier_curves,
+                     bezier_decompose_array,
+                     bezier_patches,
+                     bezier_segments,
+                     bezier_surfaces,
+                     patch_bounding_boxes,
+)
 from .curve import NurbsCurve
-from .degree import (bezier_elevation_matrix, elevate_degree, elevate_degree_array,
-                     elevate_degree_surface)
-from .fitting import (approximate_curve, approximation_knots, averaged_knots,
-                      chord_length_parameters, interpolate_curve, interpolate_surface,
-                      knots_from_breakpoints)
+from .degree import bezier_elevation_matrix, elevate_degree, elevate_degree_array, elevate_degree_surface
+from .fitting import (
+                     approximate_curve,
+                     approximation_knots,
+                     averaged_knots,
+                     chord_length_parameters,
+                     interpolate_curve,
+                     interpolate_surface,
+                     knots_from_breakpoints,
+)
 from .isocurve import isocurve
-from .knots import (Direction, clamp, clamp_surface, insert_knot, insert_knot_array,
-                    insert_knot_surface, periodic_to_clamped, refine, refine_knots_array,
-                    refine_surface, restrict, restrict_array, restrict_surface, split,
-                    split_surface)
+from .knots import (
+                     clamp,
+                     clamp_surface,
+                     insert_knot,
+                     insert_knot_array,
+                     insert_knot_surface,
+                     periodic_to_clamped,
+                     refine,
+                     refine_knots_array,
+                     refine_surface,
+                     restrict,
+                     restrict_array,
+                     restrict_surface,
+                     split,
+                     split_surface,
+)
 from .measure import arc_length, bounding_box, cumulative_arc_length, normals
-from .projection import (CurveProjectionResult, ProjectionResult, distance_to_curve,
-                         distance_to_surface, project_to_curve, project_to_surface)
+from .projection import (
+                     CurveProjectionResult,
+                     ProjectionResult,
+                     distance_to_curve,
+                     distance_to_surface,
+                     project_to_curve,
+                     project_to_surface,
+)
 from .surface import NurbsSurface
+from .tensor import Direction
 
 __all__ = [
     "NurbsCurve",

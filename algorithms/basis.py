@@ -1,4 +1,5 @@
-"""B-spline basis functions, vectorized over many parameter values.
+"""B-spline basis functions, vectorized over many parameter values, and the checks of the data
+that defines them (knots, weights).
 
 The functions here work on a full (flat) knot vector ``knots`` of length
 ``n + degree + 1`` for ``n`` control points, and on arrays of parameters at once:
@@ -22,9 +23,11 @@ from . import basis_kernels
 __all__ = [
     "basis_derivatives",
     "basis_functions",
+    "check_weights",
     "collocation_matrix",
     "distinct_knots",
     "find_span",
+    "frozen_array",
     "greville_abscissae",
     "span_range",
     "validate_knots",
@@ -74,6 +77,24 @@ def validate_knots(knots: ArrayLike, degree: int, n_control: int, name: str = "k
         raise InvalidGeometryError(
             f"{name}: an interior knot has multiplicity {counts.max()} > degree + 1 = {degree + 1}")
     return knots
+
+
+def frozen_array(a: ArrayLike) -> NDArray:
+    """A read-only float copy of ``a`` (the arrays of the immutable NURBS types)."""
+    out = np.array(a, dtype=float, copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def check_weights(weights: NDArray | None, shape: tuple[int, ...], name: str) -> NDArray | None:
+    """Refuse weights of another ``shape`` than the poles', or not finite and positive."""
+    if weights is None:
+        return None
+    if weights.shape != shape:
+        raise InvalidGeometryError(f"{name} must have shape {shape}, got {weights.shape}")
+    if not np.all(np.isfinite(weights)) or np.any(weights <= 0):
+        raise InvalidGeometryError(f"{name} must be finite and > 0")
+    return weights
 
 
 def find_span(knots: NDArray, degree: int, t: ArrayLike) -> NDArray:

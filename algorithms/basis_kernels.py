@@ -8,9 +8,8 @@ same sums in the same order (results agree to the last bit or one rounding),
 with a fixed call cost of a few microseconds.
 
 ``AVAILABLE`` is False when numba cannot be imported; the callers keep their
-numpy forms then. The kernels are compiled on first use and cached on disk
-(``cache=True``); a cold first call (no cache) costs about a second per
-kernel, a warm one (cache present) a few milliseconds.
+numpy forms then (:mod:`.jit`). :func:`ders_one` is the kernel other compiled
+modules call inside their own loops.
 
 References
 ----------
@@ -23,22 +22,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-try:                                    # numba is optional: the numpy forms remain
-    import numba
-except ImportError:                     # pragma: no cover - numba is installed in CI
-    numba = None
+from .jit import AVAILABLE, jit
 
-__all__ = ["AVAILABLE", "basis_derivatives_compiled", "surface_derivatives_compiled"]
-
-AVAILABLE = numba is not None
+__all__ = ["AVAILABLE", "basis_derivatives_compiled", "ders_one", "surface_derivatives_compiled"]
 
 
-def _jit(fn):
-    return numba.njit(cache=True, nogil=True)(fn) if AVAILABLE else fn
-
-
-@_jit
-def _ders_one(knots, p, t, span, order, ndu, a, left, right, out):
+@jit
+def ders_one(knots, p, t, span, order, ndu, a, left, right, out):
     """A2.3 of [PT] at one parameter: ``out (order + 1, p + 1)`` (``order <= p``)."""
     ndu[0, 0] = 1.0
     for j in range(1, p + 1):
@@ -83,7 +73,7 @@ def _ders_one(knots, p, t, span, order, ndu, a, left, right, out):
         factor *= p - k
 
 
-@_jit
+@jit
 def _basis_ders(knots, p, t, span, order):
     m = t.size
     top = min(order, p)
@@ -93,7 +83,7 @@ def _basis_ders(knots, p, t, span, order):
     left = np.empty(p + 1)
     right = np.empty(p + 1)
     for i in range(m):
-        _ders_one(knots, p, t[i], span[i], top, ndu, a, left, right, out[i])
+        ders_one(knots, p, t[i], span[i], top, ndu, a, left, right, out[i])
     return out
 
 
@@ -108,7 +98,7 @@ def basis_derivatives_compiled(knots: NDArray, p: int, t: NDArray, span: NDArray
                        np.ascontiguousarray(span, dtype=np.int64), int(order))
 
 
-@_jit
+@jit
 def _binomials(order):
     comb = np.zeros((order + 1, order + 1))
     for n in range(order + 1):
@@ -118,7 +108,7 @@ def _binomials(order):
     return comb
 
 
-@_jit
+@jit
 def _rational_inplace(hom, order, comb):
     """A4.4 of [PT] on one point's ``hom (order + 1, order + 1, d + 1)``, in place: the
     Cartesian derivatives into ``hom[..., :d]`` (the loop of
@@ -137,7 +127,7 @@ def _rational_inplace(hom, order, comb):
                 hom[k, l, c] = v * inv_w
 
 
-@_jit
+@jit
 def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order, rational):
     m = u.size
     c = net.shape[2]
@@ -154,8 +144,8 @@ def _surface_hom(knots_u, knots_v, p, q, net, u, v, su, sv, order, rational):
     for i in range(m):
         du[:, :] = 0.0
         dv[:, :] = 0.0
-        _ders_one(knots_u, p, u[i], su[i], tu, ndu_u, a_u, lu, ru, du)
-        _ders_one(knots_v, q, v[i], sv[i], tv, ndu_v, a_v, lv, rv, dv)
+        ders_one(knots_u, p, u[i], su[i], tu, ndu_u, a_u, lu, ru, du)
+        ders_one(knots_v, q, v[i], sv[i], tv, ndu_v, a_v, lv, rv, dv)
         iu0, iv0 = su[i] - p, sv[i] - q
         # the u sums first, then the v sums (as the numpy form's two matmuls)
         for k in range(order + 1):

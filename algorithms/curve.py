@@ -20,26 +20,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
-from .basis import basis_derivatives, find_span, validate_knots
+from .basis import basis_derivatives, check_weights, find_span, frozen_array, validate_knots
 from .rational import curve_derivatives_from_homogeneous
 
 __all__ = ["NurbsCurve"]
-
-
-def _frozen(a: ArrayLike) -> NDArray:
-    out = np.array(a, dtype=float, copy=True)
-    out.setflags(write=False)
-    return out
-
-
-def _check_weights(weights: NDArray | None, shape: tuple[int, ...], name: str) -> NDArray | None:
-    if weights is None:
-        return None
-    if weights.shape != shape:
-        raise InvalidGeometryError(f"{name} must have shape {shape}, got {weights.shape}")
-    if not np.all(np.isfinite(weights)) or np.any(weights <= 0):
-        raise InvalidGeometryError(f"{name} must be finite and > 0")
-    return weights
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,15 +49,15 @@ class NurbsCurve:
     weights: NDArray | None = None
 
     def __post_init__(self) -> None:
-        cp = _frozen(self.control_points)
+        cp = frozen_array(self.control_points)
         if cp.ndim != 2 or cp.shape[1] < 1:
             raise InvalidGeometryError(
                 f"control_points must have shape (n, d), got {cp.shape}")
         if not np.all(np.isfinite(cp)):
             raise InvalidGeometryError("control_points contain NaN or infinite values")
-        knots = _frozen(validate_knots(self.knots, self.degree, cp.shape[0]))
-        w = None if self.weights is None else _frozen(self.weights)
-        w = _check_weights(w, (cp.shape[0],), "weights")
+        knots = frozen_array(validate_knots(self.knots, self.degree, cp.shape[0]))
+        w = None if self.weights is None else frozen_array(self.weights)
+        w = check_weights(w, (cp.shape[0],), "weights")
         object.__setattr__(self, "control_points", cp)
         object.__setattr__(self, "knots", knots)
         object.__setattr__(self, "degree", int(self.degree))

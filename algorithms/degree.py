@@ -40,8 +40,8 @@ from scipy.special import comb
 from ..errors import InvalidGeometryError
 from .bezier import bezier_decompose_array
 from .curve import NurbsCurve
-from .knots import Direction, _knots_along, _net_along, _surface_result
 from .surface import NurbsSurface
+from .tensor import Direction, knots_along, net_along, surface_from_net
 
 __all__ = [
     "bezier_elevation_matrix",
@@ -127,8 +127,8 @@ def elevate_degree_surface(surface: NurbsSurface, t_u: int = 0, t_v: int = 0
                 f"degree elevation in {direction.name} must be an integer >= 0, got {t!r}")
         if t == 0:
             continue
-        knots, degree = _knots_along(out, direction)
-        pw, new = elevate_degree_array(_net_along(out, direction), knots, degree, int(t))
-        out = _surface_result(out, direction, pw, new, degree + int(t))
+        knots, degree = knots_along(out, direction)
+        pw, new = elevate_degree_array(net_along(out, direction), knots, degree, int(t))
+        out = surface_from_net(out, direction, pw, new, degree + int(t))
     return out
 

@@ -42,6 +42,8 @@ __all__ = [
     "interpolate_surface",
     "approximation_knots",
     "approximate_curve",
+    "seam_tangent",
+    "solve_banded_rows",
 ]
 
 
@@ -244,7 +246,7 @@ def _collocation_entries(knots: NDArray, degree: int, t: NDArray, derivative: in
     return cols, ders[:, derivative, :]
 
 
-def _solve_banded_rows(cols: NDArray, values: NDArray, rhs: NDArray) -> NDArray:
+def solve_banded_rows(cols: NDArray, values: NDArray, rhs: NDArray) -> NDArray:
     """Solve ``A x = rhs`` where row ``r`` of ``A`` has ``values[r]`` at ``cols[r]``.
 
     Parameters
@@ -297,11 +299,11 @@ def _solve_collocation(knots: NDArray, degree: int, t: NDArray, rhs: NDArray) ->
     """Control points ``(n, ...)`` interpolating ``rhs (n, ...)`` at ``t`` (many RHS at once)."""
     cols, values = _collocation_entries(knots, degree, t)
     flat = rhs.reshape(rhs.shape[0], -1)
-    return _solve_banded_rows(cols, values, flat).reshape(rhs.shape)
+    return solve_banded_rows(cols, values, flat).reshape(rhs.shape)
 
 
 # -------------------------------------------------------------------- curves
-def _seam_tangent(q: NDArray, t: NDArray) -> NDArray:
+def seam_tangent(q: NDArray, t: NDArray) -> NDArray:
     """Derivative at the seam of a closed sequence ``q (n, d)`` (``q[-1] == q[0]``, ``t[-1]``
     the period): of the quartic through ``Q_{n-3}, Q_{n-2}, Q_0, Q_1, Q_2`` (their
     parameters shifted by the period across the seam) when there are five distinct
@@ -402,7 +404,7 @@ def interpolate_curve(points: ArrayLike, *, degree: int = 3, parameters: ArrayLi
     if smooth_closure:
         if n < 4:
             raise InvalidGeometryError(f"smooth_closure needs at least 4 points, got {n}")
-        tangent = _seam_tangent(q, t)
+        tangent = seam_tangent(q, t)
         end_derivatives = (tangent, tangent)
     if end_derivatives is None:
         knots, t = _interpolation_knots(t, p, knots, n, "knots")
@@ -439,7 +441,7 @@ def _interpolate_with_derivatives(q: NDArray, t: NDArray, p: int, knots,
     all_cols = np.concatenate([cols, dcols])[order]
     all_values = np.concatenate([values, dvalues])[order]
     rhs = np.concatenate([q, derivs])[order]
-    return _solve_banded_rows(all_cols, all_values, rhs), knots
+    return solve_banded_rows(all_cols, all_values, rhs), knots
 
 
 # ------------------------------------------------------------------ surfaces

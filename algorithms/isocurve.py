@@ -20,9 +20,8 @@ import numpy as np
 from ..errors import InvalidGeometryError
 from .basis import basis_functions
 from .curve import NurbsCurve
-from .knots import Direction, _check_in_domain, _check_scalar, _knots_along, _net_along, \
-    as_direction
 from .surface import NurbsSurface
+from .tensor import Direction, as_direction, check_in_domain, check_parameter, knots_along, net_along
 
 __all__ = ["isocurve"]
 
@@ -45,17 +44,17 @@ def isocurve(surface: NurbsSurface, value: float, direction: Direction | str) ->
         Knots and degree of the other direction; rational when the surface is.
     """
     direction = as_direction(direction)
-    knots, degree = _knots_along(surface, direction)
-    value = _check_scalar(value, "isocurve parameter")
+    knots, degree = knots_along(surface, direction)
+    value = check_parameter(value, "isocurve parameter")
     try:
-        _check_in_domain(value, knots, degree, "isocurve parameter")
+        check_in_domain(value, knots, degree, "isocurve parameter")
     except InvalidGeometryError as exc:
         raise InvalidGeometryError(f"{exc} (direction {direction.name})") from None
-    net = _net_along(surface, direction)                     # (n_fixed, n_run, d+1)
+    net = net_along(surface, direction)                     # (n_fixed, n_run, d+1)
     span, values = basis_functions(knots, degree, np.array([value]))
     rows = net[span[0] - degree:span[0] + 1]                 # (degree+1, n_run, d+1)
     poles_w = np.einsum("i,ijc->jc", values[0], rows)
     other = Direction.V if direction is Direction.U else Direction.U
-    run_knots, run_degree = _knots_along(surface, other)
+    run_knots, run_degree = knots_along(surface, other)
     return NurbsCurve.from_homogeneous(poles_w, run_knots, run_degree,
                                        rational=surface.weights is not None)

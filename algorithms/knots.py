@@ -31,18 +31,24 @@ References
 
 from __future__ import annotations
 
-import enum
-
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
 from .surface import NurbsSurface
+from .tensor import (
+    Direction,
+    as_direction,
+    check_in_domain,
+    check_parameter,
+    domain_of,
+    knots_along,
+    net_along,
+    surface_from_net,
+)
 
 __all__ = [
-    "Direction",
-    "as_direction",
     "insert_knot_array",
     "refine_knots_array",
     "restrict_array",
@@ -58,52 +64,6 @@ __all__ = [
     "restrict_surface",
     "clamp_surface",
 ]
-
-
-class Direction(enum.Enum):
-    """Parametric direction of a surface."""
-
-    U = 0
-    V = 1
-
-
-def as_direction(direction: Direction | str | int) -> Direction:
-    """Accept a :class:`Direction`, ``"u"``/``"v"`` or ``0``/``1``."""
-    if isinstance(direction, Direction):
-        return direction
-    if isinstance(direction, str) and direction.lower() in ("u", "v"):
-        return Direction.U if direction.lower() == "u" else Direction.V
-    if isinstance(direction, (int, np.integer)) and not isinstance(direction, bool) \
-            and int(direction) in (0, 1):
-        return Direction(int(direction))
-    raise InvalidGeometryError(
-        f"direction must be Direction.U or Direction.V, got {direction!r}")
-
-
-# ---------------------------------------------------------------- validation
-def _check_scalar(value: float, name: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InvalidGeometryError(f"{name} must be a real number, got {value!r}") from None
-    if not np.isfinite(x):
-        raise InvalidGeometryError(f"{name} must be finite, got {x}")
-    return x
-
-
-def _domain(knots: NDArray, degree: int) -> tuple[float, float]:
-    n = knots.size - degree - 1
-    return float(knots[degree]), float(knots[n])
-
-
-def _check_in_domain(x: float, knots: NDArray, degree: int, name: str,
-                     open_ends: bool = False) -> None:
-    lo, hi = _domain(knots, degree)
-    inside = lo < x < hi if open_ends else lo <= x <= hi
-    if not inside:
-        kind = "interior of the domain" if open_ends else "domain"
-        raise InvalidGeometryError(
-            f"{name} = {x!r} is outside the {kind} [{lo!r}, {hi!r}]")
 
 
 def _multiplicity(knots: NDArray, x: float) -> int:
@@ -191,10 +151,10 @@ def insert_knot_array(points_w: ArrayLike, knots: ArrayLike, degree: int, value:
     """
     points_w = np.asarray(points_w, dtype=float)
     knots = np.asarray(knots, dtype=float)
-    value = _check_scalar(value, "knot value")
+    value = check_parameter(value, "knot value")
     if int(r) != r or r < 1:
         raise InvalidGeometryError(f"r must be an integer >= 1, got {r!r}")
-    _check_in_domain(value, knots, degree, "knot value")
+    check_in_domain(value, knots, degree, "knot value")
     s = _multiplicity(knots, value)
     if s + r > degree:
         raise InvalidGeometryError(
@@ -228,7 +188,7 @@ def refine_knots_array(points_w: ArrayLike, knots: ArrayLike, degree: int,
         return points_w.copy(), knots.copy()
     if not np.all(np.isfinite(x)):
         raise InvalidGeometryError("new knots contain NaN or infinite values")
-    lo, hi = _domain(knots, degree)
+    lo, hi = domain_of(knots, degree)
     bad = x[(x < lo) | (x > hi)]
     if bad.size:
         raise InvalidGeometryError(
@@ -264,12 +224,12 @@ def restrict_array(points_w: ArrayLike, knots: ArrayLike, degree: int, a: float,
     """
     points_w = np.asarray(points_w, dtype=float)
     knots = np.asarray(knots, dtype=float)
-    a = _check_scalar(a, "a")
-    b = _check_scalar(b, "b")
+    a = check_parameter(a, "a")
+    b = check_parameter(b, "b")
     if not a < b:
         raise InvalidGeometryError(f"need a < b, got a = {a!r}, b = {b!r}")
-    _check_in_domain(a, knots, degree, "a")
-    _check_in_domain(b, knots, degree, "b")
+    check_in_domain(a, knots, degree, "a")
+    check_in_domain(b, knots, degree, "b")
     points_w, knots = _trim_start(points_w, knots, degree, a)
     return _trim_end(points_w, knots, degree, b)
 
@@ -325,8 +285,8 @@ def split(curve: NurbsCurve, t: float) -> tuple[NurbsCurve, NurbsCurve]:
     InvalidGeometryError
         ``t`` not strictly inside the domain.
     """
-    t = _check_scalar(t, "split parameter")
-    _check_in_domain(t, curve.knots, curve.degree, "split parameter", open_ends=True)
+    t = check_parameter(t, "split parameter")
+    check_in_domain(t, curve.knots, curve.degree, "split parameter", open_ends=True)
     lo, hi = curve.domain
     return restrict(curve, lo, t), restrict(curve, t, hi)
 
@@ -405,55 +365,31 @@ def periodic_to_clamped(poles: ArrayLike, degree: int, knots: ArrayLike | None =
 
 
 # ------------------------------------------------------------------ surfaces
-def _net_along(surface: NurbsSurface, direction: Direction) -> NDArray:
-    pw = surface.homogeneous_points()
-    return pw if direction is Direction.U else np.swapaxes(pw, 0, 1)
-
-
-def _knots_along(surface: NurbsSurface, direction: Direction) -> tuple[NDArray, int]:
-    if direction is Direction.U:
-        return surface.knots_u, surface.degree_u
-    return surface.knots_v, surface.degree_v
-
-
-def _surface_result(surface: NurbsSurface, direction: Direction, points_w: NDArray,
-                    knots: NDArray, degree: int | None = None) -> NurbsSurface:
-    """Rebuild a surface after an operation on ``direction`` (net along axis 0)."""
-    rational = surface.weights is not None
-    if direction is Direction.U:
-        return NurbsSurface.from_homogeneous(
-            points_w, knots, surface.knots_v,
-            surface.degree_u if degree is None else degree, surface.degree_v, rational)
-    return NurbsSurface.from_homogeneous(
-        np.swapaxes(points_w, 0, 1), surface.knots_u, knots, surface.degree_u,
-        surface.degree_v if degree is None else degree, rational)
-
-
 def insert_knot_surface(surface: NurbsSurface, value: float,
                         direction: Direction | str, r: int = 1) -> NurbsSurface:
     """Surface with ``value`` inserted ``r`` times into the knots of ``direction``."""
     direction = as_direction(direction)
-    knots, degree = _knots_along(surface, direction)
-    pw, new = insert_knot_array(_net_along(surface, direction), knots, degree, value, r)
-    return _surface_result(surface, direction, pw, new)
+    knots, degree = knots_along(surface, direction)
+    pw, new = insert_knot_array(net_along(surface, direction), knots, degree, value, r)
+    return surface_from_net(surface, direction, pw, new)
 
 
 def refine_surface(surface: NurbsSurface, new_knots: ArrayLike,
                    direction: Direction | str) -> NurbsSurface:
     """Surface with all of ``new_knots`` (m,) inserted in ``direction``."""
     direction = as_direction(direction)
-    knots, degree = _knots_along(surface, direction)
-    pw, new = refine_knots_array(_net_along(surface, direction), knots, degree, new_knots)
-    return _surface_result(surface, direction, pw, new)
+    knots, degree = knots_along(surface, direction)
+    pw, new = refine_knots_array(net_along(surface, direction), knots, degree, new_knots)
+    return surface_from_net(surface, direction, pw, new)
 
 
 def _restrict_direction(surface: NurbsSurface, direction: Direction, a: float, b: float
                         ) -> NurbsSurface:
-    knots, degree = _knots_along(surface, direction)
+    knots, degree = knots_along(surface, direction)
     if _is_clamped_over(knots, degree, a, b):
         return surface
-    pw, new = restrict_array(_net_along(surface, direction), knots, degree, a, b)
-    return _surface_result(surface, direction, pw, new)
+    pw, new = restrict_array(net_along(surface, direction), knots, degree, a, b)
+    return surface_from_net(surface, direction, pw, new)
 
 
 def restrict_surface(surface: NurbsSurface, u0: float | None = None, u1: float | None = None,
@@ -475,10 +411,10 @@ def split_surface(surface: NurbsSurface, value: float, direction: Direction | st
                   ) -> tuple[NurbsSurface, NurbsSurface]:
     """Split along the isoparametric line ``direction = value`` (strictly interior)."""
     direction = as_direction(direction)
-    knots, degree = _knots_along(surface, direction)
-    value = _check_scalar(value, "split parameter")
-    _check_in_domain(value, knots, degree, "split parameter", open_ends=True)
-    lo, hi = _domain(knots, degree)
+    knots, degree = knots_along(surface, direction)
+    value = check_parameter(value, "split parameter")
+    check_in_domain(value, knots, degree, "split parameter", open_ends=True)
+    lo, hi = domain_of(knots, degree)
     return (_restrict_direction(surface, direction, lo, value),
             _restrict_direction(surface, direction, value, hi))
 

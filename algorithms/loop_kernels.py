@@ -19,12 +19,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .basis_kernels import AVAILABLE, _jit
+from .jit import AVAILABLE, jit
 
 __all__ = ["ray_crossings", "ray_crossings_numpy"]
 
 
-@_jit
+@jit
 def _ray_crossings_kernel(uv, a, b, lo, hi, width, bins, seg_sorted, indptr, out):  # pragma: no cover - compiled
     for i in range(uv.shape[0]):
         pu, pv = uv[i, 0], uv[i, 1]

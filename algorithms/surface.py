@@ -23,8 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from . import basis_kernels
-from .basis import basis_derivatives, find_span, validate_knots
-from .curve import _check_weights, _frozen
+from .basis import basis_derivatives, check_weights, find_span, frozen_array, validate_knots
 from .rational import surface_derivatives_from_homogeneous
 
 __all__ = ["NurbsSurface"]
@@ -55,16 +54,16 @@ class NurbsSurface:
     weights: NDArray | None = None
 
     def __post_init__(self) -> None:
-        cp = _frozen(self.control_points)
+        cp = frozen_array(self.control_points)
         if cp.ndim != 3 or cp.shape[2] < 1:
             raise InvalidGeometryError(
                 f"control_points must have shape (n_u, n_v, d), got {cp.shape}")
         if not np.all(np.isfinite(cp)):
             raise InvalidGeometryError("control_points contain NaN or infinite values")
-        ku = _frozen(validate_knots(self.knots_u, self.degree_u, cp.shape[0], "knots_u"))
-        kv = _frozen(validate_knots(self.knots_v, self.degree_v, cp.shape[1], "knots_v"))
-        w = None if self.weights is None else _frozen(self.weights)
-        w = _check_weights(w, cp.shape[:2], "weights")
+        ku = frozen_array(validate_knots(self.knots_u, self.degree_u, cp.shape[0], "knots_u"))
+        kv = frozen_array(validate_knots(self.knots_v, self.degree_v, cp.shape[1], "knots_v"))
+        w = None if self.weights is None else frozen_array(self.weights)
+        w = check_weights(w, cp.shape[:2], "weights")
         object.__setattr__(self, "control_points", cp)
         object.__setattr__(self, "knots_u", ku)
         object.__setattr__(self, "knots_v", kv)
@@ -102,7 +101,7 @@ class NurbsSurface:
     @functools.cached_property
     def _homogeneous_net(self) -> NDArray:
         """:meth:`homogeneous_points`, computed once per surface (read-only)."""
-        return _frozen(self.homogeneous_points())
+        return frozen_array(self.homogeneous_points())
 
     @classmethod
     def from_homogeneous(cls, points_w: ArrayLike, knots_u: ArrayLike, knots_v: ArrayLike,
@@ -220,7 +219,7 @@ class NurbsSurface:
 
     # ------------------------------------------------- operations (facades)
     # Thin delegations to the algorithm modules, imported lazily (they import
-    # this module). ``direction`` is a ``knots.Direction`` (or "u"/"v").
+    # this module). ``direction`` is a ``tensor.Direction`` (or "u"/"v").
     def insert_knot(self, value: float, direction, r: int = 1) -> NurbsSurface:
         """Same surface with ``value`` inserted ``r`` times in ``direction``."""
         from .knots import insert_knot_surface

@@ -2,7 +2,7 @@
 distance function, characteristic points and characteristic curves
 (Wang, Gursoz, Chen, Prinz, Patrikalakis 1990; paper 002).
 
-* :mod:`.projection`: orthogonal projection onto a surface (eqs. 3-4, §6.2 cases);
+* :mod:`.projector`: orthogonal projection onto a surface (eqs. 3-4, §6.2 cases);
 * :mod:`.distance`: the oriented distance ``phi`` and its derivatives (A.1, eqs. 24-31);
 * :mod:`.points`: border, turning, singular and critical points (§3.3, §4.2);
 * :mod:`.curves`: u-/v-characteristic curves and intersection curves traced as
@@ -16,7 +16,7 @@ distance function, characteristic points and characteristic curves
 * :mod:`.ridges`: curves of critical points (surfaces of revolution cut normal
   to their axis): tangential curves, and starts beside maximum/minimum ridges;
 * :mod:`.evaluator`: fast power-basis evaluation for the tracers;
-* :mod:`.kernels`: the distance jet and the projection as numba kernels;
+* :mod:`.distance_kernels`: the distance jet and the projection as numba kernels;
 * :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them);
 * :mod:`.grid`: the roles of the two surfaces and the stage's sample grid;
 * :mod:`.crossing`: the flattest crossing angle on that grid;
@@ -42,7 +42,7 @@ from .evaluator import PatchEvaluator
 from .grid import StageGrid, stage_grid
 from .points import CharacteristicPoint, PointKind, classify_critical, critical_points
 from .prefilter import NoLoopReason, no_loop_reason, uncertified_record
-from .projection import Projection, ProjectionStatus, Projector
+from .projector import Projection, ProjectionStatus, Projector
 from .ridges import Ridge
 from .trace import to_intersection_curve, trace_intersections
 

@@ -58,7 +58,7 @@ from .points import (
     make_points,
 )
 from .poles import pole_contacts
-from .projection import ProjectionStatus, Projector
+from .projector import ProjectionStatus, Projector
 from .ridges import Ridge, ridge_refiner, ridge_starts, trace_ridges
 from .starts import (
     Start,

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .distance import DistanceField, DistanceJet
-from .projection import ProjectionStatus
+from .projector import ProjectionStatus
 
 __all__ = ["grid_crossing_sine"]
 

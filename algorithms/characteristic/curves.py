@@ -36,19 +36,24 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from . import trace_kernel
+from . import trace_kernels
 from .distance import DistanceField, DistanceJet
-from .projection import Projection, ProjectionStatus
+from .projector import Projection, ProjectionStatus
 
 __all__ = [
+    "INTERSECTION_MAX_STEPS",
     "MAX_TURN",
     "CurveKind",
     "EndReason",
     "TracedCurve",
+    "correct",
     "curve_value",
     "trace_curves",
 ]
 
+#: accepted steps per traced intersection curve at most (a cap: never a hang; the
+#: characteristic curves take ``max_steps`` of :func:`trace_curves`)
+INTERSECTION_MAX_STEPS = 4000
 #: largest turn of the tangent per accepted step (radians)
 MAX_TURN = 0.3
 #: the corrector stops within this share of the step (and within ``ctol``)
@@ -173,7 +178,7 @@ def _assign(jet: DistanceJet, rows: NDArray, sub: DistanceJet) -> DistanceJet:
                        out["grad"], out["hess"], out["st_jacobian"])
 
 
-def _correct(field: DistanceField, kind: NDArray, uv: NDArray, st: NDArray,
+def correct(field: DistanceField, kind: NDArray, uv: NDArray, st: NDArray,
              pinned: NDArray, ctol: float | NDArray) -> tuple[NDArray, DistanceJet, NDArray]:
     """Newton along ``grad g`` (along the side for ``pinned`` rows: held coordinate,
     -1 for none); only the rows not yet converged are evaluated again. Returns the
@@ -242,7 +247,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         curves read only for sign changes (characteristic curves) take a
         looser one: their crossings are refined by Newton afterwards.
     compiled : bool, optional
-        Trace by :mod:`.trace_kernel` (the same steps in one numba call); default
+        Trace by :mod:`.trace_kernels` (the same steps in one numba call); default
         whenever numba is there. False: the batched numpy form (the reference).
 
     Returns
@@ -258,13 +263,13 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
     h_min = 1e-9 * diag if h_min is None else h_min
     ctol = 1e-7 * diag if ctol is None else ctol
     if compiled is None:
-        compiled = trace_kernel.AVAILABLE
+        compiled = trace_kernels.AVAILABLE
     if compiled:
         return _traced_compiled(field, kinds, comp_all, uv0, st0, direction, h0=h0, h_max=h_max,
                                 h_min=h_min, max_steps=max_steps, ctol=ctol, max_turn=max_turn,
                                 relative_ctol=relative_ctol)
     none = np.full(m, -1)
-    uv, jet, _ = _correct(field, comp_all, np.asarray(uv0, float), np.asarray(st0, float), none,
+    uv, jet, _ = correct(field, comp_all, np.asarray(uv0, float), np.asarray(st0, float), none,
                           ctol)
     _, dg = curve_value(jet, comp_all)
     tan = _tangent(dg)
@@ -305,7 +310,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
                                          field.lower[coord], field.upper[coord])
         comp = comp_all[active]
         st_guess = st[active] + np.einsum("mij,mj->mi", jac[active], pred - x0)   # eq. (21)
-        x, nj, conv = _correct(field, comp, pred, st_guess, pinned,
+        x, nj, conv = correct(field, comp, pred, st_guess, pinned,
                                np.minimum(ctol, relative_ctol * hh))
         _, ndg = curve_value(nj, comp)
         ntan = _tangent(ndg)
@@ -349,14 +354,14 @@ def _traced_compiled(field: DistanceField, kinds: list[CurveKind], comps: NDArra
                      st0: NDArray, direction: NDArray, *, h0: float | NDArray, h_max: float,
                      h_min: float, max_steps: int, ctol: float, max_turn: float,
                      relative_ctol: float) -> list[TracedCurve]:
-    """:func:`trace_curves` by :func:`.trace_kernel.trace_compiled`."""
+    """:func:`trace_curves` by :func:`.trace_kernels.trace_compiled`."""
     m = comps.size
     h0 = np.broadcast_to(np.asarray(h0, dtype=float), (m,))
-    uv, st, phi, grad, det, count, reason = trace_kernel.trace_compiled(
+    uv, st, phi, grad, det, count, reason = trace_kernels.trace_compiled(
         field, comps, np.asarray(uv0, float).reshape(m, 2), np.asarray(st0, float).reshape(m, 2),
         np.asarray(direction, float).reshape(m, 2), h0=h0, h_max=h_max, h_min=h_min,
         max_steps=max_steps, ctol=ctol, max_turn=max_turn, relative_ctol=relative_ctol)
-    ends = [EndReason(name) for name in trace_kernel.REASONS]
+    ends = [EndReason(name) for name in trace_kernels.REASONS]
     return [TracedCurve(kinds[i], uv[i, :n].copy(), st[i, :n].copy(), phi[i, :n].copy(),
                         grad[i, :n].copy(), det[i, :n].copy(), EndReason.START, ends[reason[i]])
             for i, n in enumerate(count)]

@@ -28,9 +28,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..surface import NurbsSurface
-from . import kernels
+from . import distance_kernels
 from .evaluator import PatchEvaluator
-from .projection import Projection, Projector, projection_matrix
+from .projector import Projection, Projector, projection_matrix
 
 __all__ = ["DistanceField", "DistanceJet", "distance_jet"]
 
@@ -131,7 +131,7 @@ def distance_jet(r: NurbsSurface | PatchEvaluator, projector: Projector, uv: Arr
         Start feet (continuation); default the projector's seed grid.
     """
     uv = np.asarray(uv, dtype=float).reshape(-1, 2)
-    if kernels.AVAILABLE and isinstance(r, PatchEvaluator):
+    if distance_kernels.AVAILABLE and isinstance(r, PatchEvaluator):
         return _compiled_jet(r, projector, uv, st0)
     rd = r.derivatives(uv[:, 0], uv[:, 1], 2)
     point = rd[:, 0, 0]
@@ -158,13 +158,13 @@ def distance_jet(r: NurbsSurface | PatchEvaluator, projector: Projector, uv: Arr
 
 def _compiled_jet(r: PatchEvaluator, projector: Projector, uv: NDArray,
                   st0: ArrayLike | None) -> DistanceJet:
-    """:func:`distance_jet` by :func:`.kernels.distance_points` (one compiled pass)."""
+    """:func:`distance_jet` by :func:`.distance_kernels.distance_points` (one compiled pass)."""
     if st0 is None:                   # a parallelogram q is projected in closed form
         st0 = (np.zeros_like(uv) if projector.is_affine
                else projector.seeds(r.evaluate(uv[:, 0], uv[:, 1])))
     st0 = np.ascontiguousarray(np.asarray(st0, dtype=float).reshape(-1, 2))
     lo, hi, quarter = projector.newton_bounds()
-    point, foot, normal, st, phi, grad, hess, jac, status, det = kernels.distance_points(
+    point, foot, normal, st, phi, grad, hess, jac, status, det = distance_kernels.distance_points(
         *r.compiled, *projector.evaluator.compiled, np.ascontiguousarray(uv), st0, lo, hi,
         quarter, float(projector.tol), int(projector.max_iter), projector.lower,
         projector.upper, projector.kernel_frame())

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..basis import basis_derivatives
 from ..rational import surface_derivatives_from_homogeneous
 from ..surface import NurbsSurface
-from . import kernels
+from . import distance_kernels
 
 __all__ = ["PatchEvaluator"]
 
@@ -126,12 +126,12 @@ class PatchEvaluator:
     def __post_init__(self) -> None:
         coef, iu, iv = _power_patches(self.surface)
         self._data.update(coef=coef, iu=iu, iv=iv)
-        self._data["compiled"] = kernels.evaluator_arrays(coef, iu, iv) + (
+        self._data["compiled"] = distance_kernels.evaluator_arrays(coef, iu, iv) + (
             self.surface.weights is not None,)
 
     @property
     def compiled(self) -> tuple[NDArray, NDArray, NDArray, bool]:
-        """``(coef, iu, iv, rational)`` for :mod:`.kernels`."""
+        """``(coef, iu, iv, rational)`` for :mod:`.distance_kernels`."""
         return self._data["compiled"]
 
     @property
@@ -142,8 +142,8 @@ class PatchEvaluator:
         """``(m, order + 1, order + 1, 3)``, as :meth:`NurbsSurface.derivatives` on 1-D input."""
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
-        if kernels.AVAILABLE and order <= 2:
-            return kernels.patch_derivatives(*self.compiled, u, v)[:, :order + 1, :order + 1]
+        if distance_kernels.AVAILABLE and order <= 2:
+            return distance_kernels.patch_derivatives(*self.compiled, u, v)[:, :order + 1, :order + 1]
         coef, iu, iv = self._data["coef"], self._data["iu"], self._data["iv"]
         # interior breakpoints only: a parameter beyond either end stays in the end patch
         su = np.searchsorted(iu[1:, 0], u, side="right")

@@ -21,7 +21,7 @@ from ..surface import NurbsSurface
 from .crossing import grid_crossing_sine
 from .distance import DistanceField, DistanceJet
 from .evaluator import PatchEvaluator
-from .projection import ProjectionStatus, Projector
+from .projector import ProjectionStatus, Projector
 
 __all__ = ["GRID_MAX", "GRID_MIN", "StageGrid", "choose_field", "field_grid", "stage_grid"]
 

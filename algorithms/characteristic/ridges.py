@@ -32,10 +32,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..intersection.refine import RefinedPoints
-from .curves import CurveKind, EndReason, TracedCurve, _correct, trace_curves
+from .curves import CurveKind, EndReason, TracedCurve, correct, trace_curves
 from .distance import DistanceField, DistanceJet
-from .projection import ProjectionStatus
 from .points import PointKind
+from .projector import ProjectionStatus
 from .starts import Start, ray_starts
 
 __all__ = ["RIDGE_NOISE", "Ridge", "ridge_refiner", "ridge_starts", "trace_ridges"]
@@ -141,13 +141,13 @@ def ridge_refiner(field: DistanceField, kind: CurveKind):
     wobble, and verification keeps splitting (12 465 samples on a torus's top
     circle at tol 1e-9). Here a sample is moved across the band onto the ridge by
     the corrector of the characteristic curve ``kind`` traced along it
-    (``phi_u = 0`` or ``phi_v = 0``, :func:`.curves._correct`); its foot on ``q``
+    (``phi_u = 0`` or ``phi_v = 0``, :func:`.curves.correct`); its foot on ``q``
     comes with the jet, its gap is ``|phi|``.
     """
     def refine(surface_a, surface_b, uv_a, uv_b, *, tol, anchors=None, tangent_sin=None
                ) -> RefinedPoints:
         uv, st = (uv_b, uv_a) if field.swapped else (uv_a, uv_b)
-        x, jet, ok = _correct(field, kind, np.asarray(uv, dtype=float),
+        x, jet, ok = correct(field, kind, np.asarray(uv, dtype=float),
                               np.asarray(st, dtype=float), np.full(uv.shape[0], -1),
                               1e-12 * field.diagonal)
         foot = jet.projection.foot

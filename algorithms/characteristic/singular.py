@@ -18,9 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..intersection.branches import SingularKind, branch_directions
-from .curves import CurveKind, EndReason, TracedCurve, curve_value, trace_curves
+from .curves import INTERSECTION_MAX_STEPS, CurveKind, EndReason, TracedCurve, curve_value, trace_curves
 from .distance import DistanceField
-from .trace import MAX_STEPS
 
 __all__ = ["continue_at_singular_points"]
 
@@ -70,7 +69,7 @@ def _locate(field: DistanceField, kind: CurveKind, uv: NDArray, st: NDArray, gto
     g, dg = curve_value(jet, kind)
     h = _g_hessian(field, kind, jet)
     small = np.linalg.norm(dg, axis=1) <= 1e-9 * np.abs(h).max(axis=(1, 2)) * field.diagonal
-    from .projection import ProjectionStatus
+    from .projector import ProjectionStatus
     ok = small & (np.abs(g) <= gtol) & (jet.status == ProjectionStatus.UNIQUE)
     return jet, h, ok
 
@@ -309,7 +308,7 @@ def _trace_branches(field: DistanceField, kind: CurveKind, work: list[TracedCurv
             continue
         start = np.clip(point[0] + delta * d, field.lower, field.upper)[None]
         t = trace_curves(field, kind, start, point[1][None], d[None], h0=delta, h_max=h_max,
-                         max_steps=MAX_STEPS, ctol=ctol)[0]
+                         max_steps=INTERSECTION_MAX_STEPS, ctol=ctol)[0]
         if t.uv.shape[0] < 2 or (t.uv[1] - point[0]) @ d <= 0:   # fell back onto the point
             continue
         rows = _rows(t, slice(None))

@@ -26,7 +26,7 @@ from ..intersection import IntersectionCurve
 from .curves import TracedCurve
 from .distance import DistanceField, DistanceJet
 from .points import CharacteristicPoint, PointKind
-from .projection import ProjectionStatus
+from .projector import ProjectionStatus
 from .trace import curve_gap, to_intersection_curves, trace_intersections
 
 __all__ = [
@@ -34,6 +34,7 @@ __all__ = [
     "Start",
     "away_from",
     "border_keys",
+    "label_components",
     "loop_keys",
     "ray_starts",
     "settle",
@@ -78,7 +79,7 @@ class Start:
                      np.concatenate([s.scale for s in items]), np.concatenate(groups))
 
 
-def _label(mask: NDArray) -> NDArray:
+def label_components(mask: NDArray) -> NDArray:
     """4-connected components of a boolean grid: labels ``1, 2, ...`` (0 outside the mask)."""
     labels, _ = ndimage.label(mask)
     return labels
@@ -92,8 +93,8 @@ def loop_keys(field: DistanceField, grid: DistanceJet, shape: tuple[int, int],
     nu, nv = shape
     phi = grid.phi.reshape(nu, nv)
     ok = (grid.status != ProjectionStatus.NONE).reshape(nu, nv)
-    pos = _label(ok & (phi > 0))
-    neg = _label(ok & (phi <= 0))
+    pos = label_components(ok & (phi > 0))
+    neg = label_components(ok & (phi <= 0))
     cell = (field.upper - field.lower) / (np.array(shape) - 1)
     ij = np.clip(((start.uv - field.lower) / cell).astype(int), 0, np.array(shape) - 2)
     keys = np.empty(start.uv.shape[0], dtype=np.int64)

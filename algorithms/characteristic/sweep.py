@@ -31,8 +31,8 @@ from numpy.typing import NDArray
 from .curves import CurveKind, EndReason, TracedCurve, curve_value, trace_curves
 from .distance import DistanceField, DistanceJet
 from .points import CharacteristicPoint, PointKind, edge_roots, make_points
-from .projection import ProjectionStatus
-from .starts import _label
+from .projector import ProjectionStatus
+from .starts import label_components
 
 __all__ = [
     "CHARACTERISTIC_CTOL",
@@ -128,7 +128,7 @@ def unvisited_seeds(field: DistanceField, grid: DistanceJet, shape: tuple[int, i
     todo = change & ~_cells_of(field, shape, curves)
     if not todo.any():
         return np.zeros((0, 2))
-    labels = _label(todo).ravel()
+    labels = label_components(todo).ravel()
     # per group the cell with the most regular corners; the seed: their mean
     count = valid.sum(axis=0).ravel()
     order = np.lexsort((-count, labels))

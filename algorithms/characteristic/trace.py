@@ -32,12 +32,12 @@ from ..intersection import (
 )
 from ..intersection import result as _result
 from ..intersection.splines import SplineSet
-from .curves import CurveKind, EndReason, TracedCurve, curve_value, trace_curves
+from .curves import INTERSECTION_MAX_STEPS, CurveKind, EndReason, TracedCurve, curve_value, trace_curves
 from .distance import DistanceField
 from .points import solve_held
+from .singular import continue_at_singular_points
 
 __all__ = [
-    "MAX_STEPS",
     "dense_polyline",
     "polyline_gap",
     "to_intersection_curve",
@@ -45,8 +45,6 @@ __all__ = [
     "trace_intersections",
 ]
 
-#: accepted steps per intersection curve at most (a cap: never a hang)
-MAX_STEPS = 4000
 #: rounds of midpoint insertion at most
 _SPLIT_ROUNDS = 8
 
@@ -79,18 +77,16 @@ def trace_intersections(field: DistanceField, uv: NDArray, st: NDArray, scale: N
     tangent = np.stack([dg[:, 1], -dg[:, 0]], -1)
     ctol = tol / (16 * field.speed)
     forward = trace_curves(field, CurveKind.INTERSECTION, uv, st, tangent, h0=h0, h_max=h_max,
-                           max_steps=MAX_STEPS, ctol=ctol)
+                           max_steps=INTERSECTION_MAX_STEPS, ctol=ctol)
     again = [i for i, c in enumerate(forward) if not c.closed]
     backward = trace_curves(field, CurveKind.INTERSECTION, uv[again], st[again],
-                            -tangent[again], h0=h0[again], h_max=h_max, max_steps=MAX_STEPS,
+                            -tangent[again], h0=h0[again], h_max=h_max, max_steps=INTERSECTION_MAX_STEPS,
                             ctol=ctol)
     out = list(forward)
     for i, b in zip(again, backward):
         out[i] = forward[i].after(b)
     if not branches:
         return out
-    from .singular import continue_at_singular_points  # it imports MAX_STEPS from here
-
     return continue_at_singular_points(field, out, tol=tol, h_max=h_max, ctol=ctol)
 
 

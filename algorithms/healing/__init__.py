@@ -12,9 +12,9 @@ from .connectivity import (
     Side,
     find_connectivity,
 )
+from .fill import FillMethod
 from .interpolant import Interpolant
 from .measure_joins import JoinReport, measure_join
-from .multiquadric import HardyMode
 from .network import Continuity, Network, connect
 
 # one local approximant (approximant.py and the modules of its steps) and their
@@ -23,7 +23,7 @@ __all__ = [
     "Boundary",
     "Connectivity",
     "Continuity",
-    "HardyMode",
+    "FillMethod",
     "Interpolant",
     "JoinReport",
     "LocalApproximant",

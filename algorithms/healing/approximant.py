@@ -9,9 +9,9 @@
 3. clipping of the sources against the offsets' box (:mod:`.clipping`);
 4. projection of every segment ``a b`` onto the clipped triangles, the hit
    closest to the Coons point, mapped onto the exact surface (eqs. 9-11) and
-   polished by Newton (:mod:`.segments`);
+   polished by Newton (:mod:`.piercing`);
 5. artificial projections where a segment hits nothing (Hardy's reciprocal
-   multiquadric, localized or global, eqs. 12-15, :mod:`.multiquadric`; by
+   multiquadric, localized or global, eqs. 12-15, or the thin-plate spline: :mod:`.fill`; by
    default a thin-plate spline of the same positions plus those of a ring of
    projections beyond the boundary, :mod:`.ring`, which carries the
    surroundings' slope and bending into a hole);
@@ -26,7 +26,7 @@ Beyond the paper: by default the approximant's sides are the boundary curves
 (their samples are interpolated, not projected: ``keep_boundary``), so that
 approximants sharing a curve meet before any G0 averaging and a hole bounded
 by the curves is filled from its rim; and the projected points are put on
-the exact surfaces by Newton piercing of the segments (:mod:`.segments`).
+the exact surfaces by Newton piercing of the segments (:mod:`.piercing`).
 """
 
 from __future__ import annotations
@@ -52,10 +52,10 @@ from .clipping import Source, as_sources, clip_sources
 from .coons import discrete_coons
 from .error import ErrorSample, measure_error
 from .interpolant import Interpolant, interpolate_grid
-from .multiquadric import HardyMode, fill_positions
+from .fill import FillMethod, fill_positions
 from .offsets import offsets
 from .ring import ring_segments
-from .segments import project_grid
+from .piercing import project_grid
 
 __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_approximant"]
 
@@ -63,7 +63,7 @@ __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_
 DEFAULT_RELATIVE_TOL = 1e-3
 #: default chord tolerance of the triangulation of surfaces: this fraction of ``d``
 MESH_FRACTION = 0.02
-#: rows of projections beyond the boundary feeding Hardy's fill (:mod:`.ring`)
+#: rows of projections beyond the boundary feeding the fill (:mod:`.ring`)
 RING_ROWS = 4
 #: a grid with artificial projections is refined at least to this resolution (the
 #: fill over a hole is not measured by the error of §7; finer rims carry its shape)
@@ -99,7 +99,7 @@ class LocalApproximant:
         Error of §7 at the points of eq. (19) not over holes (model units;
         NaN when nothing could be measured).
     artificial_share : float
-        Fraction of the grid points from Hardy's method (over holes or gaps;
+        Fraction of the grid points filled (:mod:`.fill`: over holes or gaps;
         boundary samples kept by ``keep_boundary`` are not artificial).
     converged : bool
         ``max_error <= tol``.
@@ -170,7 +170,7 @@ def _sides(found: NDArray, t: NDArray, y: NDArray, x: NDArray, keep_boundary: bo
     """Grid points fixed to the boundary curves, and ``found``/``t`` updated for them.
 
     Kept sides are the Coons points ``x`` themselves (``t = 1/2`` on their
-    segments, data for Hardy's fill); a side point counts as on the originals
+    segments, data for the fill); a side point counts as on the originals
     only where the curve is (within ``tol`` of its projection), not where it
     runs above or below them.
     """
@@ -238,21 +238,21 @@ def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache, preferr
     return ring, y, t, found, src
 
 
-def _fill(coons, ring, t, known, t_ring, found_ring, hardy, neighbours) -> NDArray:
-    """Positions everywhere on the grid (Hardy's fill, with the ring's data if any)."""
+def _fill(coons, ring, t, known, t_ring, found_ring, fill, neighbours) -> NDArray:
+    """Positions everywhere on the grid (:mod:`.fill`, with the ring's data if any)."""
     if ring is None or np.all(known):
-        return fill_positions(coons.u, coons.v, t, known, mode=hardy, neighbours=neighbours)
+        return fill_positions(coons.u, coons.v, t, known, method=fill, neighbours=neighbours)
     t_ext = np.zeros(ring.outer.shape)
     known_ext = np.zeros(ring.outer.shape, bool)
     t_ext[ring.outer], known_ext[ring.outer] = t_ring, found_ring
     r = ring.rows
     t_ext[r:-r, r:-r], known_ext[r:-r, r:-r] = t, known
-    return ring.inner(fill_positions(ring.u, ring.v, t_ext, known_ext, mode=hardy,
+    return ring.inner(fill_positions(ring.u, ring.v, t_ext, known_ext, method=fill,
                                      neighbours=neighbours))
 
 
 def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: float | None,
-              interpolant: Interpolant, hardy: HardyMode, neighbours: int,
+              interpolant: Interpolant, fill: FillMethod, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
               ring_rows: int, preferred: int | None, cache: dict,
               side_error: bool = False) -> _Pass:
@@ -272,7 +272,7 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
             f"lie over them (or the offset distance {off.distance:.3g} is too small)")
     y = y.reshape(shape + (3,))
     rim, found, t = _sides(found, t, y, coons.points, keep_boundary, tol)
-    t_all = _fill(coons, ring, t, found | rim, t_ring, found_ring, hardy, neighbours)
+    t_all = _fill(coons, ring, t, found | rim, t_ring, found_ring, fill, neighbours)
     z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
     grid = np.where(found[..., None], y, z)
     grid[rim] = coons.points[rim]
@@ -289,7 +289,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       max_resolution: tuple[int, int] = (64, 64),
                       interpolant: Interpolant = Interpolant.C1_BICUBIC,
                       offset: float | None = None, neighbours: int = 8,
-                      hardy: HardyMode = HardyMode.THIN_PLATE, growth: float = 1.5,
+                      fill: FillMethod = FillMethod.THIN_PLATE, growth: float = 1.5,
                       gap_tol: float | None = None, mesh_tol: float | None = None,
                       keep_boundary: bool = True, ring_rows: int | None = None,
                       fill_resolution: tuple[int, int] = FILL_RESOLUTION,
@@ -317,10 +317,11 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     offset : float, optional
         ``d`` of eq. (7), model units; default eq. (8).
     neighbours : int
-        ``K`` of the localized Hardy method (5-10).
-    hardy : HardyMode
-        Thin-plate fill (default), localized or global Hardy interpolation
-        (one dense system over all found points: ``O(n^3)``, for small grids).
+        ``K`` of Hardy's localized method (5-10).
+    fill : FillMethod
+        How missing positions are filled (:mod:`.fill`): the thin-plate spline
+        (default), Hardy's localized or global multiquadric (the global one is one
+        dense system over all found points: ``O(n^3)``, for small grids).
     ring_rows : int >= 0
         Rows of projections beyond the boundary that feed the fill (:mod:`.ring`;
         0: only the grid's own, as in 001). Default :data:`RING_ROWS` for the
@@ -344,7 +345,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     keep_boundary : bool
         The approximant's sides are the boundary curves (their arc-length
         samples are interpolated, not projected), so approximants sharing a
-        curve meet; the samples also enter Hardy's interpolation (at ``t = 1/2``),
+        curve meet; the samples also enter the fill (at ``t = 1/2``),
         so a hole bounded by the curves is filled from its rim; side points
         farther than ``tol`` from their projection (curves above or below the
         originals) do not count as on the originals in the error of §7.
@@ -400,11 +401,11 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
     fill_min = tuple(min(f, lim) for f, lim in zip(
         _check_resolution(fill_resolution, "fill_resolution", minimum), limit, strict=True))
     if ring_rows is None:
-        ring_rows = RING_ROWS if hardy is HardyMode.THIN_PLATE else 0
+        ring_rows = RING_ROWS if fill is FillMethod.THIN_PLATE else 0
     history, passes, cache = [], [], {}
     while True:
         p = _one_pass(bnd, srcs, *current, offset=offset, interpolant=interpolant,
-                      hardy=hardy, neighbours=neighbours, mesh_tol=mesh_tol,
+                      fill=fill, neighbours=neighbours, mesh_tol=mesh_tol,
                       keep_boundary=keep_boundary, tol=tol, size=size,
                       ring_rows=ring_rows, preferred=preferred_source, cache=cache,
                       side_error=side_error)

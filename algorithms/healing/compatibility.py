@@ -30,8 +30,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError
-from ..knots import Direction, refine_surface
+from ..knots import refine_surface
 from ..surface import NurbsSurface
+from ..tensor import Direction
 from .connectivity import Connectivity
 
 __all__ = ["MIN_DEGREE", "make_compatible", "normalize_domain"]

@@ -28,9 +28,9 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from ...errors import InvalidGeometryError
-from ..knots import Direction
 from ..projection import project_to_curve
 from ..surface import NurbsSurface
+from ..tensor import Direction
 
 __all__ = [
     "SIDE_SAMPLES",

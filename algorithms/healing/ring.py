@@ -1,4 +1,4 @@
-"""Data around a hole for Hardy's fill: a ring of projections beyond the boundary.
+"""Data around a hole for the fill (:mod:`.fill`): a ring of projections beyond the boundary.
 
 Where the segments of a Coons grid hit nothing (a hole), 001 §5 interpolates
 the positions ``t`` found elsewhere on the grid. For a hole bounded by the four

@@ -14,12 +14,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import AVAILABLE, _jit
+from ..jit import AVAILABLE, jit
 
 __all__ = ["AVAILABLE", "nearest_on_candidates"]
 
 
-@_jit
+@jit
 def _edge_foot(px, py, pz, ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
     abx, aby, abz = bx - ax, by - ay, bz - az
     den = abx * abx + aby * aby + abz * abz
@@ -29,7 +29,7 @@ def _edge_foot(px, py, pz, ax, ay, az, bx, by, bz):  # pragma: no cover - compil
     return np.sqrt(dx * dx + dy * dy + dz * dz), s
 
 
-@_jit
+@jit
 def _nearest_kernel(points, tri, cand, dist_out, pick_out, bary_out):  # pragma: no cover
     for i in range(points.shape[0]):
         px, py, pz = points[i, 0], points[i, 1], points[i, 2]

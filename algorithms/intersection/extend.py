@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
+from .boundary_ends import side_constraint, solve_on_side
 from .refine import RefinedCurve, refine_points
 
 __all__ = ["extend_open_ends"]
@@ -64,14 +65,12 @@ def _onto_side(surface_a: NurbsSurface, surface_b: NurbsSurface, ua: NDArray, ub
                side: int, tol: float) -> tuple | None:
     """``(p, uv_a, uv_b)`` solved with the side parameter of surface ``side`` held
     (``ua`` / ``ub`` already clipped onto the domain), or None."""
-    from .pipeline import _side_constraint, _solve_on_side
-
-    held = _side_constraint(ua if side == 0 else ub,
-                            (surface_a if side == 0 else surface_b).domain)
+    held = side_constraint(ua if side == 0 else ub,
+                           (surface_a if side == 0 else surface_b).domain)
     if held is None:
         return None
-    ra, rb, ok = _solve_on_side(surface_a, surface_b, ua[None], ub[None], np.array([side]),
-                                np.array([held[0]]), np.array([held[1]]), tol / 16)
+    ra, rb, ok = solve_on_side(surface_a, surface_b, ua[None], ub[None], np.array([side]),
+                               np.array([held[0]]), np.array([held[1]]), tol / 16)
     if not ok[0]:
         return None
     q = 0.5 * (surface_a.evaluate(ra[:, 0], ra[:, 1])[0]

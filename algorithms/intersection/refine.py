@@ -56,7 +56,7 @@ from ...errors import InvalidGeometryError
 from ..measure import normals
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from . import refine_kernel, vectors
+from . import refine_kernels, vectors
 
 __all__ = [
     "RefinedCurve",
@@ -275,10 +275,10 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
     anchor = None if anchors is None else np.asarray(anchors, dtype=float)
     if anchor is not None and anchor.shape != (n, 3):
         raise InvalidGeometryError(f"anchors must have shape ({n}, 3), got {anchor.shape}")
-    if refine_kernel.AVAILABLE:
+    if refine_kernels.AVAILABLE:
         start_a, start_b = ua.copy(), ub.copy()
         img_a, img_b, nrm_a, nrm_b, iterations, singular, fallback = \
-            refine_kernel.refine_compiled(surface_a, surface_b, ua, ub, anchor, tol, max_iter,
+            refine_kernels.refine_compiled(surface_a, surface_b, ua, ub, anchor, tol, max_iter,
                                           tangent_sin, _DEGENERATE)
         if np.any(fallback):            # a pole on the way: the numpy form, from the start
             k = np.flatnonzero(fallback)

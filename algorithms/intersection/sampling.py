@@ -56,11 +56,11 @@ from .interpolants import (
 )
 from .refine import RefinedCurve, RefinedPoints, refine_points
 from .sampling_rounds import (
-    _MIDDLE,
-    _POINT_SHARE,
     CHECK_FRACTIONS,
+    MIDDLE_SHARE,
+    POINT_SHARE,
     Refiner,
-    _Work,
+    VerificationState,
     verification_round,
 )
 from .splines import interpolate_many
@@ -298,7 +298,7 @@ def _dense_jacobians(surface_a: NurbsSurface, surface_b: NurbsSurface,
     return list(zip(np.split(jac_a, split), np.split(jac_b, split)))
 
 
-def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _Work:
+def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> VerificationState:
     """Dense samples (left out) merged by parameter with the new ones (kept)."""
     m = curve.points.shape[0]
     t_dense = t[:m]
@@ -321,7 +321,7 @@ def _merged_work(curve: RefinedCurve, t: NDArray, positions: NDArray, new) -> _W
     def merge(dense, extra):
         return np.concatenate([dense, extra])[order]
 
-    return _Work(merge(curve.points, new.points[fresh]), merge(curve.uv_a, new.uv_a[fresh]),
+    return VerificationState(merge(curve.points, new.points[fresh]), merge(curve.uv_a, new.uv_a[fresh]),
                  merge(curve.uv_b, new.uv_b[fresh]),
                  merge(curve.converged, np.ones(fresh.sum(), dtype=bool)),
                  merge(curve.singular, new.singular[fresh]), curve.closed,
@@ -409,7 +409,7 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
         at = dense.evaluate(np.repeat(np.arange(len(planned)), [p.size for _, (_, p) in planned]),
                             np.concatenate([p for _, (_, p) in planned]))
         anchors = at[:, :3]
-        new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
+        new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=POINT_SHARE * tol,
                       anchors=anchors, tangent_sin=tangent_sin)
         # a sample that slid along the curve (near-tangential surfaces) is left out
         moved = np.linalg.norm(new.points - anchors, axis=1)
@@ -417,14 +417,14 @@ def cubic_samples(surface_a: NurbsSurface, surface_b: NurbsSurface,
     for c, plan in zip(curves, plans):
         m = c.points.shape[0]
         if plan is None:
-            works.append(_Work(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
+            works.append(VerificationState(c.points, c.uv_a, c.uv_b, c.converged.copy(), c.singular.copy(),
                                c.closed, np.ones(m, dtype=bool), np.zeros(m, dtype=bool)))
             continue
         t, pos = plan
         sl = slice(offset, offset + pos.size)
         offset += pos.size
         spacing = t[-1] / (pos.size + 1)
-        ok = new.converged[sl] & (moved[sl] <= _MIDDLE * spacing)
+        ok = new.converged[sl] & (moved[sl] <= MIDDLE_SHARE * spacing)
         part = RefinedPoints(new.points[sl][ok], new.uv_a[sl][ok], new.uv_b[sl][ok],
                              new.gap[sl][ok], new.iterations[sl][ok], new.converged[sl][ok],
                              new.singular[sl][ok])

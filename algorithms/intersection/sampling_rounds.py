@@ -21,7 +21,8 @@ from .interpolants import sample_parameters
 from .refine import RefinedPoints, refine_points
 from .splines import SplineSet, interpolate_many
 
-__all__ = ["CHECK_FRACTIONS", "Refiner", "verification_round"]
+__all__ = ["CHECK_FRACTIONS", "MIDDLE_SHARE", "POINT_SHARE", "Refiner", "VerificationState",
+           "verification_round"]
 
 #: ``refiner(surface_a, surface_b, uv_a, uv_b, *, tol, anchors, tangent_sin)``: new
 #: samples put on the curve (:func:`.refine.refine_points` or a tangential curve's own)
@@ -30,7 +31,7 @@ Refiner = Callable[..., RefinedPoints]
 #: where every span is checked (fractions of the span)
 CHECK_FRACTIONS = (0.25, 0.5, 0.75)
 #: samples are refined to this share of tol (as in :mod:`.refine`)
-_POINT_SHARE = 1.0 / 16.0
+POINT_SHARE = 1.0 / 16.0
 #: Newton steps projecting left-out dense samples onto curve3d
 _PROJECTION_STEPS = 4
 #: a projection onto curve3d stops once its steps move the foot by this share of the target
@@ -41,7 +42,7 @@ _MAX_RATIO = 4.0
 _MAX_GRADED = 8
 _GRADE_PASSES = 32
 #: a failing span takes a dense sample within this fraction of its middle, else a new one
-_MIDDLE = 0.25
+MIDDLE_SHARE = 0.25
 #: a new sample must project onto its span's chord this far from both ends
 _INSIDE = 0.02
 #: a failing span is cut into at most this many pieces per round
@@ -61,7 +62,7 @@ _ACCEPT = 0.25
 
 
 @dataclass
-class _Work:
+class VerificationState:
     """One curve under sampling: its dense samples and which of them are kept."""
 
     points: NDArray
@@ -126,7 +127,7 @@ class _Check:
                      for a, b in ((0, 3), (3, 5), (5, 7)))
 
 
-def _drop_duplicates(w: _Work, tol: float) -> NDArray:
+def _drop_duplicates(w: VerificationState, tol: float) -> NDArray:
     """Kept indices, after dropping kept samples within ``_DUPLICATE tol`` of the previous
     one (near-tangential refinement can land two samples on one point); they are
     marked unconverged so that no later round takes them again."""
@@ -144,7 +145,7 @@ def _drop_duplicates(w: _Work, tol: float) -> NDArray:
     return np.flatnonzero(w.kept)
 
 
-def _dirty_spans(w: _Work, k: NDArray, spans: int) -> NDArray:
+def _dirty_spans(w: VerificationState, k: NDArray, spans: int) -> NDArray:
     """Spans (indices into the kept samples) to check this round: those within
     ``_LOCALITY`` spans of a sample kept since the last check (all in the first
     round). A C2 cubic interpolant moves by a factor ``2 - sqrt(3)`` less per span
@@ -159,7 +160,7 @@ def _dirty_spans(w: _Work, k: NDArray, spans: int) -> NDArray:
     return np.unique(near)
 
 
-def _checks(works: list[_Work], tol: float) -> list[_Check]:
+def _checks(works: list[VerificationState], tol: float) -> list[_Check]:
     """This round's interpolants of all curves (one solve, :func:`.splines.interpolate_many`)
     and their values at the check points of the spans to check (one evaluation);
     None for a curve collapsed onto a point."""
@@ -212,7 +213,7 @@ def _check_errors(checks: list[_Check], surface_a, surface_b) -> list[NDArray]:
     return [e.reshape(-1, len(CHECK_FRACTIONS)).max(axis=1) for e in np.split(err, split)]
 
 
-def _span_errors_now(w: _Work, check: _Check, dirty_error: NDArray) -> NDArray:
+def _span_errors_now(w: VerificationState, check: _Check, dirty_error: NDArray) -> NDArray:
     """Errors ``(spans,)`` of all spans: just checked, or as last checked."""
     m = w.points.shape[0]
     if w.span_error is None or w.span_error.shape[0] != m:
@@ -222,7 +223,7 @@ def _span_errors_now(w: _Work, check: _Check, dirty_error: NDArray) -> NDArray:
     return w.span_error[check.kept[:spans]]
 
 
-def _failing_spans(w: _Work, check: _Check, error: NDArray, target: float, tol: float,
+def _failing_spans(w: VerificationState, check: _Check, error: NDArray, target: float, tol: float,
                    surface_a, surface_b):
     """Spans (by index into the kept samples) over ``target`` at their check points, their
     errors, the dense samples farther than ``target`` from ``curve3d`` where the
@@ -309,7 +310,7 @@ def _graded(dt: NDArray, pieces: NDArray, cut: NDArray, closed: bool, can: NDArr
     return n.astype(np.int64)
 
 
-def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
+def _insert(w: VerificationState, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDArray,
             singular: NDArray) -> None:
     """New kept dense samples right after dense indices ``after`` (sorted, distinct)."""
     m, q = w.points.shape[0], after.size
@@ -329,7 +330,7 @@ def _insert(w: _Work, after: NDArray, points: NDArray, uv_a: NDArray, uv_b: NDAr
     w.span_error = put(w.span_error, np.nan)
 
 
-def _place(w: _Work, start: NDArray, stop: NDArray, points: NDArray
+def _place(w: VerificationState, start: NDArray, stop: NDArray, points: NDArray
            ) -> tuple[NDArray, NDArray, NDArray]:
     """Where new samples go in their spans ``start -> stop`` (dense indices, ``stop`` may
     be ``m`` for the closing span): ``(inside, after, fraction)``, three ``(q,)`` arrays.
@@ -381,11 +382,11 @@ def _pieces(error: NDArray, target: float) -> NDArray:
     return np.clip(np.ceil(np.sqrt(ratio)), 2, _MAX_PIECES).astype(np.int64)
 
 
-def _middle_samples(w: _Work, bad: NDArray, pieces: NDArray, span_of: NDArray, ends: NDArray,
+def _middle_samples(w: VerificationState, bad: NDArray, pieces: NDArray, span_of: NDArray, ends: NDArray,
                     arc: NDArray) -> tuple[NDArray, NDArray]:
     """Dense samples that split failing spans in two: for every span of ``bad`` to be cut
     in 2 pieces, the left-out converged dense sample nearest its middle (by arc length),
-    if within ``_MIDDLE`` of it. Returns the dense indices taken and a ``(len(bad),)``
+    if within ``MIDDLE_SHARE`` of it. Returns the dense indices taken and a ``(len(bad),)``
     mask of the spans they split (all spans at once)."""
     covered = np.zeros(bad.size, dtype=bool)
     halves = bad[pieces == 2]
@@ -403,12 +404,12 @@ def _middle_samples(w: _Work, bad: NDArray, pieces: NDArray, span_of: NDArray, e
     order = np.lexsort((dev, j))                     # per span, the nearest first (stable)
     first = np.concatenate([[True], np.diff(j[order]) != 0])
     best = order[first]
-    best = best[dev[best] <= _MIDDLE]
+    best = best[dev[best] <= MIDDLE_SHARE]
     covered = np.isin(bad, j[best]) & (pieces == 2)
     return cand[best], covered
 
 
-def verification_round(works: list[_Work], surface_a, surface_b, target: float, tol: float,
+def verification_round(works: list[VerificationState], surface_a, surface_b, target: float, tol: float,
                        tangent_sin: float, refiner: Refiner = refine_points) -> None:
     """One verification round over all unfinished curves (module docstring, step 2)."""
     todo = [w for w in works if not w.done]
@@ -468,7 +469,7 @@ def verification_round(works: list[_Work], surface_a, surface_b, target: float, 
     at = curves[0].curves.evaluate(np.concatenate([np.full(j[3].size, c.index)
                                                    for j, c in zip(jobs, curves)]),
                                    np.concatenate([j[3] for j in jobs]))
-    new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=_POINT_SHARE * tol,
+    new = refiner(surface_a, surface_b, at[:, 3:5], at[:, 5:7], tol=POINT_SHARE * tol,
                   anchors=at[:, :3], tangent_sin=tangent_sin)
     offset = 0
     for w, start, stop, _ in jobs:

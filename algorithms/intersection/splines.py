@@ -26,9 +26,10 @@ from numpy.typing import NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..basis import basis_derivatives, find_span
-from ..basis_kernels import AVAILABLE, _ders_one, _jit
+from ..basis_kernels import ders_one
 from ..curve import NurbsCurve
-from ..fitting import _seam_tangent, _solve_banded_rows, averaged_knots, knots_from_breakpoints
+from ..fitting import averaged_knots, knots_from_breakpoints, seam_tangent, solve_banded_rows
+from ..jit import AVAILABLE, jit
 from .interpolants import interpolate_samples
 
 __all__ = ["SplineSet", "interpolate_many"]
@@ -99,7 +100,7 @@ class SplineSet:
         return self.derivatives(index, t, 0)[:, 0]
 
 
-@_jit
+@jit
 def _evaluate_many(knots, knot_start, control, control_start, degree, index, t, order):
     m, d = t.size, control.shape[1]
     out = np.zeros((m, order + 1, d))
@@ -122,7 +123,7 @@ def _evaluate_many(knots, knot_start, control, control_start, degree, index, t, 
         span = np.searchsorted(kn, t[j], side="right") - 1
         span = min(max(span, first), last)
         ders[:, :] = 0.0
-        _ders_one(kn, p, t[j], span, min(order, p), ndu, a, left, right, ders)
+        ders_one(kn, p, t[j], span, min(order, p), ndu, a, left, right, ders)
         base = control_start[c] + span - p
         for k in range(order + 1):
             for e in range(d):
@@ -137,7 +138,7 @@ def _rows(q: NDArray, t: NDArray, closed: bool) -> tuple[NDArray, NDArray, NDArr
     """Collocation rows of one cubic interpolant (as :func:`fitting.interpolate_curve`
     builds them): ``cols, values (N, 4)``, ``rhs (N, d)`` and the knots."""
     if closed:                  # C1 closure: D_0 = D_{n-1}, the seam tangent (eqs. 9.19-9.21)
-        tangent = _seam_tangent(q, t)
+        tangent = seam_tangent(q, t)
         knots = knots_from_breakpoints(t, 3, end_condition="clamped")
         span = find_span(knots, 3, t)
         values = basis_derivatives(knots, 3, t, 0, span)[0][:, 0]
@@ -226,4 +227,4 @@ def interpolate_many(values: Sequence[NDArray], parameters: Sequence[NDArray],
 
 def _solve_blocks(cols: list[NDArray], values: list[NDArray], rhs: list[NDArray]) -> NDArray:
     """One banded solve of the block-diagonal system of all curves' rows."""
-    return _solve_banded_rows(np.concatenate(cols), np.concatenate(values), np.concatenate(rhs))
+    return solve_banded_rows(np.concatenate(cols), np.concatenate(values), np.concatenate(rhs))

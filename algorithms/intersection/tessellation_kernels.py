@@ -26,13 +26,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import AVAILABLE, _ders_one, _jit
+from ..basis_kernels import ders_one
+from ..jit import AVAILABLE, jit
 
 __all__ = ["AVAILABLE", "any_overlap", "any_overlap_in_range", "blossom_spans",
            "chord_errors_from_grid", "grid_points", "query_pairs", "restricted_boxes"]
 
 
-@_jit
+@jit
 def _line_basis(knots, p, t, span, out):
     """Basis functions ``out (n, p + 1)`` at ``t (n,)`` with spans ``span (n,)`` (A2.2)."""
     ndu = np.empty((p + 1, p + 1))
@@ -41,12 +42,12 @@ def _line_basis(knots, p, t, span, out):
     one = np.zeros((1, p + 1))
     for i in range(t.size):
         one[0, :] = 0.0
-        _ders_one(knots, p, t[i], span[i], 0, ndu, a, left, right, one)
+        ders_one(knots, p, t[i], span[i], 0, ndu, a, left, right, one)
         for j in range(p + 1):
             out[i, j] = one[0, j]
 
 
-@_jit
+@jit
 def _grid_points(knots_u, knots_v, p, q, net, u, v, su, sv, rational, out):
     k, n = u.shape
     c = net.shape[2]
@@ -98,7 +99,7 @@ def grid_points(knots_u: NDArray, knots_v: NDArray, p: int, q: int, net: NDArray
     return out
 
 
-@_jit
+@jit
 def _dist(g, a, b, c, d, wa, wb, wc, wd):
     s = 0.0
     for e in range(3):
@@ -107,7 +108,7 @@ def _dist(g, a, b, c, d, wa, wb, wc, wd):
     return np.sqrt(s)
 
 
-@_jit
+@jit
 def _chord_errors(grid, s, err, diag, error_u, error_v):
     k, n = grid.shape[0], grid.shape[1]
     for r in range(k):
@@ -157,7 +158,7 @@ def chord_errors_from_grid(grid: NDArray, s: NDArray) -> tuple[NDArray, NDArray,
     return err, diag, eu, ev
 
 
-@_jit
+@jit
 def _restrict(line, s0, s1, out, work):
     """Bernstein coefficients ``out (p + 1, c)`` of ``line (p + 1, c)`` on ``[s0, s1]``:
     the left part of the de Casteljau split at ``s1``, then the right part of that
@@ -188,7 +189,7 @@ def _restrict(line, s0, s1, out, work):
             out[p - r, e] = work[p - r, e]
 
 
-@_jit
+@jit
 def _boxes(coeffs, which, s0, s1, t0, t1, out):
     k = which.size
     p1, q1, c = coeffs.shape[1], coeffs.shape[2], coeffs.shape[3]
@@ -231,7 +232,7 @@ def restricted_boxes(coeffs: NDArray, which: NDArray, s0: NDArray, s1: NDArray, 
     return out
 
 
-@_jit
+@jit
 def _any_overlap(lo, hi, left, right, boxes, pad, depth, out):
     stack = np.empty(depth, dtype=np.int64)
     for r in range(boxes.shape[0]):
@@ -268,7 +269,7 @@ def any_overlap(tree, boxes: NDArray, pad: float) -> NDArray:
     return out
 
 
-@_jit
+@jit
 def _region_any(boxes, first, last, keep, pad, out):
     for r in range(boxes.shape[0]):
         for b in range(first[r], last[r]):
@@ -293,7 +294,7 @@ def any_overlap_in_range(boxes: NDArray, first: NDArray, last: NDArray, keep: ND
     return out
 
 
-@_jit
+@jit
 def _query_pairs(lo, hi, left, right, item, boxes, pad, depth):
     out = np.empty((max(16, 4 * boxes.shape[0]), 2), dtype=np.int64)
     k = 0
@@ -340,7 +341,7 @@ def query_pairs(tree, boxes: NDArray, pad: float) -> NDArray:
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
 
 
-@_jit
+@jit
 def blossom_spans(net, knots, p):
     """``(k, p + 1, m, c)``: the Bernstein coefficients along axis 1 of the knot spans
     ``[knots[s, p], knots[s, p + 1]]`` from their poles ``net (k, p + 1, m, c)``;

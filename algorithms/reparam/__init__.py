@@ -2,12 +2,12 @@
 guaranteed tolerance (Hamann, Jean, Razdan, handbook ch. 29, §29.2).
 
 :func:`reparametrize_surface` is the entry point; the steps live in
-:mod:`.boundary` (arc length + curvature, §29.2.4), :mod:`.reconcile`
+:mod:`.boundary_points` (arc length + curvature, §29.2.4), :mod:`.reconcile`
 (§29.2.5), :mod:`.interior` (penalty relocation, §29.2.6) and
 :mod:`.deviation` (dense error, eq. 29.3).
 """
 
-from .boundary import ArcLengthTable, arc_length_table, boundary_fractions
+from .boundary_points import ArcLengthTable, arc_length_table, boundary_fractions
 from .deviation import DeviationMap, deviation_map, original_on_new
 from .interior import RelocationResult, initial_guess, penalties, relocate
 from .rca import (

@@ -5,7 +5,7 @@ that lies within ``tol`` of the original ``s`` (both ways, eq. 29.3) and whose
 parameters follow arc length (eqs. 29.1/29.2):
 
 1. the four boundaries get interpolation points by arc length and curvature
-   (:mod:`.boundary`, section 29.2.4);
+   (:mod:`.boundary_points`, section 29.2.4);
 2. opposite boundaries are reconciled to one fraction sequence per direction
    (:mod:`.reconcile`, section 29.2.5); the new parameters are these
    fractions times the mean length of the two boundaries, so one unit of
@@ -50,11 +50,11 @@ from scipy.interpolate import RegularGridInterpolator
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..isocurve import isocurve
-from ..knots import Direction
 from ..parametrization import parametrization_quality
 from ..surface import NurbsSurface
+from ..tensor import Direction
 from ..tolerance import check_tolerance
-from .boundary import arc_length_table, boundary_fractions
+from .boundary_points import arc_length_table, boundary_fractions
 from .coarsen import RESPACE_TARGET, Fit, coarsen, respaced_fractions
 from .interior import PENALTY_TOL, initial_guess, relocate
 from .reconcile import insert_midpoints, reconcile_fractions

@@ -142,11 +142,11 @@ def test_distance_jet_function_and_field_agree():
 
 @pytest.mark.parametrize("pair", ["bicubic", "sphere", "plane", "plane by Newton"])
 def test_compiled_jet_matches_the_numpy_jet(pair, monkeypatch):
-    """The numba pass (kernels.distance_points, project_points, patch_derivatives)
+    """The numba pass (distance_kernels.distance_points, project_points, patch_derivatives)
     computes what the numpy forms compute: same feet, cases, phi and derivatives.
-    A plane q is projected in closed form in both (kernels._project_affine); "plane
+    A plane q is projected in closed form in both (distance_kernels._project_affine); "plane
     by Newton" checks the compiled closed form against the compiled Newton."""
-    from surfprep.algorithms.characteristic import kernels
+    from surfprep.algorithms.characteristic import distance_kernels
     if pair == "bicubic":
         a, b = random_pair(4)
     elif pair.startswith("plane"):
@@ -162,9 +162,9 @@ def test_compiled_jet_matches_the_numpy_jet(pair, monkeypatch):
         newton._grid["affine"] = None
         ref = DistanceField(a, newton).jet(uv)
     else:
-        monkeypatch.setattr(kernels, "AVAILABLE", False)
+        monkeypatch.setattr(distance_kernels, "AVAILABLE", False)
         ref = DistanceField(a, Projector(b, tol=1e-13)).jet(uv)
-        assert kernels.AVAILABLE is False
+        assert distance_kernels.AVAILABLE is False
     np.testing.assert_array_equal(compiled.status, ref.status)
     ok = ref.status != ProjectionStatus.NONE
     assert ok.sum() > 100
@@ -204,10 +204,10 @@ def test_a_foot_held_at_the_clip_box_is_the_closest_point_along_it(compiled, mon
     its 30 steps: 897 of 1089 grid points of the sheets crossing at 5e-3 rad); ten
     steps from the domain's middle reach it, compiled and numpy alike."""
     from char_surfaces import flat_crossing
-    from surfprep.algorithms.characteristic import kernels
-    from surfprep.algorithms.characteristic.projection import EXTENSION
+    from surfprep.algorithms.characteristic import distance_kernels
+    from surfprep.algorithms.characteristic.projector import EXTENSION
     if not compiled:
-        monkeypatch.setattr(kernels, "AVAILABLE", False)
+        monkeypatch.setattr(distance_kernels, "AVAILABLE", False)
     a, b = flat_crossing(5e-3)
     pts = b.evaluate(np.full(40, 0.5), np.linspace(0.05, 0.95, 40)) + [2.0, 0.0, 0.0]
     for steps in (10, 30):

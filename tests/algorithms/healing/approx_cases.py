@@ -8,7 +8,7 @@ import numpy as np
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.intersection.mesh import TriangleMesh
 from surfprep.algorithms.intersection.tessellation import tessellate
-from surfprep.algorithms.knots import Direction
+from surfprep.algorithms.tensor import Direction
 from surfprep.algorithms.surface import NurbsSurface
 
 

@@ -20,7 +20,7 @@ from approx_cases import (
     upper_envelope,
 )
 from surfprep.algorithms.healing import (
-    HardyMode,
+    FillMethod,
     Interpolant,
     SurfaceSource,
     corners_boundary,
@@ -147,7 +147,7 @@ def test_hole_in_a_triangle_mesh(smooth, with_surface):
 def test_global_and_local_hardy_agree_roughly(smooth):
     b, src = iso_boundary(smooth, *PATCH), surrounding_patches(smooth, HOLE)
     local = _fixed(b, src, 10)
-    glob = _fixed(b, src, 10, hardy=HardyMode.GLOBAL)
+    glob = _fixed(b, src, 10, fill=FillMethod.HARDY_GLOBAL)
     np.testing.assert_array_equal(local.artificial, glob.artificial)
     np.testing.assert_array_equal(local.grid[~local.artificial], glob.grid[~glob.artificial])
     assert np.abs(local.grid - glob.grid).max() < 5e-3
@@ -296,7 +296,7 @@ def test_ring_carries_the_surroundings_into_a_rim_bounded_hole(smooth):
     # interior (Hardy's fill from the rim alone), checked densely against the true surface
     boundary, sources = iso_boundary(smooth, *HOLE), surrounding_patches(smooth, HOLE)
     ring = _fixed(boundary, sources, 16)
-    rim_only = _fixed(boundary, sources, 16, hardy=HardyMode.LOCAL)
+    rim_only = _fixed(boundary, sources, 16, fill=FillMethod.HARDY_LOCAL)
     assert ring.artificial_share == pytest.approx(15 ** 2 / 17 ** 2)
     dev_ring = distance_to_surface(smooth, _dense(ring)[1].reshape(-1, 3)).max()
     dev_rim = distance_to_surface(smooth, _dense(rim_only)[1].reshape(-1, 3)).max()

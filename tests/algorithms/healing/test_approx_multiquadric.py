@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from surfprep.algorithms.healing.multiquadric import (
-    HardyMode,
+from surfprep.algorithms.healing.fill import (
+    FillMethod,
     _kernel,
     fill_positions,
     hardy_parameters,
@@ -24,13 +24,13 @@ def test_radius_is_the_mean_spacing():
     assert hardy_parameters(u, v) == pytest.approx(0.5 * (0.1 + 0.25))
 
 
-@pytest.mark.parametrize("mode", list(HardyMode))
+@pytest.mark.parametrize("mode", list(FillMethod))
 def test_found_positions_kept_and_smooth_field_filled(mode):
     u, v = _params(16, 16)
     t = 0.5 + 0.1 * np.sin(2 * u) * np.cos(1.5 * v)
     found = np.ones_like(t, bool)
     found[6:10, 5:9] = False
-    got = fill_positions(u, v, np.where(found, t, -7.0), found, mode=mode)
+    got = fill_positions(u, v, np.where(found, t, -7.0), found, method=mode)
     np.testing.assert_array_equal(got[found], t[found])
     assert np.abs(got - t)[~found].max() < 5e-3     # the field varies by 0.1 there
 

@@ -12,7 +12,7 @@ from surfprep.algorithms.healing.error import (
     distance_to_triangles,
     error_parameters,
 )
-from surfprep.algorithms.healing.segments import (
+from surfprep.algorithms.healing.piercing import (
     intersect_segments,
     pierce_surface,
     project_grid,

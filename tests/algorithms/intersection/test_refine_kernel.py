@@ -1,4 +1,4 @@
-"""The compiled auxiliary-plane iteration (refine_kernel.py) against the numpy form of
+"""The compiled auxiliary-plane iteration (refine_kernels.py) against the numpy form of
 refine_points: same iterations, same points to rounding, the same flags; a start on a
 pole goes through the numpy form."""
 
@@ -7,14 +7,14 @@ import pytest
 from ssi_surfaces import sphere_band
 
 from surfprep.algorithms import NurbsSurface
-from surfprep.algorithms.intersection import refine_kernel
+from surfprep.algorithms.intersection import refine_kernels
 from surfprep.algorithms.intersection.refine import refine_points
 
 
 def test_compiled_kernels_are_available():
     # numba is a declared dependency: without it the numpy fallbacks would run
     # silently and the comparisons below would compare a form with itself
-    assert refine_kernel.AVAILABLE
+    assert refine_kernels.AVAILABLE
 
 
 def _plane(z: float, half: float = 2.0, normal_axis: int = 2) -> NurbsSurface:
@@ -36,7 +36,7 @@ def _height_field(seed: int) -> NurbsSurface:
 def _both(monkeypatch, a, b, uv_a, uv_b, **kw):
     compiled = refine_points(a, b, uv_a, uv_b, **kw)
     with monkeypatch.context() as m:
-        m.setattr(refine_kernel, "AVAILABLE", False)
+        m.setattr(refine_kernels, "AVAILABLE", False)
         reference = refine_points(a, b, uv_a, uv_b, **kw)
     return compiled, reference
 

@@ -16,7 +16,7 @@ from surfprep.algorithms.reparam import (
     reconcile_fractions,
     relocate,
 )
-from surfprep.algorithms.reparam.boundary import boundary_interpolant
+from surfprep.algorithms.reparam.boundary_points import boundary_interpolant
 from surfprep.algorithms.reparam.deviation import subdivide
 
 

@@ -1,6 +1,6 @@
 """Closest points on NURBS curves (point inversion, eqs. 6.3-6.5 of [PT]), vectorized.
 
-The method is the one of :mod:`.projection` for surfaces (seeds from a sample
+The method is the one of :mod:`surfprep.algorithms.projection` for surfaces (seeds from a sample
 k-d tree, vectorized Newton held at the domain ends, candidates across
 discontinuities of the derivative) in one parameter; see its docstring.
 
@@ -17,21 +17,21 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InvalidGeometryError
-from .creases import CreasePieces
-from .curve import NurbsCurve
-from .projection import (
-    _MIN_SAMPLES,
-    _best_per_query,
-    _check_count,
-    _check_points,
-    _pick_seeds,
-    _sample_counts,
-    _seed_grid,
-    _solve,
-    _span_extents,
-    _span_samples,
-    _tolerance,
+from ...errors import InvalidGeometryError
+from ..creases import CreasePieces
+from ..curve import NurbsCurve
+from .newton import (
+    MIN_SAMPLES,
+    best_per_query,
+    check_count,
+    check_points,
+    pick_seeds,
+    projection_tolerance,
+    sample_counts,
+    seed_grid,
+    solve,
+    span_extents,
+    span_samples,
 )
 
 __all__ = ["CurveProjectionResult", "distance_to_curve", "project_to_curve"]
@@ -80,12 +80,12 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
     CurveProjectionResult
         ``t (...)``, ``points (..., d)``, ``distance (...)``, ``converged (...)``.
     """
-    p = _check_points(points, curve.dimension)
+    p = check_points(points, curve.dimension)
     shape = p.shape[:-1]
     targets = p.reshape(-1, curve.dimension)
-    tol = _tolerance(tol, curve)
-    max_iter = _check_count(max_iter, "max_iter", 1)
-    n_seeds = _check_count(n_seeds, "n_seeds", 1)
+    tol = projection_tolerance(tol, curve)
+    max_iter = check_count(max_iter, "max_iter", 1)
+    n_seeds = check_count(n_seeds, "n_seeds", 1)
     lo, hi = (np.array([x]) for x in curve.domain)
     pieces = CreasePieces([curve.knots], [curve.degree])
     if guess is not None:
@@ -95,19 +95,19 @@ def project_to_curve(curve: NurbsCurve, points: ArrayLike, *, tol: float | None 
         rows, x0 = np.arange(targets.shape[0]), np.clip(x0.reshape(-1, 1), lo, hi)
     else:
         def build():
-            extents = _span_extents(curve.control_points, curve.knots, curve.degree)
-            (counts,) = _sample_counts([extents], [curve.degree], samples_per_span,
-                                       4 * _MIN_SAMPLES, density=4)
-            st = _span_samples(curve.knots, curve.degree, counts)
+            extents = span_extents(curve.control_points, curve.knots, curve.degree)
+            (counts,) = sample_counts([extents], [curve.degree], samples_per_span,
+                                       4 * MIN_SAMPLES, density=4)
+            st = span_samples(curve.knots, curve.degree, counts)
             return (st,), curve.evaluate(st), [pieces.axis_index(0, st)]
 
-        seeds = _seed_grid(curve, ("curve", samples_per_span), build)
-        rows, sample = _pick_seeds(seeds, targets, n_seeds)
+        seeds = seed_grid(curve, ("curve", samples_per_span), build)
+        rows, sample = pick_seeds(seeds, targets, n_seeds)
         x0 = seeds.params[0][sample][:, None]
     local, value = _curve_local(curve)
     rows, x0 = pieces.split_seeds(rows, x0)
-    x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
-    best = _best_per_query(rows, distance)
+    x, foot, distance, converged = solve(local, value, targets[rows], x0, pieces, tol, max_iter)
+    best = best_per_query(rows, distance)
     return CurveProjectionResult(t=x[best, 0].reshape(shape),
                                  points=foot[best].reshape(shape + (curve.dimension,)),
                                  distance=distance[best].reshape(shape),

@@ -1,19 +1,42 @@
-"""Artificial projections over holes: Hardy's reciprocal multiquadric (001 §5, eqs. 12-15;
+"""Positions over holes: the fill of the artificial projections (001 §5, eqs. 12-15;
 000 §29.3.4).
 
-Where a segment ``a b`` hits nothing (a hole or gap in the original geometry)
-its position ``t`` on the segment is interpolated from the positions found
-elsewhere, as a bivariate function of the grid parameters ``(u, v)``:
+Where a segment ``a b`` of the local approximant hits nothing (a hole or gap in
+the original geometry) its position ``t`` on the segment is interpolated from
+the positions found elsewhere, as a bivariate function of the grid parameters
+``(u, v)``; the artificial projection is ``z = (1 - t) a + t b`` (eq. 15).
+Three methods (:class:`FillMethod`):
 
-.. math:: t(u, v) = \\sum_i c_i \\left(R + (u - u_i)^2 + (v - v_i)^2\\right)^{-\\gamma}
-          \\qquad (12, 14)
+==================  ================================================  ====================
+method              interpolant                                       data used
+==================  ================================================  ====================
+``HARDY_LOCAL``     Hardy's reciprocal multiquadric,                  the ``K`` nearest
+                    :math:`\\sum_i c_i (R + |x - x_i|^2)^{-\\gamma}`    found (eq. 13, 14)
+``HARDY_GLOBAL``    the same kernel                                   all found (eq. 12)
+``THIN_PLATE``      thin-plate spline :math:`r^2 \\log r` plus a       all found up to
+                    linear polynomial (not Hardy's kernel)            1500, else the 64
+                                                                      nearest
+==================  ================================================  ====================
 
-with ``R = (δ_u + δ_v) / 2`` (mean parameter spacings) and ``γ = 0.001``. The
-global version (eq. 12) uses every found position; the localized one (eq. 14)
-only the at least ``K`` found positions nearest in the Manhattan norm of the
-grid indices (eq. 13: all at index distance 1, then 2, ... until ``K`` is
-reached or exceeded). The artificial projection is ``z = (1 - t) a + t b``
-(eq. 15).
+Hardy's method is the one of 001 §5, with ``R = (δ_u + δ_v) / 2`` (mean
+parameter spacings, :func:`hardy_parameters`) and ``γ = 0.001``; the localized
+form uses the at least ``K`` found positions nearest in the Manhattan norm of the
+grid indices (eq. 13: all at index distance 1, then 2, ... until ``K`` is reached
+or exceeded). The thin-plate spline is the smoothest interpolant of the found
+positions (it minimises the bending energy; no ``R`` or ``γ`` to tune) and,
+with the ring of projections beyond a hole's rim (:mod:`.ring`), continues the
+surroundings' slope and bending into the hole: it is the default of
+:func:`.approximant.local_approximant`.
+
+References
+----------
+.. [H71] R. L. Hardy, "Multiquadric equations of topography and other irregular
+   surfaces", *Journal of Geophysical Research* 76(8), 1905-1915, 1971.
+.. [D77] J. Duchon, "Splines minimizing rotation-invariant semi-norms in Sobolev
+   spaces", in *Constructive Theory of Functions of Several Variables*, Lecture
+   Notes in Mathematics 571, Springer, 1977, 85-100.
+.. [001] B. Hamann, B. A. Jean, "Interactive surface correction based on a local
+   approximation scheme", *Computer Aided Geometric Design* 13(4), 351-368, 1996, §5.
 """
 
 from __future__ import annotations
@@ -26,7 +49,7 @@ from scipy.interpolate import RBFInterpolator
 
 from ...errors import DegenerateGeometryError
 
-__all__ = ["HARDY_GAMMA", "HardyMode", "fill_positions", "hardy_parameters"]
+__all__ = ["HARDY_GAMMA", "FillMethod", "fill_positions", "hardy_parameters"]
 
 #: the exponent of 001 §5
 HARDY_GAMMA = 0.001
@@ -36,17 +59,17 @@ THIN_PLATE_GLOBAL = 1500
 THIN_PLATE_NEIGHBOURS = 64
 
 
-class HardyMode(enum.Enum):
-    """Which found positions enter Hardy's interpolation."""
+class FillMethod(enum.Enum):
+    """How the missing positions are interpolated from the found ones (module docstring)."""
 
-    #: the K Manhattan-nearest found positions for every missing one (eq. 14)
-    LOCAL = "local"
-    #: all found positions, one system (eq. 12)
-    GLOBAL = "global"
-    #: not Hardy's kernel: the thin-plate spline ``r^2 log r`` plus a linear
-    #: polynomial (the smoothest interpolant of the found positions: no ``R`` or
-    #: ``γ`` to tune; with the ring of :mod:`.ring` it continues the surroundings'
-    #: slope and bending into a hole); over all found positions up to
+    #: Hardy's reciprocal multiquadric over the K Manhattan-nearest found positions
+    #: of every missing one (001 eq. 14)
+    HARDY_LOCAL = "hardy_local"
+    #: Hardy's reciprocal multiquadric over all found positions, one system (001 eq. 12)
+    HARDY_GLOBAL = "hardy_global"
+    #: the thin-plate spline ``r^2 log r`` plus a linear polynomial: not Hardy's kernel
+    #: (the smoothest interpolant; with the ring of :mod:`.ring` it continues the
+    #: surroundings' slope and bending into a hole); over all found positions up to
     #: :data:`THIN_PLATE_GLOBAL`, else the :data:`THIN_PLATE_NEIGHBOURS` nearest
     THIN_PLATE = "thin_plate"
 
@@ -123,9 +146,9 @@ def _thin_plate(u: NDArray, v: NDArray, t: NDArray, found: NDArray) -> NDArray:
 
 
 def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
-                   mode: HardyMode = HardyMode.LOCAL, neighbours: int = 8,
+                   method: FillMethod = FillMethod.HARDY_LOCAL, neighbours: int = 8,
                    radius: float | None = None, gamma: float = HARDY_GAMMA) -> NDArray:
-    """Segment positions ``t`` everywhere: found ones kept, missing ones by eq. (12) or (14).
+    """Segment positions ``t`` everywhere: found ones kept, missing ones filled by ``method``.
 
     Parameters
     ----------
@@ -134,9 +157,9 @@ def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
     t : (M + 1, N + 1) float
         Found positions (anything where ``found`` is False).
     found : (M + 1, N + 1) bool
-    mode : HardyMode
+    method : FillMethod
     neighbours : int
-        ``K`` of the localized version (5-10 in 001).
+        ``K`` of Hardy's localized version (5-10 in 001).
     radius : float, optional
         ``R``; default :func:`hardy_parameters`.
     gamma : float
@@ -158,9 +181,9 @@ def fill_positions(u: NDArray, v: NDArray, t: NDArray, found: NDArray, *,
     if np.all(found):
         return out
     r = hardy_parameters(u, v) if radius is None else float(radius)
-    if mode is HardyMode.THIN_PLATE:
+    if method is FillMethod.THIN_PLATE:
         out[~found] = _thin_plate(u, v, out, found)
-    elif mode is HardyMode.GLOBAL:
+    elif method is FillMethod.HARDY_GLOBAL:
         out[~found] = _global(u, v, out, found, r, gamma)
     else:
         out[~found] = _local(u, v, out, found, r, gamma, max(1, int(neighbours)))

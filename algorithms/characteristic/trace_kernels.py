@@ -5,7 +5,7 @@ costs some fifty small numpy operations (predictor, side clipping, the Newton
 corrector's rounds, the acceptance test, the per-curve bookkeeping): on the
 benchmark pairs the certificate spent about half its time there, for jets of a
 few dozen points. :func:`trace_compiled` runs the same steps, stops and end
-reasons curve by curve in one compiled pass, with :func:`.kernels._jet_rows`
+reasons curve by curve in one compiled pass, with :func:`.distance_kernels.jet_rows`
 (the distance jet, 002 eqs. 24-31) at one point per evaluation:
 
 * predictor ``x + h t + h^2 / 2 bend``, shortened to land on a side it would
@@ -26,10 +26,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import _jit
-from .kernels import AVAILABLE, _jet_rows
+from ..jit import jit
+from .distance_kernels import AVAILABLE, jet_rows
 
-__all__ = ["AVAILABLE", "REASONS", "trace_compiled"]
+__all__ = ["AVAILABLE", "REASONS", "jet", "trace_compiled"]
 
 #: end reason codes of the kernel, in :class:`.curves.EndReason` value names
 REASONS = ("domain", "projection", "closed", "singular", "step_limit")
@@ -38,18 +38,18 @@ _DOMAIN, _PROJECTION, _CLOSED, _SINGULAR, _STEP_LIMIT = range(5)
 _CORRECTOR = 5
 
 
-@_jit
-def _jet(rq, pp, o, w, u, v, s0, t0):
+@jit
+def jet(rq, pp, o, w, u, v, s0, t0):
     """The jet at ``(u, v)`` (foot seeded at ``(s0, t0)``) into row 0 of the buffers ``o``."""
     uv, st0 = w[11], w[12]
     uv[0, 0], uv[0, 1], st0[0, 0], st0[0, 1] = u, v, s0, t0
-    _jet_rows(rq[0], rq[1], rq[2], rq[3], rq[4], rq[5], rq[6], rq[7], uv, st0,
+    jet_rows(rq[0], rq[1], rq[2], rq[3], rq[4], rq[5], rq[6], rq[7], uv, st0,
               pp[0], pp[1], pp[2], pp[3], pp[4], pp[5], pp[6], pp[7],
               o[0], o[1], o[2], o[3], o[4], o[5], o[6], o[7], o[8], o[9],
               w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10])
 
 
-@_jit
+@jit
 def _g(o, comp):
     """``g, g_u, g_v`` of the curve ``comp`` (0 ``phi_u``, 1 ``phi_v``, -1 ``phi``)."""
     if comp < 0:
@@ -57,17 +57,17 @@ def _g(o, comp):
     return o[5][0, comp], o[6][0, comp, 0], o[6][0, comp, 1]
 
 
-@_jit
+@jit
 def _finite_or_zero(x):
     return x if np.isfinite(x) else 0.0
 
 
-@_jit
+@jit
 def _correct(rq, pp, o, w, comp, pin, x0, x1, s0, t0, ctol, diag, r_lo, r_hi):
     """Newton along ``grad g`` (along the side ``pin`` holds, -1 none) from ``(x0, x1)``:
     :func:`.curves._correct` for one point. Returns ``(x0, x1, converged)``; the jet
     at the returned point is in ``o``."""
-    _jet(rq, pp, o, w, x0, x1, s0, t0)
+    jet(rq, pp, o, w, x0, x1, s0, t0)
     converged = False
     for _ in range(_CORRECTOR):
         g, d0, d1 = _g(o, comp)
@@ -89,11 +89,11 @@ def _correct(rq, pp, o, w, comp, pin, x0, x1, s0, t0, ctol, diag, r_lo, r_hi):
             break
         x0 = min(max(x0 + dx0, r_lo[0]), r_hi[0])
         x1 = min(max(x1 + dx1, r_lo[1]), r_hi[1])
-        _jet(rq, pp, o, w, x0, x1, o[3][0, 0], o[3][0, 1])
+        jet(rq, pp, o, w, x0, x1, o[3][0, 0], o[3][0, 1])
     return x0, x1, converged and np.isfinite(x0) and np.isfinite(x1)
 
 
-@_jit
+@jit
 def _tangent(o, comp, ref0, ref1):
     """Unit tangent of eqs. (19), (20), (33), oriented along ``(ref0, ref1)``."""
     _, d0, d1 = _g(o, comp)
@@ -105,7 +105,7 @@ def _tangent(o, comp, ref0, ref1):
     return t0, t1
 
 
-@_jit
+@jit
 def _store(o, x0, x1, k, j, uv, st, phi, grad, det):
     uv[k, j, 0], uv[k, j, 1] = x0, x1
     st[k, j, 0], st[k, j, 1] = o[3][0, 0], o[3][0, 1]
@@ -114,7 +114,7 @@ def _store(o, x0, x1, k, j, uv, st, phi, grad, det):
     det[k, j] = o[9][0]
 
 
-@_jit
+@jit
 def _predict(x0, x1, t0, t1, b0, b1, h, r_lo, r_hi):
     """The predictor, shortened to end on a side it would cross: ``(p0, p1, pinned)``."""
     p0, p1 = x0 + h * t0 + 0.5 * h * h * b0, x1 + h * t1 + 0.5 * h * h * b1
@@ -135,7 +135,7 @@ def _predict(x0, x1, t0, t1, b0, b1, h, r_lo, r_hi):
     return p0, p1, pinned
 
 
-@_jit
+@jit
 def _trace_one(rq, pp, o, w, k, comp, uv0, st0, direction, r_lo, r_hi, diag, h0, h_max,
                h_min, max_steps, ctol, max_turn, relative_ctol, uv, st, phi, grad, det):
     """One curve from start ``k``: samples into row ``k``; returns ``(count, reason)``."""
@@ -187,7 +187,7 @@ def _trace_one(rq, pp, o, w, k, comp, uv0, st0, direction, r_lo, r_hi, diag, h0,
     return steps + 1, (reason if reason >= 0 else _STEP_LIMIT)
 
 
-@_jit
+@jit
 def buffers(rq):
     """``(o, w)``: one-row jet outputs and the scratch arrays :func:`_jet` takes."""
     o = (np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 3)), np.empty((1, 2)), np.empty(1),
@@ -212,7 +212,7 @@ def kernel_arguments(field) -> tuple[tuple, tuple]:
     return rq, pp
 
 
-@_jit
+@jit
 def _trace_all(rq, pp, comps, uv0, st0, direction, h0, r_lo, r_hi, diag, h_max, h_min,
                max_steps, ctol, max_turn, relative_ctol):
     m = uv0.shape[0]

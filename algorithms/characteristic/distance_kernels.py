@@ -17,12 +17,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import AVAILABLE, _jit
+from ..jit import AVAILABLE, jit
 
-__all__ = ["AVAILABLE", "distance_points", "patch_derivatives", "project_points"]
+__all__ = ["AVAILABLE", "distance_points", "jet_rows", "patch_derivatives", "project_points"]
 
 
-@_jit
+@jit
 def _span(breaks, x):
     """Index of the patch holding ``x``: interior breakpoints ``<= x`` (ends extend)."""
     k = 0                                        # breaks: start of every patch, rising
@@ -34,7 +34,7 @@ def _span(breaks, x):
     return k
 
 
-@_jit
+@jit
 def _powers(x, scale, degree, out):
     """``out (3, degree + 1)``: ``d^o/du^o x^k`` for ``o <= 2``, ``x = (u - a) scale``."""
     for k in range(degree + 1):
@@ -43,7 +43,7 @@ def _powers(x, scale, degree, out):
         out[2, k] = k * (k - 1) * x ** (k - 2) * scale * scale if k >= 2 else 0.0
 
 
-@_jit
+@jit
 def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out, full=True):
     """Derivatives to order 2 in each direction at one point: ``out (3, 3, 3)``.
 
@@ -92,7 +92,7 @@ def _point_derivatives(coef, iu, iv, du, dv, rational, u, v, hom, out, full=True
                 out[k, m, c] = acc * inv
 
 
-@_jit
+@jit
 def patch_derivatives(coef, iu, iv, rational, u, v):
     """``(n, 3, 3, 3)`` derivatives to order 2 in each direction at ``u, v (n,)``."""
     n = u.shape[0]
@@ -105,7 +105,7 @@ def patch_derivatives(coef, iu, iv, rational, u, v):
     return res
 
 
-@_jit
+@jit
 def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, tol, max_iter,
                  du, dv, hom, d, qd):
     """Newton on eqs. (3)-(4) for one point; ``qd (3, 3, 3)`` filled at the foot.
@@ -157,7 +157,7 @@ def _project_one(coef, iu, iv, rational, x0, x1, x2, s0, t0, lo, hi, quarter, to
     return s0, t0, moved, before
 
 
-@_jit
+@jit
 def project_points(coef, iu, iv, rational, x, st0, lo, hi, quarter, tol, max_iter):
     """Newton on eqs. (3)-(4) for every row of ``x (n, 3)`` from ``st0 (n, 2)``.
 
@@ -190,7 +190,7 @@ def project_points(coef, iu, iv, rational, x, st0, lo, hi, quarter, tol, max_ite
     return st, qd, moved, before
 
 
-@_jit
+@jit
 def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
     """The §6.2 case of one foot, as :meth:`.projection.Projector.status`:
     0 unique, 1 multiple (``K`` not positive definite), 2 none (outside ``q``'s
@@ -210,7 +210,7 @@ def _status(s, t, k00, k01, k11, moved, before, lower, upper, tol):
     return 0
 
 
-@_jit
+@jit
 def _project_affine(frame, x0, x1, x2, lo, hi, lower, qd):
     """The foot on a parallelogram ``q`` in closed form (as
     :meth:`.projection.Projector._project_affine`): ``frame (5, 3)`` from
@@ -230,8 +230,8 @@ def _project_affine(frame, x0, x1, x2, lo, hi, lower, qd):
     return s, t, 0.0, np.inf
 
 
-@_jit
-def _jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
+@jit
+def jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
               lo, hi, quarter, tol, max_iter, lower, upper, frame, point, foot, normal, st,
               phi, grad, hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t):
     """The rows of :func:`distance_points`' outputs at ``uv (n, 2)``, feet seeded at
@@ -316,7 +316,7 @@ def _jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv
         hess[i, 0, 0], hess[i, 0, 1], hess[i, 1, 0], hess[i, 1, 1] = huu, mixed, mixed, hvv
 
 
-@_jit
+@jit
 def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0,
                     lo, hi, quarter, tol, max_iter, lower, upper, frame):
     """``phi``, its gradient and Hessian (002 eqs. 2, 24-31) at ``uv (n, 2)`` of ``r``.
@@ -363,7 +363,7 @@ def distance_points(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_ration
     c2 = np.empty(3)
     n_s = np.empty(3)
     n_t = np.empty(3)
-    _jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0, lo, hi,
+    jet_rows(r_coef, r_iu, r_iv, r_rational, q_coef, q_iu, q_iv, q_rational, uv, st0, lo, hi,
               quarter, tol, max_iter, lower, upper, frame, point, foot, normal, st, phi, grad,
               hess, jac, status, det_k, du, dv, hom, d, rd, qd, big, c1, c2, n_s, n_t)
     return point, foot, normal, st, phi, grad, hess, jac, status, det_k

@@ -15,13 +15,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..basis_kernels import _jit
-from .trace_kernel import AVAILABLE, _jet, buffers, kernel_arguments
+from ..jit import jit
+from .trace_kernels import AVAILABLE, buffers, jet, kernel_arguments
 
 __all__ = ["AVAILABLE", "newton_compiled"]
 
 
-@_jit
+@jit
 def _step(h00, h01, h11, g0, g1, flat, degenerate, pseudo):
     """``(d0, d1, ok)``: the Newton step; with ``pseudo`` the eigenvalues below
     ``degenerate`` of the largest are left out when ``H`` is rank 1."""
@@ -53,7 +53,7 @@ def _step(h00, h01, h11, g0, g1, flat, degenerate, pseudo):
     return d0, d1, top > flat
 
 
-@_jit
+@jit
 def _newton_all(rq, pp, uv, st, max_iter, diag, r_lo, r_hi, flat, degenerate, pseudo):
     o, w = buffers(rq)
     m = uv.shape[0]
@@ -62,7 +62,7 @@ def _newton_all(rq, pp, uv, st, max_iter, diag, r_lo, r_hi, flat, degenerate, ps
     for k in range(m):
         x0, x1, s0, s1 = uv[k, 0], uv[k, 1], st[k, 0], st[k, 1]
         for _ in range(max_iter):
-            _jet(rq, pp, o, w, x0, x1, s0, s1)
+            jet(rq, pp, o, w, x0, x1, s0, s1)
             s0, s1 = o[3][0, 0], o[3][0, 1]
             h = o[6]
             d0, d1, ok = _step(h[0, 0, 0], h[0, 0, 1], h[0, 1, 1], o[5][0, 0], o[5][0, 1],

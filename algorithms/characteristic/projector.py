@@ -45,7 +45,7 @@ from scipy.spatial import cKDTree
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
-from . import kernels
+from . import distance_kernels
 from .evaluator import PatchEvaluator
 
 __all__ = [
@@ -245,8 +245,8 @@ class Projector:
         st = self.seeds(x) if st0 is None else np.array(st0, dtype=float).reshape(-1, 2)
         span = self.upper - self.lower
         lo, hi = self.lower - EXTENSION * span, self.upper + EXTENSION * span
-        if kernels.AVAILABLE:
-            st, qd, moved, before = kernels.project_points(
+        if distance_kernels.AVAILABLE:
+            st, qd, moved, before = distance_kernels.project_points(
                 *ev.compiled, x, np.ascontiguousarray(st), lo, hi, 0.25 * span,
                 float(self.tol), int(self.max_iter))
             return self._finish(x, st, qd, moved, before)
@@ -317,7 +317,7 @@ class Projector:
         return status, det
 
     def kernel_frame(self) -> NDArray:
-        """``(5, 3)`` float for :mod:`.kernels`: a parallelogram's ``p0, q_s, q_t``, the
+        """``(5, 3)`` float for :mod:`.distance_kernels`: a parallelogram's ``p0, q_s, q_t``, the
         inverse Gram matrix ``(g00, g01, g11)`` and ``(1, 0, 0)``; zeros otherwise."""
         if "frame" not in self._grid:
             frame = np.zeros((5, 3))

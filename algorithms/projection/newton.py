@@ -1,54 +1,15 @@
-"""Closest points on NURBS surfaces and curves (point inversion), vectorized over points.
+"""The machinery shared by the closest-point projections onto surfaces and curves.
 
-For a query point ``P`` the foot point minimizes ``f(u, v) = |S(u, v) - P|^2 / 2``
-over the parameter rectangle. With ``r = S(u, v) - P`` (section 6.1 of [PT]):
-
-.. math:: \\nabla f = \\begin{pmatrix} r \\cdot S_u \\\\ r \\cdot S_v \\end{pmatrix},
-          \\qquad
-          \\nabla^2 f = \\begin{pmatrix} |S_u|^2 + r \\cdot S_{uu} & S_u \\cdot S_v + r \\cdot S_{uv} \\\\
-                                         S_u \\cdot S_v + r \\cdot S_{uv} & |S_v|^2 + r \\cdot S_{vv}
-                        \\end{pmatrix}  \\qquad (6.6, 6.7)
-
-and Newton's step solves ``H delta = -grad f``. The method, for all points at once:
-
-1. **Seeds.** The surface is sampled on a grid a few times denser than its knot
-   spans (``evaluate_grid``); a :class:`scipy.spatial.cKDTree` gives each
-   query's nearest samples. The nearest one (distance ``d0``) is always a
-   seed; up to ``n_seeds - 1`` more are taken among the samples within
-   ``d0 + h`` (``h`` the largest grid cell size: every closer basin has a
-   sample there) that are local minima of the distance on the grid and not
-   grid neighbours of the nearest, so a point over a fold or a narrow neck
-   also starts on the other sheet, while a point over a plain region costs
-   one seed. Every
-   (point, seed) pair is one Newton problem.
-2. **Newton with bounds.** A parameter at a bound whose gradient pushes
-   outward is fixed for that iteration (the problem continues in 1D along the
-   boundary, or stops at a corner); the others take the Newton step of the
-   full Hessian when it is positive definite, else of the Hessian shifted to
-   be positive definite (a descent step that follows negative curvature),
-   projected onto the box. A step that increases the distance is halved (up
-   to 30 times); each accepted step decreases the distance, so a result is
-   never farther than its seed sample.
-3. **Convergence** (eq. 6.8 of [PT], in model units): the point coincides
-   (``|r| <= tol``), or the zero-cosine test holds for the free parameters,
-   written as tangential residuals ``|r . S_u| / |S_u| <= tol`` (the 3D
-   distance from the foot along the tangent), or the 3D step
-   ``|S(x_new) - S(x)|`` is ``<= tol``. The step of the iteration that passes
-   the test is still applied, which squares the error (Newton).
-   Only the unconverged problems are evaluated in each iteration.
-4. **Creases.** Knot lines of multiplicity >= degree may carry a jump of the
-   first derivatives, where Newton would stall. The domain is cut there into
-   pieces and each problem runs inside one piece (its box). A seed on a
-   crease starts on both sides; a problem that stops on a crease with
-   descent on the other side continues in the neighbouring piece; grid
-   neighbours across a crease do not count in the local-minimum test of
-   the seeds; a foot within ``_CREASE_REACH`` of its piece's width from a
-   crease is sought again from the crease's other side (the basin there may
-   have no seed). A foot exactly on a crease is reported ``1e-13`` of the
-   parameter range before it when reached from below (:mod:`.creases`).
-5. The best result over the seeds of each query is returned.
-
-Curves are the same with one parameter (``r . C'`` and ``|C'|^2 + r . C''``).
+Steps 1-4 of :mod:`surfprep.algorithms.projection` (its docstring walks the
+method): the sample grid of a surface or curve cached on the instance
+(:func:`seed_grid`, sample counts by control-polygon extent per knot span:
+:func:`span_extents`, :func:`sample_counts`, :func:`span_samples`), the seeds
+among its samples (:func:`pick_seeds`), Newton held at the domain's bounds for
+all (point, seed) problems at once (:func:`solve`: the Hessian shifted to be
+positive definite, halving line search, the convergence tests of eq. 6.8 of
+[PT], crease pieces crossed), and the best result per query
+(:func:`best_per_query`). :mod:`.onto_surface` and :mod:`.onto_curve` give it
+the local derivatives of their geometry.
 
 References
 ----------
@@ -66,23 +27,27 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from ..errors import InvalidGeometryError
-from .basis import distinct_knots
-from .creases import CreasePieces
-from .surface import NurbsSurface
-from .tolerance import check_tolerance
+from ...errors import InvalidGeometryError
+from ..basis import distinct_knots
+from ..creases import CreasePieces
+from ..tolerance import check_tolerance
 
 __all__ = [
     "DEFAULT_RELATIVE_TOL",
-    "CurveProjectionResult",
-    "ProjectionResult",
-    "distance_to_curve",
-    "distance_to_surface",
-    "project_to_curve",
-    "project_to_surface",
+    "MIN_SAMPLES",
+    "SeedGrid",
+    "best_per_query",
+    "check_count",
+    "check_points",
+    "pick_seeds",
+    "projection_tolerance",
+    "sample_counts",
+    "seed_grid",
+    "solve",
+    "span_extents",
+    "span_samples",
 ]
 
-#: Default ``tol``: this fraction of the control-net bounding-box diagonal.
 DEFAULT_RELATIVE_TOL = 1e-10
 _MAX_HALVINGS = 30
 _SAMPLE_BUDGET = 200_000
@@ -90,34 +55,11 @@ _CANDIDATES = 24
 _MAX_CROSSINGS = 8
 #: a foot this share of its piece's width from a crease is sought across it too
 _CREASE_REACH = 0.02
-_MIN_SAMPLES = 256      # grid intervals per surface direction, at least
-
-
-@dataclass(frozen=True)
-class ProjectionResult:
-    """Closest points on a surface.
-
-    Attributes
-    ----------
-    uv : (..., 2) float
-        Parameters of the foot points, inside the domain.
-    points : (..., 3) float
-        Foot points ``S(uv)``.
-    distance : (...) float
-        ``|P - S(uv)|``.
-    converged : (...) bool
-        The convergence test passed (False: iteration limit or no descent
-        before the test passed; the result is still the best point found).
-    """
-
-    uv: NDArray
-    points: NDArray
-    distance: NDArray
-    converged: NDArray
+MIN_SAMPLES = 256      # grid intervals per surface direction, at least
 
 
 # ----------------------------------------------------------------- validation
-def _check_points(points: ArrayLike, dimension: int) -> NDArray:
+def check_points(points: ArrayLike, dimension: int) -> NDArray:
     p = np.asarray(points, dtype=float)
     if p.ndim < 1 or p.shape[-1] != dimension:
         raise InvalidGeometryError(
@@ -127,7 +69,7 @@ def _check_points(points: ArrayLike, dimension: int) -> NDArray:
     return p
 
 
-def _tolerance(tol: float | None, geometry) -> float:
+def projection_tolerance(tol: float | None, geometry) -> float:
     box = geometry.bounding_box()
     diagonal = float(np.linalg.norm(box[1] - box[0]))
     if tol is None:
@@ -135,14 +77,14 @@ def _tolerance(tol: float | None, geometry) -> float:
     return check_tolerance(tol)
 
 
-def _check_count(value: int, name: str, minimum: int) -> int:
+def check_count(value: int, name: str, minimum: int) -> int:
     if isinstance(value, bool) or int(value) != value or value < minimum:
         raise InvalidGeometryError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(value)
 
 
 # -------------------------------------------------------------------- seeds
-def _span_samples(knots: NDArray, degree: int, counts: NDArray) -> NDArray:
+def span_samples(knots: NDArray, degree: int, counts: NDArray) -> NDArray:
     """``counts[i]`` equal steps in the i-th non-empty knot span of the domain: (s,) float."""
     breaks, _ = distinct_knots(knots, degree)
     span = np.repeat(np.arange(counts.size), counts)
@@ -152,7 +94,7 @@ def _span_samples(knots: NDArray, degree: int, counts: NDArray) -> NDArray:
     return np.concatenate([inner, breaks[-1:]])
 
 
-def _span_extents(net: NDArray, knots: NDArray, degree: int) -> NDArray:
+def span_extents(net: NDArray, knots: NDArray, degree: int) -> NDArray:
     """Length of the control polygon over each non-empty knot span, along axis 0 of
     ``net (n, ..., d)`` (the longest over the other axes, leg by leg): (S,) float."""
     n = net.shape[0]
@@ -170,13 +112,13 @@ def _span_counts(extents: NDArray, degree: int, total: int) -> NDArray:
     return np.maximum(degree + 1, np.ceil(total * weight)).astype(int)
 
 
-def _sample_counts(extents: list[NDArray], degrees: list[int], per_span: int | None,
+def sample_counts(extents: list[NDArray], degrees: list[int], per_span: int | None,
                    minimum: int, density: int = 2) -> list[NDArray]:
     """Samples per span and direction: ``per_span`` everywhere when given, else at least
     ``max(minimum, density (degree + 1) spans)`` per direction shared by control-polygon
     extent, reduced until the grid fits :data:`_SAMPLE_BUDGET`."""
     if per_span is not None:
-        per_span = _check_count(per_span, "samples_per_span", 1)
+        per_span = check_count(per_span, "samples_per_span", 1)
         return [np.full(e.size, per_span) for e in extents]
     totals = [max(minimum, density * (p + 1) * e.size) for e, p in zip(extents, degrees)]
     while True:
@@ -199,9 +141,9 @@ def _grid_spacing(grid: NDArray) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class _SeedGrid:
-    """The sample grid of a surface or curve for :func:`_pick_seeds`, built once per
-    geometry and sampling (:func:`_seed_grid`): parameters per axis, the grid
+class SeedGrid:
+    """The sample grid of a surface or curve for :func:`pick_seeds`, built once per
+    geometry and sampling (:func:`seed_grid`): parameters per axis, the grid
     ``(a, [b,] d)``, its k-d tree, crease pieces per axis and :func:`_grid_spacing`."""
 
     params: tuple[NDArray, ...]
@@ -215,9 +157,9 @@ class _SeedGrid:
 _SEED_CACHE = "_projection_seed_grids"
 
 
-def _seed_grid(geometry, key, build: Callable[[], tuple[tuple[NDArray, ...], NDArray,
-                                                      list[NDArray]]]) -> _SeedGrid:
-    """The :class:`_SeedGrid` of ``geometry`` for sampling ``key``, cached on the
+def seed_grid(geometry, key, build: Callable[[], tuple[tuple[NDArray, ...], NDArray,
+                                                      list[NDArray]]]) -> SeedGrid:
+    """The :class:`SeedGrid` of ``geometry`` for sampling ``key``, cached on the
     instance (geometry is immutable, so its grid never goes stale; the cache lives
     in the instance ``__dict__`` as a ``functools.cached_property`` would, and dies
     with it). ``build()`` gives ``(params, grid, pieces)``."""
@@ -230,13 +172,13 @@ def _seed_grid(geometry, key, build: Callable[[], tuple[tuple[NDArray, ...], NDA
         params, grid, pieces = build()
         for a in (*params, grid):
             a.setflags(write=False)
-        found = _SeedGrid(params, grid, cKDTree(grid.reshape(-1, grid.shape[-1])), pieces,
+        found = SeedGrid(params, grid, cKDTree(grid.reshape(-1, grid.shape[-1])), pieces,
                           _grid_spacing(grid))
         cache[key] = found
     return found
 
 
-def _pick_seeds(seeds: _SeedGrid, points: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
+def pick_seeds(seeds: SeedGrid, points: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
     """(query, sample) pairs for the Newton starts.
 
     The nearest sample (distance ``d0``) is always a seed. Any basin whose minimum
@@ -249,7 +191,7 @@ def _pick_seeds(seeds: _SeedGrid, points: NDArray, n_seeds: int) -> tuple[NDArra
 
     Parameters
     ----------
-    seeds : _SeedGrid
+    seeds : SeedGrid
         Samples on a 1D or 2D parameter grid ``(a, [b,] d)`` with their tree and
         crease-free piece along each axis ((a,) and (b,) int).
 
@@ -287,7 +229,7 @@ def _pick_seeds(seeds: _SeedGrid, points: NDArray, n_seeds: int) -> tuple[NDArra
     return rows, nearest[rows, cols]
 
 
-def _best_per_query(rows: NDArray, distance: NDArray) -> NDArray:
+def best_per_query(rows: NDArray, distance: NDArray) -> NDArray:
     """Index of the smallest distance among the candidates of each query (rows sorted)."""
     if rows.size == 0:
         return rows
@@ -402,7 +344,7 @@ def _minimize(local: Callable, value: Callable, targets: NDArray, x0: NDArray, l
 
 
 # ------------------------------------------------------------------- creases
-def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, pieces: CreasePieces,
+def solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, pieces: CreasePieces,
            tol: float, max_iter: int):
     """:func:`_minimize` piece by piece: a problem that ends on a crease with descent
     beyond it continues in the neighbouring piece (up to ``_MAX_CROSSINGS`` times)."""
@@ -432,114 +374,3 @@ def _solve(local: Callable, value: Callable, targets: NDArray, x0: NDArray, piec
         x[todo], points[todo], distance[todo] = xr[better], pr[better], dr[better]
         converged[todo] = cr[better]
     return x, points, distance, converged
-
-
-# ------------------------------------------------------------------ surfaces
-def _surface_local(surface: NurbsSurface) -> tuple[Callable, Callable]:
-    def local(x):
-        d = surface.derivatives(x[:, 0], x[:, 1], 2)
-        jac = np.stack([d[:, 1, 0], d[:, 0, 1]], axis=2)
-        hess = np.stack([np.stack([d[:, 2, 0], d[:, 1, 1]], axis=2),
-                         np.stack([d[:, 1, 1], d[:, 0, 2]], axis=2)], axis=3)
-        return d[:, 0, 0], jac, hess
-
-    def value(x):
-        return surface.evaluate(x[:, 0], x[:, 1])
-
-    return local, value
-
-
-def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float | None = None,
-                       max_iter: int = 30, n_seeds: int = 3,
-                       samples_per_span: int | None = None,
-                       guess: ArrayLike | None = None) -> ProjectionResult:
-    """Closest points of a surface to many points (point inversion, section 6.1 of [PT]).
-
-    Parameters
-    ----------
-    surface : NurbsSurface
-    points : (..., 3) float
-    tol : float, optional
-        Model units: convergence of the 3D step and of the tangential residual
-        (eq. 6.8). Default :data:`DEFAULT_RELATIVE_TOL` times the control-net
-        bounding-box diagonal.
-    max_iter : int
-        Newton iterations per seed.
-    n_seeds : int
-        Seeds per point from the sample grid (nearest sample plus non-adjacent
-        ones); 1 is fastest, more guard against wrong local minima.
-    samples_per_span : int, optional
-        Grid samples per knot span and direction. Default: at least
-        ``max(256, 2 (degree + 1) spans)`` per direction, shared among the spans
-        in proportion to the length of their control polygon (at least
-        ``degree + 1`` each), fewer when the grid would exceed 200 000 samples.
-    guess : (..., 2) float, optional
-        Start parameters instead of the sample grid (a local projection, for
-        marching methods that know where the foot is).
-
-    Returns
-    -------
-    ProjectionResult
-        ``uv (..., 2)``, ``points (..., 3)``, ``distance (...)``, ``converged (...)``.
-    """
-    p = _check_points(points, surface.dimension)
-    shape = p.shape[:-1]
-    targets = p.reshape(-1, surface.dimension)
-    tol = _tolerance(tol, surface)
-    max_iter = _check_count(max_iter, "max_iter", 1)
-    n_seeds = _check_count(n_seeds, "n_seeds", 1)
-    u0, u1, v0, v1 = surface.domain
-    lo, hi = np.array([u0, v0]), np.array([u1, v1])
-    pieces = CreasePieces([surface.knots_u, surface.knots_v], [surface.degree_u, surface.degree_v])
-    if guess is not None:
-        x0 = np.asarray(guess, dtype=float)
-        if x0.shape != shape + (2,) or not np.all(np.isfinite(x0)):
-            raise InvalidGeometryError(f"guess must be finite of shape {shape + (2,)}, "
-                                       f"got {x0.shape}")
-        rows = np.arange(targets.shape[0])
-        x0 = np.clip(x0.reshape(-1, 2), lo, hi)
-    else:
-        rows, x0 = _surface_seeds(surface, targets, n_seeds, samples_per_span, pieces)
-    local, value = _surface_local(surface)
-    rows, x0 = pieces.split_seeds(rows, x0)
-    x, foot, distance, converged = _solve(local, value, targets[rows], x0, pieces, tol, max_iter)
-    best = _best_per_query(rows, distance)
-    return ProjectionResult(uv=x[best].reshape(shape + (2,)),
-                            points=foot[best].reshape(shape + (surface.dimension,)),
-                            distance=distance[best].reshape(shape),
-                            converged=converged[best].reshape(shape))
-
-
-def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
-                   samples_per_span: int | None, pieces: CreasePieces) -> tuple[NDArray, NDArray]:
-    def build():
-        net = surface.control_points
-        extents = [_span_extents(net, surface.knots_u, surface.degree_u),
-                   _span_extents(np.swapaxes(net, 0, 1), surface.knots_v, surface.degree_v)]
-        per_u, per_v = _sample_counts(extents, [surface.degree_u, surface.degree_v],
-                                      samples_per_span, _MIN_SAMPLES)
-        su = _span_samples(surface.knots_u, surface.degree_u, per_u)
-        sv = _span_samples(surface.knots_v, surface.degree_v, per_v)
-        return ((su, sv), surface.evaluate_grid(su, sv),
-                [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
-
-    seeds = _seed_grid(surface, ("surface", samples_per_span), build)
-    su, sv = seeds.params
-    rows, sample = _pick_seeds(seeds, targets, n_seeds)
-    iu, iv = np.unravel_index(sample, (su.size, sv.size))
-    return rows, np.stack([su[iu], sv[iv]], axis=1)
-
-
-def distance_to_surface(surface: NurbsSurface, points: ArrayLike, *,
-                        tol: float | None = None) -> NDArray:
-    """Distances ``(...)`` from ``points (..., 3)`` to the surface (:func:`project_to_surface`).
-
-    The dense check of later features: sample a result, measure its distance
-    to the surface it must lie on, compare with the tolerance.
-    """
-    return project_to_surface(surface, points, tol=tol).distance
-
-
-# Curves share the machinery above; their functions live in their own module and
-# are served from here too (imported last: that module uses the names above).
-from .curve_projection import CurveProjectionResult, distance_to_curve, project_to_curve

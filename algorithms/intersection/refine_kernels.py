@@ -19,20 +19,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..basis import span_range
-from ..basis_kernels import AVAILABLE, _jit
-from ..basis_kernels import _ders_one as _basis_one
+from ..basis_kernels import ders_one
+from ..jit import AVAILABLE, jit
 from ..surface import NurbsSurface
 
 __all__ = ["AVAILABLE", "refine_compiled"]
 
 
-@_jit
+@jit
 def _span(knots, t, first, last):
     s = np.searchsorted(knots, t, side="right") - 1
     return min(max(s, first), last)
 
 
-@_jit
+@jit
 def _frame(ku, kv, p, q, net, rational, spans, u, v, du, dv, ndu_u, ndu_v, a_u, a_v,
            lu, ru, lv, rv, h, out):
     """Point, S_u, S_v (rows of ``out (3, 3)``) at ``(u, v)``; ``h (3, 4)`` scratch."""
@@ -40,8 +40,8 @@ def _frame(ku, kv, p, q, net, rational, spans, u, v, du, dv, ndu_u, ndu_v, a_u, 
     sv_i = _span(kv, v, spans[2], spans[3])
     du[:, :] = 0.0
     dv[:, :] = 0.0
-    _basis_one(ku, p, u, su_i, 1, ndu_u, a_u, lu, ru, du)
-    _basis_one(kv, q, v, sv_i, 1, ndu_v, a_v, lv, rv, dv)
+    ders_one(ku, p, u, su_i, 1, ndu_u, a_u, lu, ru, du)
+    ders_one(kv, q, v, sv_i, 1, ndu_v, a_v, lv, rv, dv)
     iu0, iv0 = su_i - p, sv_i - q
     # h rows: value, d/du, d/dv of the homogeneous point (x, y, z, w)
     for c in range(4):
@@ -74,24 +74,24 @@ def _frame(ku, kv, p, q, net, rational, spans, u, v, du, dv, ndu_u, ndu_v, a_u, 
             out[2, c] = h[2, c]
 
 
-@_jit
+@jit
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@_jit
+@jit
 def _norm(a):
     return np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
-@_jit
+@jit
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@_jit
+@jit
 def _normal(fr, n, degenerate):
     """Unit normal of frame ``fr`` into ``n``; False at a degenerate frame (a pole)."""
     _cross(fr[1], fr[2], n)
@@ -104,7 +104,7 @@ def _normal(fr, n, degenerate):
     return True
 
 
-@_jit
+@jit
 def _increment(fr, n, delta, degenerate, tmp_u, tmp_v, step):
     """Eqs. 29.22-29.25 into ``step (2,)``; False where the 2x2 system is singular."""
     _cross(fr[1], n, tmp_u)                 # su_p
@@ -118,7 +118,7 @@ def _increment(fr, n, delta, degenerate, tmp_u, tmp_v, step):
     return True
 
 
-@_jit
+@jit
 def _refine_all(ka_u, ka_v, pa, qa, net_a, rat_a, spans_a, dom_a,
                 kb_u, kb_v, pb, qb, net_b, rat_b, spans_b, dom_b,
                 ua, ub, anchor, has_anchor, tol, max_iter, tangent_sin, degenerate,
