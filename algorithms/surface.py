@@ -99,8 +99,9 @@ class NurbsSurface:
         return np.concatenate([self.control_points * w[..., None], w[..., None]], axis=2)
 
     @functools.cached_property
-    def _homogeneous_net(self) -> NDArray:
-        """:meth:`homogeneous_points`, computed once per surface (read-only)."""
+    def homogeneous_net(self) -> NDArray:
+        """:meth:`homogeneous_points` computed once per surface, read-only ``(n_u, n_v, d + 1)``
+        (the evaluation kernels take it as is)."""
         return frozen_array(self.homogeneous_points())
 
     @classmethod
@@ -145,7 +146,7 @@ class NurbsSurface:
         p, q = self.degree_u, self.degree_v
         su = find_span(self.knots_u, p, u)
         sv = find_span(self.knots_v, q, v)
-        net = self._homogeneous_net
+        net = self.homogeneous_net
         if basis_kernels.AVAILABLE:           # the same sums, compiled (no per-call overhead)
             out = basis_kernels.surface_derivatives_compiled(
                 self.knots_u, self.knots_v, p, q, net, u, v, su, sv, order,
@@ -199,7 +200,7 @@ class NurbsSurface:
         du, su = basis_derivatives(self.knots_u, p, u, order)      # (a, o+1, p+1)
         dv, sv = basis_derivatives(self.knots_v, q, v, order)      # (b, o+1, q+1)
         iu = su[:, None] - p + np.arange(p + 1)                    # (a, p+1)
-        pw = self._homogeneous_net
+        pw = self.homogeneous_net
         # contract u first: (a, o+1, n_v, d+1)
         tmp = np.einsum("aki,aijc->akjc", du, pw[iu], optimize=True)
         iv = sv[:, None] - q + np.arange(q + 1)                    # (b, q+1)

@@ -26,7 +26,7 @@ from OCP.gp import gp_Pnt, gp_Vec
 
 import surfprep
 from surfprep.plugin import occ_reference
-from surfprep.plugin.geom import curve_to_occ, surface_to_occ
+from surfprep.plugin.occ.geom import curve_to_occ, surface_to_occ
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"

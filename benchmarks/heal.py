@@ -69,15 +69,10 @@ import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.plugin.convert import to_nurbs
-from surfprep.plugin.edges import edge_to_nurbs
-from surfprep.plugin.faces import make_face
-from surfprep.plugin.geom import curve_to_occ, surface_from_occ
-from surfprep.plugin.heal_topology import (
-    count_free_edges,
-    is_valid,
-    max_edge_tolerance,
-    sew,
-)
+from surfprep.plugin.occ.edges import edge_to_nurbs
+from surfprep.plugin.occ.faces import make_face
+from surfprep.plugin.occ.geom import curve_to_occ, surface_from_occ
+from surfprep.plugin.occ.shapes import count_free_edges, is_valid, max_edge_tolerance, sew
 
 
 def graph(x, y):
@@ -359,8 +354,8 @@ def _crease_angle(cross) -> float:
 
 def table1_rows() -> list[str]:
     from surfprep.algorithms.healing import corners_boundary, local_approximant
-    from surfprep.plugin.faces import face_to_nurbs
-    from surfprep.plugin.heal_cut import boundary_on_faces
+    from surfprep.plugin.occ.faces import face_to_nurbs
+    from surfprep.plugin.heal.cut import boundary_on_faces
     cross = _crossing()
     a, b = cross.sheet(0.0, 1.2, 0.0), cross.sheet(0.8, 2.0, cross.SLOPE)
     tfs = [face_to_nurbs(make_face(a)), face_to_nurbs(make_face(b))]

@@ -24,7 +24,7 @@ import numpy as np
 import surfprep
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.plugin import occ_reference
-from surfprep.plugin.geom import surface_to_occ
+from surfprep.plugin.occ.geom import surface_to_occ
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"

@@ -42,7 +42,7 @@ from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.reparam import default_tolerance, reparametrize_surface
 from surfprep.algorithms.reparam.deviation import subdivide
 from surfprep.algorithms.reparam.rca import crease_knots
-from surfprep.plugin.geom import surface_from_occ, surface_to_occ
+from surfprep.plugin.occ.geom import surface_from_occ, surface_to_occ
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT.parent / "shared" / "data"

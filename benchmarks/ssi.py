@@ -47,7 +47,7 @@ from surfprep.algorithms.intersection import (
     intersect_surfaces,
     polyline_distance,
 )
-from surfprep.plugin.geom import surface_to_occ
+from surfprep.plugin.occ.geom import surface_to_occ
 from surfprep.plugin.occ_reference import intersect_surfaces_occ
 
 TAU = 2 * np.pi
@@ -215,7 +215,7 @@ from intersect import plane, sphere
 a, b = plane(2, origin=(0, 0, 0.3)), sphere(1.0)
 start = time.perf_counter()
 if {occ}:
-    from surfprep.plugin.geom import surface_to_occ
+    from surfprep.plugin.occ.geom import surface_to_occ
     from surfprep.plugin.occ_reference import intersect_surfaces_occ
     ga, gb = surface_to_occ(a), surface_to_occ(b)
     start = time.perf_counter()

@@ -13,36 +13,21 @@ from typing import Any
 from OCP.Geom import Geom_Curve, Geom_Surface
 from OCP.Geom2d import Geom2d_Curve
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
-from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import ConversionError
-from .geom import (
-    curve2d_to_occ,
-    curve_from_occ,
-    curve_to_occ,
-    surface_from_occ,
-    surface_to_occ,
-)
+from ..algorithms.trimmed import TrimmedFace
 from .io import CadModel
-from .topology import TrimmedFace, edge_to_nurbs, face_to_nurbs, trimmed_face_to_occ
+from .occ.edges import edge_to_nurbs
+from .occ.faces import face_to_nurbs, trimmed_face_to_occ
+from .occ.geom import curve2d_to_occ, curve_from_occ, curve_to_occ, surface_from_occ, surface_to_occ
+from .occ.shapes import all_faces
 
-__all__ = ["to_nurbs", "to_occ", "faces_of"]
-
-
-def faces_of(shape: TopoDS_Shape) -> list[TopoDS_Face]:
-    """The faces of a shape, in ``TopExp_Explorer`` order (a face shared by
-    two sub-shapes of a compound is listed each time it occurs)."""
-    faces = []
-    explorer = TopExp_Explorer(shape, TopAbs_FACE)
-    while explorer.More():
-        faces.append(TopoDS.Face_s(explorer.Current()))
-        explorer.Next()
-    return faces
+__all__ = ["to_nurbs", "to_occ", "unwrap"]
 
 
-def _unwrap(x: Any) -> Any:
+def unwrap(x: Any) -> Any:
     """The OCP object inside a cadquery / build123d wrapper, or a list of them.
 
     cadquery's ``Workplane`` has no ``wrapped`` but ``vals()``; cadquery and
@@ -56,9 +41,9 @@ def _unwrap(x: Any) -> Any:
         return wrapped
     vals = getattr(x, "vals", None)
     if callable(vals) and type(x).__module__.startswith("cadquery"):
-        return [_unwrap(v) for v in vals()]
+        return [unwrap(v) for v in vals()]
     if isinstance(x, (list, tuple)):
-        return [_unwrap(v) for v in x]
+        return [unwrap(v) for v in x]
     return x
 
 
@@ -90,7 +75,7 @@ def to_nurbs(x: Any) -> NurbsSurface | NurbsCurve | TrimmedFace | list[TrimmedFa
     """
     if isinstance(x, CadModel):
         return [face_to_nurbs(f, name=n) for f, n in zip(x.faces, x.face_names)]
-    obj = _unwrap(x)
+    obj = unwrap(x)
     if isinstance(obj, Geom_Surface):
         return surface_from_occ(obj)
     if isinstance(obj, (Geom_Curve, Geom2d_Curve)):
@@ -102,7 +87,7 @@ def to_nurbs(x: Any) -> NurbsSurface | NurbsCurve | TrimmedFace | list[TrimmedFa
             return face_to_nurbs(TopoDS.Face_s(obj))
         if obj.ShapeType() == TopAbs_EDGE:
             return edge_to_nurbs(TopoDS.Edge_s(obj))
-        faces = faces_of(obj)
+        faces = all_faces(obj)
         if not faces:
             raise ConversionError(
                 f"the {type(obj).__name__} ({obj.ShapeType().name}) has no face to convert")

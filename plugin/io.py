@@ -40,10 +40,11 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import (ConversionError, InputFileError, NoFacesError, OpenCascadeError,
                       OutputFileError)
-from .edges import make_edge
-from .faces import TrimmedFace, make_face, trimmed_face_to_occ
-from .step_iges import (FileFormat, Rgb, TranslationError, _all_faces, _compound,
-                        _FaceNames, read_file, write_file)
+from ..algorithms.trimmed import TrimmedFace
+from .occ.edges import make_edge
+from .occ.faces import make_face, trimmed_face_to_occ
+from .occ.shapes import FaceNames, all_faces, compound
+from .step_iges import FileFormat, Rgb, TranslationError, read_file, write_file
 
 __all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "bounding_box", "sniff_format"]
 
@@ -97,7 +98,7 @@ class CadModel:
     @classmethod
     def from_shape(cls, shape: TopoDS_Shape) -> CadModel:
         """A model of an in-memory shape, without names or colours."""
-        faces = _all_faces(shape)
+        faces = all_faces(shape)
         return cls(shape, faces, (None,) * len(faces), (None,) * len(faces))
 
     @property
@@ -255,14 +256,14 @@ def _healed(model: CadModel) -> CadModel:
     if shape.IsNull():
         raise OpenCascadeError(f"ShapeFix_Shape returned a null shape for {model.path}")
     context = fixer.Context()
-    names, colors = _FaceNames(), _FaceNames()
+    names, colors = FaceNames(), FaceNames()
     for face, name, color in zip(model.faces, model.face_names, model.face_colors):
         new = context.Apply(face)
         if name is not None:
             names.add(new, name)
         if color is not None:
             colors.add(new, color)
-    faces = _all_faces(shape)
+    faces = all_faces(shape)
     if not faces:
         raise NoFacesError(f"no faces left after healing {model.path}")
     return CadModel(shape, faces, tuple(names.get(f) for f in faces),
@@ -399,7 +400,7 @@ def to_shape(obj: Any) -> TopoDS_Shape:
         shapes = [to_shape(item) for item in obj]
         if not shapes:
             raise ConversionError("cannot write an empty list of objects")
-        return shapes[0] if len(shapes) == 1 else _compound(shapes)
+        return shapes[0] if len(shapes) == 1 else compound(shapes)
     raise ConversionError(
         f"cannot write a {type(obj).__name__}: expected a CadModel, TopoDS_Shape, "
         "cadquery/build123d object, NurbsSurface, NurbsCurve or a list of them")

@@ -18,7 +18,7 @@ from OCP.Standard import Standard_Failure
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import ConversionError, OpenCascadeError
-from .geom import curve2d_to_occ, curve_to_occ, surface_to_occ
+from .occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
 
 __all__ = ["evaluate_surface", "evaluate_curve", "project_point_on_surface"]
 

@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator, Sequence
 
-from OCP.BRep import BRep_Builder
 from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.IGESCAFControl import IGESCAFControl_Reader, IGESCAFControl_Writer
 from OCP.IGESControl import IGESControl_Reader, IGESControl_Writer
@@ -36,11 +35,11 @@ from OCP.TColStd import TColStd_SequenceOfAsciiString
 from OCP.TDataStd import TDataStd_Name
 from OCP.TDF import TDF_ChildIterator, TDF_Label, TDF_LabelSequence
 from OCP.TDocStd import TDocStd_Document
-from OCP.TopAbs import TopAbs_FACE, TopAbs_FORWARD
-from OCP.TopExp import TopExp_Explorer
-from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face, TopoDS_Shape
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
+
+from .occ.shapes import FaceNames, all_faces, compound
 
 __all__ = [
     "FileFormat",
@@ -235,8 +234,8 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
     shapes = [s for s in shapes if not s.IsNull()]
     if not shapes:
         raise TranslationError("XDE transfer produced no shape")
-    shape = shapes[0] if len(shapes) == 1 else _compound(shapes)
-    faces = _all_faces(shape)
+    shape = shapes[0] if len(shapes) == 1 else compound(shapes)
+    faces = all_faces(shape)
 
     names = _names_by_face(shape_tool)
     face_names = tuple(names.get(f) for f in faces)
@@ -260,61 +259,9 @@ def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
     shape = reader.OneShape()
     if shape.IsNull():
         raise TranslationError(f"{fmt.value} transfer produced a null shape")
-    faces = _all_faces(shape)
+    faces = all_faces(shape)
     return TranslatedModel(shape, faces, (None,) * len(faces), (None,) * len(faces), unit,
                            used_xde=False)
-
-
-def _compound(shapes: Sequence[TopoDS_Shape]) -> TopoDS_Compound:
-    builder = BRep_Builder()
-    compound = TopoDS_Compound()
-    builder.MakeCompound(compound)
-    for s in shapes:
-        builder.Add(compound, s)
-    return compound
-
-
-def _all_faces(shape: TopoDS_Shape) -> tuple[TopoDS_Face, ...]:
-    """Every face occurrence of ``shape`` in exploration (file) order.
-
-    A face the file references twice (same definition, e.g. from two IGES
-    groups) appears twice, as ``TopExp_Explorer`` visits it twice: the face
-    count then matches what other tools report for the file.
-    """
-    faces = []
-    explorer = TopExp_Explorer(shape, TopAbs_FACE)
-    while explorer.More():
-        faces.append(TopoDS.Face_s(explorer.Current()))
-        explorer.Next()
-    return tuple(faces)
-
-
-class _FaceNames:
-    """Names of face definitions, looked up by face whatever its location/orientation.
-
-    OCP's ``TopoDS_Shape.__eq__`` is not ``IsSame``, so the lookup buckets by
-    hash of the unlocated face and confirms with ``IsSame``.
-    """
-
-    def __init__(self) -> None:
-        self._buckets: dict[int, list[tuple[TopoDS_Shape, str]]] = {}
-
-    @staticmethod
-    def _key(face: TopoDS_Shape) -> TopoDS_Shape:
-        return face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD)
-
-    def add(self, face: TopoDS_Shape, name: str) -> None:
-        key = self._key(face)
-        bucket = self._buckets.setdefault(hash(key), [])
-        if not any(k.IsSame(key) for k, _ in bucket):
-            bucket.append((key, name))
-
-    def get(self, face: TopoDS_Shape) -> str | None:
-        key = self._key(face)
-        for k, name in self._buckets.get(hash(key), ()):
-            if k.IsSame(key):
-                return name
-        return None
 
 
 def _label_name(label: TDF_Label) -> str | None:
@@ -328,9 +275,9 @@ def _label_name(label: TDF_Label) -> str | None:
     return None
 
 
-def _names_by_face(shape_tool: XCAFDoc_ShapeTool) -> _FaceNames:
+def _names_by_face(shape_tool: XCAFDoc_ShapeTool) -> FaceNames:
     """Names of every named face label under the document's shape labels."""
-    names = _FaceNames()
+    names = FaceNames()
     # every shape label (free shapes, parts, components) and their sub-shape labels
     top = TDF_LabelSequence()
     shape_tool.GetShapes(top)
@@ -388,7 +335,7 @@ def _write_xde(path, fmt, shape, faces, face_names, face_colors) -> None:
     lone_face = shape.ShapeType() == TopAbs_FACE
     if lone_face and fmt is FileFormat.STEP:
         # STEP names a lone face only as a sub-shape: wrap it in a compound
-        shape = _compound([shape])
+        shape = compound([shape])
         lone_face = False
     root = shape_tool.AddShape(shape, False)
     for face, name, color in zip(faces, face_names, face_colors):

@@ -22,7 +22,7 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.gp import gp_Ax3, gp_Cylinder, gp_Dir, gp_Pln, gp_Pnt
 
 from surfprep.algorithms import NurbsSurface
-from surfprep.plugin.faces import make_face
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.io import CadModel, write
 from surfprep.plugin.step_iges import _compound
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 from importlib import import_module
 
 from .algorithms import Direction, NurbsCurve, NurbsSurface
+from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
 from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
 from .errors import (ConversionError, DegenerateGeometryError, InputFileError,
                      InvalidGeometryError, InvalidToleranceError, NoFacesError,
@@ -31,18 +32,15 @@ _PLUGIN_EXPORTS = {
     "FileFormat": "surfprep.plugin.io",
     "to_nurbs": "surfprep.plugin.convert",
     "to_occ": "surfprep.plugin.convert",
-    "TrimmedFace": "surfprep.plugin.topology",
-    "TrimLoop": "surfprep.plugin.topology",
-    "TrimEdge": "surfprep.plugin.topology",
-    "make_face": "surfprep.plugin.topology",
-    "make_edge": "surfprep.plugin.topology",
+    "make_face": "surfprep.plugin.occ.faces",
+    "make_edge": "surfprep.plugin.occ.edges",
     "intersect": "surfprep.plugin.intersect",
     "reparametrize": "surfprep.plugin.reparam",
     "heal": "surfprep.plugin.heal",
 }
 
 __all__ = [
-    "NurbsCurve", "NurbsSurface", "Direction",
+    "NurbsCurve", "NurbsSurface", "Direction", "TrimmedFace", "TrimLoop", "TrimEdge",
     "parametrization_quality", "ParametrizationQuality",
     *_PLUGIN_EXPORTS,
     "SurfprepError", "InvalidGeometryError", "DegenerateGeometryError",

@@ -65,7 +65,7 @@ def _finite_or_zero(x):
 @jit
 def _correct(rq, pp, o, w, comp, pin, x0, x1, s0, t0, ctol, diag, r_lo, r_hi):
     """Newton along ``grad g`` (along the side ``pin`` holds, -1 none) from ``(x0, x1)``:
-    :func:`.curves._correct` for one point. Returns ``(x0, x1, converged)``; the jet
+    :func:`.curves.correct` for one point. Returns ``(x0, x1, converged)``; the jet
     at the returned point is in ``o``."""
     jet(rq, pp, o, w, x0, x1, s0, t0)
     converged = False

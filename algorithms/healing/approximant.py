@@ -51,11 +51,11 @@ from .boundary import Boundary, BoundaryCurve, as_boundary
 from .clipping import Source, as_sources, clip_sources
 from .coons import discrete_coons
 from .error import ErrorSample, measure_error
-from .interpolant import Interpolant, interpolate_grid
 from .fill import FillMethod, fill_positions
+from .interpolant import Interpolant, interpolate_grid
 from .offsets import offsets
-from .ring import ring_segments
 from .piercing import project_grid
+from .ring import ring_segments
 
 __all__ = ["DEFAULT_RELATIVE_TOL", "LocalApproximant", "ResolutionStep", "local_approximant"]
 

@@ -27,10 +27,12 @@ from weakref import WeakKeyDictionary
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError
+from ...errors import InvalidGeometryError, SurfprepError
+from ..face_region import inside_loops
 from ..intersection.mesh import TriangleMesh
 from ..intersection.tessellation import tessellate
 from ..surface import NurbsSurface
+from ..trimmed import TrimmedFace, is_natural, loop_uv
 
 __all__ = [
     "ClippedTriangles",
@@ -38,13 +40,12 @@ __all__ = [
     "SurfaceSource",
     "as_sources",
     "clip_sources",
-    "inside_loops",
+    "face_source",
     "trimmed_source",
 ]
 
 #: default chord tolerance of :func:`trimmed_source`, fraction of the surface's box diagonal
 TRIM_MESH_FRACTION = 1e-3
-_PIP_CHUNK = 4096
 #: a surface at most this many times the clipping box's size is triangulated whole and kept
 CACHE_SIZE_RATIO = 4.0
 #: a kept triangulation serves chord tolerances up to this factor coarser than its own
@@ -95,38 +96,6 @@ class SurfaceSource:
 
 
 Source = NurbsSurface | TriangleMesh | SurfaceSource
-
-
-def inside_loops(points: NDArray, loops: Sequence[NDArray]) -> NDArray:
-    """Even-odd test of parameter points against closed polygons.
-
-    Parameters
-    ----------
-    points : (m, 2) float
-    loops : sequence of (n_k, 2) float
-        Closed polygons (the last point joins the first), e.g. samples of a
-        face's trimming loops in ``(u, v)``: the outer loop and its holes.
-
-    Returns
-    -------
-    (m,) bool
-        Inside an odd number of loops.
-    """
-    edges = [np.stack([lp, np.roll(lp, -1, axis=0)], axis=1)
-             for lp in (np.asarray(x, dtype=float) for x in loops) if lp.shape[0] >= 3]
-    inside = np.zeros(points.shape[0], bool)
-    if not edges:
-        return inside
-    e = np.concatenate(edges)                                    # (E, 2, 2)
-    (x0, y0), (x1, y1) = e[:, 0].T, e[:, 1].T
-    for start in range(0, points.shape[0], _PIP_CHUNK):
-        px = points[start:start + _PIP_CHUNK, :1]
-        py = points[start:start + _PIP_CHUNK, 1:]
-        spans = (y0 > py) != (y1 > py)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xc = x0 + (py - y0) * (x1 - x0) / (y1 - y0)
-        inside[start:start + _PIP_CHUNK] = np.sum(spans & (px < xc), axis=1) % 2 == 1
-    return inside
 
 
 def trimmed_source(surface: NurbsSurface, loops: Sequence[NDArray], *,
@@ -305,3 +274,16 @@ def clip_sources(sources: tuple[SurfaceSource, ...], box: NDArray, *, mesh_tol: 
         src.append(np.full(p.shape[0], k, np.int64))
     return ClippedTriangles(np.concatenate(pts), np.concatenate(uv), np.concatenate(src),
                             sources, kept, np.array(box, dtype=float))
+
+
+def face_source(face: TrimmedFace) -> NurbsSurface | SurfaceSource:
+    """A face as a source of :func:`local_approximant`: its surface where the face is
+    the whole surface, else :func:`trimmed_source` (only the part inside its loops is
+    projected onto, so a hole in the face or a part trimmed away gets the fill)."""
+    if is_natural(face):
+        return face.surface
+    loops = [loop_uv(lp) for lp in face.loops]
+    try:
+        return trimmed_source(face.surface, loops, name=face.name or "")
+    except SurfprepError:
+        return face.surface

@@ -373,8 +373,8 @@ def _corner_clusters(patches: list[NurbsSurface], samples: _SideSamples,
     for x, y in cKDTree(points).query_pairs(tol):
         union(x, y)
     for e in edges:
-        ends_a = [_corner_number(e.side_a, k) + 4 * e.a for k in (0, 1)]
-        ends_b = [_corner_number(e.side_b, k) + 4 * e.b for k in (0, 1)]
+        ends_a = [corner_number(e.side_a, k) + 4 * e.a for k in (0, 1)]
+        ends_b = [corner_number(e.side_b, k) + 4 * e.b for k in (0, 1)]
         if e.reversed:
             ends_b = ends_b[::-1]
         union(ends_a[0], ends_b[0])
@@ -395,7 +395,7 @@ def _corner_clusters(patches: list[NurbsSurface], samples: _SideSamples,
 _CORNER_NAMES = ((Side.V0, 0), (Side.V0, 1), (Side.V1, 0), (Side.V1, 1))
 
 
-def _corner_number(side: Side, end: int) -> int:
+def corner_number(side: Side, end: int) -> int:
     """Number 0..3 (u0v0, u1v0, u0v1, u1v1) of the corner at ``end`` of ``side``."""
     at_u = {Side.U0: 0, Side.U1: 1}
     at_v = {Side.V0: 0, Side.V1: 1}

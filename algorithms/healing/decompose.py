@@ -23,6 +23,23 @@ mean ``(u, v)`` of the side midpoints) mapped onto the surface and interpolated
 sharing a spoke get the same curve. A layout is refused
 (:class:`NotDecomposableError`) when a spoke leaves the face's outline or a
 sub-patch's Coons map in ``(u, v)`` folds (a very non-convex outline).
+
+On a :class:`~..trimmed.TrimmedFace` (:func:`quad_boundaries`, the reason for a
+refusal in :func:`why_not_decomposable`):
+
+* a face of one loop of four real edges: its four edges (as
+  :func:`.adjacency.four_sided_boundary`);
+* a face bounded by the whole surface (no trimming loop): the surface's four
+  boundary isocurves;
+* other faces of one loop: :func:`decompose_loop` on its outer loop
+  (:func:`loop_edges`);
+* faces with inner loops (holes), seam edges, loop ends further apart than
+  ``gap_tol``, very non-convex outlines: not decomposable.
+
+:func:`surfprep.heal` approximates every sub-patch with
+:func:`.approximant.local_approximant` (the face's own source preferred) and
+joins them with the rest; if one sub-patch misses ``tol``, the whole face is kept
+as it was.
 """
 
 from __future__ import annotations
@@ -35,18 +52,25 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
+from ..face_region import inside_loops
 from ..fitting import interpolate_curve
-from .clipping import inside_loops
+from ..tolerance import check_tolerance
+from ..trimmed import TrimEdge, TrimmedFace
+from .adjacency import four_sided_boundary
 
 __all__ = [
     "DEFAULT_SMOOTH_ANGLE",
     "Decomposition",
     "LoopEdge",
     "NotDecomposableError",
+    "decompose_face",
     "decompose_loop",
     "join_curves",
+    "loop_edges",
+    "quad_boundaries",
     "reverse_curve",
     "turning_angles",
+    "why_not_decomposable",
 ]
 
 #: a vertex turning by less than this (radians) joins its two edges into one side
@@ -390,3 +414,102 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         quads, centre = _star(surface, real, cuts, sides, outline, orientation)
     return Decomposition(tuple(tuple(q) for q, _ in quads), tuple(uv for _, uv in quads),
                          corners, centre, turning)
+
+
+# ------------------------------------------------------------------ trimmed faces
+def _loop_edge(edge: TrimEdge) -> LoopEdge:
+    curve = None if edge.degenerated else edge.curve3d
+    if not edge.reversed:
+        return LoopEdge(curve, edge.pcurve)
+    return LoopEdge(None if curve is None else reverse_curve(curve), reverse_curve(edge.pcurve))
+
+
+def loop_edges(face: TrimmedFace, *, gap_tol: float) -> list[LoopEdge]:
+    """The face's single outer loop as :class:`LoopEdge` (oriented along the loop).
+
+    Raises
+    ------
+    NotDecomposableError
+        Inner loops, a seam edge, a real edge without 3D curve, or consecutive
+        3D edge ends further apart than ``gap_tol``.
+    """
+    if len(face.loops) != 1:
+        raise NotDecomposableError(f"{len(face.loops) - 1} inner loop(s) (holes in the face)")
+    edges = face.loops[0].edges
+    if any(e.is_seam for e in edges):
+        raise NotDecomposableError("a seam edge (face closed on its surface)")
+    if any(e.curve3d is None and not e.degenerated for e in edges):
+        raise NotDecomposableError("an edge without a 3D curve")
+    out = [_loop_edge(e) for e in edges]
+    real = [e.curve for e in out if e.curve is not None]
+    ends = np.array([c.evaluate(np.array(c.domain)) for c in real])      # (m, 2, 3)
+    gaps = np.linalg.norm(ends[:, 1] - np.roll(ends[:, 0], -1, axis=0), axis=1)
+    degenerate_between = any(e.curve is None for e in out)
+    if not degenerate_between and gaps.size and gaps.max() > gap_tol:
+        raise NotDecomposableError(
+            f"loop edges do not meet: gap {gaps.max():.3g} > gap_tol {gap_tol:.3g}")
+    return out
+
+
+def decompose_face(face: TrimmedFace, *, gap_tol: float,
+                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition | None:
+    """The decomposition of a face that is neither four-sided nor untrimmed (None for
+    those: :func:`quad_boundaries` handles them); raises with the reason."""
+    gap_tol = check_tolerance(gap_tol, "gap_tol")
+    if four_sided_boundary(face) is not None or not face.loops:
+        return None
+    return decompose_loop(face.surface, loop_edges(face, gap_tol=gap_tol),
+                          smooth_angle=smooth_angle)
+
+
+def _surface_sides(face: TrimmedFace) -> list[NurbsCurve]:
+    """The four boundary isocurves of an untrimmed surface, in loop order."""
+    s = face.surface
+    u0, u1, v0, v1 = s.domain
+    return [s.isocurve(v0, "v"), s.isocurve(u1, "u"), reverse_curve(s.isocurve(v1, "v")),
+            reverse_curve(s.isocurve(u0, "u"))]
+
+
+def quad_boundaries(face: TrimmedFace, *, gap_tol: float,
+                    smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> list[list[NurbsCurve]] | None:
+    """Boundaries of four-sided sub-patches covering ``face`` (module docstring).
+
+    Parameters
+    ----------
+    face : TrimmedFace
+    gap_tol : float
+        Model units: largest gap between consecutive edges of the loop.
+    smooth_angle : float
+        Radians: vertices turning less join their edges into one side.
+
+    Returns
+    -------
+    list of list of four NurbsCurve, or None
+        Each boundary in loop order (bottom, right, top, left); None when the
+        face is not decomposable (:func:`why_not_decomposable` says why).
+    """
+    try:
+        return _boundaries(face, gap_tol, smooth_angle)
+    except NotDecomposableError:
+        return None
+
+
+def why_not_decomposable(face: TrimmedFace, *, gap_tol: float,
+                         smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> str | None:
+    """The reason :func:`quad_boundaries` returns None for ``face``, else None."""
+    try:
+        _boundaries(face, gap_tol, smooth_angle)
+    except NotDecomposableError as exc:
+        return str(exc)
+    return None
+
+
+def _boundaries(face: TrimmedFace, gap_tol: float, smooth_angle: float
+                ) -> list[list[NurbsCurve]]:
+    four = four_sided_boundary(face)
+    if four is not None:
+        return [four]
+    if not face.loops:
+        return [_surface_sides(face)]
+    decomposition = decompose_face(face, gap_tol=gap_tol, smooth_angle=smooth_angle)
+    return [list(q) for q in decomposition.quads]

@@ -16,6 +16,9 @@ public too, module by module:
 * :mod:`.result`: :class:`IntersectionCurve` and its interpolants;
 * :mod:`.sides`, :mod:`.seams`, :mod:`.extend`, :mod:`.singular_join`: curves along
   domain sides, cuts at seams, hanging ends marched, curves joined at double points;
+* :mod:`.boundary_ends`: curve ends solved on the domain side they lie on;
+* :mod:`.trimming`: curves clipped to trimmed faces (:func:`clip_curve`), shared
+  edges of one shape told apart;
 * :mod:`.angles`: how flat a crossing the triangles can follow;
 * :mod:`.compare`: distances between two answers (Hausdorff, per-branch).
 """
@@ -57,6 +60,7 @@ from .segments import SegmentSoup, SoupStats, mesh_segments
 from .tessellation import Tessellation, tessellate
 from .topology import Chain, EndKind, SegmentTopology, build_topology, topology_from_soup
 from .triangles import TriangleHits, intersect_triangles
+from .trimming import along_a_boundary, clip_curve
 
 __all__ = [
     "intersect_surfaces", "SmallAngleWarning", "StrayCurves", "StrayCurveWarning",
@@ -74,4 +78,5 @@ __all__ = [
     "overlap_patches", "surface_patch_boxes", "patch_rectangles", "subpatch_boxes",
     "hausdorff", "polyline_distance", "curve_set_distance", "CurveSetDistance",
     "connected_branches",
+    "clip_curve", "along_a_boundary",
 ]

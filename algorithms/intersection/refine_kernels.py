@@ -205,7 +205,7 @@ def _surface_args(surface: NurbsSurface) -> tuple:
                       *span_range(surface.knots_v, surface.degree_v)], dtype=np.int64)
     return (np.ascontiguousarray(surface.knots_u, dtype=float),
             np.ascontiguousarray(surface.knots_v, dtype=float), int(surface.degree_u),
-            int(surface.degree_v), np.ascontiguousarray(surface._homogeneous_net),
+            int(surface.degree_v), np.ascontiguousarray(surface.homogeneous_net),
             surface.weights is not None, spans, np.array(surface.domain, dtype=float))
 
 

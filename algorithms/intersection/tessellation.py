@@ -154,7 +154,7 @@ def _chord_errors(surface: NurbsSurface, rects: NDArray
         sv = find_span(surface.knots_v, surface.degree_v, v.ravel()).reshape(v.shape)
         grid = tessellation_kernels.grid_points(
             surface.knots_u, surface.knots_v, surface.degree_u, surface.degree_v,
-            surface._homogeneous_net, u, v, su, sv, surface.weights is not None)
+            surface.homogeneous_net, u, v, su, sv, surface.weights is not None)
     else:
         grid = surface.evaluate(u[:, :, None], v[:, None, :])      # (k, n, n, 3)
     if tessellation_kernels.AVAILABLE:          # the formulas below, compiled

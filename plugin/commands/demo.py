@@ -10,7 +10,7 @@ Steps (later features append theirs to :func:`run_demo`):
    surfprep's evaluation and OpenCascade's evaluation of the face's own surface,
    and between the rebuilt OpenCascade surface and the original;
 3. rebuild each face on the converted surface (with its trimming loops through
-   :mod:`surfprep.plugin.topology`, or with natural boundaries if that fails),
+   :mod:`surfprep.plugin.occ.faces`, or with natural boundaries if that fails),
    write them to ``OUTDIR/<sample>-rebuilt.step`` and read that file back;
 4. write ``OUTDIR/<sample>-report.json`` and print a summary.
 """
@@ -32,14 +32,13 @@ import surfprep
 
 from ...algorithms import NurbsSurface
 from ...errors import ConversionError, InputFileError, OutputFileError, SurfprepError
-from ..geom import surface_from_occ, surface_to_occ
-from ..faces import make_face
+from ..occ.faces import face_to_nurbs, make_face, trimmed_face_to_occ
+from ..occ.geom import surface_from_occ, surface_to_occ
+from ..occ.shapes import compound, face_area
 from ..io import CadModel, read, write
 from ..occ_reference import evaluate_surface
-from ..step_iges import _compound
 from .base import Command, Console, refuse_overwriting_inputs, write_json_report
-from .info import (SPLINE_KINDS, SurfaceKind, face_area, format_table, model_report,
-                   surface_kind)
+from .info import SPLINE_KINDS, SurfaceKind, format_table, model_report, surface_kind
 
 __all__ = ["COMMAND", "DEMO_SAMPLE", "samples_dir", "run_demo", "FaceRoundTrip",
            "DEFAULT_OUTDIR", "GRID_SIZE", "DEVIATION_TOLERANCE"]
@@ -108,10 +107,9 @@ def _wrap(t: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 def _rebuild(face: TopoDS_Face, surface: NurbsSurface, name: str | None):
-    """The face on the converted surface: trimmed via plugin.topology, else natural."""
+    """The face on the converted surface: trimmed via plugin.occ.faces, else natural."""
     try:
-        from .. import topology
-        rebuilt = topology.trimmed_face_to_occ(topology.face_to_nurbs(face, name))
+        rebuilt = trimmed_face_to_occ(face_to_nurbs(face, name))
         return rebuilt, "trimmed", None
     except (SurfprepError, ImportError, AttributeError) as exc:
         return make_face(surface), "natural boundary", " ".join(str(exc).split())
@@ -176,7 +174,7 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
     reread_faces = 0
     if rebuilt_faces:
         refuse_overwriting_inputs(step_path, inputs)
-        shape = rebuilt_faces[0] if len(rebuilt_faces) == 1 else _compound(rebuilt_faces)
+        shape = rebuilt_faces[0] if len(rebuilt_faces) == 1 else compound(rebuilt_faces)
         rebuilt_model = CadModel(shape, tuple(rebuilt_faces), tuple(rebuilt_names),
                                  tuple(model.face_colors[t.index] for t in trips))
         written = write(rebuilt_model, step_path, overwrite=True)

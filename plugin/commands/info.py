@@ -9,17 +9,16 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from OCP.BRep import BRep_Tool
-from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.GProp import GProp_GProps
 from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face
 
 from ...algorithms.parametrization import parametrization_quality
 from ...errors import OpenCascadeError
-from ..geom import surface_from_occ
+from ..occ.geom import surface_from_occ
+from ..occ.shapes import face_area
 from ..io import CadModel, bounding_box, read
 from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
 
@@ -93,12 +92,6 @@ class FaceInfo:
 def surface_kind(adaptor: GeomAdaptor_Surface) -> SurfaceKind:
     """The :class:`SurfaceKind` of an adapted surface."""
     return _KIND_OF.get(adaptor.GetType(), SurfaceKind.OTHER)
-
-
-def face_area(face: TopoDS_Face) -> float:
-    props = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(face, props)
-    return float(props.Mass())
 
 
 def describe_face(face: TopoDS_Face, index: int, name: str | None = None) -> FaceInfo:

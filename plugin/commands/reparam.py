@@ -93,7 +93,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..geom import surface_from_occ
+    from ..occ.geom import surface_from_occ
     from ..reparam import reparametrize_model
     inputs = (args.file,)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from surfprep.algorithms import loop_kernels
-from surfprep.algorithms.loop_kernels import ray_crossings, ray_crossings_numpy
-from surfprep.plugin.trim_loops import LoopIndex
+from surfprep.algorithms import face_region_kernels
+from surfprep.algorithms.face_region_kernels import ray_crossings, ray_crossings_numpy
+from surfprep.algorithms.face_region import LoopIndex
 
 
 def test_numba_is_available():
     """numba is a declared dependency: the compiled form must be the one that runs."""
-    assert loop_kernels.AVAILABLE
+    assert face_region_kernels.AVAILABLE
 
 
 def _star_with_hole(n: int = 200) -> np.ndarray:

@@ -10,7 +10,7 @@ import pytest
 import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.plugin import cli
-from surfprep.plugin.faces import make_face
+from surfprep.plugin.occ.faces import make_face
 
 
 def run(capsys, *argv) -> tuple[int, str, str]:

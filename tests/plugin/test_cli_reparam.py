@@ -11,7 +11,7 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 
 import surfprep
 from surfprep.plugin.cli import main
-from surfprep.plugin.geom import surface_from_occ
+from surfprep.plugin.occ.geom import surface_from_occ
 
 
 @pytest.fixture(scope="module")

@@ -21,10 +21,11 @@ from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import ConversionError
-from surfprep.plugin.convert import faces_of, to_nurbs, to_occ
+from surfprep.plugin.convert import to_nurbs, to_occ
+from surfprep.plugin.occ.shapes import all_faces
 from surfprep.plugin.occ_reference import evaluate_curve
-from surfprep.plugin.topology import TrimmedFace
-from surfprep.plugin.topology import make_face as to_occ_face
+from surfprep.algorithms.trimmed import TrimmedFace
+from surfprep.plugin.occ.faces import make_face as to_occ_face
 
 
 def _same_face(a: TrimmedFace, b: TrimmedFace) -> bool:
@@ -71,7 +72,7 @@ def test_face_edge_and_shape_inputs():
     faces = to_nurbs(box)
     assert isinstance(faces, list) and len(faces) == 6
     assert all(isinstance(f, TrimmedFace) for f in faces)
-    assert _same_face(to_nurbs(faces_of(box)[0]), faces[0])
+    assert _same_face(to_nurbs(all_faces(box)[0]), faces[0])
     edge = cq.Workplane().box(1, 2, 3).edges().vals()[0]
     curve = to_nurbs(edge.wrapped)
     assert isinstance(curve, NurbsCurve) and curve.dimension == 3
@@ -102,7 +103,7 @@ def test_located_shapes_apply_the_location():
     # analytic solid: rotated and moved
     shape = (cq.Workplane().cylinder(2, 1).val()
              .rotate((0, 0, 0), (1, 1, 0), 30).translate((5, -2, 1)))
-    for face in faces_of(shape.wrapped):
+    for face in all_faces(shape.wrapped):
         tf = to_nurbs(face)
         converted = BRepAdaptor_Surface(TopoDS.Face_s(BRepBuilderAPI_NurbsConvert(face, True).Shape()))
         u0, u1, v0, v1 = tf.surface.domain

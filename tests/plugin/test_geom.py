@@ -41,8 +41,13 @@ from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_A
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import ConversionError
-from surfprep.plugin.geom import (curve2d_to_occ, curve_from_occ, curve_to_occ, surface_from_occ,
-                                  surface_to_occ)
+from surfprep.plugin.occ.geom import (
+    curve2d_to_occ,
+    curve_from_occ,
+    curve_to_occ,
+    surface_from_occ,
+    surface_to_occ,
+)
 from surfprep.plugin.occ_reference import SURFACE_ENTRIES, evaluate_curve, evaluate_surface
 
 RTOL = 1e-12

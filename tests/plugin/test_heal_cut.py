@@ -17,10 +17,11 @@ from OCP.TopExp import TopExp_Explorer
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.plugin.convert import to_nurbs
-from surfprep.plugin.faces import make_face
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.heal import heal
-from surfprep.plugin.heal_cut import face_area, outline
-from surfprep.plugin.heal_topology import polyline_distance
+from surfprep.plugin.occ.shapes import face_area
+from surfprep.plugin.heal.cut import outline
+from surfprep.algorithms.healing.adjacency import polyline_distance
 from surfprep.plugin.io import to_shape
 
 X_CROSS = 1.0          # the sheets cross along x = 1
@@ -166,8 +167,8 @@ def test_table1_intersecting_surfaces_row(crossing):
     surfaces: 8.9, 3.5, 3.1, 2.3, 3.0 x 1e-3 in a unit cube): ours over the crossing of the
     two sheets (about 2 x 1 x 0.6), the error measured densely against both sheets."""
     from surfprep.algorithms.healing import corners_boundary, local_approximant
-    from surfprep.plugin.faces import face_to_nurbs
-    from surfprep.plugin.heal_cut import boundary_on_faces
+    from surfprep.plugin.occ.faces import face_to_nurbs
+    from surfprep.plugin.heal.cut import boundary_on_faces
     a, b, _ = crossing
     bnd = boundary_on_faces(corners_boundary(*np.array(corners())),
                             [face_to_nurbs(make_face(a)), face_to_nurbs(make_face(b))], 0.3)
@@ -190,8 +191,8 @@ def test_patch_inside_a_face_leaves_a_hole_closed_in_geometry():
     # hole's edges: the gap along the cut measured on the geometry
     from surfprep.algorithms.healing.connectivity import Side, side_points
     from surfprep.algorithms.projection import project_to_curve
-    from surfprep.plugin.faces import face_to_nurbs
-    from surfprep.plugin.heal_cut import inner_edges
+    from surfprep.plugin.occ.faces import face_to_nurbs
+    from surfprep.plugin.heal.cut import inner_edges
     a = sheet(0.0, 1.0, 0.0)
     uv = np.array([[0.3, 0.3], [0.7, 0.3], [0.7, 0.7], [0.3, 0.7]])
     corners_on_a = a.evaluate(uv[:, 0], uv[:, 1])

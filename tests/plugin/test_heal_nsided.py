@@ -25,15 +25,16 @@ from decompose_cases import (
 from surfprep.algorithms.healing import connect, local_approximant
 from surfprep.algorithms.healing.decompose import reverse_curve
 from surfprep.algorithms.projection import distance_to_surface
-from surfprep.plugin.edges import TrimEdge
-from surfprep.plugin.faces import TrimLoop, face_to_nurbs, make_face
-from surfprep.plugin.heal import face_source
-from surfprep.plugin.heal_nsided import (
+from surfprep.algorithms.trimmed import TrimEdge
+from surfprep.algorithms.trimmed import TrimLoop
+from surfprep.plugin.occ.faces import face_to_nurbs, make_face
+from surfprep.algorithms.healing.clipping import face_source
+from surfprep.algorithms.healing.decompose import (
     decompose_face,
     quad_boundaries,
     why_not_decomposable,
 )
-from surfprep.plugin.heal_topology import four_sided_boundary
+from surfprep.algorithms.healing.adjacency import four_sided_boundary
 
 SURFACE = wavy_surface()
 GAP = 1e-6
@@ -116,7 +117,7 @@ def test_heal_split_faces_replaces_a_triangle_by_three_patches():
     # are joined G0 into one valid face set (the default); with split_faces=False the
     # face is kept
     from surfprep.plugin.heal import heal
-    from surfprep.plugin.heal_topology import face_edges, polyline_distance
+    from surfprep.algorithms.healing.adjacency import face_edges, polyline_distance
     shape = _occ_triangle_face()
     kept = heal(shape, split_faces=False)
     assert kept.patches == () and kept.model.n_faces == 1

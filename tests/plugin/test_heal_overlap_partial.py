@@ -14,10 +14,10 @@ from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.healing.connectivity import Side
 from surfprep.algorithms.projection import project_to_curve, project_to_surface
 from surfprep.plugin.convert import to_nurbs
-from surfprep.plugin.faces import make_face
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.heal import heal
-from surfprep.plugin.heal_cut import face_area
-from surfprep.plugin.heal_overlap_trim import overlap_share
+from surfprep.plugin.occ.shapes import face_area
+from surfprep.algorithms.healing.partial_overlap import overlap_share
 from surfprep.plugin.io import to_shape
 
 
@@ -98,8 +98,8 @@ def _with_hole(face, centre, radius):
                                    radius, 2).Shape()
     cut = BRepAlgoAPI_Cut(face, cyl)
     assert cut.IsDone()
-    from surfprep.plugin.step_iges import _all_faces
-    (out,) = _all_faces(cut.Shape())
+    from surfprep.plugin.occ.shapes import all_faces
+    (out,) = all_faces(cut.Shape())
     return out
 
 

@@ -52,7 +52,7 @@ def test_heartvalve_every_face_approximated(data_dir):
     where a side meets two edges of one face, with shared corners moved onto the edge ends).
     With the faces that are not four-sided split into sub-patches too (the default; 25
     patches were measured) the four-sided ones are all still replaced and the gaps close."""
-    from surfprep.plugin.heal_topology import four_sided_boundary
+    from surfprep.algorithms.healing.adjacency import four_sided_boundary
     from surfprep.plugin.io import read
 
     path = data_dir / "overture_heartvalve_rhino.igs"
@@ -78,9 +78,10 @@ def test_microstation_faces_not_four_sided_decompose(data_dir):
 
     from surfprep.algorithms.healing import connect, local_approximant
     from surfprep.algorithms.projection import distance_to_surface
-    from surfprep.plugin.heal import _default_gap_tol, _read_faces, face_source
-    from surfprep.plugin.heal_nsided import quad_boundaries, why_not_decomposable
-    from surfprep.plugin.heal_topology import face_edges, four_sided_boundary
+    from surfprep.plugin.heal import _default_gap_tol, _read_faces
+    from surfprep.algorithms.healing.clipping import face_source
+    from surfprep.algorithms.healing.decompose import quad_boundaries, why_not_decomposable
+    from surfprep.algorithms.healing.adjacency import face_edges, four_sided_boundary
     from surfprep.plugin.io import read
 
     model = read(data_dir / "occt_k1geo_microstation.stp")

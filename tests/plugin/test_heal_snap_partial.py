@@ -12,8 +12,8 @@ from surfprep.algorithms.fitting import interpolate_curve, interpolate_surface
 from surfprep.algorithms.healing import connect
 from surfprep.algorithms.healing.connectivity import Side, side_points
 from surfprep.algorithms.projection import project_to_curve
-from surfprep.plugin.heal_snap import snap_to_originals
-from surfprep.plugin.heal_topology import FaceEdge
+from surfprep.algorithms.healing.snap import snap_to_originals
+from surfprep.algorithms.healing.adjacency import FaceEdge
 
 
 def _edge(curve, face=7, k=0):

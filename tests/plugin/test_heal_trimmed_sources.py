@@ -13,9 +13,9 @@ from OCP.TopoDS import TopoDS_Compound
 from surfprep.algorithms.healing import SurfaceSource
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.surface import NurbsSurface
-from surfprep.plugin.faces import face_to_nurbs, make_face
-from surfprep.plugin.geom import surface_to_occ
-from surfprep.plugin.heal import face_source
+from surfprep.plugin.occ.faces import face_to_nurbs, make_face
+from surfprep.plugin.occ.geom import surface_to_occ
+from surfprep.algorithms.healing.clipping import face_source
 
 import surfprep
 

@@ -13,7 +13,7 @@ from OCP.gp import gp_Ax3, gp_Dir, gp_Pnt
 import surfprep
 from surfprep.algorithms.intersection import connected_branches, curve_set_distance, polyline_distance
 from surfprep.errors import ConversionError, InvalidToleranceError
-from surfprep.plugin.intersect import FaceIntersection, face_operands, inside_face, intersect
+from surfprep.plugin.intersect import FaceIntersection, face_operands, intersect
 from surfprep.plugin.occ_reference import section_faces_occ
 
 
@@ -124,7 +124,7 @@ def test_inside_face_even_odd_with_hole():
     du, dv = s.evaluate(1.0, 0.0) - o, s.evaluate(0.0, 1.0) - o
     m = np.stack([du, dv], 1)
     uv = np.linalg.lstsq(m, (np.c_[x, np.zeros(len(x))] - o).T, rcond=None)[0].T
-    assert inside_face(face, uv).tolist() == [False, True, True, False, True]
+    assert face.region.contains(uv).tolist() == [False, True, True, False, True]
 
 
 def test_inside_face_dense_against_the_exact_plate():
@@ -143,9 +143,9 @@ def test_inside_face_dense_against_the_exact_plate():
     margin = np.minimum(np.minimum(1 - np.abs(xyz[:, 0]), 1 - np.abs(xyz[:, 1])), r - 0.5)
     clear = np.abs(margin) > 1e-3                       # beyond the loop polygon's sag
     for tol in (0.0, 1e-7):
-        got = inside_face(face, uv, tol)
+        got = face.region.contains(uv, tol)
         assert np.array_equal(got[clear], exact[clear])
-        assert np.array_equal(inside_face(face, uv[::-1], tol), got[::-1])   # cache reused
+        assert np.array_equal(face.region.contains(uv[::-1], tol), got[::-1])   # cache reused
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +163,7 @@ def test_real_file_faces_across_and_within(debis):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    from surfprep.plugin.edges import edge_to_nurbs
+    from surfprep.plugin.occ.edges import edge_to_nurbs
     fa, fb = debis.faces[9], debis.faces[11]
     result = intersect(fa, fb)
     check_result(result)

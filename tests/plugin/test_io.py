@@ -16,7 +16,7 @@ from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import (ConversionError, InputFileError, NoFacesError, OutputFileError,
                              SurfprepError)
 from surfprep.plugin import io as sio
-from surfprep.plugin.faces import make_face
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.io import CadModel, FileFormat, read, write
 from surfprep.plugin.step_iges import TranslationError
 

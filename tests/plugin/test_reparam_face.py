@@ -23,9 +23,9 @@ from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.reparam.deviation import subdivide
 from surfprep.errors import ConversionError, InvalidGeometryError
-from surfprep.plugin.edges import edge_to_nurbs
-from surfprep.plugin.faces import TrimmedFace
-from surfprep.plugin.geom import surface_from_occ, surface_to_occ
+from surfprep.plugin.occ.edges import edge_to_nurbs
+from surfprep.algorithms.trimmed import TrimmedFace
+from surfprep.plugin.occ.geom import surface_from_occ, surface_to_occ
 from surfprep.plugin.reparam import face_area, reparametrize_face
 
 

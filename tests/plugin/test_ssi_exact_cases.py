@@ -52,7 +52,7 @@ import surfprep
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import connected_branches, curve_set_distance
 from surfprep.algorithms.projection import distance_to_surface
-from surfprep.plugin.geom import surface_from_occ
+from surfprep.plugin.occ.geom import surface_from_occ
 from surfprep.plugin.intersect import face_operands
 from surfprep.plugin.occ_reference import intersect_surfaces_occ, section_faces_occ
 

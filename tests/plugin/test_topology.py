@@ -29,12 +29,13 @@ from OCP.TopoDS import TopoDS
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import ConversionError, InvalidGeometryError, InvalidToleranceError
-from surfprep.plugin.convert import faces_of
-from surfprep.plugin.geom import curve_from_occ, surface_to_occ
+from surfprep.plugin.occ.shapes import all_faces
+from surfprep.plugin.occ.geom import curve_from_occ, surface_to_occ
 from surfprep.plugin.occ_reference import evaluate_curve, evaluate_surface, project_point_on_surface
-from surfprep.plugin.faces import needs_nurbs_convert
-from surfprep.plugin.topology import (TrimEdge, TrimLoop, TrimmedFace, face_to_nurbs, make_edge,
-                                      make_face, trimmed_face_to_occ)
+from surfprep.plugin.occ.faces import needs_nurbs_convert
+from surfprep.algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
+from surfprep.plugin.occ.faces import face_to_nurbs, make_face, trimmed_face_to_occ
+from surfprep.plugin.occ.edges import make_edge
 
 DATA_FILES = ["occt_fuselage.stp", "occt_catia4_face_L1.igs", "occt_deflettore_solidedge.igs"]
 
@@ -156,7 +157,7 @@ def check_round_trip(face, tf: TrimmedFace, displacement: float = 0.0) -> None:
 def test_analytic_faces(name):
     shape = ANALYTIC[name]()
     size = _diagonal(shape)
-    for face in faces_of(shape):
+    for face in all_faces(shape):
         tf = face_to_nurbs(face)
         # The surface lies on the original analytic surface (location applied).
         u0, u1, v0, v1 = tf.surface.domain
@@ -172,7 +173,7 @@ def test_analytic_faces(name):
 
 
 def test_seams_and_degenerated_edges_are_recognised():
-    cylinder = [face_to_nurbs(f) for f in faces_of(ANALYTIC["cylinder"]())]
+    cylinder = [face_to_nurbs(f) for f in all_faces(ANALYTIC["cylinder"]())]
     lateral = next(tf for tf in cylinder if any(e.is_seam for e in tf.edges))
     seams = [e for e in lateral.edges if e.is_seam]
     assert len(seams) == 2 and seams[0].reversed != seams[1].reversed
@@ -181,14 +182,14 @@ def test_seams_and_degenerated_edges_are_recognised():
     du = seams[0].pcurve.evaluate(0.5 * (seams[0].t0 + seams[0].t1)) - \
         seams[0].seam_pcurve.evaluate(0.5 * (seams[0].t0 + seams[0].t1))
     assert abs(abs(du[0]) - (lateral.surface.domain[1] - lateral.surface.domain[0])) < 1e-12
-    sphere = face_to_nurbs(faces_of(ANALYTIC["sphere"]())[0])
+    sphere = face_to_nurbs(all_faces(ANALYTIC["sphere"]())[0])
     degenerated = [e for e in sphere.edges if e.degenerated]
     assert len(degenerated) == 2 and all(e.curve3d is None for e in degenerated)
 
 
 def test_face_with_hole():
     plate = ANALYTIC["plate_with_hole"]()
-    top = next(f for f in faces_of(plate) if len(face_to_nurbs(f).loops) == 2)
+    top = next(f for f in all_faces(plate) if len(face_to_nurbs(f).loops) == 2)
     tf = face_to_nurbs(top)
     assert len(tf.loops[tf.outer_loop_index].edges) == 4
     assert len(tf.loops[1 - tf.outer_loop_index].edges) == 1
@@ -202,7 +203,7 @@ def test_face_with_hole():
 def test_missing_3d_curves_are_built():
     """Edges with a pcurve only get their 3D curve from BRepLib.BuildCurves3d."""
     plate = ANALYTIC["plate_with_hole"]()
-    top = next(f for f in faces_of(plate) if len(face_to_nurbs(f).loops) == 2)
+    top = next(f for f in all_faces(plate) if len(face_to_nurbs(f).loops) == 2)
     tf = face_to_nurbs(top)
     loops = [TrimLoop(tuple(TrimEdge(None, e.pcurve, e.t0, e.t1, e.reversed, e.tolerance,
                                      vertex_tolerances=e.vertex_tolerances) for e in loop.edges))
@@ -216,7 +217,7 @@ def test_missing_3d_curves_are_built():
 def test_real_trimmed_faces(data_shapes, name):
     shape = data_shapes[name]
     size = _diagonal(shape)
-    for face in faces_of(shape):
+    for face in all_faces(shape):
         tf = face_to_nurbs(face)
         occ_surface = BRep_Tool.Surface_s(face)
         # B-spline faces convert exactly: same values as OCC on a dense grid
@@ -256,7 +257,7 @@ def _occ_edges_in_order(face):
 
 
 def test_catia_face_has_47_trim_edges(data_shapes):
-    faces = faces_of(data_shapes["occt_catia4_face_L1.igs"])
+    faces = all_faces(data_shapes["occt_catia4_face_L1.igs"])
     assert len(faces) == 1
     tf = face_to_nurbs(faces[0])
     assert len(tf.edges) == 47
@@ -320,7 +321,7 @@ def test_make_face_errors():
 # --------------------------------------------------------------- make_edge
 def test_make_edge_with_pcurves_on_one_and_two_faces():
     cylinder = ANALYTIC["cylinder"]()
-    faces = faces_of(cylinder)
+    faces = all_faces(cylinder)
     tfs = [face_to_nurbs(f) for f in faces]
     lateral_index = next(i for i, tf in enumerate(tfs) if any(e.is_seam for e in tf.edges))
     seam = next(e for e in tfs[lateral_index].edges if e.is_seam and not e.reversed)
@@ -364,7 +365,7 @@ def test_every_valid_face_of_every_file_round_trips(data_dir, name):
     by 1e-4 relative with its precision setting (pyocc_ventilator_catia5)."""
     shape = read_cad(data_dir / name)
     size = _diagonal(shape)
-    for face in faces_of(shape):
+    for face in all_faces(shape):
         if not BRepCheck_Analyzer(face).IsValid():
             try:
                 trimmed_face_to_occ(face_to_nurbs(face))

@@ -26,7 +26,8 @@ from surfprep.algorithms.healing import (
     corners_boundary,
     local_approximant,
 )
-from surfprep.algorithms.healing.clipping import inside_loops, trimmed_source
+from surfprep.algorithms.face_region import inside_loops
+from surfprep.algorithms.healing.clipping import trimmed_source
 from surfprep.algorithms.intersection.mesh import TriangleMesh
 from surfprep.algorithms.projection import distance_to_curve, distance_to_surface
 

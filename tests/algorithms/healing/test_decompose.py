@@ -16,7 +16,7 @@ from decompose_cases import (
     wavy_surface,
 )
 from surfprep.algorithms.healing import connect, local_approximant
-from surfprep.algorithms.healing.clipping import inside_loops
+from surfprep.algorithms.face_region import inside_loops
 from surfprep.algorithms.healing.connectivity import Side, side_points
 from surfprep.algorithms.healing.decompose import (
     NotDecomposableError,

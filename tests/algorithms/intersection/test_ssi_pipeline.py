@@ -35,7 +35,7 @@ from surfprep.algorithms.intersection import (  # noqa: E402
     polyline_distance,
 )
 from surfprep.errors import InvalidGeometryError, InvalidToleranceError  # noqa: E402
-from surfprep.plugin.geom import surface_from_occ  # noqa: E402
+from surfprep.plugin.occ.geom import surface_from_occ  # noqa: E402
 from surfprep.plugin.occ_reference import intersect_surfaces_occ  # noqa: E402
 
 TAU = 2 * np.pi
@@ -345,7 +345,7 @@ def test_small_loop_needs_a_finer_mesh_tolerance():
 def debis(data_dir):
     path = data_dir / "occt_k1_catia_debis.stp"
     import surfprep
-    from surfprep.plugin.faces import face_to_nurbs
+    from surfprep.plugin.occ.faces import face_to_nurbs
     model = surfprep.read(path)
     return model, [face_to_nurbs(f) for f in model.faces]
 
@@ -357,7 +357,7 @@ def shared_edge_points(model, ia: int, ib: int, n: int = 201):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    from surfprep.plugin.edges import edge_to_nurbs
+    from surfprep.plugin.occ.edges import edge_to_nurbs
 
     def edges(face):
         out, ex = [], TopExp_Explorer(face, TopAbs_EDGE)
@@ -445,7 +445,7 @@ def sharp_edge_pairs(model, faces, min_angle=20.0):
     from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
     from surfprep.algorithms.projection import project_to_surface
-    from surfprep.plugin.edges import edge_to_nurbs
+    from surfprep.plugin.occ.edges import edge_to_nurbs
     ancestors = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(model.shape, TopAbs_EDGE, TopAbs_FACE, ancestors)
     def face_index(f):

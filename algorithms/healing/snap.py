@@ -14,12 +14,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..algorithms.healing import Network
-from ..algorithms.healing.connectivity import Side, _corner_number, side_points
-from ..algorithms.healing.continuity import covered_samples, fit_side_to_curve
-from ..algorithms.healing.measure_joins import measure_join
-from ..algorithms.projection import project_to_curve
-from .heal_topology import EDGE_SAMPLES, FaceEdge, dense_edge, polyline_distance
+from ..projection import project_to_curve
+from .adjacency import EDGE_SAMPLES, FaceEdge, dense_edge, polyline_distance
+from .connectivity import Side, corner_number, side_points
+from .continuity import covered_samples, fit_side_to_curve
+from .measure_joins import measure_join
+from .network import Network
 
 __all__ = ["MAX_SNAP_SPANS", "SNAP_CHECK_SAMPLES", "PartialTarget", "snap_to_originals"]
 
@@ -123,8 +123,8 @@ def _edge_pieces(edge: FaceEdge, side: NDArray, dense_side: NDArray, gap_tol: fl
 
 def _in_cluster(patch: int, side: Side, end: int, members: set) -> bool:
     """Whether the corner at ``end`` of ``side`` is shared with another approximant."""
-    number = _corner_number(side, end)
-    return any(_corner_number(s, e) == number for p, s, e in members if p == patch)
+    number = corner_number(side, end)
+    return any(corner_number(s, e) == number for p, s, e in members if p == patch)
 
 
 def _snapped(surface, side: Side, target, free: tuple[bool, bool], tight: float):
@@ -264,9 +264,9 @@ def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
     for p, side, target in targets:
         ends = np.concatenate([c.evaluate(np.array(c.domain)) for c in _curves(target)])
         for end in (0, 1):
-            number = _corner_number(side, end)
+            number = corner_number(side, end)
             cluster = next((c for c in clusters if any(
-                m[0] == p and _corner_number(m[1], m[2]) == number for m in c.members)), None)
+                m[0] == p and corner_number(m[1], m[2]) == number for m in c.members)), None)
             if cluster is None:
                 continue
             i, j = _corner_index(patches[p], number)
@@ -276,7 +276,7 @@ def _pin_corners(patches: list, targets: list, clusters, tight: float) -> None:
             if not tight < np.linalg.norm(goal - corner) <= reach:
                 continue
             for q in {m[0] for m in cluster.members}:
-                numbers = {_corner_number(m[1], m[2]) for m in cluster.members if m[0] == q}
+                numbers = {corner_number(m[1], m[2]) for m in cluster.members if m[0] == q}
                 net = patches[q].control_points.copy()
                 for n in numbers:
                     net[_corner_index(patches[q], n)] = goal

@@ -1,6 +1,7 @@
 """Trimmed faces between OpenCascade topology and surfprep's NURBS types.
 
-:func:`face_to_nurbs` reads a ``TopoDS_Face`` as a :class:`TrimmedFace`: one
+:func:`face_to_nurbs` reads a ``TopoDS_Face`` as a
+:class:`~surfprep.algorithms.trimmed.TrimmedFace`: one
 :class:`~surfprep.algorithms.NurbsSurface` (the face's location applied) and its
 trimming loops, every edge with its 3D curve and its pcurve (2D curve in the
 surface's parameters), both restricted to the edge's range.
@@ -16,13 +17,12 @@ consistently (measured: pcurve mapped through the surface equals the 3D curve
 to ~1e-15 on cadquery's analytic solids). Faces already made of B-spline
 surfaces and of B-spline / Bezier / line curves are read exactly, without it.
 
-:func:`make_face` goes the other way (edges: :mod:`surfprep.plugin.edges`).
+:func:`make_face` goes the other way (edges: :mod:`.edges`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
@@ -40,76 +40,21 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Vertex, TopoDS_Wire
 
-from ..algorithms import NurbsCurve, NurbsSurface
-from ..errors import ConversionError, InvalidGeometryError, OpenCascadeError
-from .edges import (DEFAULT_TOLERANCE, EXACT_2D, EXACT_3D, TrimEdge, build_trim_edge,
-                    check_tolerance, check_valid, converts_exactly, curve3d_points, read_trim_edge)
+from ...algorithms import NurbsCurve, NurbsSurface
+from ...algorithms.tolerance import check_tolerance
+from ...algorithms.trimmed import DEFAULT_TOLERANCE, TrimEdge, TrimLoop, TrimmedFace, curve3d_points
+from ...errors import ConversionError, InvalidGeometryError, OpenCascadeError
+from .edges import EXACT_2D, EXACT_3D, build_trim_edge, converts_exactly, read_trim_edge
 from .geom import surface_from_occ, surface_to_occ
+from .shapes import check_valid
 
-__all__ = ["TrimLoop", "TrimmedFace", "face_to_nurbs", "make_face", "trimmed_face_to_occ",
-           "needs_nurbs_convert"]
+__all__ = ["face_to_nurbs", "make_face", "trimmed_face_to_occ", "needs_nurbs_convert",
+           "checked_or_fixed"]
 
 #: make_face refuses a loop whose consecutive edge ends are further apart than this many
 #: times ``tol``, or this many times the largest edge or vertex tolerance of the two edges.
 _MAX_GAP_IN_TOLERANCES = 100.0
 _MAX_GAP_IN_EDGE_TOLERANCES = 10.0
-
-
-@dataclass(frozen=True, eq=False)
-class TrimLoop:
-    """A closed loop of edges (an OpenCascade wire), in loop order."""
-
-    edges: tuple[TrimEdge, ...]
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "edges", tuple(self.edges))
-        if not self.edges:
-            raise InvalidGeometryError("a trimming loop needs at least one edge")
-
-    def __repr__(self) -> str:
-        return f"TrimLoop({len(self.edges)} edges)"
-
-
-@dataclass(frozen=True, eq=False)
-class TrimmedFace:
-    """A trimmed face in NURBS terms.
-
-    Attributes
-    ----------
-    surface : NurbsSurface
-        The face's surface, its location applied.
-    loops : tuple of TrimLoop
-        Every wire of the face, in the orientation it has in the face seen as
-        FORWARD (outer loop counter-clockwise in ``(u, v)``, holes clockwise).
-    outer_loop_index : int
-        Index of the outer loop in ``loops`` (0 when there is no loop).
-    reversed : bool
-        The face's orientation: True when its normal is opposite to
-        ``S_u x S_v``.
-    name : str or None
-    """
-
-    surface: NurbsSurface
-    loops: tuple[TrimLoop, ...] = ()
-    outer_loop_index: int = 0
-    reversed: bool = False
-    name: str | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "loops", tuple(self.loops))
-        if self.loops and not 0 <= self.outer_loop_index < len(self.loops):
-            raise InvalidGeometryError(
-                f"outer_loop_index {self.outer_loop_index} out of range for {len(self.loops)} loops")
-
-    def __repr__(self) -> str:
-        return (f"TrimmedFace({self.surface!r}, loops={[len(lp.edges) for lp in self.loops]}, "
-                f"outer_loop_index={self.outer_loop_index}, reversed={self.reversed}, "
-                f"name={self.name!r})")
-
-    @property
-    def edges(self) -> tuple[TrimEdge, ...]:
-        """All edge occurrences of all loops."""
-        return tuple(e for loop in self.loops for e in loop.edges)
 
 
 # ----------------------------------------------------------------- reading
@@ -235,7 +180,7 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
         corners: list[tuple[np.ndarray, float, TopoDS_Vertex]] = []
         for loop in loops:
             brep.Add(face, _make_wire(surface, occ_surface, loop, tol, corners))
-        face = _checked_or_fixed(face, tol)
+        face = checked_or_fixed(face, tol)
     if reversed:
         face = TopoDS.Face_s(face.Reversed())
     check_valid(face, "face")
@@ -271,7 +216,7 @@ def trimmed_face_to_occ(face: TrimmedFace, tol: float = DEFAULT_TOLERANCE) -> To
     return make_face(face.surface, face.loops, tol, reversed=face.reversed)
 
 
-def _checked_or_fixed(face: TopoDS_Face, tol: float) -> TopoDS_Face:
+def checked_or_fixed(face: TopoDS_Face, tol: float) -> TopoDS_Face:
     """Return ``face`` if valid; else what ShapeFix_Face makes of it."""
     if BRepCheck_Analyzer(face).IsValid():
         return face

@@ -1,4 +1,4 @@
-"""The methods of :func:`surfprep.plugin.intersect.intersect` and its result types.
+"""The methods of :func:`surfprep.intersect` and its result types.
 
 * :class:`Method`: ``"mesh"`` (triangles), ``"characteristic"`` (paper 002),
   ``"auto"`` (triangles, then the characteristic points as a certificate);
@@ -17,22 +17,22 @@ from typing import TYPE_CHECKING
 
 from numpy.typing import NDArray
 
-from ..algorithms.characteristic import (
+from ...algorithms.characteristic import (
     CharacteristicRecord,
     CoincidentRegion,
     FoundBy,
     auto_intersection,
     characteristic_intersection,
 )
-from ..algorithms.intersection import (
+from ...algorithms.intersection import (
     IntersectionCurve,
     StrayCurves,
     intersect_surfaces,
 )
-from ..errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import InvalidGeometryError, InvalidToleranceError
 
 if TYPE_CHECKING:
-    from .intersect_operands import FaceOperand
+    from .operands import FaceOperand
 
 __all__ = [
     "CoincidentFaces",

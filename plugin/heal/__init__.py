@@ -4,87 +4,75 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
 ``TopoDS_Shape``, cadquery / build123d object):
 
 1. every face is read as a :class:`TrimmedFace`; each directed patch
-   (``patches``, :mod:`.heal_spec`) is approximated over the original faces,
-   which are then cut away under it (:mod:`.heal_cut`): it replaces what it
+   (``patches``, :mod:`.spec`) is approximated over the original faces,
+   which are then cut away under it (:mod:`.cut`): it replaces what it
    covers; of two faces overlapping partially (any sides, trimmed or not) the
-   later is trimmed back to the other's boundary (:mod:`.heal_overlap_trim`);
+   later is trimmed back to the other's boundary (:mod:`.trim_back`);
    faces lying on another within ``gap_tol`` (exact duplicates as in
    overture_marscapsule_proe.igs) are dropped; of two four-sided faces
    overlapping over a strip the later one is trimmed back to the other's side,
    or both replaced by one approximant over the union (``overlap="union"``,
-   :mod:`.heal_overlap`): no doubled area is left;
+   :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; free
    edges chained into loops of four from two or more faces are holes;
 3. every four-sided face (one loop of four real edges, trimmed or not) gets a
-   :func:`local_approximant` over its own four edges, projected onto all
-   original faces (trimmed faces as the part inside their loops,
-   :func:`face_source`; the face itself preferred over other faces crossing
+   :func:`~surfprep.algorithms.healing.local_approximant` over its own four
+   edges, projected onto all original faces (trimmed faces as the part inside
+   their loops, :func:`~surfprep.algorithms.healing.clipping.face_source`; the face itself preferred over other faces crossing
    the segments; a face whose approximant misses ``tol`` at the largest
    resolution is kept as it is, and the report says so); a face that is not
    four-sided is split into four-sided sub-patches (``split_faces``, default) and
    replaced when all of them fit; every hole one over its four free edges (a loop whose patch lands on faces, e.g. the mouth of
    a slot, is no hole and stays open);
-4. the approximants are joined by :func:`connect` (G0 or G1, topology
+4. the approximants are joined by :func:`~surfprep.algorithms.healing.connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
    as it was (not re-approximated) is fitted to that face's edge or edges, or
    to the part of an edge it meets (with the shared corners moved onto the
    ends), and a side along part of a longer approximant side (a T-junction
    :func:`connect` does not join) to that part, so those gaps close up to the
-   fit error too (:mod:`.heal_snap`);
+   fit error too (:mod:`surfprep.algorithms.healing.snap`);
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
    shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
    untouched faces keep their names (a replaced face passes its name to its
    approximant; holes are named ``heal_hole_<k>``).
 
-``heal`` is a function that also carries the two building blocks, so that
-``surfprep.heal.local_approximant(...)`` and ``surfprep.heal.connect(...)``
-work next to ``surfprep.heal(shape)``.
+The building blocks are :mod:`surfprep.algorithms.healing`
+(``local_approximant``, ``connect``, ``Continuity``, ``Side``); the approximants
+to build are planned in :mod:`.jobs`.
 """
 
 from __future__ import annotations
 
 import os
 import time
-from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
-from ..algorithms.healing import (
-    Continuity,
-    JoinReport,
-    LocalApproximant,
-    Network,
-    connect,
-    local_approximant,
-)
-from ..algorithms.healing.clipping import trimmed_source
-from ..algorithms.healing.connectivity import Side
-from ..algorithms.projection import project_to_surface
-from ..algorithms.tolerance import check_tolerance
-from ..errors import InvalidGeometryError, SurfprepError
-from .faces import TrimmedFace, face_to_nurbs, make_face
-from .heal_cut import CutModel, covered_holes_dropped, cut_under_patches, inner_edges
-from .heal_nsided import quad_boundaries, why_not_decomposable
-from .heal_overlap import OverlapRepair, find_overlaps, overlap_boundaries
-from .heal_overlap_trim import is_natural, loop_uv, trim_overlaps_of
-from .heal_snap import snap_to_originals
-from .heal_spec import DirectedPatch, read_patch_spec
-from .heal_topology import (
-    count_free_edges,
+from ...algorithms.healing import Continuity, JoinReport, LocalApproximant, Network, connect
+from ...algorithms.healing.adjacency import (
     duplicate_faces,
     face_edges,
     four_sided_boundary,
     hole_loops,
-    is_valid,
-    max_edge_tolerance,
     pair_edges,
-    sew,
 )
-from .io import CadModel, read, to_shape
-from .step_iges import _all_faces, _FaceNames
+from ...algorithms.healing.clipping import face_source
+from ...algorithms.healing.snap import snap_to_originals
+from ...algorithms.healing.strip_overlap import OverlapRepair, find_overlaps, overlap_boundaries
+from ...algorithms.projection import project_to_surface
+from ...algorithms.tolerance import check_tolerance
+from ...algorithms.trimmed import TrimmedFace
+from ...errors import InvalidGeometryError, SurfprepError
+from ..io import CadModel, read, to_shape
+from ..occ.faces import face_to_nurbs, make_face
+from ..occ.shapes import FaceNames, all_faces, count_free_edges, is_valid, max_edge_tolerance, sew
+from .cut import covered_holes_dropped, cut_under_patches, inner_edges
+from .jobs import PatchOrigin, approximate, directed_jobs, plan_jobs, replaced_faces
+from .spec import read_patch_spec
+from .trim_back import trim_overlaps_of
 
 __all__ = [
     "DEFAULT_GAP_FACTOR",
@@ -101,18 +89,6 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
-
-
-@dataclass(frozen=True)
-class PatchOrigin:
-    """Where an approximant comes from: ``kind`` "face", "hole", "union" or "directed",
-    and face indices: the face replaced, the faces bounding the hole, the two faces of
-    a union, the input faces a directed patch cut. Indices other than a directed
-    patch's count the faces after the cuts (a cut face's pieces take its place)."""
-
-    kind: str
-    faces: tuple[int, ...]
-    index: int
 
 
 @dataclass(frozen=True)
@@ -241,139 +217,10 @@ def _read_faces(model: CadModel) -> tuple[list[TrimmedFace | None], list[str]]:
     return faces, skipped
 
 
-def face_source(face: TrimmedFace):
-    """A face as a source of :func:`local_approximant`: its surface where the face is
-    the whole surface, else :func:`trimmed_source` (only the part inside its loops is
-    projected onto, so a hole in the face or a part trimmed away gets the fill)."""
-    if is_natural(face):
-        return face.surface
-    loops = [loop_uv(lp) for lp in face.loops]
-    try:
-        return trimmed_source(face.surface, loops, name=face.name or "")
-    except SurfprepError:
-        return face.surface
-
-
 def _default_gap_tol(model: CadModel, edges) -> float:
     lengths = [float(np.sum(np.linalg.norm(np.diff(e.samples, axis=0), axis=1))) for e in edges]
     bound = _GAP_FACTOR_EDGE * float(np.median(lengths)) if lengths else np.inf
     return float(min(DEFAULT_GAP_FACTOR * model.size, bound))
-
-
-# ------------------------------------------------------------------- patches
-@dataclass(frozen=True)
-class _Job:
-    origin: PatchOrigin
-    boundary: Any
-    name: str | None
-    reference: TrimmedFace | None     # face whose orientation the approximant takes
-    split: bool = False               # one of the sub-patches of a face that is not four-sided
-
-
-def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: float,
-                     skipped: list[str]) -> tuple[list, bool]:
-    """The four-curve boundaries replacing ``face``: its own four edges, or with
-    ``split_faces`` the sub-patches of :func:`.heal_nsided.quad_boundaries`; and
-    whether the face was split (its sides then also checked against the edges)."""
-    curves = four_sided_boundary(face)
-    if curves is not None:
-        return [curves], False
-    if not split_faces:
-        return [], False
-    boundaries = quad_boundaries(face, gap_tol=gap_tol)
-    if boundaries is None:
-        skipped.append(f"face {index}: not split into four-sided patches "
-                       f"({why_not_decomposable(face, gap_tol=gap_tol)}); kept as it is")
-        return [], False
-    return boundaries, True
-
-
-def _jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: bool = False,
-          gap_tol: float = 0.0, skipped: list[str] | None = None) -> list[_Job]:
-    jobs = []
-    for i, (j, outline) in unions.items():
-        jobs.append(_Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
-    in_union = set(unions) | {j for j, _ in unions.values()}
-    for i in (i for i in kept if i not in in_union):
-        if trimmed.get(i):
-            boundaries, split = [trimmed[i]], False
-        else:
-            boundaries, split = _face_boundaries(faces[i], i, split_faces, gap_tol,
-                                                 [] if skipped is None else skipped)
-        for n, curves in enumerate(boundaries):
-            name = faces[i].name if len(boundaries) == 1 or not faces[i].name \
-                else f"{faces[i].name}_{n}"
-            jobs.append(_Job(PatchOrigin("face", (i,), i), curves, name, faces[i], split))
-    for k, loop in enumerate(holes):
-        jobs.append(_Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
-                         [e.curve for e in loop], f"heal_hole_{k}", None))
-    return jobs
-
-
-def _replaced(done) -> set[int]:
-    return {f for job, _ in done if job.origin.kind in ("face", "union") for f in job.origin.faces}
-
-
-def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[_Job, Any]]:
-    """The directed patches' approximants (built by :func:`cut_under_patches` from the
-    uncut faces) as jobs done; their origin lists the input faces they cut."""
-    out = []
-    for k, la in cut.approximants:
-        faces = tuple(sorted({c.face for c in cut.cuts if c.patch == k}))
-        out.append((_Job(PatchOrigin("directed", faces, k), la.boundary,
-                         directed[k].name or f"heal_patch_{k}", None), la))
-    return out
-
-
-def _approximate(jobs: list[_Job], sources, source_of: dict[int, int], tol, gap_tol,
-                 skipped: list[str]) -> list[tuple[_Job, LocalApproximant]]:
-    """One approximant per job; a face's own surface is its preferred source (other
-    faces only where it is missed), so long segments do not pick far-away faces."""
-    out, failed = [], set()
-    for job in jobs:
-        if job.split and job.origin.index in failed:
-            continue              # the face is kept whole: its other sub-patches are moot
-        own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
-        try:
-            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
-                                   preferred_source=own, side_error=job.split)
-        except (SurfprepError, np.linalg.LinAlgError) as exc:
-            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
-                           f"({type(exc).__name__}: {exc}); left as it was")
-            failed |= {job.origin.index} if job.split else set()
-            continue
-        if job.origin.kind in ("face", "union") and not la.converged:
-            skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
-                           f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
-                           "kept as it was")
-            failed |= {job.origin.index} if job.split else set()
-            continue
-        if job.origin.kind == "hole" and not la.converged:
-            # the error is measured only where segments land on the originals: over a real
-            # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
-            # of a slot, an open end) is no hole, and a patch over it would not fit them
-            skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
-                           f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
-                           f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
-                           "left open")
-            continue
-        out.append((job, la))
-    return _whole_faces_only(jobs, out, skipped, failed)
-
-
-def _whole_faces_only(jobs: list[_Job], out: list, skipped: list[str],
-                      failed: set[int] = frozenset()) -> list:
-    """A face split into sub-patches is replaced only when every sub-patch fits (the
-    sub-patches after the first that does not fit, of a face in ``failed``, are not
-    built)."""
-    want = Counter(j.origin.index for j in jobs if j.origin.kind == "face")
-    got = Counter(j.origin.index for j, _ in out if j.origin.kind == "face")
-    partial = {i for i, k in want.items() if got[i] not in (0, k)} | \
-        {i for i in failed if got[i]}
-    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit"
-                f"{' (the rest not tried after one failed)' if i in failed else ''}; "
-                "kept as it was" for i in sorted(partial)]
-    return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
 
 
 #: samples per direction of the replaced face's surface for the orientation start
@@ -414,25 +261,27 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
         cadquery or build123d object.
     tol : float, optional
         Largest error of each approximant (001 §7), model units; default that
-        of :func:`local_approximant` (relative to each patch's size).
+        of :func:`~surfprep.algorithms.healing.local_approximant` (relative to
+        each patch's size).
     continuity : "G0" or "G1"
     gap_tol : float, optional
         Model units: edges closer than this are one edge (neighbours, gaps to
         close, duplicates). Default ``min(1e-3 x model diagonal, 0.01 x median
         edge length)``.
     patches : path, dict or list, optional
-        Directed patches (:func:`.heal_spec.read_patch_spec`); each replaces the
-        region it covers (the faces under it are cut away, :mod:`.heal_cut`).
+        Directed patches (:func:`.spec.read_patch_spec`); each replaces the
+        region it covers (the faces under it are cut away, :mod:`.cut`).
     overlap : "trim" or "union"
         A strip overlap of two four-sided faces: the later face trimmed back, or
         one approximant over the union's outline replacing both.
     split_faces : bool
         Faces that are not four-sided are split into four-sided sub-patches on the
-        face (:func:`.heal_nsided.quad_boundaries`) and replaced when every
-        sub-patch fits (sides checked against the edges too); their sides are
-        fitted to the parts of kept neighbours' edges and of longer approximant
-        sides they meet (:mod:`.heal_snap`). On by default; False keeps every face
-        that is not four-sided as it is (faster: its sub-patches are not built).
+        face (:func:`surfprep.algorithms.healing.decompose.quad_boundaries`) and
+        replaced when every sub-patch fits (sides checked against the edges too);
+        their sides are fitted to the parts of kept neighbours' edges and of
+        longer approximant sides they meet (:mod:`surfprep.algorithms.healing.snap`).
+        On by default; False keeps every face that is not four-sided as it is
+        (faster: its sub-patches are not built).
 
     Returns
     -------
@@ -472,16 +321,16 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    jobs = _jobs(faces, kept, holes, trimmed, unions, split_faces=split_faces, gap_tol=gap_tol,
+    jobs = plan_jobs(faces, kept, holes, trimmed, unions, split_faces=split_faces, gap_tol=gap_tol,
                  skipped=skipped)
-    done = _approximate(jobs, sources,
+    done = approximate(jobs, sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
     done += directed_jobs(directed, cut)
     network = None
     if done:
         network = connect([la.surface for _, la in done], continuity=continuity,
                           gap_tol=gap_tol, strict=False)
-        replaced = _replaced(done)
+        replaced = replaced_faces(done)
         network, snapped = snap_to_originals(
             network, [e for e in edges if e.face not in replaced]
             + inner_edges(faces, replaced | gone), gap_tol,
@@ -492,7 +341,7 @@ def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str =
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped if network is not None else 0
     result.extra["trimmed_overlaps"] = [
-        {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in _replaced(done),
+        {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
 
@@ -511,9 +360,9 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
               ) -> HealResult:
     """The output from ``work`` (the input with faces under directed patches cut) and the
     approximants; figures before from ``model`` (the input)."""
-    gone = _replaced(done) | {b for _, b in dropped}
+    gone = replaced_faces(done) | {b for _, b in dropped}
     untouched = [i for i in range(work.n_faces) if i not in gone]
-    new_faces, names = [], _FaceNames()
+    new_faces, names = [], FaceNames()
     for (job, _), surface in zip(done, network.patches if network else ()):
         face = _oriented_face(surface, job.reference)
         new_faces.append(face)
@@ -524,7 +373,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
         if work.face_names[i] is not None:
             names.add(work.faces[i], work.face_names[i])
     shape, sewing = sew(originals + new_faces, gap_tol)
-    out_faces = _all_faces(shape)
+    out_faces = all_faces(shape)
     out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
     result_model = CadModel(shape, out_faces, out_names, (None,) * len(out_faces),
                             model.length_unit, None, model.file_format)
@@ -546,7 +395,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
         extra={"faces_in": model.n_faces})
 
 
-def _sewn_name(face: TopoDS_Face, sewing, names: _FaceNames, inputs: list) -> str | None:
+def _sewn_name(face: TopoDS_Face, sewing, names: FaceNames, inputs: list) -> str | None:
     name = names.get(face)
     if name is not None:
         return name
@@ -555,8 +404,3 @@ def _sewn_name(face: TopoDS_Face, sewing, names: _FaceNames, inputs: list) -> st
             return names.get(original)
     return None
 
-
-heal.local_approximant = local_approximant
-heal.connect = connect
-heal.Continuity = Continuity
-heal.Side = Side

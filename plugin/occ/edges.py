@@ -1,21 +1,17 @@
 """Edges between OpenCascade and surfprep's NURBS types.
 
-:class:`TrimEdge` is one edge of a trimming loop in NURBS terms (3D curve,
-pcurve, range, orientation, tolerances); :func:`edge_to_nurbs` reads an edge's
-3D curve; :func:`make_edge` builds an edge with pcurves on one or two faces.
-The reading and building of edges inside a face's loops (used by
-:mod:`surfprep.plugin.faces`) live here too.
+:func:`edge_to_nurbs` reads an edge's 3D curve; :func:`make_edge` builds an edge
+with pcurves on one or two faces. The reading and building of the edges inside
+a face's loops (:class:`~surfprep.algorithms.trimmed.TrimEdge`, used by
+:mod:`.faces`) live here too.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
-import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
-from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.Geom import Geom_BezierCurve, Geom_BSplineCurve, Geom_Line
 from OCP.Geom2d import Geom2d_BezierCurve, Geom2d_BSplineCurve, Geom2d_Line
@@ -24,93 +20,14 @@ from OCP.TopExp import TopExp
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Vertex
 
-from ..algorithms import NurbsCurve, NurbsSurface
-from ..algorithms.tolerance import check_tolerance
-from ..errors import ConversionError, InvalidGeometryError, OpenCascadeError
+from ...algorithms import NurbsCurve, NurbsSurface
+from ...algorithms.tolerance import check_tolerance
+from ...algorithms.trimmed import DEFAULT_TOLERANCE, TrimEdge, edge_deviation
+from ...errors import ConversionError, InvalidGeometryError, OpenCascadeError
 from .geom import curve2d_to_occ, curve_from_occ, curve_to_occ
+from .shapes import check_valid
 
-__all__ = ["TrimEdge", "edge_to_nurbs", "make_edge", "check_valid", "DEFAULT_TOLERANCE"]
-
-#: Default tolerance of built edges, vertices and faces (OpenCascade's Precision::Confusion).
-DEFAULT_TOLERANCE = 1e-7
-
-
-@dataclass(frozen=True, eq=False)
-class TrimEdge:
-    """One edge of a trimming loop, as it is used in the loop.
-
-    Attributes
-    ----------
-    curve3d : NurbsCurve (d=3) or None
-        The edge's 3D curve restricted to ``[t0, t1]``; ``None`` for a
-        degenerated edge (a surface pole) or when only the pcurve is known.
-    pcurve : NurbsCurve (d=2)
-        The edge's curve in the surface's ``(u, v)`` parameters, over the same
-        range ``[t0, t1]`` (same parameter as ``curve3d``): for this
-        occurrence of the edge (on a seam, the pcurve of this side).
-    t0, t1 : float
-        Edge range, in the natural direction of the curves.
-    reversed : bool
-        True when the loop runs along the edge from ``t1`` to ``t0``.
-    tolerance : float
-        OpenCascade's edge tolerance (max. distance between the 3D curve and
-        the pcurve mapped through the surface).
-    vertex_tolerances : (float, float)
-        Tolerances of the edge's vertices at ``t0`` and at ``t1`` (how far the
-        curve ends may be from the loop's corners); kept so that a rebuilt face
-        tolerates what the original did.
-    seam_pcurve : NurbsCurve (d=2) or None
-        For a seam edge (one edge used twice on a closed surface) the pcurve
-        of the other side; ``None`` otherwise.
-    degenerated : bool
-        True for an edge collapsed to a point in 3D.
-    """
-
-    curve3d: NurbsCurve | None
-    pcurve: NurbsCurve
-    t0: float
-    t1: float
-    reversed: bool = False
-    tolerance: float = DEFAULT_TOLERANCE
-    seam_pcurve: NurbsCurve | None = None
-    degenerated: bool = False
-    vertex_tolerances: tuple[float, float] = (DEFAULT_TOLERANCE, DEFAULT_TOLERANCE)
-
-    def __post_init__(self) -> None:
-        if self.pcurve.dimension != 2:
-            raise InvalidGeometryError(f"pcurve must be 2D, got dimension {self.pcurve.dimension}")
-        if self.curve3d is not None and self.curve3d.dimension != 3:
-            raise InvalidGeometryError(f"curve3d must be 3D, got dimension {self.curve3d.dimension}")
-        if self.seam_pcurve is not None and self.seam_pcurve.dimension != 2:
-            raise InvalidGeometryError("seam_pcurve must be 2D")
-        object.__setattr__(self, "vertex_tolerances",
-                           tuple(float(x) for x in self.vertex_tolerances))
-        if len(self.vertex_tolerances) != 2:
-            raise InvalidGeometryError("vertex_tolerances must be (at t0, at t1)")
-        if not self.t0 < self.t1:
-            raise InvalidGeometryError(f"empty edge range [{self.t0}, {self.t1}]")
-        object.__setattr__(self, "t0", float(self.t0))
-        object.__setattr__(self, "t1", float(self.t1))
-
-    @property
-    def is_seam(self) -> bool:
-        return self.seam_pcurve is not None
-
-    def __repr__(self) -> str:
-        kind = "degenerated" if self.degenerated else ("seam" if self.is_seam else "edge")
-        return (f"TrimEdge({kind}, range=({self.t0:g}, {self.t1:g}), reversed={self.reversed}, "
-                f"tolerance={self.tolerance:g})")
-
-    def corner_tolerances(self) -> tuple[float, float]:
-        """Vertex tolerances at the start and end of this occurrence, in loop direction."""
-        a, b = self.vertex_tolerances
-        return (b, a) if self.reversed else (a, b)
-
-    def uv_ends(self) -> tuple[np.ndarray, np.ndarray]:
-        """Start and end of this occurrence in ``(u, v)``, in loop direction."""
-        a, b = self.pcurve.evaluate(np.array([self.t0, self.t1]))
-        return (b, a) if self.reversed else (a, b)
-
+__all__ = ["build_trim_edge", "edge_to_nurbs", "make_edge", "read_trim_edge"]
 
 # ----------------------------------------------------------------- reading
 EXACT_3D = (Geom_BSplineCurve, Geom_BezierCurve, Geom_Line)
@@ -199,12 +116,6 @@ def read_trim_edge(edge: TopoDS_Edge, face: TopoDS_Face,
 
 
 # ----------------------------------------------------------------- building
-def check_valid(shape, what: str = "shape") -> None:
-    """Raise :class:`OpenCascadeError` unless ``BRepCheck_Analyzer`` finds ``shape`` valid."""
-    if not BRepCheck_Analyzer(shape).IsValid():
-        raise OpenCascadeError(f"the {what} built is not valid (BRepCheck_Analyzer)")
-
-
 def make_edge(curve3d: NurbsCurve,
               pcurves: Sequence[tuple[NurbsCurve, TopoDS_Face]] = (),
               tol: float = DEFAULT_TOLERANCE) -> TopoDS_Edge:
@@ -255,27 +166,6 @@ def make_edge(curve3d: NurbsCurve,
 def check_edge_builder(builder: BRepBuilderAPI_MakeEdge) -> None:
     if not builder.IsDone():
         raise OpenCascadeError(f"BRepBuilderAPI_MakeEdge failed: {builder.Error().name}")
-
-
-def curve3d_points(edge: TrimEdge, surface: NurbsSurface, t: np.ndarray) -> np.ndarray:
-    if edge.curve3d is not None:
-        return edge.curve3d.evaluate(t)
-    uv = edge.pcurve.evaluate(t)
-    return surface.evaluate(uv[:, 0], uv[:, 1])
-
-
-def edge_deviation(edge: TrimEdge, surface: NurbsSurface, samples: int = 33) -> float:
-    """Max distance between the 3D curve and the pcurve(s) mapped through the surface."""
-    if edge.curve3d is None:
-        return 0.0
-    t = np.linspace(edge.t0, edge.t1, samples)
-    c = edge.curve3d.evaluate(t)
-    dev = 0.0
-    for pc in (edge.pcurve, edge.seam_pcurve):
-        if pc is not None:
-            uv = pc.evaluate(t)
-            dev = max(dev, float(np.max(np.linalg.norm(surface.evaluate(uv[:, 0], uv[:, 1]) - c, axis=1))))
-    return dev
 
 
 def build_trim_edge(surface: NurbsSurface, occ_surface, e: TrimEdge,

@@ -1,4 +1,5 @@
-"""Overlapping four-sided faces for :func:`surfprep.heal`: one is trimmed back to the other.
+"""Four-sided faces overlapping over a strip (for :func:`surfprep.heal`): one is trimmed back
+to the other, or both replaced over their union.
 
 Two four-sided faces A and B *overlap* when a side of A lies on B's surface
 inside B (within ``gap_tol`` of the surface, farther than ``gap_tol`` from B's
@@ -9,7 +10,7 @@ at the closest point to the end of A's side) and B's far side. A and the
 trimmed B then share A's side as a full boundary curve, and the network joins
 them G0/G1 like any neighbours. With ``overlap="union"`` both are replaced
 instead by one approximant over the union's outline (:func:`union_boundary`).
-Exact duplicates are handled before this (:func:`.heal_topology.duplicate_faces`).
+Exact duplicates are handled before this (:func:`.adjacency.duplicate_faces`).
 """
 
 from __future__ import annotations
@@ -21,11 +22,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from ..algorithms import NurbsCurve
-from ..algorithms.projection import distance_to_surface, project_to_curve, project_to_surface
-from ..errors import InvalidGeometryError
-from .faces import TrimmedFace
-from .heal_topology import four_sided_boundary
+from ...errors import InvalidGeometryError
+from ..curve import NurbsCurve
+from ..projection import distance_to_surface, project_to_curve, project_to_surface
+from ..trimmed import TrimmedFace
+from .adjacency import four_sided_boundary
 
 __all__ = [
     "Overlap",

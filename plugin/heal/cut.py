@@ -40,18 +40,18 @@ from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_IN, TopAbs_SOLID
 from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
-from ..algorithms import NurbsSurface
-from ..algorithms.healing import local_approximant
-from ..algorithms.healing.boundary import Boundary, as_boundary
-from ..algorithms.projection import project_to_surface
-from ..errors import OpenCascadeError, SurfprepError
-from .faces import TrimmedFace, face_to_nurbs, make_face
-from .heal_topology import EDGE_SAMPLES, FaceEdge, is_valid, polyline_distance, sew
-from .step_iges import _all_faces, _compound
+from ...algorithms import NurbsSurface
+from ...algorithms.healing import local_approximant
+from ...algorithms.healing.adjacency import EDGE_SAMPLES, FaceEdge, polyline_distance
+from ...algorithms.healing.boundary import Boundary, as_boundary
+from ...algorithms.projection import project_to_surface
+from ...algorithms.trimmed import TrimmedFace
+from ...errors import OpenCascadeError, SurfprepError
+from ..occ.faces import face_to_nurbs, make_face
+from ..occ.shapes import all_faces, compound, face_area, is_valid, sew
 
 __all__ = ["CutModel", "FaceCut", "boundary_on_faces", "cut_faces", "cut_under_patches",
-           "face_area", "inner_edges", "outline", "read_faces", "rebuilt_model",
-           "replace_pieces", "slab"]
+           "inner_edges", "outline", "read_faces", "rebuilt_model", "replace_pieces", "slab"]
 
 #: samples per boundary curve put onto the faces
 BOUNDARY_SAMPLES = 65
@@ -182,12 +182,6 @@ def slab(surface: NurbsSurface, h: float, tol: float, margin: float = 0.0) -> To
 
 
 # --------------------------------------------------------------------- cut
-def face_area(shape: TopoDS_Shape) -> float:
-    props = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(shape, props)
-    return float(props.Mass())
-
-
 def _boolean(op, face: TopoDS_Face, tool: TopoDS_Shape, fuzzy: float) -> TopoDS_Shape:
     builder = op()
     from OCP.TopTools import TopTools_ListOfShape
@@ -266,7 +260,7 @@ def cut_faces(faces: list[TopoDS_Face], tool: TopoDS_Shape, line: NDArray, patch
             pieces[i] = []
             cuts.append(FaceCut(patch, i, area, area, 0))
             continue
-        result = _all_faces(_boolean(BRepAlgoAPI_Cut, face, tool, fuzzy))
+        result = all_faces(_boolean(BRepAlgoAPI_Cut, face, tool, fuzzy))
         if area - sum(face_area(f) for f in result) <= MIN_CUT_SHARE * area:
             continue                                     # passes by, or only touches
         width = SLIVER_SHARE * float(np.linalg.norm(np.ptp(line, axis=0)))
@@ -308,7 +302,7 @@ class CutModel:
 
 
 def rebuilt_model(model, faces: list[TopoDS_Face], names: list, colors: list):
-    return replace(model, shape=_compound(faces), faces=tuple(faces), face_names=tuple(names),
+    return replace(model, shape=compound(faces), faces=tuple(faces), face_names=tuple(names),
                    face_colors=tuple(colors))
 
 

@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from ..algorithms.healing import corners_boundary
-from ..errors import InputFileError, InvalidGeometryError
-from .faces import TrimmedFace
+from ...algorithms.healing import corners_boundary
+from ...algorithms.trimmed import TrimmedFace
+from ...errors import InputFileError, InvalidGeometryError
 
 __all__ = ["DirectedPatch", "read_patch_spec"]
 

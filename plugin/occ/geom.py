@@ -25,8 +25,8 @@ from OCP.Standard import Standard_Failure
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array1OfPnt2d, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
 
-from ..algorithms import NurbsCurve, NurbsSurface
-from ..errors import ConversionError, OpenCascadeError
+from ...algorithms import NurbsCurve, NurbsSurface
+from ...errors import ConversionError, OpenCascadeError
 
 __all__ = [
     "surface_from_occ",

@@ -1,13 +1,13 @@
-"""Topology for :func:`surfprep.heal`: which faces are four-sided, which edges are free,
-which free loops are four-sided holes, which faces duplicate others, and the
-OpenCascade side of the result (sewing, shell/solid, free edges, validity).
+"""Adjacency of the faces to heal: which faces are four-sided, which edges are free,
+which free loops are four-sided holes, which faces duplicate others (001 §8).
 
 Edges are compared in space, by samples of their 3D curves: two edges of
 different faces are *paired* when every sample of each lies within ``gap_tol``
 of the other's polyline. An edge paired with none is *free*. Free edges whose
 ends meet (within ``gap_tol``) form loops; a loop of exactly four edges taken
 from at least two faces is a hole to fill (a loop of one face's own four edges
-is that face's open border, not a hole).
+is that face's open border, not a hole). The OpenCascade side of the result
+(sewing, free edges of a shape, validity) is :mod:`surfprep.plugin.occ.shapes`.
 """
 
 from __future__ import annotations
@@ -16,34 +16,22 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from OCP.BRep import BRep_Tool
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
-from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
-from OCP.Standard import Standard_Failure
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL
-from OCP.TopExp import TopExp, TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Shape
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 from scipy.spatial import cKDTree
 
-from ..algorithms import NurbsCurve
-from ..algorithms.projection import distance_to_surface
-from ..errors import OpenCascadeError
-from .faces import TrimmedFace
+from ..curve import NurbsCurve
+from ..projection import distance_to_surface
+from ..trimmed import TrimmedFace
 
 __all__ = [
     "EDGE_SAMPLES",
     "FaceEdge",
-    "count_free_edges",
+    "dense_edge",
     "duplicate_faces",
     "face_edges",
     "four_sided_boundary",
     "hole_loops",
-    "is_valid",
-    "max_edge_tolerance",
     "pair_edges",
-    "sew",
+    "polyline_distance",
 ]
 
 #: samples per edge for the pairing test
@@ -245,62 +233,3 @@ def _lies_on(face: TrimmedFace, other: TrimmedFace, gap_tol: float) -> bool:
     t = np.linspace(0.2, 0.8, 4)
     pts = face.surface.evaluate_grid(u0 + t * (u1 - u0), v0 + t * (v1 - v0)).reshape(-1, 3)
     return bool(distance_to_surface(other.surface, pts).max() <= gap_tol)
-
-
-# ------------------------------------------------------------ OpenCascade side
-def sew(faces: list[TopoDS_Shape], tol: float) -> tuple[TopoDS_Shape, BRepBuilderAPI_Sewing]:
-    """Faces sewn at ``tol`` into a shell (a solid when closed), orientations fixed."""
-    sewing = BRepBuilderAPI_Sewing(tol)
-    for f in faces:
-        sewing.Add(f)
-    try:
-        sewing.Perform()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepBuilderAPI_Sewing failed: {exc}") from exc
-    shape = sewing.SewedShape()
-    if shape.IsNull():
-        raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")
-    return _shell_or_solid(shape), sewing
-
-
-def _shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
-    if shape.ShapeType() != TopAbs_SHELL:
-        return shape
-    fixer = ShapeFix_Shell(TopoDS.Shell_s(shape))
-    fixer.Perform()
-    shell = fixer.Shell()
-    if not BRep_Tool.IsClosed_s(shell):
-        return shell
-    maker = BRepBuilderAPI_MakeSolid(shell)
-    if not maker.IsDone():
-        return shell
-    fix = ShapeFix_Solid(maker.Solid())
-    fix.Perform()
-    return fix.Solid()
-
-
-def count_free_edges(shape: TopoDS_Shape) -> int:
-    """Edges used by exactly one face (degenerated edges not counted)."""
-    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
-    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
-    count = 0
-    for k in range(1, edge_faces.Extent() + 1):
-        edge = TopoDS.Edge_s(edge_faces.FindKey(k))
-        if BRep_Tool.Degenerated_s(edge):
-            continue
-        if edge_faces.FindFromIndex(k).Size() == 1:
-            count += 1
-    return count
-
-
-def is_valid(shape: TopoDS_Shape) -> bool:
-    return bool(BRepCheck_Analyzer(shape).IsValid())
-
-
-def max_edge_tolerance(shape: TopoDS_Shape) -> float:
-    out = 0.0
-    explorer = TopExp_Explorer(shape, TopAbs_EDGE)
-    while explorer.More():
-        out = max(out, BRep_Tool.Tolerance_s(TopoDS.Edge_s(explorer.Current())))
-        explorer.Next()
-    return out

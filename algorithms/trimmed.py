@@ -1,0 +1,223 @@
+"""Trimmed faces as plain data: a NURBS surface and loops of edges in its parameter domain.
+
+:class:`TrimmedFace` is a face of a B-rep in NURBS terms: its
+:class:`~surfprep.algorithms.NurbsSurface` and its trimming loops
+(:class:`TrimLoop`), each a closed sequence of :class:`TrimEdge` occurrences
+carrying the edge's 3D curve, its pcurve (the curve in the surface's ``(u, v)``)
+over the same parameter range, the orientation of the occurrence in the loop and
+the tolerances OpenCascade kept with it. The outer loop runs counter-clockwise in
+``(u, v)``, holes clockwise, as in a ``TopoDS_Face`` seen FORWARD.
+
+The types hold numpy arrays only: reading them from and building them into
+OpenCascade faces is :mod:`surfprep.plugin.occ.faces`; which ``(u, v)`` lie
+inside a trimmed face is :mod:`.face_region`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InvalidGeometryError
+from .curve import NurbsCurve
+from .surface import NurbsSurface
+
+__all__ = [
+    "DEFAULT_TOLERANCE",
+    "TrimEdge",
+    "TrimLoop",
+    "TrimmedFace",
+    "LOOP_SAMPLES_PER_EDGE",
+    "curve3d_points",
+    "edge_deviation",
+    "is_natural",
+    "loop_uv",
+]
+
+#: Default tolerance of edges, vertices and faces (OpenCascade's Precision::Confusion).
+DEFAULT_TOLERANCE = 1e-7
+#: pcurve samples per edge of a trimming loop (:func:`loop_uv`)
+LOOP_SAMPLES_PER_EDGE = 33
+
+
+@dataclass(frozen=True, eq=False)
+class TrimEdge:
+    """One edge of a trimming loop, as it is used in the loop.
+
+    Attributes
+    ----------
+    curve3d : NurbsCurve (d=3) or None
+        The edge's 3D curve restricted to ``[t0, t1]``; ``None`` for a
+        degenerated edge (a surface pole) or when only the pcurve is known.
+    pcurve : NurbsCurve (d=2)
+        The edge's curve in the surface's ``(u, v)`` parameters, over the same
+        range ``[t0, t1]`` (same parameter as ``curve3d``): for this
+        occurrence of the edge (on a seam, the pcurve of this side).
+    t0, t1 : float
+        Edge range, in the natural direction of the curves.
+    reversed : bool
+        True when the loop runs along the edge from ``t1`` to ``t0``.
+    tolerance : float
+        OpenCascade's edge tolerance (max. distance between the 3D curve and
+        the pcurve mapped through the surface).
+    vertex_tolerances : (float, float)
+        Tolerances of the edge's vertices at ``t0`` and at ``t1`` (how far the
+        curve ends may be from the loop's corners); kept so that a rebuilt face
+        tolerates what the original did.
+    seam_pcurve : NurbsCurve (d=2) or None
+        For a seam edge (one edge used twice on a closed surface) the pcurve
+        of the other side; ``None`` otherwise.
+    degenerated : bool
+        True for an edge collapsed to a point in 3D.
+    """
+
+    curve3d: NurbsCurve | None
+    pcurve: NurbsCurve
+    t0: float
+    t1: float
+    reversed: bool = False
+    tolerance: float = DEFAULT_TOLERANCE
+    seam_pcurve: NurbsCurve | None = None
+    degenerated: bool = False
+    vertex_tolerances: tuple[float, float] = (DEFAULT_TOLERANCE, DEFAULT_TOLERANCE)
+
+    def __post_init__(self) -> None:
+        if self.pcurve.dimension != 2:
+            raise InvalidGeometryError(f"pcurve must be 2D, got dimension {self.pcurve.dimension}")
+        if self.curve3d is not None and self.curve3d.dimension != 3:
+            raise InvalidGeometryError(f"curve3d must be 3D, got dimension {self.curve3d.dimension}")
+        if self.seam_pcurve is not None and self.seam_pcurve.dimension != 2:
+            raise InvalidGeometryError("seam_pcurve must be 2D")
+        object.__setattr__(self, "vertex_tolerances",
+                           tuple(float(x) for x in self.vertex_tolerances))
+        if len(self.vertex_tolerances) != 2:
+            raise InvalidGeometryError("vertex_tolerances must be (at t0, at t1)")
+        if not self.t0 < self.t1:
+            raise InvalidGeometryError(f"empty edge range [{self.t0}, {self.t1}]")
+        object.__setattr__(self, "t0", float(self.t0))
+        object.__setattr__(self, "t1", float(self.t1))
+
+    @property
+    def is_seam(self) -> bool:
+        return self.seam_pcurve is not None
+
+    def __repr__(self) -> str:
+        kind = "degenerated" if self.degenerated else ("seam" if self.is_seam else "edge")
+        return (f"TrimEdge({kind}, range=({self.t0:g}, {self.t1:g}), reversed={self.reversed}, "
+                f"tolerance={self.tolerance:g})")
+
+    def corner_tolerances(self) -> tuple[float, float]:
+        """Vertex tolerances at the start and end of this occurrence, in loop direction."""
+        a, b = self.vertex_tolerances
+        return (b, a) if self.reversed else (a, b)
+
+    def uv_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end of this occurrence in ``(u, v)``, in loop direction."""
+        a, b = self.pcurve.evaluate(np.array([self.t0, self.t1]))
+        return (b, a) if self.reversed else (a, b)
+
+
+@dataclass(frozen=True, eq=False)
+class TrimLoop:
+    """A closed loop of edges (an OpenCascade wire), in loop order."""
+
+    edges: tuple[TrimEdge, ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "edges", tuple(self.edges))
+        if not self.edges:
+            raise InvalidGeometryError("a trimming loop needs at least one edge")
+
+    def __repr__(self) -> str:
+        return f"TrimLoop({len(self.edges)} edges)"
+
+
+@dataclass(frozen=True, eq=False)
+class TrimmedFace:
+    """A trimmed face in NURBS terms.
+
+    Attributes
+    ----------
+    surface : NurbsSurface
+        The face's surface, its location applied.
+    loops : tuple of TrimLoop
+        Every wire of the face, in the orientation it has in the face seen as
+        FORWARD (outer loop counter-clockwise in ``(u, v)``, holes clockwise).
+    outer_loop_index : int
+        Index of the outer loop in ``loops`` (0 when there is no loop).
+    reversed : bool
+        The face's orientation: True when its normal is opposite to
+        ``S_u x S_v``.
+    name : str or None
+    """
+
+    surface: NurbsSurface
+    loops: tuple[TrimLoop, ...] = ()
+    outer_loop_index: int = 0
+    reversed: bool = False
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "loops", tuple(self.loops))
+        if self.loops and not 0 <= self.outer_loop_index < len(self.loops):
+            raise InvalidGeometryError(
+                f"outer_loop_index {self.outer_loop_index} out of range for {len(self.loops)} loops")
+
+    def __repr__(self) -> str:
+        return (f"TrimmedFace({self.surface!r}, loops={[len(lp.edges) for lp in self.loops]}, "
+                f"outer_loop_index={self.outer_loop_index}, reversed={self.reversed}, "
+                f"name={self.name!r})")
+
+    @property
+    def edges(self) -> tuple[TrimEdge, ...]:
+        """All edge occurrences of all loops."""
+        return tuple(e for loop in self.loops for e in loop.edges)
+
+
+def curve3d_points(edge: TrimEdge, surface: NurbsSurface, t: np.ndarray) -> np.ndarray:
+    """Points ``(m, 3)`` of the edge at ``t (m,)``: its 3D curve, else its pcurve through the surface."""
+    if edge.curve3d is not None:
+        return edge.curve3d.evaluate(t)
+    uv = edge.pcurve.evaluate(t)
+    return surface.evaluate(uv[:, 0], uv[:, 1])
+
+
+def edge_deviation(edge: TrimEdge, surface: NurbsSurface, samples: int = 33) -> float:
+    """Max distance between the 3D curve and the pcurve(s) mapped through the surface."""
+    if edge.curve3d is None:
+        return 0.0
+    t = np.linspace(edge.t0, edge.t1, samples)
+    c = edge.curve3d.evaluate(t)
+    dev = 0.0
+    for pc in (edge.pcurve, edge.seam_pcurve):
+        if pc is not None:
+            uv = pc.evaluate(t)
+            dev = max(dev, float(np.max(np.linalg.norm(surface.evaluate(uv[:, 0], uv[:, 1]) - c, axis=1))))
+    return dev
+
+
+def loop_uv(loop: TrimLoop) -> NDArray:
+    """(n, 2) float: one trimming loop sampled along its pcurves, in loop order."""
+    parts = []
+    for e in loop.edges:
+        t = np.linspace(e.t0, e.t1, LOOP_SAMPLES_PER_EDGE)
+        uv = e.pcurve.evaluate(t[::-1] if e.reversed else t)
+        parts.append(uv[:-1])
+    return np.concatenate(parts)
+
+
+def is_natural(face: TrimmedFace) -> bool:
+    """No loop, or one loop running along the domain's rectangle: the face is its
+    whole surface."""
+    if not face.loops:
+        return True
+    if len(face.loops) != 1:
+        return False
+    u0, u1, v0, v1 = face.surface.domain
+    eps = 1e-7 * max(u1 - u0, v1 - v0)
+    uv = loop_uv(face.loops[0])
+    on_side = ((np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps)
+               | (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps))
+    return bool(np.all(on_side))

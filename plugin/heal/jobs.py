@@ -1,0 +1,164 @@
+"""The approximants :func:`surfprep.heal` builds, planned and built.
+
+:func:`plan_jobs` lists one :class:`Job` per face to replace (its own four edges,
+its strip-trimmed boundary, or its four-sided sub-patches,
+:func:`surfprep.algorithms.healing.decompose.quad_boundaries`), per union of two
+overlapping faces and per hole; :func:`approximate` builds each with
+:func:`surfprep.algorithms.healing.local_approximant` (a face's own surface its
+preferred source) and keeps a face whole unless every sub-patch of it fits;
+:func:`directed_jobs` adds the directed patches :mod:`.cut` built. Each job's
+:class:`PatchOrigin` says where the approximant comes from, for the report.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...algorithms.healing import LocalApproximant, local_approximant
+from ...algorithms.healing.adjacency import four_sided_boundary
+from ...algorithms.healing.decompose import quad_boundaries, why_not_decomposable
+from ...algorithms.trimmed import TrimmedFace
+from ...errors import SurfprepError
+from .cut import CutModel
+from .spec import DirectedPatch
+
+__all__ = ["Job", "PatchOrigin", "approximate", "directed_jobs", "plan_jobs", "replaced_faces"]
+
+
+@dataclass(frozen=True)
+class PatchOrigin:
+    """Where an approximant comes from: ``kind`` "face", "hole", "union" or "directed",
+    and face indices: the face replaced, the faces bounding the hole, the two faces of
+    a union, the input faces a directed patch cut. Indices other than a directed
+    patch's count the faces after the cuts (a cut face's pieces take its place)."""
+
+    kind: str
+    faces: tuple[int, ...]
+    index: int
+
+
+@dataclass(frozen=True)
+class Job:
+    """One approximant to build: where it comes from, its four boundary curves, its name
+    and the face whose orientation it takes."""
+
+    origin: PatchOrigin
+    boundary: Any
+    name: str | None
+    reference: TrimmedFace | None     # face whose orientation the approximant takes
+    split: bool = False               # one of the sub-patches of a face that is not four-sided
+
+
+def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: float,
+                     skipped: list[str]) -> tuple[list, bool]:
+    """The four-curve boundaries replacing ``face``: its own four edges, or with
+    ``split_faces`` the sub-patches of
+    :func:`surfprep.algorithms.healing.decompose.quad_boundaries`; and
+    whether the face was split (its sides then also checked against the edges)."""
+    curves = four_sided_boundary(face)
+    if curves is not None:
+        return [curves], False
+    if not split_faces:
+        return [], False
+    boundaries = quad_boundaries(face, gap_tol=gap_tol)
+    if boundaries is None:
+        skipped.append(f"face {index}: not split into four-sided patches "
+                       f"({why_not_decomposable(face, gap_tol=gap_tol)}); kept as it is")
+        return [], False
+    return boundaries, True
+
+
+def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: bool = False,
+              gap_tol: float = 0.0, skipped: list[str] | None = None) -> list[Job]:
+    """The approximants to build: one per union of overlapping faces, per kept face
+    (its own four edges, a strip-trimmed boundary, or its four-sided sub-patches) and
+    per hole."""
+    jobs = []
+    for i, (j, outline) in unions.items():
+        jobs.append(Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
+    in_union = set(unions) | {j for j, _ in unions.values()}
+    for i in (i for i in kept if i not in in_union):
+        if trimmed.get(i):
+            boundaries, split = [trimmed[i]], False
+        else:
+            boundaries, split = _face_boundaries(faces[i], i, split_faces, gap_tol,
+                                                 [] if skipped is None else skipped)
+        for n, curves in enumerate(boundaries):
+            name = faces[i].name if len(boundaries) == 1 or not faces[i].name \
+                else f"{faces[i].name}_{n}"
+            jobs.append(Job(PatchOrigin("face", (i,), i), curves, name, faces[i], split))
+    for k, loop in enumerate(holes):
+        jobs.append(Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
+                         [e.curve for e in loop], f"heal_hole_{k}", None))
+    return jobs
+
+
+def replaced_faces(done) -> set[int]:
+    """Input faces an approximant of ``done`` replaces (faces and unions)."""
+    return {f for job, _ in done if job.origin.kind in ("face", "union") for f in job.origin.faces}
+
+
+def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[Job, Any]]:
+    """The directed patches' approximants (built by :func:`cut_under_patches` from the
+    uncut faces) as jobs done; their origin lists the input faces they cut."""
+    out = []
+    for k, la in cut.approximants:
+        faces = tuple(sorted({c.face for c in cut.cuts if c.patch == k}))
+        out.append((Job(PatchOrigin("directed", faces, k), la.boundary,
+                         directed[k].name or f"heal_patch_{k}", None), la))
+    return out
+
+
+def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_tol,
+                skipped: list[str]) -> list[tuple[Job, LocalApproximant]]:
+    """One approximant per job; a face's own surface is its preferred source (other
+    faces only where it is missed), so long segments do not pick far-away faces."""
+    out, failed = [], set()
+    for job in jobs:
+        if job.split and job.origin.index in failed:
+            continue              # the face is kept whole: its other sub-patches are moot
+        own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
+        try:
+            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
+                                   preferred_source=own, side_error=job.split)
+        except (SurfprepError, np.linalg.LinAlgError) as exc:
+            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
+                           f"({type(exc).__name__}: {exc}); left as it was")
+            failed |= {job.origin.index} if job.split else set()
+            continue
+        if job.origin.kind in ("face", "union") and not la.converged:
+            skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
+                           f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
+                           "kept as it was")
+            failed |= {job.origin.index} if job.split else set()
+            continue
+        if job.origin.kind == "hole" and not la.converged:
+            # the error is measured only where segments land on the originals: over a real
+            # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
+            # of a slot, an open end) is no hole, and a patch over it would not fit them
+            skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
+                           f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
+                           f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
+                           "left open")
+            continue
+        out.append((job, la))
+    return _whole_faces_only(jobs, out, skipped, failed)
+
+
+def _whole_faces_only(jobs: list[Job], out: list, skipped: list[str],
+                      failed: set[int] = frozenset()) -> list:
+    """A face split into sub-patches is replaced only when every sub-patch fits (the
+    sub-patches after the first that does not fit, of a face in ``failed``, are not
+    built)."""
+    want = Counter(j.origin.index for j in jobs if j.origin.kind == "face")
+    got = Counter(j.origin.index for j, _ in out if j.origin.kind == "face")
+    partial = {i for i, k in want.items() if got[i] not in (0, k)} | \
+        {i for i in failed if got[i]}
+    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit"
+                f"{' (the rest not tried after one failed)' if i in failed else ''}; "
+                "kept as it was" for i in sorted(partial)]
+    return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
