@@ -28,6 +28,7 @@ __all__ = [
     "distinct_knots",
     "find_span",
     "frozen_array",
+    "owned_array",
     "greville_abscissae",
     "span_range",
     "validate_knots",
@@ -82,6 +83,17 @@ def validate_knots(knots: ArrayLike, degree: int, n_control: int, name: str = "k
 def frozen_array(a: ArrayLike) -> NDArray:
     """A read-only float copy of ``a`` (the arrays of the immutable NURBS types)."""
     out = np.array(a, dtype=float, copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def owned_array(a: ArrayLike) -> NDArray:
+    """``a`` made read-only in place when it is a C-contiguous float array owning its data
+    (a fresh result), else a read-only copy (a view or another layout): the arrays of a
+    trusted ``construct_fast``, laid out as :func:`frozen_array` lays them out."""
+    out = np.asarray(a, dtype=float)
+    if not (out.flags.c_contiguous and out.flags.owndata):
+        out = np.array(out, dtype=float, order="C")
     out.setflags(write=False)
     return out
 

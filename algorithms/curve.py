@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
-from .basis import basis_derivatives, check_weights, find_span, frozen_array, validate_knots
+from .basis import basis_derivatives, check_weights, find_span, frozen_array, owned_array, validate_knots
 from .rational import curve_derivatives_from_homogeneous
 
 __all__ = ["NurbsCurve"]
@@ -62,6 +62,25 @@ class NurbsCurve:
         object.__setattr__(self, "knots", knots)
         object.__setattr__(self, "degree", int(self.degree))
         object.__setattr__(self, "weights", w)
+
+    @classmethod
+    def construct_fast(cls, control_points: NDArray, knots: NDArray, degree: int,
+                       weights: NDArray | None = None) -> NurbsCurve:
+        """A curve from arrays known to be valid, without checking them.
+
+        The trusted constructor for results of operations on valid curves (knot
+        insertion, splitting, interpolants), as scipy's ``BSpline.construct_fast``:
+        the shapes, the knot order, finiteness and the weights' signs are not
+        checked. The arrays are taken as C-contiguous float arrays (copied only
+        when they are not) and made read-only in place, so the caller must not
+        keep writing to them. Users build curves with ``NurbsCurve(...)``.
+        """
+        self = object.__new__(cls)
+        object.__setattr__(self, "control_points", owned_array(control_points))
+        object.__setattr__(self, "knots", owned_array(knots))
+        object.__setattr__(self, "degree", int(degree))
+        object.__setattr__(self, "weights", None if weights is None else owned_array(weights))
+        return self
 
     # ------------------------------------------------------------------ shape
     @property

@@ -242,9 +242,10 @@ def _is_clamped_over(knots: NDArray, degree: int, a: float, b: float) -> bool:
 
 def _curve_result(curve: NurbsCurve, points_w: NDArray, knots: NDArray,
                   degree: int | None = None) -> NurbsCurve:
-    return NurbsCurve.from_homogeneous(points_w, knots,
-                                       curve.degree if degree is None else degree,
-                                       rational=curve.weights is not None)
+    w = points_w[:, -1]
+    return NurbsCurve.construct_fast(points_w[:, :-1] / w[:, None], knots,
+                                     curve.degree if degree is None else degree,
+                                     w if curve.weights is not None else None)
 
 
 def insert_knot(curve: NurbsCurve, t: float, r: int = 1) -> NurbsCurve:

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from . import basis_kernels
-from .basis import basis_derivatives, check_weights, find_span, frozen_array, validate_knots
+from .basis import basis_derivatives, check_weights, find_span, frozen_array, owned_array, validate_knots
 from .rational import surface_derivatives_from_homogeneous
 
 __all__ = ["NurbsSurface"]
@@ -70,6 +70,27 @@ class NurbsSurface:
         object.__setattr__(self, "degree_u", int(self.degree_u))
         object.__setattr__(self, "degree_v", int(self.degree_v))
         object.__setattr__(self, "weights", w)
+
+    @classmethod
+    def construct_fast(cls, control_points: NDArray, knots_u: NDArray, knots_v: NDArray,
+                       degree_u: int, degree_v: int,
+                       weights: NDArray | None = None) -> NurbsSurface:
+        """A surface from arrays known to be valid, without checking them.
+
+        The trusted constructor for results of operations on valid surfaces (knot
+        insertion, restriction, degree elevation, interpolants), as scipy's
+        ``BSpline.construct_fast``: nothing is checked, the arrays are taken as
+        C-contiguous float arrays (copied only when they are not) and made
+        read-only in place. Users build surfaces with ``NurbsSurface(...)``.
+        """
+        self = object.__new__(cls)
+        object.__setattr__(self, "control_points", owned_array(control_points))
+        object.__setattr__(self, "knots_u", owned_array(knots_u))
+        object.__setattr__(self, "knots_v", owned_array(knots_v))
+        object.__setattr__(self, "degree_u", int(degree_u))
+        object.__setattr__(self, "degree_v", int(degree_v))
+        object.__setattr__(self, "weights", None if weights is None else owned_array(weights))
+        return self
 
     # ------------------------------------------------------------------ shape
     @property

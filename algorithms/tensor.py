@@ -95,12 +95,15 @@ def knots_along(surface: NurbsSurface, direction: Direction) -> tuple[NDArray, i
 
 def surface_from_net(surface: NurbsSurface, direction: Direction, points_w: NDArray,
                      knots: NDArray, degree: int | None = None) -> NurbsSurface:
-    """Rebuild a surface after an operation on ``direction`` (net along axis 0)."""
-    rational = surface.weights is not None
+    """Rebuild a surface after an operation on ``direction`` (net along axis 0), trusted
+    (:meth:`NurbsSurface.construct_fast`: the operations keep the net valid)."""
+    pw = points_w if direction is Direction.U else np.swapaxes(points_w, 0, 1)
+    w = pw[..., -1]
+    weights = w if surface.weights is not None else None
     if direction is Direction.U:
-        return NurbsSurface.from_homogeneous(
-            points_w, knots, surface.knots_v,
-            surface.degree_u if degree is None else degree, surface.degree_v, rational)
-    return NurbsSurface.from_homogeneous(
-        np.swapaxes(points_w, 0, 1), surface.knots_u, knots, surface.degree_u,
-        surface.degree_v if degree is None else degree, rational)
+        return NurbsSurface.construct_fast(
+            pw[..., :-1] / w[..., None], knots, surface.knots_v,
+            surface.degree_u if degree is None else degree, surface.degree_v, weights)
+    return NurbsSurface.construct_fast(
+        pw[..., :-1] / w[..., None], surface.knots_u, knots, surface.degree_u,
+        surface.degree_v if degree is None else degree, weights)

@@ -69,8 +69,8 @@ def interpolate_stacked(values: Sequence[NDArray | None], parameters: NDArray,
             out.append(None)
             continue
         d = v.shape[1]
-        out.append(NurbsCurve(stacked.control_points[:, col:col + d], stacked.knots,
-                              stacked.degree))
+        out.append(NurbsCurve.construct_fast(stacked.control_points[:, col:col + d],
+                                             stacked.knots, stacked.degree))
         col += d
     return out
 

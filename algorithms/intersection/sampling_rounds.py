@@ -123,7 +123,8 @@ class _Check:
     def parts(self) -> tuple[NurbsCurve, NurbsCurve, NurbsCurve]:
         """``(curve3d, pcurve_a, pcurve_b)``."""
         stacked = self.curves.curve(self.index)
-        return tuple(NurbsCurve(stacked.control_points[:, a:b], stacked.knots, stacked.degree)
+        return tuple(NurbsCurve.construct_fast(stacked.control_points[:, a:b], stacked.knots,
+                                               stacked.degree)
                      for a, b in ((0, 3), (3, 5), (5, 7)))
 
 

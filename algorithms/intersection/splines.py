@@ -80,7 +80,7 @@ class SplineSet:
         """Curve ``i`` as a NurbsCurve."""
         k = self.knots[self.knot_start[i]:self.knot_start[i + 1]]
         c = self.control[self.control_start[i]:self.control_start[i + 1]]
-        return NurbsCurve(c, k, int(self.degree[i]))
+        return NurbsCurve.construct_fast(c, k, int(self.degree[i]))
 
     def derivatives(self, index: NDArray, t: NDArray, order: int = 0) -> NDArray:
         """Derivatives ``(m, order + 1, d)`` of curves ``index (m,)`` at ``t (m,)``."""
