@@ -1,28 +1,97 @@
 """surfprep: prepare B-spline CAD geometry for grid generation and downstream CAD.
 
-The NURBS types and the exceptions load at once; the OpenCascade side
-(``read``, ``write``, ``to_nurbs``, ``to_occ``, ``make_face``, ...) loads on
-first use, so numpy-only code does not pay for importing OCP.
+The NURBS types, the trimmed-face types and the exceptions load at once; the
+OpenCascade side (``read``, ``write``, ``to_nurbs``, ``to_occ``, ``make_face``,
+the verbs ``intersect``, ``reparametrize``, ``heal`` and their result types)
+loads on first use, so numpy-only code does not pay for importing OCP.
+
+Every verb returns a result object with the geometry (``.geometry``) and its
+plain-JSON report (``.report()``): :class:`IntersectionResult` (also the list
+of curves), :class:`ReparametrizeResult`, :class:`HealResult`.
 
 >>> import surfprep
 >>> model = surfprep.read("step_samples/occt_fuselage.stp")     # doctest: +SKIP
 >>> face = surfprep.to_nurbs(model.faces[0])                     # doctest: +SKIP
 >>> face.surface.evaluate_grid([0.0, 0.5], [0.0, 1.0]).shape     # doctest: +SKIP
 (2, 2, 3)
+
+The method of each part comes from one of five papers, cited in the code by
+their key (``001 §5``...); :mod:`surfprep.algorithms` decodes the keys.
 """
 
 from __future__ import annotations
 
 from importlib import import_module
+from typing import TYPE_CHECKING
 
 from .algorithms import Direction, NurbsCurve, NurbsSurface
-from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
 from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
-from .errors import (ConversionError, DegenerateGeometryError, InputFileError,
-                     InvalidGeometryError, InvalidToleranceError, NoFacesError,
-                     OpenCascadeError, OutputFileError, SurfprepError)
+from .algorithms.reparam import ReparametrizationResult
+from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
+from .errors import (
+    ConversionError,
+    DegenerateGeometryError,
+    InputFileError,
+    InvalidGeometryError,
+    InvalidToleranceError,
+    NoFacesError,
+    OpenCascadeError,
+    OutputFileError,
+    SurfprepError,
+)
+from .inputs import ShapeLike
+
+if TYPE_CHECKING:
+    from .plugin.convert import to_nurbs, to_occ
+    from .plugin.heal import HealResult, heal
+    from .plugin.intersect import FaceIntersection, IntersectionResult, intersect
+    from .plugin.io import CadModel, FileFormat, read, write
+    from .plugin.occ.edges import make_edge
+    from .plugin.occ.faces import make_face
+    from .plugin.reparam import ReparametrizeResult, reparametrize
 
 __version__ = "0.1.0"
+
+__all__ = [
+    # NURBS and trimmed-face types (numpy only)
+    "NurbsCurve",
+    "NurbsSurface",
+    "Direction",
+    "TrimmedFace",
+    "TrimLoop",
+    "TrimEdge",
+    "parametrization_quality",
+    "ParametrizationQuality",
+    "ShapeLike",
+    # files and conversion (OpenCascade)
+    "read",
+    "write",
+    "CadModel",
+    "FileFormat",
+    "to_nurbs",
+    "to_occ",
+    "make_face",
+    "make_edge",
+    # the verbs and their results
+    "intersect",
+    "IntersectionResult",
+    "FaceIntersection",
+    "reparametrize",
+    "ReparametrizeResult",
+    "ReparametrizationResult",
+    "heal",
+    "HealResult",
+    # errors
+    "SurfprepError",
+    "InvalidGeometryError",
+    "DegenerateGeometryError",
+    "InvalidToleranceError",
+    "ConversionError",
+    "InputFileError",
+    "NoFacesError",
+    "OutputFileError",
+    "OpenCascadeError",
+]
 
 #: Public names served by the OpenCascade side, and the module each comes from.
 _PLUGIN_EXPORTS = {
@@ -35,18 +104,13 @@ _PLUGIN_EXPORTS = {
     "make_face": "surfprep.plugin.occ.faces",
     "make_edge": "surfprep.plugin.occ.edges",
     "intersect": "surfprep.plugin.intersect",
+    "IntersectionResult": "surfprep.plugin.intersect",
+    "FaceIntersection": "surfprep.plugin.intersect",
     "reparametrize": "surfprep.plugin.reparam",
+    "ReparametrizeResult": "surfprep.plugin.reparam",
     "heal": "surfprep.plugin.heal",
+    "HealResult": "surfprep.plugin.heal",
 }
-
-__all__ = [
-    "NurbsCurve", "NurbsSurface", "Direction", "TrimmedFace", "TrimLoop", "TrimEdge",
-    "parametrization_quality", "ParametrizationQuality",
-    *_PLUGIN_EXPORTS,
-    "SurfprepError", "InvalidGeometryError", "DegenerateGeometryError",
-    "InvalidToleranceError", "ConversionError", "InputFileError", "NoFacesError",
-    "OutputFileError", "OpenCascadeError",
-]
 
 
 def __getattr__(name: str):

@@ -14,7 +14,6 @@ from .plotting import pyplot, save_figure
 
 __all__ = [
     "COMMAND",
-    "characteristic_report",
     "compare_with_occ",
     "intersection_report",
     "plot_characteristic",
@@ -28,64 +27,9 @@ OCC_SAMPLES = 4001
 
 
 def intersection_report(results, time_s: float, tol: float | None, files) -> dict:
-    """The JSON report: time, tolerance and one entry per curve."""
-    curves = []
-    for k, r in enumerate(results):
-        dev = r.max_deviation()
-        curves.append({
-            "index": k,
-            "faces": list(r.faces),
-            "face_names": [r.face_a.name, r.face_b.name],
-            "closed": r.closed,
-            "points": int(r.points.shape[0]),
-            "length": r.length,
-            "max_distance_a": dev.to_a,
-            "max_distance_b": dev.to_b,
-            "start": r.curve.start_kind,
-            "end": r.curve.end_kind,
-            "found_by": getattr(r, "found_by", "mesh"),
-        })
-    report = {"files": [str(f) for f in files], "tol": tol, "time_s": time_s,
-              "n_curves": len(results), "curves": curves}
-    report.update(characteristic_report(results))
-    return report
-
-
-def characteristic_report(results) -> dict:
-    """Method, isolated (tangential contact) points, coincident regions and, per face
-    pair, the characteristic points by kind and the times of the two stages."""
-    method = getattr(results, "method", None)
-    if method is None:
-        return {}
-    pairs = []
-    for rec in results.records:
-        entry = {"faces": [rec.face_a.index, rec.face_b.index], "time_s": rec.time_s,
-                 "curves_before_clipping": len(rec.curves)}
-        if rec.record is not None:
-            r = rec.record
-            entry.update({
-                "phi_on": r.phi_on,
-                "characteristic_points": r.counts(),
-                "characteristic_curves": len(r.characteristic_curves),
-                "found_by_characteristic": len(r.added),
-                "characteristic_time_s": r.characteristic_time_s,
-                "intersection_time_s": r.intersection_time_s,
-            })
-            if "skipped" in r.extra:
-                entry["certificate_skipped"] = r.extra["skipped"]
-            if "route" in r.extra:
-                entry["route"] = r.extra["route"]
-        pairs.append(entry)
-    return {
-        "method": method.value,
-        "isolated_points": [{"faces": list(p.faces), "point": p.point.tolist(),
-                             "uv_a": p.uv_a.tolist(), "uv_b": p.uv_b.tolist()}
-                            for p in results.isolated_points],
-        "coincident": [{"faces": list(c.faces), "share": c.region.share,
-                        "box_a": c.region.box_a.tolist(), "box_b": c.region.box_b.tolist(),
-                        "max_distance": c.region.max_distance} for c in results.coincident],
-        "pairs": pairs,
-    }
+    """The JSON report: the files, the tolerance, the time and what the result reports
+    (:meth:`surfprep.plugin.intersect.IntersectionResult.report`)."""
+    return {"files": [str(f) for f in files], "tol": tol, "time_s": time_s, **results.report()}
 
 
 def compare_with_occ(results, model_a, model_b) -> dict:

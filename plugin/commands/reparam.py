@@ -23,17 +23,7 @@ def face_entry(entry) -> dict:
     out = {"index": entry.index, "name": entry.name, "time_s": entry.time_s,
            "status": "ok" if entry.done is not None else "skipped", "error": entry.error}
     if entry.done is not None:
-        d, r = entry.done, entry.done.result
-        out.update({
-            "tol": r.tol, "max_deviation": r.max_deviation,
-            "mismatch_before": r.mismatch_before, "mismatch_after": r.mismatch_after,
-            "poles_before": d.poles_before, "poles_after": d.poles_after,
-            "grid": list(r.grid_shape), "iterations": r.iterations,
-            "knots_inserted": r.knots_inserted, "lines_removed": r.lines_removed,
-            "relocation_sweeps": r.relocation_sweeps,
-            "area_before": d.area_before, "area_after": d.area_after,
-            "pcurve_deviation": d.pcurve_deviation,
-        })
+        out.update(entry.done.report())
     return out
 
 

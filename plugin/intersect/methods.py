@@ -3,7 +3,8 @@
 * :class:`Method`: ``"mesh"`` (triangles), ``"characteristic"`` (paper 002),
   ``"auto"`` (triangles, then the characteristic points as a certificate);
 * :class:`IntersectionResult`: the returned list of curves, with the isolated
-  (tangential contact) points, the coincident regions and the per-pair records;
+  (tangential contact) points, the coincident regions, the per-pair records and
+  the JSON report (:meth:`IntersectionResult.report`);
 * :func:`pair_curves`: the untrimmed curves of one face pair by a method.
 """
 
@@ -102,7 +103,8 @@ class PairRecord:
 
 
 class IntersectionResult(list):
-    """The curves of :func:`intersect` (a ``list`` of :class:`FaceIntersection`) and more.
+    """What :func:`surfprep.intersect` found: a ``list`` of :class:`FaceIntersection` (the
+    curves, clipped to both faces) and everything else it measured.
 
     Attributes
     ----------
@@ -112,15 +114,85 @@ class IntersectionResult(list):
     records : list of PairRecord
         One per face pair whose boxes overlap.
     method : Method
+    tol : float or None
+        The tolerance the curves were computed to (model units).
+    time_s : float
+        Wall time of the intersection.
     """
 
     def __init__(self, curves=(), *, isolated_points=(), coincident=(), records=(),
-                 method: Method = Method.AUTO) -> None:
+                 method: Method = Method.AUTO, tol: float | None = None,
+                 time_s: float = 0.0) -> None:
         super().__init__(curves)
         self.isolated_points = list(isolated_points)
         self.coincident = list(coincident)
         self.records = list(records)
         self.method = Method(method)
+        self.tol = tol
+        self.time_s = time_s
+
+    @property
+    def geometry(self) -> list:
+        """The curves (:class:`FaceIntersection`), as every verb's result has its geometry."""
+        return list(self)
+
+    def edges(self) -> list:
+        """``[TopoDS_Edge]``: every curve with a pcurve on each face
+        (:meth:`FaceIntersection.to_edges`)."""
+        return [e for r in self for e in r.to_edges()]
+
+    def report(self) -> dict:
+        """Plain-JSON report: per curve its faces, closedness, points, length, largest
+        distance from each surface, end kinds and how it was found; the method, the
+        isolated points, the coincident regions and, per face pair, the
+        characteristic points by kind and the times of the two stages."""
+        curves = []
+        for k, r in enumerate(self):
+            dev = r.max_deviation()
+            curves.append({
+                "index": k,
+                "faces": list(r.faces),
+                "face_names": [r.face_a.name, r.face_b.name],
+                "closed": r.closed,
+                "points": int(r.points.shape[0]),
+                "length": r.length,
+                "max_distance_a": dev.to_a,
+                "max_distance_b": dev.to_b,
+                "start": r.curve.start_kind,
+                "end": r.curve.end_kind,
+                "found_by": r.found_by,
+            })
+        pairs = []
+        for rec in self.records:
+            entry = {"faces": [rec.face_a.index, rec.face_b.index], "time_s": rec.time_s,
+                     "curves_before_clipping": len(rec.curves)}
+            if rec.record is not None:
+                r = rec.record
+                entry.update({
+                    "phi_on": r.phi_on,
+                    "characteristic_points": r.counts(),
+                    "characteristic_curves": len(r.characteristic_curves),
+                    "found_by_characteristic": len(r.added),
+                    "characteristic_time_s": r.characteristic_time_s,
+                    "intersection_time_s": r.intersection_time_s,
+                })
+                if "skipped" in r.extra:
+                    entry["certificate_skipped"] = r.extra["skipped"]
+                if "route" in r.extra:
+                    entry["route"] = r.extra["route"]
+            pairs.append(entry)
+        return {
+            "n_curves": len(self),
+            "curves": curves,
+            "method": self.method.value,
+            "isolated_points": [{"faces": list(p.faces), "point": p.point.tolist(),
+                                 "uv_a": p.uv_a.tolist(), "uv_b": p.uv_b.tolist()}
+                                for p in self.isolated_points],
+            "coincident": [{"faces": list(c.faces), "share": c.region.share,
+                            "box_a": c.region.box_a.tolist(), "box_b": c.region.box_b.tolist(),
+                            "max_distance": c.region.max_distance} for c in self.coincident],
+            "pairs": pairs,
+        }
 
 
 def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,

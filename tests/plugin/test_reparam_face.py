@@ -96,16 +96,16 @@ def test_trimmed_face_keeps_its_boundary_and_area():
 def test_public_api_returns_what_came_in():
     import cadquery as cq
     surface, tol = _u_cubed_sheet(), 2e-3
-    new = surfprep.reparametrize(surface, tol=tol)
+    new = surfprep.reparametrize(surface, tol=tol).geometry
     assert isinstance(new, surfprep.NurbsSurface)
-    assert isinstance(surfprep.reparametrize(surface_to_occ(surface), tol=tol),
+    assert isinstance(surfprep.reparametrize(surface_to_occ(surface), tol=tol).geometry,
                       surfprep.NurbsSurface)
     face = _disk_face(surface)
-    assert isinstance(surfprep.reparametrize(face, tol=tol), TopoDS_Face)
-    wrapped = surfprep.reparametrize(cq.Face(face), tol=tol)
+    assert isinstance(surfprep.reparametrize(face, tol=tol).geometry, TopoDS_Face)
+    wrapped = surfprep.reparametrize(cq.Face(face), tol=tol).geometry
     assert isinstance(wrapped, cq.Face) and wrapped.isValid()
     trimmed = surfprep.to_nurbs(face)
-    assert isinstance(surfprep.reparametrize(trimmed, tol=tol), TrimmedFace)
+    assert isinstance(surfprep.reparametrize(trimmed, tol=tol).geometry, TrimmedFace)
     with pytest.raises(ConversionError):
         surfprep.reparametrize("face")
 
