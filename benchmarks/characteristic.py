@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "algorithms" / "characteristic"))
+sys.path.insert(0, str(ROOT / "tests"))          # the tests' operand builders (tests/helpers)
 
-from char_surfaces import (
+from helpers.surfaces import (
     degree_six_pair,
     flat_crossing,
     horizontal_plane,
@@ -72,7 +72,7 @@ def bumps_level() -> float:
 
 def bumpy_flat():
     """The bumpy bicubic x plane of the SSI benchmark (issue 3): four loops."""
-    from char_surfaces import bumps_net, height_field
+    from helpers.surfaces import bumps_net, height_field
     z = bumps_net(20, [(0.25, 0.25, 0.08, 0.5), (0.72, 0.3, 0.06, 0.45), (0.4, 0.7, 0.12, 0.6),
                        (0.8, 0.78, 0.05, 0.4)])
     return height_field(z), horizontal_plane(0.2)

@@ -267,9 +267,9 @@ def _faces(shape):
 def _crossing():
     import sys
     from pathlib import Path
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "plugin"))
-    import test_heal_cut as cross  # the geometry of the test, one definition
-    return cross
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from helpers import heal_cases  # the geometry of tests/plugin/heal/test_cut.py, one definition
+    return heal_cases
 
 
 def _max_join_angle(faces, gap: float) -> float:

@@ -2,15 +2,15 @@
 
 The paper gives the error of §7 (max over the points e, f, g of eq. 19, cells over
 holes left out), times 1e-3, for geometries in a unit cube at sampling resolutions
-4x4 ... 12x12. We build the same kinds of geometry (tests/algorithms/healing/
-approx_cases.py, shared with the tests) and print ours beside theirs, with the RMS,
-the share of artificial (Hardy) points, a dense check (the largest distance of a
+4x4 ... 12x12. We build the same kinds of geometry (tests/helpers/heal_cases.py,
+shared with the tests) and print ours beside theirs, with the RMS, the share of
+artificial (filled) points, a dense check (the largest distance of a
 61 x 61 grid of approximant points to the originals, holes left out) and the time.
 
 Pure algorithms (no OpenCascade): there is no OpenCascade counterpart of one local
 approximant; benchmarks/heal.py compares the healing against OpenCascade's fillers.
 
-Run: ``/work/venv/bin/python benchmarks/heal_table1.py``
+Run: ``python benchmarks/heal_table1.py``
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "algorithms" / "healing"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))   # tests/helpers
 
-from approx_cases import (
+from helpers.heal_cases import (
     crossing_surfaces,
     envelope_boundary,
     iso_boundary,

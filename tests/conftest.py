@@ -12,14 +12,13 @@ import os
 from pathlib import Path
 
 import pytest
+from helpers.paths import DATA_DIR
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
-#: ``shared/data`` next to the repository checkout (same layout locally and in CI).
-DATA_DIR = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
 
 
 @pytest.fixture(scope="session")

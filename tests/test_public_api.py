@@ -60,6 +60,7 @@ def test_all_is_a_literal_list_and_the_lazy_names_are_typed():
 
 def test_every_verb_returns_geometry_and_a_report():
     import numpy as np
+
     from surfprep.algorithms.fitting import interpolate_surface
 
     t = np.linspace(0, 1, 6)

@@ -3,13 +3,28 @@
 from __future__ import annotations
 
 import numpy as np
+from helpers.strategies import (
+    assert_same_curve,
+    assert_same_surface,
+    curve_samples,
+    curves,
+    make_curve,
+    make_surface,
+    scale_of,
+    surfaces,
+)
 from hypothesis import given, settings
-from nurbs_strategies import (assert_same_curve, assert_same_surface, curve_samples, curves,
-                              make_curve, make_surface, scale_of, surfaces)
 from scipy.special import comb
 
-from surfprep.algorithms import (NurbsCurve, NurbsSurface, bezier_curves, bezier_patches,
-                                 bezier_segments, bezier_surfaces, patch_bounding_boxes)
+from surfprep.algorithms import (
+    NurbsCurve,
+    NurbsSurface,
+    bezier_curves,
+    bezier_patches,
+    bezier_segments,
+    bezier_surfaces,
+    patch_bounding_boxes,
+)
 
 SETTINGS = settings(max_examples=50, deadline=None)
 

@@ -4,13 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import (
+    assert_same_curve,
+    assert_same_surface,
+    curve_samples,
+    curves,
+    make_curve,
+    surface_samples,
+    surfaces,
+)
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import (assert_same_curve, assert_same_surface, curve_samples, curves,
-                              make_curve, surface_samples, surfaces)
 
-from surfprep.algorithms import (NurbsCurve, bezier_elevation_matrix, elevate_degree,
-                                 elevate_degree_surface)
+from surfprep.algorithms import NurbsCurve, bezier_elevation_matrix, elevate_degree, elevate_degree_surface
 from surfprep.errors import InvalidGeometryError
 
 
@@ -89,7 +95,7 @@ def test_surface_elevation_keeps_geometry(surface, t_u, t_v):
 
 
 def test_surface_facade_and_errors():
-    from nurbs_strategies import make_surface
+    from helpers.strategies import make_surface
     surface = make_surface(9, 2, 3, 2, 1, 2, rational=True)
     result = surface.elevate_degree(1, 2)
     assert (result.degree_u, result.degree_v) == (3, 5)
@@ -105,7 +111,7 @@ def test_surface_facade_and_errors():
 
 @pytest.mark.parametrize("degrees", [(9, 1), (1, 9), (7, 8)])
 def test_high_degree_surface_elevation(degrees):
-    from nurbs_strategies import make_surface
+    from helpers.strategies import make_surface
     surface = make_surface(sum(degrees), *degrees, 2, 1, 3, rational=True)
     result = surface.elevate_degree(1, 1)
     assert_same_surface(result, surface, *surface_samples(surface))

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from hypothesis import given, settings
-from nurbs_strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from scipy.interpolate import BSpline
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface

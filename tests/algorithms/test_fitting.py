@@ -6,9 +6,7 @@ import itertools
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from nurbs_strategies import (
+from helpers.strategies import (
     assert_same_curve,
     assert_same_surface,
     curve_samples,
@@ -17,6 +15,8 @@ from nurbs_strategies import (
     scale_of,
     surface_samples,
 )
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.interpolate import make_interp_spline
 
 from surfprep.algorithms import NurbsCurve

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import make_surface, scale_of, surfaces
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import make_surface, scale_of, surfaces
 
 from surfprep.algorithms import Direction, isocurve
 from surfprep.errors import InvalidGeometryError

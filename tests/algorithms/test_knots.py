@@ -4,14 +4,33 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import (
+    assert_same_curve,
+    assert_same_surface,
+    curve_samples,
+    curves,
+    make_curve,
+    make_surface,
+    surface_samples,
+    surfaces,
+)
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import (assert_same_curve, assert_same_surface, curve_samples, curves,
-                              make_curve, make_surface, surface_samples, surfaces)
 
-from surfprep.algorithms import (Direction, NurbsCurve, clamp, insert_knot, insert_knot_array,
-                                 periodic_to_clamped, refine, refine_surface, restrict,
-                                 restrict_surface, split, split_surface)
+from surfprep.algorithms import (
+    Direction,
+    NurbsCurve,
+    clamp,
+    insert_knot,
+    insert_knot_array,
+    periodic_to_clamped,
+    refine,
+    refine_surface,
+    restrict,
+    restrict_surface,
+    split,
+    split_surface,
+)
 from surfprep.errors import InvalidGeometryError
 
 SETTINGS = settings(max_examples=60, deadline=None)

@@ -4,13 +4,19 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import curve_samples, curves, make_curve, scale_of, surfaces
 from scipy.integrate import quad
 
-from surfprep.algorithms import (NurbsCurve, NurbsSurface, arc_length, bounding_box,
-                                 cumulative_arc_length, normals)
+from surfprep.algorithms import (
+    NurbsCurve,
+    NurbsSurface,
+    arc_length,
+    bounding_box,
+    cumulative_arc_length,
+    normals,
+)
 from surfprep.errors import DegenerateGeometryError, InvalidGeometryError, InvalidToleranceError
 
 S2 = np.sqrt(0.5)

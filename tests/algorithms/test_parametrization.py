@@ -8,8 +8,12 @@ import numpy as np
 import pytest
 
 from surfprep.algorithms import NurbsSurface
-from surfprep.algorithms.parametrization import (MIN_INTERVALS, ParametrizationQuality,
-                                                 parametrization_quality, quality_grid)
+from surfprep.algorithms.parametrization import (
+    MIN_INTERVALS,
+    ParametrizationQuality,
+    parametrization_quality,
+    quality_grid,
+)
 
 
 def bilinear_plane(width: float = 3.0, height: float = 2.0) -> NurbsSurface:

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.strategies import curves, random_knots, scale_of, surface_samples, surfaces
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from nurbs_strategies import curves, random_knots, scale_of, surface_samples, surfaces
 from scipy.spatial import cKDTree
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface

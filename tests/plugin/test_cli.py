@@ -10,22 +10,17 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.cli import run
+from helpers.paths import SAMPLES
 
 from surfprep.plugin import cli
 from surfprep.plugin.commands import COMMANDS
 from surfprep.plugin.commands import info as info_command
 
-REPO = Path(__file__).resolve().parents[2]
-SAMPLES = REPO / "step_samples"
 FUSELAGE = SAMPLES / "occt_fuselage.stp"
 SYNTHETIC = SAMPLES / "synthetic_named_faces.step"
 CAPSULE = SAMPLES / "overture_marscapsule_proe.igs"
 
-
-def run(capsys, *argv: str) -> tuple[int, str, str]:
-    code = cli.main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def assert_one_line_error(err: str, *words: str) -> None:

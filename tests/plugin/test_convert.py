@@ -2,30 +2,34 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import build123d as bd
 import cadquery as cq
 import numpy as np
 import pytest
+from helpers.paths import SAMPLES
 from OCP.BRepAdaptor import BRepAdaptor_Curve, BRepAdaptor_Surface
-from OCP.BRepCheck import BRepCheck_Analyzer
-from OCP.Geom import (Geom_BSplineCurve, Geom_BSplineSurface, Geom_Circle, Geom_Plane,
-                      Geom_SphericalSurface, Geom_TrimmedCurve)
-from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Circle
-from OCP.gp import gp_Ax2, gp_Ax2d, gp_Ax3, gp_Dir, gp_Pnt, gp_Pnt2d
 from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
-from OCP.gp import gp_Ax1, gp_Trsf, gp_Vec
+from OCP.BRepCheck import BRepCheck_Analyzer
+from OCP.Geom import (
+    Geom_BSplineCurve,
+    Geom_BSplineSurface,
+    Geom_Circle,
+    Geom_Plane,
+    Geom_SphericalSurface,
+    Geom_TrimmedCurve,
+)
+from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Circle
+from OCP.gp import gp_Ax1, gp_Ax2, gp_Ax2d, gp_Ax3, gp_Dir, gp_Pnt, gp_Pnt2d, gp_Trsf, gp_Vec
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
+from surfprep.algorithms.trimmed import TrimmedFace
 from surfprep.errors import ConversionError
 from surfprep.plugin.convert import to_nurbs, to_occ
+from surfprep.plugin.occ.faces import make_face as to_occ_face
 from surfprep.plugin.occ.shapes import all_faces
 from surfprep.plugin.occ_reference import evaluate_curve
-from surfprep.algorithms.trimmed import TrimmedFace
-from surfprep.plugin.occ.faces import make_face as to_occ_face
 
 
 def _same_face(a: TrimmedFace, b: TrimmedFace) -> bool:
@@ -210,7 +214,7 @@ def test_curve_of_unsupported_dimension():
 def test_cad_model_faces_carry_their_names_from_the_file():
     from surfprep.plugin.io import read
 
-    sample = Path(__file__).resolve().parents[2] / "step_samples" / "synthetic_named_faces.step"
+    sample = SAMPLES / "synthetic_named_faces.step"
     model = read(sample)
     faces = to_nurbs(model)
     assert [f.name for f in faces] == list(model.face_names)

@@ -8,20 +8,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.paths import SAMPLES
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Shape
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
-from surfprep.errors import (ConversionError, InputFileError, NoFacesError, OutputFileError,
-                             SurfprepError)
+from surfprep.errors import ConversionError, InputFileError, NoFacesError, OutputFileError, SurfprepError
 from surfprep.plugin import io as sio
-from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.io import CadModel, FileFormat, read, write
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.step_iges import TranslationError
-
-REPO = Path(__file__).resolve().parents[2]
-SAMPLES = REPO / "step_samples"
 
 FUSELAGE = SAMPLES / "occt_fuselage.stp"
 CAPSULE = SAMPLES / "overture_marscapsule_proe.igs"

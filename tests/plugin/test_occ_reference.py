@@ -10,8 +10,12 @@ from OCP.gp import gp_Ax3
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import ConversionError
 from surfprep.plugin.occ.geom import surface_to_occ
-from surfprep.plugin.occ_reference import (SURFACE_ENTRIES, evaluate_curve, evaluate_surface,
-                                           project_point_on_surface)
+from surfprep.plugin.occ_reference import (
+    SURFACE_ENTRIES,
+    evaluate_curve,
+    evaluate_surface,
+    project_point_on_surface,
+)
 
 
 def _surface() -> NurbsSurface:

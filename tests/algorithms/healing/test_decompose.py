@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from decompose_cases import (
+from helpers.heal_cases import (
     disc,
     notched,
     outline_uv,
@@ -15,8 +15,9 @@ from decompose_cases import (
     triangle,
     wavy_surface,
 )
-from surfprep.algorithms.healing import connect, local_approximant
+
 from surfprep.algorithms.face_region import inside_loops
+from surfprep.algorithms.healing import connect, local_approximant
 from surfprep.algorithms.healing.connectivity import Side, side_points
 from surfprep.algorithms.healing.decompose import (
     NotDecomposableError,

@@ -6,6 +6,7 @@ length, and the join is measured (normals where they exist)."""
 from __future__ import annotations
 
 import numpy as np
+
 from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.healing import connect
 

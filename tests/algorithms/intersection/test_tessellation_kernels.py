@@ -3,7 +3,7 @@ numpy forms in tessellation.py / culling.py."""
 
 import numpy as np
 import pytest
-from ssi_surfaces import sphere_band
+from helpers.surfaces import sphere_band
 
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.intersection import tessellation_kernels

@@ -1,0 +1,132 @@
+"""Faces that are not four-sided as four-sided sub-patches (healing/decompose.py on a
+TrimmedFace):
+faces built in OpenCascade on a wavy B-spline surface and read back, their
+sub-patches approximated over the face (its trimmed source) and joined."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.heal_cases import (
+    disc,
+    edge_from_uv,
+    line,
+    occ_triangle_face,
+    pentagon,
+    polygon_loop,
+    six_edges_two_smooth,
+    triangle,
+    wavy_surface,
+)
+
+from surfprep.algorithms.healing import connect, local_approximant
+from surfprep.algorithms.healing.adjacency import four_sided_boundary
+from surfprep.algorithms.healing.clipping import face_source
+from surfprep.algorithms.healing.decompose import (
+    decompose_face,
+    quad_boundaries,
+    reverse_curve,
+    why_not_decomposable,
+)
+from surfprep.algorithms.projection import distance_to_surface
+from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
+from surfprep.plugin.occ.faces import face_to_nurbs, make_face
+
+SURFACE = wavy_surface()
+GAP = 1e-6
+
+
+def occ_face(loops, reverse_edges=False):
+    """TrimmedFace read back from an OpenCascade face with these loops (LoopEdges);
+    with ``reverse_edges`` every edge is stored the other way and used reversed."""
+    trim = []
+    for loop in loops:
+        edges = []
+        for e in loop:
+            if reverse_edges:
+                edges.append(TrimEdge(reverse_curve(e.curve), reverse_curve(e.pcurve), 0.0, 1.0,
+                                      reversed=True))
+            else:
+                edges.append(TrimEdge(e.curve, e.pcurve, 0.0, 1.0))
+        trim.append(TrimLoop(edges))
+    return face_to_nurbs(make_face(SURFACE, trim))
+
+
+def _ends_meet(boundary):
+    ends = np.array([[c.evaluate(c.domain[0]), c.evaluate(c.domain[1])] for c in boundary])
+    forward = np.linalg.norm(ends[:, 1] - np.roll(ends[:, 0], -1, axis=0), axis=1).max()
+    return forward < 1e-7
+
+
+@pytest.mark.parametrize(("case", "n_quads", "reverse"),
+                         [(triangle, 3, False), (triangle, 3, True), (pentagon, 5, False),
+                          (six_edges_two_smooth, 1, False), (disc, 1, True)])
+def test_quad_boundaries_of_occ_faces(case, n_quads, reverse):
+    face = occ_face([case(SURFACE)], reverse_edges=reverse)
+    quads = quad_boundaries(face, gap_tol=GAP)
+    assert quads is not None and len(quads) == n_quads
+    assert all(len(q) == 4 and _ends_meet(q) for q in quads)
+
+
+def test_four_sided_face_is_its_own_boundary():
+    face = occ_face([polygon_loop(SURFACE, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)])])
+    quads = quad_boundaries(face, gap_tol=GAP)
+    assert len(quads) == 1 and quads[0] == four_sided_boundary(face)
+    assert decompose_face(face, gap_tol=GAP) is None
+
+
+def test_face_with_a_hole_is_not_decomposable_and_says_why():
+    outer = polygon_loop(SURFACE, [(0.05, 0.05), (0.95, 0.05), (0.5, 0.95)])
+    hole = [edge_from_uv(SURFACE, line(a, b)) for a, b in
+            [((0.4, 0.3), (0.5, 0.5)), ((0.5, 0.5), (0.6, 0.3)), ((0.6, 0.3), (0.4, 0.3))]]
+    face = occ_face([outer, hole])
+    assert quad_boundaries(face, gap_tol=GAP) is None
+    assert "inner loop" in why_not_decomposable(face, gap_tol=GAP)
+
+
+def test_triangle_sub_patches_follow_the_trimmed_face_and_join_g1():
+    face = occ_face([triangle(SURFACE)])
+    source = face_source(face)
+    quads = quad_boundaries(face, gap_tol=GAP)
+    las = [local_approximant(q, [source], preferred_source=0) for q in quads]
+    assert all(la.converged for la in las)
+    net = connect(las, continuity="G1")
+    size = float(np.linalg.norm(np.ptp(SURFACE.bounding_box(), axis=0)))
+    assert len(net.joins) == 3
+    assert max(j.max_gap for j in net.joins) <= 1e-9 * size
+    assert max(j.max_angle for j in net.joins) < 0.2
+    t = np.linspace(0, 1, 41)
+    for la, p in zip(las, net.patches):
+        assert distance_to_surface(face.surface, p.evaluate_grid(t, t).reshape(-1, 3)).max() \
+            <= la.tol
+
+
+
+def test_heal_split_faces_replaces_a_triangle_by_three_patches():
+    # surfprep.heal(split_faces=True): the three-sided face becomes three sub-patches
+    # that follow it (dense check against the surface), keep its area and outline, and
+    # are joined G0 into one valid face set (the default); with split_faces=False the
+    # face is kept
+    from surfprep.algorithms.healing.adjacency import face_edges, polyline_distance
+    from surfprep.plugin.heal import heal
+    shape = occ_triangle_face()
+    kept = heal(shape, split_faces=False)
+    assert kept.patches == () and kept.model.n_faces == 1
+    r = heal(shape)
+    assert [p.origin.kind for p in r.patches] == ["face"] * 3
+    assert {p.origin.faces for p in r.patches} == {(0,)}
+    assert r.valid_after and r.model.n_faces == 3
+    for la in r.approximants:
+        u0, u1, v0, v1 = la.surface.domain
+        uu, vv = np.meshgrid(np.linspace(u0, u1, 25), np.linspace(v0, v1, 25), indexing="ij")
+        pts = la.surface.evaluate(uu.ravel(), vv.ravel())
+        assert distance_to_surface(SURFACE, pts).max() <= la.tol
+    assert all(j.max_gap < 1e-9 for j in r.joins) and len(r.joins) == 3
+    before = face_edges([face_to_nurbs(shape)])
+    after = face_edges([face_to_nurbs(f) for f in r.model.faces])
+    outline = np.concatenate([e.samples for e in before])
+    on_outline = np.concatenate([e.samples for e in after])
+    near = [polyline_distance(e.samples, outline).max() for e in after]
+    tol = max(la.tol for la in r.approximants)
+    assert sum(d <= tol for d in near) == 6               # two outer sides per sub-patch
+    assert polyline_distance(outline, on_outline).max() <= tol   # the whole outline kept

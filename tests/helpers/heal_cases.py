@@ -1,0 +1,283 @@
+"""Geometry of the healing tests and of benchmarks/heal_table1.py.
+
+* the kinds of 001's Figs. 5-8 (part of a single patch, a hole, intersecting
+  surfaces, a highly oscillating surface), all in the unit cube as in Table 1;
+* faces for the decomposition tests: loops of straight (u, v) lines or arcs on a
+  wavy bicubic surface, with 3D edges interpolated through the mapped pcurves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from surfprep.algorithms.curve import NurbsCurve
+from surfprep.algorithms.fitting import interpolate_curve, interpolate_surface
+from surfprep.algorithms.healing.adjacency import polyline_distance
+from surfprep.algorithms.healing.decompose import LoopEdge
+from surfprep.algorithms.intersection.mesh import TriangleMesh
+from surfprep.algorithms.intersection.tessellation import tessellate
+from surfprep.algorithms.projection import project_to_surface
+from surfprep.algorithms.surface import NurbsSurface
+from surfprep.algorithms.tensor import Direction
+
+
+def graph_surface(height, samples: int = 13) -> NurbsSurface:
+    """Bicubic interpolant of ``z = height(x, y)`` over the unit square, ``(u, v) = (x, y)``
+    at the samples."""
+    s = np.linspace(0.0, 1.0, samples)
+    x, y = np.meshgrid(s, s, indexing="ij")
+    return interpolate_surface(np.stack([x, y, height(x, y)], axis=-1), params_u=s, params_v=s)
+
+
+def smooth_surface() -> NurbsSurface:
+    """A gently curved patch (001 Fig. 5 kind)."""
+    return graph_surface(lambda x, y: 0.3 + 0.15 * np.sin(2.5 * x + 0.5) * np.cos(2.0 * y - 0.3),
+                         samples=9)
+
+
+def oscillating_surface() -> NurbsSurface:
+    """Several waves in each direction (001 Fig. 8 kind)."""
+    return graph_surface(lambda x, y: 0.5 + 0.04 * np.sin(5 * np.pi * x) * np.sin(4 * np.pi * y),
+                         samples=41)
+
+
+def iso_boundary(surface: NurbsSurface, u0: float, u1: float, v0: float, v1: float) -> list:
+    """Four isocurves of ``surface`` bounding ``[u0, u1] x [v0, v1]``, bottom, right, top, left
+    (top and left in the surface's directions: the boundary orients them)."""
+    sub = surface.restrict(u0, u1, v0, v1)
+    return [sub.isocurve(v0, Direction.V), sub.isocurve(u1, Direction.U),
+            sub.isocurve(v1, Direction.V), sub.isocurve(u0, Direction.U)]
+
+
+def surrounding_patches(surface: NurbsSurface, hole: tuple) -> list[NurbsSurface]:
+    """Four patches of ``surface`` around the parameter rectangle ``hole`` (a hole in it)."""
+    u0, u1, v0, v1 = hole
+    return [surface.restrict(None, u0, None, None), surface.restrict(u1, None, None, None),
+            surface.restrict(u0, u1, None, v0), surface.restrict(u0, u1, v1, None)]
+
+
+def holed_mesh(surface: NurbsSurface, hole: tuple, tol: float = 2e-4) -> TriangleMesh:
+    """Triangulation of ``surface`` with the triangles over ``hole`` cut out (with uv)."""
+    mesh = tessellate(surface, tol).mesh
+    c = mesh.triangle_uv().mean(axis=1)
+    u0, u1, v0, v1 = hole
+    inside = (c[:, 0] > u0) & (c[:, 0] < u1) & (c[:, 1] > v0) & (c[:, 1] < v1)
+    return TriangleMesh.from_arrays(mesh.vertices, mesh.triangles[~inside], mesh.uv)
+
+
+def _rising(x, y):
+    return 0.45 + 0.35 * (x - 0.5) + 0.24 * y * (1.0 - y)
+
+
+def _falling(x, y):
+    return 0.45 - 0.35 * (x - 0.5) + 0.08 * (y - 0.5) ** 2
+
+
+def crossing_surfaces() -> tuple[NurbsSurface, NurbsSurface]:
+    """Two surfaces cutting through each other along a curve near ``x = 0.5`` (001 Fig. 7):
+    one rising, one falling in x; their upper envelope has a crease there. Both heights
+    are polynomials the bicubic interpolants reproduce exactly."""
+    return graph_surface(_rising, samples=7), graph_surface(_falling, samples=7)
+
+
+def upper_envelope(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Height of the upper envelope of :func:`crossing_surfaces` (exact)."""
+    return np.maximum(_rising(x, y), _falling(x, y))
+
+
+def envelope_boundary(x0: float, x1: float, y0: float, y1: float, samples: int = 81) -> list:
+    """Four polylines on the upper envelope of :func:`crossing_surfaces` around a rectangle."""
+    s = np.linspace(0.0, 1.0, samples)
+
+    def line(p, q):
+        x = p[0] + s * (q[0] - p[0])
+        y = p[1] + s * (q[1] - p[1])
+        return np.stack([x, y, upper_envelope(x, y)], axis=1)
+
+    c = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    return [line(c[k], c[(k + 1) % 4]) for k in range(4)]
+
+
+def stepped_gap(step: float = 0.01, gap: tuple = (0.45, 0.55), samples: int = 81
+                ) -> tuple[list, list[NurbsSurface]]:
+    """Two surfaces with a gap between them and a step across it (001 Fig. 6 kind).
+
+    The smooth surface is cut at ``x = gap[0]`` and ``x = gap[1]``; the right part is
+    raised by ``step``. The boundary runs around ``[0.2, 0.8]^2``: on the surfaces
+    where they exist, a straight bridge across the gap on the bottom and top sides.
+
+    Returns
+    -------
+    boundary : four (n, 3) polylines
+    sources : [left, right] NurbsSurface
+    """
+    smooth = smooth_surface()
+    left = smooth.restrict(None, gap[0], None, None)
+    right_part = smooth.restrict(gap[1], None, None, None)
+    right = NurbsSurface(right_part.control_points + np.array([0.0, 0.0, step]),
+                         right_part.knots_u, right_part.knots_v, 3, 3)
+
+    def height(x, y):
+        z = smooth.evaluate(x, y)[..., 2]
+        z = np.where(x >= gap[1], z + step, z)
+        z_left = smooth.evaluate(np.full_like(x, gap[0]), y)[..., 2]
+        z_right = smooth.evaluate(np.full_like(x, gap[1]), y)[..., 2] + step
+        bridge = (x - gap[0]) / (gap[1] - gap[0])
+        inside = (x > gap[0]) & (x < gap[1])
+        return np.where(inside, (1 - bridge) * z_left + bridge * z_right, z)
+
+    s = np.linspace(0.0, 1.0, samples)
+
+    def line(p, q):
+        x = p[0] + s * (q[0] - p[0])
+        y = p[1] + s * (q[1] - p[1])
+        return np.stack([x, y, height(x, y)], axis=1)
+
+    c = [(0.2, 0.2), (0.8, 0.2), (0.8, 0.8), (0.2, 0.8)]
+    return [line(c[k], c[(k + 1) % 4]) for k in range(4)], [left, right]
+
+
+# ------------------------------------------------------------ decomposition
+def wavy_surface():
+    """Bicubic graph over [0, 1]^2 (domain [0, 1]^2), a unit-size free-form patch."""
+    x = np.linspace(0, 1, 9)
+    gx, gy = np.meshgrid(x, x, indexing="ij")
+    z = 0.15 * np.sin(2.5 * gx) * np.cos(2.0 * gy) + 0.1 * gx * gy
+    return interpolate_surface(np.stack([gx, gy, z], axis=-1))
+
+
+def edge_from_uv(surface, uv_of_t, n=65) -> LoopEdge:
+    """Edge with pcurve through ``uv_of_t(t)``, ``t`` in [0, 1], and its 3D curve."""
+    t = np.linspace(0, 1, n)
+    uv = uv_of_t(t)
+    pcurve = interpolate_curve(uv, parameters=t)
+    xyz = surface.evaluate(pcurve.evaluate(t)[:, 0], pcurve.evaluate(t)[:, 1])
+    return LoopEdge(interpolate_curve(xyz, parameters=t), pcurve)
+
+
+def line(a, b):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return lambda t: (1 - t)[:, None] * a + t[:, None] * b
+
+
+def arc(centre, radius, a0, a1):
+    c = np.asarray(centre, float)
+    return lambda t: c + radius * np.column_stack([np.cos(a0 + t * (a1 - a0)),
+                                                   np.sin(a0 + t * (a1 - a0))])
+
+
+def polygon_loop(surface, corners):
+    """Straight uv edges between consecutive corners (counter-clockwise)."""
+    c = np.asarray(corners, float)
+    return [edge_from_uv(surface, line(c[k], c[(k + 1) % len(c)])) for k in range(len(c))]
+
+
+def triangle(surface):
+    return polygon_loop(surface, [(0.1, 0.1), (0.9, 0.2), (0.4, 0.85)])
+
+
+def pentagon(surface):
+    a = np.pi / 2 + 2 * np.pi * np.arange(5) / 5
+    return polygon_loop(surface, np.column_stack([0.5 + 0.4 * np.cos(a), 0.5 + 0.4 * np.sin(a)]))
+
+
+def six_edges_two_smooth(surface):
+    """A rounded rectangle in uv: four corners, two sides each made of two edges that
+    continue each other smoothly (a straight side split in two, an arc split in two)."""
+    return [edge_from_uv(surface, line((0.1, 0.1), (0.5, 0.1))),
+            edge_from_uv(surface, line((0.5, 0.1), (0.9, 0.1))),
+            edge_from_uv(surface, line((0.9, 0.1), (0.9, 0.8))),
+            edge_from_uv(surface, arc((0.5, 0.45), np.hypot(0.4, 0.35),
+                                      np.arctan2(0.35, 0.4), np.pi / 2)),
+            edge_from_uv(surface, arc((0.5, 0.45), np.hypot(0.4, 0.35), np.pi / 2,
+                                      np.pi - np.arctan2(0.35, 0.4))),
+            edge_from_uv(surface, line((0.1, 0.8), (0.1, 0.1)))]
+
+
+def disc(surface, pieces=1):
+    """A circle in uv as ``pieces`` smooth arcs."""
+    step = 2 * np.pi / pieces
+    return [edge_from_uv(surface, arc((0.5, 0.5), 0.35, k * step, (k + 1) * step), n=129)
+            for k in range(pieces)]
+
+
+def notched(surface):
+    """A deep U-shaped outline (very non-convex, eight corners)."""
+    return polygon_loop(surface, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.7, 0.9), (0.7, 0.3),
+                                  (0.3, 0.3), (0.3, 0.9), (0.1, 0.9)])
+
+
+def outline_uv(edges):
+    return np.concatenate([e.pcurve.evaluate(np.linspace(0, 1, 200))[:-1] for e in edges])
+
+
+__all__ = ["NurbsCurve", "disc", "edge_from_uv", "notched", "outline_uv", "pentagon",
+           "polygon_loop", "six_edges_two_smooth", "triangle", "wavy_surface"]
+
+
+def occ_triangle_face():
+    """A ``TopoDS_Face`` on :func:`wavy_surface` trimmed to :func:`triangle` (three edges)."""
+    from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
+    from surfprep.plugin.occ.faces import make_face
+
+    surface = wavy_surface()
+    trim = [TrimLoop([TrimEdge(e.curve, e.pcurve, 0.0, 1.0) for e in triangle(surface)])]
+    return make_face(surface, trim)
+
+
+# ------------------------------------------------------------ crossing sheets
+# Two bent sheets cutting through each other, each overshooting the crossing (001 Fig. 7,
+# "intersecting surfaces"), and the corners of a directed patch over the crossing: the
+# geometry of tests/plugin/heal/test_cut.py and of benchmarks/heal.py.
+X_CROSS = 1.0          # the sheets cross along x = 1
+SLOPE = 0.4            # B rises with this slope beyond the crossing
+X0, X1 = 0.7, 1.3      # the patch spans these x
+
+
+def bend(x, y):
+    return 0.05 * np.sin(2 * y) + 0.03 * x ** 2
+
+
+def truth(x, y):
+    """The intended surface: A before the crossing, B after."""
+    return bend(x, y) + SLOPE * np.maximum(x - X_CROSS, 0.0)
+
+
+def sheet(x0, x1, slope):
+    x, y = np.linspace(x0, x1, 9), np.linspace(0, 1, 6)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    return interpolate_surface(np.stack([gx, gy, bend(gx, gy) + slope * (gx - X_CROSS)], -1))
+
+
+def compound(shapes):
+    """A compound of the faces."""
+    from surfprep.plugin.io import to_shape
+    return to_shape(list(shapes))
+
+
+def corners():
+    pts = [(X0, 0), (X1, 0), (X1, 1), (X0, 1)]
+    return [[x, y, float(truth(x, y))] for x, y in pts]
+
+
+def _outline(surface):
+    from surfprep.plugin.heal.cut import outline
+    return outline(surface)
+
+
+def crossings(surfaces, n=41, near=0.02) -> int:
+    """Sample points of one surface closer than ``near`` to another one away from that
+    one's outline (farther than ``2 near``): a face crossing or lying on another."""
+    count = 0
+    for i, s in enumerate(surfaces):
+        u0, u1, v0, v1 = s.domain
+        pts = s.evaluate_grid(np.linspace(u0, u1, n), np.linspace(v0, v1, n)).reshape(-1, 3)
+        for j, other in enumerate(surfaces):
+            if i == j:
+                continue
+            foot = project_to_surface(other, pts)
+            close = foot.distance < near
+            if np.any(close):
+                rim = polyline_distance(foot.points[close], _outline(other))
+                count += int(np.sum(rim > 2 * near))
+    return count

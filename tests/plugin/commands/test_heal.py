@@ -1,0 +1,115 @@
+"""``surfprep heal``: a STEP file with a 1e-3 gap in, a sewn shell out, report and plot."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from helpers.cli import run
+
+import surfprep
+from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.plugin.occ.faces import make_face
+
+
+def graph_patch(x0, x1, nu, dz):
+    x, y = np.linspace(x0, x1, nu), np.linspace(0, 1, 6)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    z = 0.3 * np.sin(1.3 * gx) * np.cos(0.9 * gy) + dz
+    return interpolate_surface(np.stack([gx, gy, z], axis=-1))
+
+
+@pytest.fixture(scope="module")
+def gap_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cli_heal") / "gap.step"
+    surfprep.write([make_face(graph_patch(0, 1, 6, 0.0)), make_face(graph_patch(1, 2, 8, 1e-3))],
+                   path)
+    return path
+
+
+def test_heal_gap_file(gap_file, tmp_path, capsys):
+    out, report, plot = tmp_path / "healed.step", tmp_path / "r.json", tmp_path / "d.png"
+    code, stdout, err = run(capsys, "heal", gap_file, "-o", out, "--continuity", "G1",
+                            "--json", report, "--plot", plot)
+    assert code == 0, err
+    assert "2 approximant(s)" in stdout and "valid True -> True" in stdout
+    rep = json.loads(report.read_text())
+    assert rep["continuity"] == "G1" and len(rep["shared_edges"]) == 1
+    edge = rep["shared_edges"][0]
+    assert edge["max_gap"] < 1e-12 and edge["max_angle_deg"] < 1e-2
+    assert rep["shared_edges_before"][0]["max_gap"] > 9e-4
+    assert rep["free_edges"]["tight_before"] == 8 and rep["free_edges"]["tight_after"] == 6
+    for p in rep["patches"]:
+        assert set(p) >= {"resolution", "max_error", "rms_error", "artificial_share"}
+    assert plot.stat().st_size > 10_000
+    healed = surfprep.read(out)
+    assert healed.n_faces == 2
+
+
+def test_heal_errors_are_one_line(gap_file, tmp_path, capsys):
+    code, _, err = run(capsys, "heal", gap_file, "-o", gap_file)
+    assert code != 0 and "overwrite" in err and len(err.strip().splitlines()) == 1
+    bad = tmp_path / "spec.json"
+    bad.write_text("{not json")
+    code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "x.step", "--patches", bad)
+    assert code != 0 and "JSON" in err
+    code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "y.step", "--gap-tol", "-1")
+    assert code != 0 and "gap_tol" in err
+
+
+@pytest.mark.slow
+def test_heal_directed_patch_over_crossing(tmp_path, capsys):
+    # two sheets cutting through each other and a patch spec over the crossing: the
+    # faces under the patch are cut away, the summary and the JSON say how much
+    def sheet(x0, x1, slope):
+        x, y = np.linspace(x0, x1, 9), np.linspace(0, 1, 6)
+        gx, gy = np.meshgrid(x, y, indexing="ij")
+        z = 0.05 * np.sin(2 * gy) + slope * (gx - 1.0)
+        return interpolate_surface(np.stack([gx, gy, z], axis=-1))
+    src = tmp_path / "crossing.step"
+    surfprep.write([make_face(sheet(0, 1.2, 0.0)), make_face(sheet(0.8, 2, 0.4))], src)
+    z = [0.0, 0.12, 0.12 + 0.05 * np.sin(2), 0.05 * np.sin(2)]
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps({"patches": [{"name": "over", "corners": [
+        [0.7, 0, z[0]], [1.3, 0, z[1]], [1.3, 1, z[2]], [0.7, 1, z[3]]]}]}))
+    out, report = tmp_path / "healed.step", tmp_path / "r.json"
+    code, stdout, err = run(capsys, "heal", src, "-o", out, "--patches", spec,
+                            "--json", report)
+    assert code == 0, err
+    assert "directed patches cut away" in stdout and "of 2 face(s)" in stdout
+    rep = json.loads(report.read_text())
+    assert sorted(c["face"] for c in rep["cuts"]) == [0, 1]
+    assert all(0.4 < c["area_cut"] < 0.6 for c in rep["cuts"])
+    assert rep["valid"]["after"] and surfprep.read(out).n_faces == 3
+
+
+@pytest.mark.parametrize("overlap, faces_out", [("trim", 2), ("union", 1)])
+def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
+    # a strip overlap of two four-sided sheets: --overlap trim keeps two faces (the later
+    # one trimmed back), --overlap union replaces both by one approximant
+    src = tmp_path / "overlap.step"
+    surfprep.write([make_face(graph_patch(0, 1, 6, 0.0)), make_face(graph_patch(0.7, 1.7, 7, 0.0))],
+                   src)
+    out, report = tmp_path / f"{overlap}.step", tmp_path / f"{overlap}.json"
+    code, _, err = run(capsys, "heal", src, "-o", out, "--overlap", overlap, "--json", report)
+    assert code == 0, err
+    rep = json.loads(report.read_text())
+    action = "union" if overlap == "union" else "trimmed back"
+    assert [t["action"] for t in rep["trimmed_overlaps"]] == [action]
+    assert surfprep.read(out).n_faces == faces_out
+    code, _, err = run(capsys, "heal", src, "-o", tmp_path / "x.step", "--overlap", "merge")
+    assert code != 0 and "overlap" in err
+
+
+def test_heal_split_faces_option(tmp_path, capsys):
+    # a three-sided face: three sub-patches by default (--split-faces), kept as it is
+    # with --no-split-faces
+    from helpers.heal_cases import occ_triangle_face
+    src = tmp_path / "triangle.step"
+    surfprep.write([occ_triangle_face()], src)
+    for flags, faces_out in (((), 3), (("--split-faces",), 3), (("--no-split-faces",), 1)):
+        out = tmp_path / f"out{'_'.join(flags)}.step"
+        code, _, err = run(capsys, "heal", src, "-o", out, *flags)
+        assert code == 0, err
+        assert surfprep.read(out).n_faces == faces_out
