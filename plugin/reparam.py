@@ -1,4 +1,4 @@
-"""Chord-length (RCA) reparametrization of surfaces and trimmed faces (section 29.2).
+"""Chord-length (RCA) reparametrization of surfaces and trimmed faces (000 §29.2).
 
 :func:`reparametrize` is the public entry point (``surfprep.reparametrize``):
 

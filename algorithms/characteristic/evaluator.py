@@ -1,4 +1,5 @@
-"""Fast evaluation of a surface and its derivatives to second order at a few points.
+"""Fast evaluation of a surface and its derivatives to second order at a few points (for the
+tracers of the characteristic curves of 002).
 
 The curve tracers of this package evaluate both surfaces hundreds of times at
 a few dozen points each; :meth:`NurbsSurface.derivatives` spends most of such a

@@ -1,4 +1,4 @@
-"""Pairs the certificate need not examine: cheap, exact reasons why two surfaces
+"""Pairs the certificate (002 §6.3) need not examine: cheap, exact reasons why two surfaces
 can have no closed loop and no isolated contact point.
 
 The certificate (:func:`.algorithm.certify`) looks for closed loops around

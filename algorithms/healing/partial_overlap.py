@@ -1,4 +1,5 @@
-"""Faces lying partly on others (for :func:`surfprep.heal`): found and measured here, cut by
+"""Faces lying partly on others (001 §1 "overlaps", for :func:`surfprep.heal`): found and
+measured here, cut by
 :mod:`surfprep.plugin.heal.trim_back`.
 
 Two faces *overlap partially* when a part of one (B, the later) lies on the other

@@ -1,4 +1,5 @@
-"""Sides of heal's approximants fitted to the edges of faces kept as they were.
+"""Sides of heal's approximants fitted to the edges of faces kept as they were (the joins
+of 001 §8 where the neighbour is not an approximant).
 
 A side of an approximant that meets a face :func:`surfprep.heal` keeps (not
 another approximant) is fitted to that face's edge or edges

@@ -1,4 +1,5 @@
-"""Four-sided faces overlapping over a strip (for :func:`surfprep.heal`): one is trimmed back
+"""Four-sided faces overlapping over a strip (001 §1 "overlaps", for :func:`surfprep.heal`):
+one is trimmed back
 to the other, or both replaced over their union.
 
 Two four-sided faces A and B *overlap* when a side of A lies on B's surface

@@ -1,4 +1,4 @@
-"""Compiled closest points on candidate triangles (the §7 error's hot loop).
+"""Compiled closest points on candidate triangles (the hot loop of the error of 001 §7).
 
 :func:`nearest_on_candidates` gives, for every point, the nearest of its
 candidate triangles and the barycentric weights of the foot: the same

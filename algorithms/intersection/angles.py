@@ -1,4 +1,4 @@
-"""How flat a crossing the triangle method can follow at a given mesh tolerance.
+"""How flat a crossing the triangle method of 000 §29.4 can follow at a given mesh tolerance.
 
 The tessellations stray up to ``mesh_tol`` from their surfaces, so where two
 surfaces cross at the angle ``theta`` the triangles cross up to about ``2

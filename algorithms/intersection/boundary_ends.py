@@ -1,4 +1,4 @@
-"""Curve ends on a domain side, solved on that side (step 5 of :mod:`.pipeline`).
+"""Curve ends on a domain side, solved on that side (step 5 of :mod:`.pipeline`, 000 §29.4.6).
 
 An intersection curve that leaves a surface's domain ends on one of its four
 sides. The auxiliary-plane refinement (:mod:`.refine`) does not know that: it

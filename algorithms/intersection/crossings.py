@@ -1,4 +1,5 @@
-"""Graded samples where an intersection curve crosses a C1 knot line of a surface.
+"""Graded samples where an intersection curve crosses a C1 knot line of a surface (the
+sampling of 000 §29.4 step 6).
 
 A surface converted from a rational analytic one (a sphere, cylinder or torus
 as OpenCascade writes it: rational quadratic arcs) is parametrized only C1 at

@@ -1,4 +1,5 @@
-"""The auxiliary-plane iteration of :func:`.refine.refine_points`, compiled (numba).
+"""The auxiliary-plane iteration of :func:`.refine.refine_points` (000 eqs. 29.18-29.26),
+compiled (numba).
 
 Each point iterates on its own (eqs. 29.18-29.26, the same steps and order as the
 numpy loop in :mod:`.refine`), so the iteration is a true per-point loop: the

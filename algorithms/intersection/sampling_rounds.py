@@ -1,4 +1,4 @@
-"""Verification rounds of the cubic sampling (step 2 of :mod:`.sampling`).
+"""Verification rounds of the cubic sampling (step 2 of :mod:`.sampling`; 000 §29.4 step 6).
 
 Every round checks the interpolants of all unfinished curves at once: one
 collocation solve and one evaluation for all of them (:mod:`.splines`), every

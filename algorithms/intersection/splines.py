@@ -1,4 +1,5 @@
-"""Many cubic interpolants at once: one banded solve, one compiled evaluation.
+"""Many cubic interpolants at once: one banded solve, one compiled evaluation (the
+interpolants of the intersection curves of 000 §29.4).
 
 The sampling rounds of :mod:`.sampling` interpolate every unfinished curve
 (:func:`.interpolants.interpolate_samples`: the C2 cubic of

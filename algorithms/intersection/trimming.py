@@ -1,4 +1,5 @@
-"""Intersection curves clipped to trimmed faces (the last step of ``surfprep.intersect``).
+"""Intersection curves clipped to trimmed faces (the last step of ``surfprep.intersect``): the
+edges of 002 §1 with their images in both parameter domains.
 
 :func:`clip_curve` cuts a curve of two surfaces into the runs inside both trimmed
 faces (:class:`~surfprep.algorithms.face_region.FaceRegion`, the one

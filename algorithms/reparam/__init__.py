@@ -1,5 +1,5 @@
 """Chord-length (RCA) reparametrization of B-spline surfaces within a
-guaranteed tolerance (Hamann, Jean, Razdan, handbook ch. 29, §29.2).
+guaranteed tolerance (000 §29.2: Hamann, Jean, Razdan, Handbook of Grid Generation ch. 29).
 
 :func:`reparametrize_surface` is the entry point; the steps live in
 :mod:`.boundary_points` (arc length + curvature, §29.2.4), :mod:`.reconcile`

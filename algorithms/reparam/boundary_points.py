@@ -1,4 +1,4 @@
-"""Boundary curves by arc length and curvature (section 29.2.4).
+"""Boundary curves by arc length and curvature (000 §29.2.4).
 
 Each boundary of the surface is an isoparametric curve of the original. Its
 interpolation points are placed in three steps:

@@ -1,4 +1,4 @@
-"""Fewer interpolation lines where the dense error leaves headroom (after section 29.2.3).
+"""Fewer interpolation lines where the dense error leaves headroom (after 000 §29.2.3).
 
 The error loop of :mod:`.rca` only ever adds grid lines, and it adds them in
 whole batches (every interval that is off gets its midpoint), so a finished fit

@@ -1,4 +1,4 @@
-"""Dense error of the approximation, eq. 29.3 (section 29.2.3), measured both ways.
+"""Dense error of the approximation, eq. 29.3 (000 §29.2.3), measured both ways.
 
 .. math:: \\max_{i,j} \\; \\min_{k,l} \\| s(u_i, v_j) - r(u_k, v_l) \\| < \\varepsilon  \\qquad (29.3)
 

@@ -1,4 +1,4 @@
-"""Interior interpolation points by relocation with a penalty factor (section 29.2.6).
+"""Interior interpolation points by relocation with a penalty factor (000 §29.2.6).
 
 The interpolation grid has ``n_u x n_v`` points; node ``(i, j)`` belongs to the
 new parameters ``(f^u_i, f^v_j)`` (the reconciled fractions). Its position is

@@ -1,4 +1,4 @@
-"""Chord-length (RCA) reparametrization of a surface within a tolerance (section 29.2).
+"""Chord-length (RCA) reparametrization of a surface within a tolerance (000 §29.2).
 
 :func:`reparametrize_surface` builds a new C2 bicubic B-spline surface ``r``
 that lies within ``tol`` of the original ``s`` (both ways, eq. 29.3) and whose

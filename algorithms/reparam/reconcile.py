@@ -1,4 +1,4 @@
-"""Reconciliation of opposite boundary curves (section 29.2.5): the RCA parametrization.
+"""Reconciliation of opposite boundary curves (000 §29.2.5): the RCA parametrization.
 
 Each boundary carries its own interpolation points, expressed as fractions of
 its arc length. For every point of one set a point at the same fraction is

@@ -1,4 +1,4 @@
-"""The interpolating spline of a relocated grid and its dense error (sections 29.2.3, 29.2.7).
+"""The interpolating spline of a relocated grid and its dense error (000 §29.2.3, §29.2.7).
 
 Shared by the error loop of :mod:`.rca` and the coarsening of :mod:`.coarsen`:
 crease lines of the grid become triple knots (C0) joining not-a-knot cubic

@@ -1,4 +1,4 @@
-"""The approximants :func:`surfprep.heal` builds, planned and built.
+"""The approximants :func:`surfprep.heal` builds (001, 003), planned and built.
 
 :func:`plan_jobs` lists one :class:`Job` per face to replace (its own four edges,
 its strip-trimmed boundary, or its four-sided sub-patches,

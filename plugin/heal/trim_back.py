@@ -1,4 +1,4 @@
-"""Faces lying partly on others, trimmed back (for :func:`surfprep.heal`).
+"""Faces lying partly on others, trimmed back (001 §1 "overlaps", for :func:`surfprep.heal`).
 
 Two faces *overlap partially* when a part of one (B, the later) lies on the
 other (A) within ``gap_tol``, and the part is neither the whole of B (an exact
