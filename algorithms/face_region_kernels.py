@@ -25,7 +25,8 @@ __all__ = ["ray_crossings", "ray_crossings_numpy"]
 
 
 @jit
-def _ray_crossings_kernel(uv, a, b, lo, hi, width, bins, seg_sorted, indptr, out):  # pragma: no cover - compiled
+def _ray_crossings_kernel(uv, a, b, lo, hi, width, bins, seg_sorted,  # pragma: no cover - compiled
+                          indptr, out):
     for i in range(uv.shape[0]):
         pu, pv = uv[i, 0], uv[i, 1]
         count = 0

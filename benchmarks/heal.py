@@ -56,14 +56,13 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from OCP.BRep import BRep_Builder
 from OCP.BRepOffsetAPI import BRepOffsetAPI_MakeFilling
 from OCP.GeomAbs import GeomAbs_C0, GeomAbs_G1
 from OCP.GeomFill import GeomFill_BSplineCurves, GeomFill_CoonsStyle
 from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
-from OCP.TopoDS import TopoDS, TopoDS_Compound
+from OCP.TopoDS import TopoDS
 
 import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
@@ -72,7 +71,7 @@ from surfprep.plugin.convert import to_nurbs
 from surfprep.plugin.occ.edges import edge_to_nurbs
 from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.occ.geom import curve_to_occ, surface_from_occ
-from surfprep.plugin.occ.shapes import count_free_edges, is_valid, max_edge_tolerance, sew
+from surfprep.plugin.occ.shapes import compound, count_free_edges, is_valid, max_edge_tolerance, sew
 
 
 def graph(x, y):
@@ -83,15 +82,6 @@ def graph_patch(x0, x1, y0, y1, nu=6, nv=6, dz=0.0):
     x, y = np.linspace(x0, x1, nu), np.linspace(y0, y1, nv)
     gx, gy = np.meshgrid(x, y, indexing="ij")
     return interpolate_surface(np.stack([gx, gy, graph(gx, gy) + dz], axis=-1))
-
-
-def compound(shapes):
-    out = TopoDS_Compound()
-    b = BRep_Builder()
-    b.MakeCompound(out)
-    for s in shapes:
-        b.Add(out, s)
-    return out
 
 
 def edges_of(face):
@@ -354,8 +344,8 @@ def _crease_angle(cross) -> float:
 
 def table1_rows() -> list[str]:
     from surfprep.algorithms.healing import corners_boundary, local_approximant
-    from surfprep.plugin.occ.faces import face_to_nurbs
     from surfprep.plugin.heal.cut import boundary_on_faces
+    from surfprep.plugin.occ.faces import face_to_nurbs
     cross = _crossing()
     a, b = cross.sheet(0.0, 1.2, 0.0), cross.sheet(0.8, 2.0, cross.SLOPE)
     tfs = [face_to_nurbs(make_face(a)), face_to_nurbs(make_face(b))]

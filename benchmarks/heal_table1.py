@@ -32,6 +32,7 @@ from helpers.heal_cases import (
     stepped_gap,
     surrounding_patches,
 )
+
 from surfprep.algorithms.healing import Interpolant, local_approximant
 from surfprep.algorithms.projection import distance_to_surface
 

@@ -45,8 +45,8 @@ from surfprep.algorithms.intersection import (
     intersect_surfaces,
 )
 from surfprep.algorithms.projection import distance_to_surface
-from surfprep.plugin.occ.geom import surface_from_occ
 from surfprep.plugin.intersect import intersect
+from surfprep.plugin.occ.geom import surface_from_occ
 from surfprep.plugin.occ_reference import intersect_surfaces_occ, section_faces_occ
 
 ROOT = Path(__file__).resolve().parents[1]

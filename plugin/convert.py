@@ -16,8 +16,8 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
-from ..errors import ConversionError
 from ..algorithms.trimmed import TrimmedFace
+from ..errors import ConversionError
 from .io import CadModel
 from .occ.edges import edge_to_nurbs
 from .occ.faces import face_to_nurbs, trimmed_face_to_occ

@@ -38,9 +38,8 @@ from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
-from ..errors import (ConversionError, InputFileError, NoFacesError, OpenCascadeError,
-                      OutputFileError)
 from ..algorithms.trimmed import TrimmedFace
+from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from .occ.edges import make_edge
 from .occ.faces import make_face, trimmed_face_to_occ
 from .occ.shapes import FaceNames, all_faces, compound

@@ -45,8 +45,8 @@ from ..algorithms.fitting import interpolate_curve, knots_from_breakpoints
 from ..algorithms.projection import project_to_surface
 from ..algorithms.reparam import ReparametrizationResult, reparametrize_surface
 from ..algorithms.reparam.deviation import inverse_map
-from ..errors import ConversionError, InvalidGeometryError, OpenCascadeError
 from ..algorithms.trimmed import DEFAULT_TOLERANCE, TrimEdge, TrimmedFace
+from ..errors import ConversionError, InvalidGeometryError, OpenCascadeError
 from .convert import unwrap
 from .occ.edges import read_trim_edge
 from .occ.faces import checked_or_fixed, face_to_nurbs, trimmed_face_to_occ

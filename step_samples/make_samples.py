@@ -22,8 +22,8 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
 from OCP.gp import gp_Ax3, gp_Cylinder, gp_Dir, gp_Pln, gp_Pnt
 
 from surfprep.algorithms import NurbsSurface
-from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.io import CadModel, write
+from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.step_iges import _compound
 
 OUTPUT = Path(__file__).resolve().parent / "synthetic_named_faces.step"

@@ -82,7 +82,8 @@ def _apart(a: NurbsSurface, b: NurbsSurface, tol: float) -> bool:
     hold the Bézier boxes) are descended as grid trees first and exact Bézier boxes
     extracted only for the candidate pairs, so a large surface far from most of the
     other costs little."""
-    if patch_rectangles(a).shape[0] * patch_rectangles(b).shape[0] <= _DIRECT_PAIRS:     # small nets: all pairs at once
+    # small nets: all pairs at once
+    if patch_rectangles(a).shape[0] * patch_rectangles(b).shape[0] <= _DIRECT_PAIRS:
         ba, bb = surface_patch_boxes(a)[0], surface_patch_boxes(b)[0]
         return not bool(np.all((ba[:, None, 0] <= bb[None, :, 1] + tol)
                                & (bb[None, :, 0] <= ba[:, None, 1] + tol), axis=-1).any())

@@ -11,12 +11,13 @@ only scattered pieces with gaps (000 §29.4.3 handles crossings, not contact).
 Such a stretch is found here directly on the side: the side curve is sampled
 densely (``SIDE_SAMPLES_PER_SPAN`` per knot span), every sample projected onto
 the other surface, and runs of consecutive samples within ``tol / 8`` of it
-become curves (their points halfway to the feet: within ``tol / 16`` of both). Each run's ends are located by bisection along the side
-(where the side leaves the other surface), and every sample keeps its side
-parameter exactly: the side curve is the intersection there, so no refinement
-is needed (nor possible: the auxiliary-plane step would slide the points into
-the domain; the constrained solve of a point on a side has a one-parameter
-family of solutions along a side that lies on the other surface).
+become curves (their points halfway to the feet: within ``tol / 16`` of both).
+Each run's ends are located by bisection along the side (where the side leaves
+the other surface), and every sample keeps its side parameter exactly: the side
+curve is the intersection there, so no refinement is needed (nor possible: the
+auxiliary-plane step would slide the points into the domain; the constrained
+solve of a point on a side has a one-parameter family of solutions along a side
+that lies on the other surface).
 
 Only sides on which the traced soup has an end are examined, so pairs that
 cross transversally pay nothing.

@@ -32,10 +32,10 @@ import surfprep
 
 from ...algorithms import NurbsSurface
 from ...errors import ConversionError, InputFileError, OutputFileError, SurfprepError
+from ..io import CadModel, read, write
 from ..occ.faces import face_to_nurbs, make_face, trimmed_face_to_occ
 from ..occ.geom import surface_from_occ, surface_to_occ
 from ..occ.shapes import compound, face_area
-from ..io import CadModel, read, write
 from ..occ_reference import evaluate_surface
 from .base import Command, Console, refuse_overwriting_inputs, write_json_report
 from .info import SPLINE_KINDS, SurfaceKind, format_table, model_report, surface_kind

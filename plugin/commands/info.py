@@ -17,9 +17,9 @@ from OCP.TopoDS import TopoDS_Face
 
 from ...algorithms.parametrization import parametrization_quality
 from ...errors import OpenCascadeError
+from ..io import CadModel, bounding_box, read
 from ..occ.geom import surface_from_occ
 from ..occ.shapes import face_area
-from ..io import CadModel, bounding_box, read
 from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
 
 __all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",

@@ -18,12 +18,13 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
 3. every four-sided face (one loop of four real edges, trimmed or not) gets a
    :func:`~surfprep.algorithms.healing.local_approximant` over its own four
    edges, projected onto all original faces (trimmed faces as the part inside
-   their loops, :func:`~surfprep.algorithms.healing.clipping.face_source`; the face itself preferred over other faces crossing
-   the segments; a face whose approximant misses ``tol`` at the largest
-   resolution is kept as it is, and the report says so); a face that is not
-   four-sided is split into four-sided sub-patches (``split_faces``, default) and
-   replaced when all of them fit; every hole one over its four free edges (a loop whose patch lands on faces, e.g. the mouth of
-   a slot, is no hole and stays open);
+   their loops, :func:`~surfprep.algorithms.healing.clipping.face_source`; the
+   face itself preferred over other faces crossing the segments; a face whose
+   approximant misses ``tol`` at the largest resolution is kept as it is, and
+   the report says so); a face that is not four-sided is split into four-sided
+   sub-patches (``split_faces``, default) and replaced when all of them fit;
+   every hole one over its four free edges (a loop whose patch lands on faces,
+   e.g. the mouth of a slot, is no hole and stays open);
 4. the approximants are joined by :func:`~surfprep.algorithms.healing.connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
    as it was (not re-approximated) is fitted to that face's edge or edges, or

@@ -22,8 +22,12 @@ reported and left (the slab would cover the part trimmed away).
 from __future__ import annotations
 
 from ...algorithms.healing.adjacency import duplicate_faces, face_edges, pair_edges
-from ...algorithms.healing.partial_overlap import (PartialOverlap, overlap_area, overlap_share,
-                                                   partial_overlap_pairs)
+from ...algorithms.healing.partial_overlap import (
+    PartialOverlap,
+    overlap_area,
+    overlap_share,
+    partial_overlap_pairs,
+)
 from ...algorithms.trimmed import TrimmedFace, is_natural
 from ...errors import OpenCascadeError
 from .cut import cut_faces, outline, read_faces, rebuilt_model, replace_pieces, slab
@@ -100,7 +104,8 @@ def trim_overlaps_of(work, faces: list[TrimmedFace | None], *, gap_tol: float, t
                      skipped: list[str]):
     """:func:`trim_partial_overlaps` over the readable faces of ``work`` that are no
     duplicates (:func:`duplicate_faces`, dropped later); strips (:func:`is_strip`) are
-    left to :func:`surfprep.algorithms.healing.strip_overlap.find_overlaps`. Returns ``(model, faces, overlaps)``."""
+    left to :func:`surfprep.algorithms.healing.strip_overlap.find_overlaps`. Returns
+    ``(model, faces, overlaps)``."""
     edges = face_edges(faces)
     twins = {b for _, b in duplicate_faces(faces, edges, pair_edges(edges, gap_tol), gap_tol)}
     readable = [i for i, f in enumerate(faces) if f is not None and i not in twins]

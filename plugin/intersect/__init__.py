@@ -59,7 +59,15 @@ from ...algorithms.characteristic import CharacteristicRecord
 from ...algorithms.intersection import IntersectionCurve, along_a_boundary, clip_curve, closed_in_space
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..occ.edges import make_edge
-from .methods import CoincidentFaces, ContactPoint, FoundBy, IntersectionResult, Method, PairRecord, pair_curves
+from .methods import (
+    CoincidentFaces,
+    ContactPoint,
+    FoundBy,
+    IntersectionResult,
+    Method,
+    PairRecord,
+    pair_curves,
+)
 from .operands import FaceOperand, face_operands
 
 __all__ = [

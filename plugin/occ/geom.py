@@ -14,8 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from OCP.Geom import (Geom_BSplineCurve, Geom_BSplineSurface, Geom_Curve,
-                      Geom_RectangularTrimmedSurface, Geom_Surface, Geom_TrimmedCurve)
+from OCP.Geom import (
+    Geom_BSplineCurve,
+    Geom_BSplineSurface,
+    Geom_Curve,
+    Geom_RectangularTrimmedSurface,
+    Geom_Surface,
+    Geom_TrimmedCurve,
+)
 from OCP.Geom2d import Geom2d_BSplineCurve, Geom2d_Curve, Geom2d_TrimmedCurve
 from OCP.Geom2dConvert import Geom2dConvert
 from OCP.GeomConvert import GeomConvert

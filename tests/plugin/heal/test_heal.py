@@ -11,8 +11,6 @@ import json
 
 import numpy as np
 import pytest
-from OCP.BRep import BRep_Builder
-from OCP.TopoDS import TopoDS_Compound
 
 import surfprep
 from surfprep.algorithms.fitting import interpolate_surface
@@ -22,6 +20,7 @@ from surfprep.plugin.convert import to_nurbs
 from surfprep.plugin.heal import heal
 from surfprep.plugin.io import CadModel
 from surfprep.plugin.occ.faces import make_face
+from surfprep.plugin.occ.shapes import compound
 
 
 def graph(x, y):
@@ -37,15 +36,6 @@ def graph_patch(x0, x1, y0, y1, nu=6, nv=6, dz=0.0, flip_u=False, swap=False):
     if swap:
         net = np.swapaxes(net, 0, 1)
     return interpolate_surface(net)
-
-
-def compound(faces):
-    out = TopoDS_Compound()
-    builder = BRep_Builder()
-    builder.MakeCompound(out)
-    for f in faces:
-        builder.Add(out, f)
-    return out
 
 
 def deviation_from_graph(result) -> float:

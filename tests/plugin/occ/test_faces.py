@@ -228,7 +228,8 @@ def test_real_trimmed_faces(data_shapes, name):
         assert np.max(np.abs(ours - ref)) <= 1e-12 * size
         # pcurves convert exactly: surfprep's S(pcurve(t)) equals OCC's
         for edge, occ_edge in zip(tf.edges, _occ_edges_in_order(face)):
-            pcurve_occ = BRep_Tool.CurveOnSurface_s(occ_edge, TopoDS.Face_s(face.Oriented(TopAbs_FORWARD)), 0.0, 0.0)
+            forward = TopoDS.Face_s(face.Oriented(TopAbs_FORWARD))
+            pcurve_occ = BRep_Tool.CurveOnSurface_s(occ_edge, forward, 0.0, 0.0)
             t = np.linspace(edge.t0, edge.t1, 17)
             uv_ref = evaluate_curve(pcurve_occ, t, 0)[:, 0]
             assert np.max(np.abs(edge.pcurve.evaluate(t) - uv_ref)) <= 1e-12 * (1 + np.max(np.abs(uv_ref)))
