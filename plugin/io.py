@@ -40,6 +40,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
+from ..inputs import ShapeLike
 from .occ.edges import make_edge
 from .occ.faces import make_face, trimmed_face_to_occ
 from .occ.shapes import FaceNames, all_faces, compound
@@ -271,7 +272,7 @@ def _healed(model: CadModel) -> CadModel:
 
 
 # ==================================================================== write
-def write(obj: Any, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+def write(obj: ShapeLike, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
     """Write geometry to a STEP or IGES file, atomically.
 
     Parameters
@@ -375,7 +376,7 @@ def new_file_mode() -> int:
 
 
 # ========================================================== object -> shape
-def to_shape(obj: Any) -> TopoDS_Shape:
+def to_shape(obj: ShapeLike) -> TopoDS_Shape:
     """One ``TopoDS_Shape`` for anything :func:`write` accepts (lists become a compound)."""
     if isinstance(obj, CadModel):
         return obj.shape

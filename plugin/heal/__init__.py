@@ -67,6 +67,7 @@ from ...algorithms.projection import project_to_surface
 from ...algorithms.tolerance import check_tolerance
 from ...algorithms.trimmed import TrimmedFace
 from ...errors import InvalidGeometryError, SurfprepError
+from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs, make_face
 from ..occ.shapes import FaceNames, all_faces, count_free_edges, is_valid, max_edge_tolerance, sew
@@ -255,7 +256,7 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 
 
 # ---------------------------------------------------------------------- heal
-def heal(shape: Any, *, tol: float | None = None, continuity: Continuity | str = "G0",
+def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.

@@ -50,7 +50,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -58,6 +57,7 @@ from numpy.typing import NDArray
 from ...algorithms.characteristic import CharacteristicRecord
 from ...algorithms.intersection import IntersectionCurve, along_a_boundary, clip_curve, closed_in_space
 from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...inputs import ShapeLike
 from ..occ.edges import make_edge
 from .methods import (
     CoincidentFaces,
@@ -182,7 +182,7 @@ def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOper
     return out
 
 
-def intersect(a: Any, b: Any = None, *, tol: float | None = None,
+def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = None,
               mesh_tol: float | None = None, method: Method | str = Method.AUTO,
               progress: Callable[[int, int], None] | None = None) -> IntersectionResult:
     """Intersection curves of the faces of ``a`` with those of ``b`` (or among ``a``'s).

@@ -22,6 +22,7 @@ from ...algorithms import NurbsSurface
 from ...algorithms.face_region import FaceRegion
 from ...algorithms.trimmed import TrimmedFace
 from ...errors import OpenCascadeError
+from ...inputs import ShapeLike
 from ..convert import to_nurbs, unwrap
 from ..io import CadModel
 from ..occ.faces import make_face, needs_nurbs_convert, trimmed_face_to_occ
@@ -105,6 +106,6 @@ def _as_faces(x: Any) -> list[tuple[TrimmedFace, TopoDS_Face | None]]:
     return _as_faces(converted)
 
 
-def face_operands(x: Any) -> list[FaceOperand]:
+def face_operands(x: ShapeLike) -> list[FaceOperand]:
     """The faces of anything :func:`intersect` accepts, numbered in order."""
     return [FaceOperand(i, t, f) for i, (t, f) in enumerate(_as_faces(x))]
