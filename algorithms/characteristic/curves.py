@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from . import trace_kernels
+from . import curves_kernels
 from .distance import DistanceField, DistanceJet
 from .projector import Projection, ProjectionStatus
 
@@ -247,7 +247,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
         curves read only for sign changes (characteristic curves) take a
         looser one: their crossings are refined by Newton afterwards.
     compiled : bool, optional
-        Trace by :mod:`.trace_kernels` (the same steps in one numba call); default
+        Trace by :mod:`.curves_kernels` (the same steps in one numba call); default
         whenever numba is there. False: the batched numpy form (the reference).
 
     Returns
@@ -263,7 +263,7 @@ def trace_curves(field: DistanceField, kind: CurveKind | list[CurveKind], uv0: N
     h_min = 1e-9 * diag if h_min is None else h_min
     ctol = 1e-7 * diag if ctol is None else ctol
     if compiled is None:
-        compiled = trace_kernels.AVAILABLE
+        compiled = curves_kernels.AVAILABLE
     if compiled:
         return _traced_compiled(field, kinds, comp_all, uv0, st0, direction, h0=h0, h_max=h_max,
                                 h_min=h_min, max_steps=max_steps, ctol=ctol, max_turn=max_turn,
@@ -354,14 +354,14 @@ def _traced_compiled(field: DistanceField, kinds: list[CurveKind], comps: NDArra
                      st0: NDArray, direction: NDArray, *, h0: float | NDArray, h_max: float,
                      h_min: float, max_steps: int, ctol: float, max_turn: float,
                      relative_ctol: float) -> list[TracedCurve]:
-    """:func:`trace_curves` by :func:`.trace_kernels.trace_compiled`."""
+    """:func:`trace_curves` by :func:`.curves_kernels.trace_compiled`."""
     m = comps.size
     h0 = np.broadcast_to(np.asarray(h0, dtype=float), (m,))
-    uv, st, phi, grad, det, count, reason = trace_kernels.trace_compiled(
+    uv, st, phi, grad, det, count, reason = curves_kernels.trace_compiled(
         field, comps, np.asarray(uv0, float).reshape(m, 2), np.asarray(st0, float).reshape(m, 2),
         np.asarray(direction, float).reshape(m, 2), h0=h0, h_max=h_max, h_min=h_min,
         max_steps=max_steps, ctol=ctol, max_turn=max_turn, relative_ctol=relative_ctol)
-    ends = [EndReason(name) for name in trace_kernels.REASONS]
+    ends = [EndReason(name) for name in curves_kernels.REASONS]
     return [TracedCurve(kinds[i], uv[i, :n].copy(), st[i, :n].copy(), phi[i, :n].copy(),
                         grad[i, :n].copy(), det[i, :n].copy(), EndReason.START, ends[reason[i]])
             for i, n in enumerate(count)]

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
-from . import newton_kernels
+from . import points_kernels
 from .distance import DistanceField, DistanceJet
 from .projector import ProjectionStatus
 
@@ -163,7 +163,7 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
     points (a surface of revolution cut normal to its axis: ``det H = 0`` all
     along it) instead of giving up; ``H`` below ``1e-9 hess_scale`` (``phi``
     flat) still stops the seed. ``compiled`` (default: when numba is there) runs
-    the same iterations by :mod:`.newton_kernels`; False: the batched numpy form.
+    the same iterations by :mod:`.points_kernels`; False: the batched numpy form.
 
     Returns
     -------
@@ -175,12 +175,12 @@ def critical_points(field: DistanceField, seeds: NDArray, st0: NDArray | None = 
     uv = np.array(seeds, dtype=float).reshape(-1, 2)
     st = None if st0 is None else np.array(st0, dtype=float).reshape(-1, 2)
     if compiled is None:
-        compiled = newton_kernels.AVAILABLE
+        compiled = points_kernels.AVAILABLE
     if compiled:
         if st is None:
             st = (np.zeros_like(uv) if field.projector.is_affine
                   else field.projector.seeds(field.evaluator.evaluate(uv[:, 0], uv[:, 1])))
-        uv, st, done = newton_kernels.newton_compiled(
+        uv, st, done = points_kernels.newton_compiled(
             field, uv, st, max_iter=max_iter, flat=1e-9 * hess_scale,
             degenerate=DEGENERATE_SHARE, pseudo=hess_scale > 0)
         return _distinct(field, uv, st, done, dedupe)

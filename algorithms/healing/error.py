@@ -33,7 +33,7 @@ from scipy.spatial import cKDTree
 from ..intersection.mesh import TriangleMesh
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
-from . import triangle_kernels
+from . import error_kernels
 from .clipping import ClippedTriangles, SurfaceSource
 
 __all__ = [
@@ -233,8 +233,8 @@ def _source_triangles(points: NDArray, clipped: ClippedTriangles, ids: NDArray
     k = min(_CANDIDATE_TRIANGLES, ids.size)
     _, cand = cKDTree(clipped.points[ids].mean(axis=1)).query(points, k=k)
     cand = ids[cand.reshape(k_pts, k)]
-    if triangle_kernels.AVAILABLE:
-        dist, pick, bary = triangle_kernels.nearest_on_candidates(points, clipped.points, cand)
+    if error_kernels.AVAILABLE:
+        dist, pick, bary = error_kernels.nearest_on_candidates(points, clipped.points, cand)
     else:                               # pragma: no cover - numba is installed in CI
         dist, pick, bary = _nearest_numpy(points, clipped.points, cand)
     chosen = cand[np.arange(k_pts), pick]
@@ -244,7 +244,7 @@ def _source_triangles(points: NDArray, clipped: ClippedTriangles, ids: NDArray
 
 def _nearest_numpy(points: NDArray, tri: NDArray, cand: NDArray
                    ) -> tuple[NDArray, NDArray, NDArray]:
-    """:func:`.triangle_kernels.nearest_on_candidates` by :func:`closest_on_triangles`."""
+    """:func:`.error_kernels.nearest_on_candidates` by :func:`closest_on_triangles`."""
     k_pts, k = cand.shape
     rows = np.repeat(np.arange(k_pts), k)
     foot, bary = closest_on_triangles(points[rows], tri[cand.ravel()])

@@ -154,16 +154,16 @@ def test_saddle_on_the_intersection_is_a_double_point():
 
 @pytest.mark.parametrize("pair", ["degree six", "torus ridge"])
 def test_compiled_critical_newton_matches_the_numpy_form(pair):
-    """newton_kernels runs critical_points' Newton seed by seed: the same points (plain
+    """points_kernels runs critical_points' Newton seed by seed: the same points (plain
     step on the degree-6 pair; pseudo-inverse steps onto the torus's ridge of
     critical points, where det H = 0 all along the top circle)."""
     from helpers.surfaces import degree_six_pair, torus_and_plane
 
-    from surfprep.algorithms.characteristic import newton_kernels
+    from surfprep.algorithms.characteristic import points_kernels
     from surfprep.algorithms.characteristic.grid import choose_field, field_grid
     from surfprep.algorithms.characteristic.points import grid_seeds
 
-    assert newton_kernels.AVAILABLE                # numba is a declared dependency
+    assert points_kernels.AVAILABLE                # numba is a declared dependency
     a, b = degree_six_pair() if pair == "degree six" else torus_and_plane(1e-3)
     field = choose_field(a, b, tol=1e-9)
     grid, shape = field_grid(field)

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from surfprep.algorithms.healing import triangle_kernels
+from surfprep.algorithms.healing import error_kernels
 from surfprep.algorithms.healing.error import _nearest_numpy
 
 
 def test_numba_is_available():
-    assert triangle_kernels.AVAILABLE
+    assert error_kernels.AVAILABLE
 
 
 def test_compiled_equals_numpy_on_random_and_degenerate_triangles():
@@ -21,7 +21,7 @@ def test_compiled_equals_numpy_on_random_and_degenerate_triangles():
     cand = rng.integers(0, 60, size=(500, 12))
     cand[:, 0] = 5
     cand[:, 1] = 6
-    d, pick, bary = triangle_kernels.nearest_on_candidates(points, tri, cand)
+    d, pick, bary = error_kernels.nearest_on_candidates(points, tri, cand)
     d_ref, pick_ref, bary_ref = _nearest_numpy(points, tri, cand)
     np.testing.assert_allclose(d, d_ref, rtol=1e-12, atol=1e-14)
     np.testing.assert_array_equal(pick, pick_ref)

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..jit import jit
-from .trace_kernels import AVAILABLE, buffers, jet, kernel_arguments
+from .curves_kernels import AVAILABLE, buffers, jet, kernel_arguments
 
 __all__ = ["AVAILABLE", "newton_compiled"]
 

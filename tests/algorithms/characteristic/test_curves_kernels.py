@@ -1,4 +1,4 @@
-"""The compiled tracer (trace_kernels.py) takes the same steps as the numpy reference
+"""The compiled tracer (curves_kernels.py) takes the same steps as the numpy reference
 (curves.trace_curves(compiled=False)): the same samples, feet and end reasons for
 the three kinds of curve, on a polynomial and a rational pair, with sides reached
 (pinned steps), closed loops and projection losses among them."""
@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from helpers.surfaces import degree_six_pair, several_bumps, sphere_and_plane, torus_and_plane
 
-from surfprep.algorithms.characteristic import CurveKind, EndReason, trace_curves, trace_kernels
+from surfprep.algorithms.characteristic import CurveKind, EndReason, curves_kernels, trace_curves
 from surfprep.algorithms.characteristic.algorithm import choose_field
 
 
 def test_compiled_kernels_are_available():
     # numba is a declared dependency: without it the numpy fallbacks would run
     # silently and the comparisons below would compare a form with itself
-    assert trace_kernels.AVAILABLE
+    assert curves_kernels.AVAILABLE
 
 
 def _pairs():
