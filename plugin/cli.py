@@ -5,8 +5,10 @@ to add one). This module builds the parser from that list, dispatches, and turns
 failures into exit codes:
 
 * 0 success;
-* 1 an unexpected internal error (one line; the traceback with ``--debug``), or
-  a check a command reports as failed;
+* 1 done with faces skipped (an entity the reader did not translate, a face a
+  command could not process: each said on stderr), a check a command reports as
+  failed, or an unexpected internal error (one line; the traceback with
+  ``--debug``);
 * 2 a usage error (argparse) or an expected failure
   (:class:`~surfprep.errors.SurfprepError`: bad input file, refused output...),
   printed as one line ``surfprep: error: <message>`` on stderr.
@@ -26,6 +28,7 @@ from collections.abc import Sequence
 
 from ..errors import SurfprepError
 from .commands import COMMANDS, Console
+from .occ.failures import describe, is_occ_failure
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAILURE", "EXIT_ERROR"]
 
@@ -49,8 +52,10 @@ examples:
   surfprep demo -o out/                the whole pipeline on a bundled sample
   surfprep COMMAND --help              options of one command
 
-exit codes: 0 ok, 1 internal error or failed check, 2 bad usage or input/output
-error (one line on stderr; add --debug for a traceback).
+exit codes: 0 done; 1 done with faces skipped (entities the reader did not
+translate, faces a command could not process; each said on stderr) or an internal
+error; 2 nothing done: bad usage or an input/output error (one line on stderr; add
+--debug for a traceback).
 Progress ("face 12/255") goes to stderr when it is a terminal or with --progress."""
 
 
@@ -72,6 +77,9 @@ def _common_options(defaults: bool) -> argparse.ArgumentParser:
                        help="show the Python traceback of an error")
     group.add_argument("--progress", action="store_true", default=default(None),
                        help="report progress on stderr even when it is not a terminal")
+    group.add_argument("--strict", action="store_true", default=default(False),
+                       help="an entity of an input file that OpenCascade does not translate "
+                            "is an error (exit 2), not a warning")
     return parent
 
 
@@ -143,6 +151,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `surfprep info x.step | head`
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the CLI's last line of defence
+        if is_occ_failure(exc):   # an OpenCascade exception no command turned into ours
+            if args.debug:
+                traceback.print_exc(file=err)
+            print(f"{PROG}: error: OpenCascade failed: {describe(exc)}", file=err)
+            return EXIT_ERROR
         if args.debug:
             traceback.print_exc(file=err)
             print(f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)}", file=err)

@@ -1,9 +1,12 @@
 """Reading and writing STEP and IGES files: :func:`read`, :func:`write`, :class:`CadModel`.
 
 ``read`` checks the file before OpenCascade sees it (exists, is a regular file,
-not empty, extension known, content matches the extension, not truncated), then
+not empty, extension known, content matches the extension, not truncated, no
+dangling reference or non-finite number: :mod:`.content_checks`), then
 translates it through XDE to keep face names and colours (plain readers as a
-fallback) and refuses a file without faces. Every failure is one of the package
+fallback), in a child process so that a reader crashing or hanging on a corrupt
+file cannot take the caller down (:mod:`.isolation`), and refuses a file without
+faces. Every failure is one of the package
 exceptions (:mod:`surfprep.errors`) with a one-line message naming the file.
 
 ``write`` converts what it is given (a :class:`CadModel`, OCC shapes,
@@ -23,6 +26,7 @@ to derive tolerances.
 
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 from collections.abc import Iterable
@@ -31,20 +35,24 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any
 
+from OCP.BinTools import BinTools, BinTools_FormatVersion
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
 from OCP.ShapeFix import ShapeFix_Shape
-from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike
+from . import isolation
+from .content_checks import content_problems
+from .dropped import DroppedEntity
 from .occ.edges import make_edge
 from .occ.faces import make_face, trimmed_face_to_occ
+from .occ.failures import describe, is_occ_failure
 from .occ.shapes import FaceNames, all_faces, compound
-from .step_iges import FileFormat, Rgb, TranslationError, read_file, write_file
+from .step_iges import FileFormat, Rgb, TranslatedModel, TranslationError, read_file, write_file
 
 __all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "bounding_box", "sniff_format"]
 
@@ -55,6 +63,9 @@ _HEAD_BYTES = 4096
 _TAIL_BYTES = 2048
 _STEP_MAGIC = b"ISO-10303-21"
 _STEP_TRAILER = b"END-ISO-10303-21"
+#: seconds an isolated translation may take (the largest file of the test data, 4 MB,
+#: reads in about 1 s)
+DEFAULT_READ_TIMEOUT = 120.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +88,11 @@ class CadModel:
     path : Path or None
         The file read, resolved; None for a model built in memory.
     file_format : FileFormat or None
+    dropped : tuple of DroppedEntity
+        Entities of the file the translation produced no shape for (a face lost,
+        :mod:`.dropped`); empty for a model built in memory.
+    translation_notes : tuple of (str, str, int)
+        OCCT's other messages while reading, ``(entity type, message, count)``.
     """
 
     shape: TopoDS_Shape
@@ -87,6 +103,8 @@ class CadModel:
     path: Path | None = None
     file_format: FileFormat | None = None
     model_unit: str = field(default=MODEL_UNIT)
+    dropped: tuple[DroppedEntity, ...] = ()
+    translation_notes: tuple[tuple[str, str, int], ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.faces)
@@ -127,15 +145,18 @@ def bounding_box(shape: TopoDS_Shape) -> tuple[float, float, float, float, float
     box = Bnd_Box()
     try:
         BRepBndLib.AddOptimal_s(shape, box, False, False)
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"bounding box computation failed: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"bounding box computation failed: {describe(exc)}") from exc
     if box.IsVoid():
         raise OpenCascadeError("the shape has an empty bounding box")
     return tuple(float(x) for x in box.Get())
 
 
 # ===================================================================== read
-def read(path: str | os.PathLike, *, heal: bool = False) -> CadModel:
+def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
+         timeout: float = DEFAULT_READ_TIMEOUT) -> CadModel:
     """Read a STEP (.step/.stp) or IGES (.igs/.iges) file.
 
     Parameters
@@ -144,31 +165,88 @@ def read(path: str | os.PathLike, *, heal: bool = False) -> CadModel:
     heal : bool
         Run OpenCascade's generic ``ShapeFix_Shape`` on the result (face names
         and colours follow the faces it keeps).
+    isolate : bool
+        Translate in a child process (:mod:`.isolation`, the default): OCCT's
+        readers can crash (SIGSEGV) or hang on corrupt files, and a caller's
+        process must survive them. The child is forked (a few milliseconds, no
+        second import) and sends the shape back in OCCT's binary format, exactly.
+        False translates in this process (where ``fork`` is unavailable it always
+        does).
+    timeout : float
+        Seconds the isolated translation may take before it is killed.
 
     Raises
     ------
     InputFileError
         Missing file, a directory, empty file, unknown extension, content of the
-        other format (a STEP file named .igs), truncated or unreadable file.
+        other format (a STEP file named .igs), truncated or unreadable file, a
+        reader that crashed or did not finish within ``timeout``.
     NoFacesError
         The file was read but holds no face.
     """
     file = Path(path)
     fmt = _check_input_file(file)
-    try:
-        translated = read_file(file, fmt)
-    except TranslationError as exc:
-        raise InputFileError(f"cannot read {fmt.value} file {file}: {exc}") from None
-    except Standard_Failure as exc:
-        raise InputFileError(
-            f"cannot read {fmt.value} file {file}: OpenCascade failed: {exc}") from None
+    if isolate and isolation.AVAILABLE:
+        translated = _translate_isolated(file, fmt, timeout)
+    else:
+        translated = _translate(file, fmt)
     if not translated.faces:
         kind = translated.shape.ShapeType().name.removeprefix("TopAbs_").lower()
         raise NoFacesError(f"{fmt.value} file {file} holds no faces (OpenCascade read it "
                            f"as a {kind} without faces)")
     model = CadModel(translated.shape, translated.faces, translated.face_names,
-                     translated.face_colors, translated.length_unit, file.resolve(), fmt)
+                     translated.face_colors, translated.length_unit, file.resolve(), fmt,
+                     dropped=translated.checks.dropped,
+                     translation_notes=translated.checks.notes)
     return _healed(model) if heal else model
+
+
+def _translate(file: Path, fmt: FileFormat) -> TranslatedModel:
+    """OCCT's translation of the file, its failures as :class:`InputFileError`."""
+    try:
+        return read_file(file, fmt)
+    except TranslationError as exc:
+        raise InputFileError(f"cannot read {fmt.value} file {file}: {exc}") from None
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise InputFileError(
+            f"cannot read {fmt.value} file {file}: OpenCascade failed: {describe(exc)}") from None
+
+
+def _portable(file: Path, fmt: FileFormat) -> dict:
+    """In the child: the translation as plain data (the shape in OCCT's binary format)."""
+    translated = _translate(file, fmt)
+    stream = io.BytesIO()
+    BinTools.Write_s(translated.shape, stream, False, False,
+                     BinTools_FormatVersion.BinTools_FormatVersion_CURRENT)
+    return {"shape": stream.getvalue(), "n_faces": len(translated.faces),
+            "face_names": translated.face_names, "face_colors": translated.face_colors,
+            "length_unit": translated.length_unit, "used_xde": translated.used_xde,
+            "checks": translated.checks}
+
+
+def _translate_isolated(file: Path, fmt: FileFormat, timeout: float) -> TranslatedModel:
+    """:func:`_translate` in a child process (:func:`.isolation.call_isolated`)."""
+    what = f"{fmt.value} file {file}"
+    try:
+        data = isolation.call_isolated(_portable, file, fmt, timeout=timeout)
+    except isolation.ChildCrashed as exc:
+        how = f"crashed ({exc.signal_name})" if exc.signal_name else f"died ({exc})"
+        raise InputFileError(f"cannot read {what}: OpenCascade's reader {how}; the file "
+                             "is corrupt or holds what the reader cannot handle") from None
+    except isolation.ChildTimedOut:
+        raise InputFileError(f"cannot read {what}: OpenCascade's reader did not finish within "
+                             f"{timeout:g} s (stopped); the file is corrupt or far larger "
+                             "than it looks") from None
+    shape = TopoDS_Shape()
+    BinTools.Read_s(shape, io.BytesIO(data["shape"]))
+    faces = all_faces(shape)
+    if len(faces) != data["n_faces"]:
+        raise OpenCascadeError(f"reading {what}: {data['n_faces']} faces translated, "
+                               f"{len(faces)} came back from the reading process")
+    return TranslatedModel(shape, faces, tuple(data["face_names"]), tuple(data["face_colors"]),
+                           data["length_unit"], data["used_xde"], data["checks"])
 
 
 def _check_input_file(file: Path) -> FileFormat:
@@ -205,6 +283,12 @@ def _check_input_file(file: Path) -> FileFormat:
     if not _has_trailer(content, tail):
         raise InputFileError(
             f"{fmt.value} file {file} is truncated (no {_format_trailer(fmt)} at its end)")
+    try:
+        problems = content_problems(file.read_bytes(), fmt.value)
+    except OSError as exc:
+        raise InputFileError(f"cannot read input file {file}: {exc.strerror or exc}") from None
+    if problems:
+        raise InputFileError(f"{fmt.value} file {file} is corrupt: " + "; ".join(problems))
     return fmt
 
 
@@ -251,8 +335,10 @@ def _healed(model: CadModel) -> CadModel:
         fixer = ShapeFix_Shape(model.shape)
         fixer.Perform()
         shape = fixer.Shape()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"ShapeFix_Shape failed on {model.path}: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"ShapeFix_Shape failed on {model.path}: {describe(exc)}") from exc
     if shape.IsNull():
         raise OpenCascadeError(f"ShapeFix_Shape returned a null shape for {model.path}")
     context = fixer.Context()
@@ -268,7 +354,8 @@ def _healed(model: CadModel) -> CadModel:
         raise NoFacesError(f"no faces left after healing {model.path}")
     return CadModel(shape, faces, tuple(names.get(f) for f in faces),
                     tuple(colors.get(f) for f in faces), model.length_unit, model.path,
-                    model.file_format)
+                    model.file_format, dropped=model.dropped,
+                    translation_notes=model.translation_notes)
 
 
 # ==================================================================== write
@@ -332,9 +419,11 @@ def write(obj: ShapeLike, path: str | os.PathLike, *, overwrite: bool = False) -
         os.replace(tmp, target)
     except TranslationError as exc:
         raise OutputFileError(f"cannot write {fmt.value} file {target}: {exc}") from None
-    except Standard_Failure as exc:
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
         raise OutputFileError(
-            f"cannot write {fmt.value} file {target}: OpenCascade failed: {exc}") from None
+            f"cannot write {fmt.value} file {target}: OpenCascade failed: {describe(exc)}") from None
     except OSError as exc:
         raise OutputFileError(f"cannot write {target}: {exc.strerror or exc}") from None
     finally:

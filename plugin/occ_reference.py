@@ -14,10 +14,10 @@ from OCP.Geom import Geom_Curve, Geom_Surface
 from OCP.Geom2d import Geom2d_Curve
 from OCP.GeomAPI import GeomAPI_ProjectPointOnSurf
 from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec, gp_Vec2d
-from OCP.Standard import Standard_Failure
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..errors import ConversionError, OpenCascadeError
+from .occ.failures import describe, is_occ_failure
 from .occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
 
 __all__ = ["evaluate_surface", "evaluate_curve", "project_point_on_surface"]
@@ -169,8 +169,11 @@ def project_point_on_surface(surface: NurbsSurface | Geom_Surface,
     for i, xyz in enumerate(flat.tolist()):
         try:
             projector.Perform(gp_Pnt(*xyz))
-        except Standard_Failure as exc:
-            raise OpenCascadeError(f"GeomAPI_ProjectPointOnSurf failed on point {xyz}: {exc}") from exc
+        except Exception as exc:
+            if not is_occ_failure(exc):
+                raise
+            raise OpenCascadeError(
+                f"GeomAPI_ProjectPointOnSurf failed on point {xyz}: {describe(exc)}") from exc
         if not projector.IsDone() or projector.NbPoints() == 0:
             raise OpenCascadeError(f"GeomAPI_ProjectPointOnSurf found no projection of point {xyz}")
         uv[i] = projector.LowerDistanceParameters()
@@ -257,8 +260,10 @@ def intersect_surfaces_occ(surface_a: NurbsSurface | Geom_Surface,
     sa, sb = _occ_surface(surface_a), _occ_surface(surface_b)
     try:
         algo = GeomAPI_IntSS(sa, sb, float(tol))
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"GeomAPI_IntSS failed: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"GeomAPI_IntSS failed: {describe(exc)}") from exc
     if not algo.IsDone():
         raise OpenCascadeError("GeomAPI_IntSS did not finish (IsDone() is false)")
     out = []
@@ -320,8 +325,10 @@ def section_faces_occ(face_a: TopoDS_Face, face_b: TopoDS_Face, tol: float = 1e-
         section.ComputePCurveOn1(True)
         section.ComputePCurveOn2(True)
         section.Build()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepAlgoAPI_Section failed: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"BRepAlgoAPI_Section failed: {describe(exc)}") from exc
     if not section.IsDone():
         raise OpenCascadeError("BRepAlgoAPI_Section did not finish (IsDone() is false)")
     shape = section.Shape()

@@ -39,6 +39,7 @@ from OCP.TopAbs import TopAbs_FACE
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
+from .dropped import TranslationChecks, translation_checks
 from .occ.shapes import FaceNames, all_faces, compound
 
 __all__ = [
@@ -95,6 +96,7 @@ class TranslatedModel:
     face_colors: tuple[Rgb | None, ...]
     length_unit: str
     used_xde: bool
+    checks: TranslationChecks = TranslationChecks()
 
 
 # --------------------------------------------------------------- OCCT state
@@ -215,6 +217,7 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
             if not reader.Transfer(doc):
                 raise TranslationError("STEP (XDE) transfer failed")
         unit = _step_length_unit(reader.Reader())
+        session = reader.Reader().WS()
     else:
         reader = IGESCAFControl_Reader()
         reader.SetNameMode(True)
@@ -225,6 +228,7 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
         if not reader.Transfer(doc):
             raise TranslationError("IGES (XDE) transfer failed")
         unit = _iges_length_unit(reader)
+        session = reader.WS()
 
     shape_tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
     color_tool = XCAFDoc_DocumentTool.ColorTool_s(doc.Main())
@@ -240,7 +244,8 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
     names = _names_by_face(shape_tool)
     face_names = tuple(names.get(f) for f in faces)
     face_colors = tuple(_face_color(color_tool, f) for f in faces)
-    return TranslatedModel(shape, faces, face_names, face_colors, unit, used_xde=True)
+    return TranslatedModel(shape, faces, face_names, face_colors, unit, used_xde=True,
+                           checks=translation_checks(session, path.read_bytes(), fmt.value))
 
 
 def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
@@ -261,7 +266,8 @@ def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
         raise TranslationError(f"{fmt.value} transfer produced a null shape")
     faces = all_faces(shape)
     return TranslatedModel(shape, faces, (None,) * len(faces), (None,) * len(faces), unit,
-                           used_xde=False)
+                           used_xde=False,
+                           checks=translation_checks(reader.WS(), path.read_bytes(), fmt.value))
 
 
 def _label_name(label: TDF_Label) -> str | None:

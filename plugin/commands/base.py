@@ -20,10 +20,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, TextIO
 
-from ...errors import OutputFileError
-from ..io import new_file_mode
+from ...errors import InputFileError, OutputFileError
+from ..io import new_file_mode, read
 
-__all__ = ["Command", "Console", "write_json_report", "to_jsonable", "STDOUT"]
+__all__ = ["Command", "Console", "write_json_report", "to_jsonable", "STDOUT", "read_model",
+           "done_code", "dropped_report"]
 
 #: Value of a report-path option meaning "print to standard output".
 STDOUT = "-"
@@ -162,3 +163,35 @@ def check_outputs(inputs: tuple[Path, ...], output: Path, *, plot: Path | None =
             refuse_overwriting_inputs(Path(target), inputs)
     if plot is not None:
         require_matplotlib()
+
+
+#: dropped entities named in the warning line (the JSON report lists them all)
+LISTED_DROPS = 3
+
+
+def read_model(path, console: Console, *, strict: bool = False, **options):
+    """:func:`surfprep.read` for a command: what the translation left out is a warning
+    line on stderr (an error with ``strict``), never silent."""
+    model = read(path, **options)
+    if model.dropped:
+        listed = "; ".join(str(d) for d in model.dropped[:LISTED_DROPS])
+        more = len(model.dropped) - LISTED_DROPS
+        message = (f"{Path(path).name}: OpenCascade did not translate {len(model.dropped)} "
+                   f"entit{'y' if len(model.dropped) == 1 else 'ies'} of the file: {listed}"
+                   + (f"; and {more} more (--json lists them)" if more > 0 else ""))
+        if strict:
+            raise InputFileError(message + " (--strict)")
+        console.note(f"surfprep: warning: {message}")
+    return model
+
+
+def dropped_report(*models) -> list[dict]:
+    """The dropped entities of ``models`` for a JSON report, each with its file's name."""
+    return [{"file": m.path.name if m.path is not None else None, **d.as_dict()}
+            for m in models if m is not None for d in m.dropped]
+
+
+def done_code(*models, skipped: bool = False) -> int:
+    """The exit code of a command that finished: 1 when faces were skipped (``skipped``,
+    or an entity of an input the reader did not translate), else 0."""
+    return 1 if skipped or any(m is not None and m.dropped for m in models) else 0

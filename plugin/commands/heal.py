@@ -8,8 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import read, write
-from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from ..io import write
+from .base import (
+    STDOUT,
+    Command,
+    Console,
+    check_outputs,
+    done_code,
+    dropped_report,
+    read_model,
+    write_json_report,
+)
 from .plotting import pyplot, save_figure
 
 __all__ = ["COMMAND", "plot_deviation"]
@@ -105,17 +114,17 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     from ..heal import heal
     inputs = tuple(p for p in (args.input, args.patches) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
-    model = read(args.input)
+    model = read_model(args.input, console, strict=args.strict)
     result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                   patches=args.patches, overlap=args.overlap,
                   split_faces=args.split_faces)
-    report = {"input": str(args.input), **result.report()}
+    report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model)}
     report["output"] = str(write(result.model, args.output, overwrite=True))
     if args.plot is not None:
         report["plot"] = str(plot_deviation(result, args.plot))
     if args.json_path == STDOUT:
         write_json_report(report, STDOUT, console)
-        return 0
+        return done_code(model)
     for line in _summary(report):
         console.print(line)
     console.print(f"written to {report['output']}")
@@ -124,7 +133,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     if args.json_path is not None:
         path = write_json_report(report, args.json_path, console, protected=inputs)
         console.note(f"report written to {path}")
-    return 0
+    return done_code(model)
 
 
 COMMAND = Command(

@@ -12,15 +12,24 @@ from OCP.BRep import BRep_Tool
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.Standard import Standard_Failure
 from OCP.TopoDS import TopoDS_Face
 
 from ...algorithms.parametrization import parametrization_quality
 from ...errors import OpenCascadeError
-from ..io import CadModel, bounding_box, read
+from ..io import CadModel, bounding_box
+from ..occ.failures import describe, is_occ_failure
 from ..occ.geom import surface_from_occ
 from ..occ.shapes import face_area
-from .base import STDOUT, Command, Console, refuse_overwriting_inputs, write_json_report
+from .base import (
+    STDOUT,
+    Command,
+    Console,
+    done_code,
+    dropped_report,
+    read_model,
+    refuse_overwriting_inputs,
+    write_json_report,
+)
 
 __all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",
            "format_table", "surface_kind", "face_area", "SPLINE_KINDS"]
@@ -118,8 +127,10 @@ def describe_face(face: TopoDS_Face, index: int, name: str | None = None) -> Fac
             spans = (1, 1)
             rational = bool(bezier.IsURational() or bezier.IsVRational())
             quality = parametrization_quality(surface_from_occ(bezier))
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"cannot describe face {index}: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"cannot describe face {index}: {describe(exc)}") from exc
     return FaceInfo(
         index=index, name=name, surface_type=kind, degree=degree, poles=poles,
         knot_spans=spans, rational=rational, uv_bounds=uv, area=area,
@@ -150,6 +161,9 @@ def model_report(model: CadModel, console: Console) -> dict:
         "bounding_box": {"min": [x0, y0, z0], "max": [x1, y1, z1]},
         "size": model.size,
         "faces": faces,
+        "dropped": dropped_report(model),
+        "translation_notes": [{"type": kind, "message": message, "count": count}
+                              for kind, message, count in model.translation_notes],
     }
 
 
@@ -216,16 +230,16 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace, console: Console) -> int:
     if args.json_path not in (None, STDOUT):  # fail before the work, not after
         refuse_overwriting_inputs(Path(args.json_path), (args.file,))
-    model = read(args.file, heal=args.heal)
+    model = read_model(args.file, console, strict=args.strict, heal=args.heal)
     report = model_report(model, console)
     if args.json_path == STDOUT:
         write_json_report(report, STDOUT, console)
-        return 0
+        return done_code(model)
     console.print(format_table(report))
     if args.json_path is not None:
         written = write_json_report(report, args.json_path, console, protected=(model.path,))
         console.note(f"report written to {written}")
-    return 0
+    return done_code(model)
 
 
 COMMAND = Command(

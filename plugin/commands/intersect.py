@@ -8,8 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import read, write
-from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from ..io import write
+from .base import (
+    STDOUT,
+    Command,
+    Console,
+    check_outputs,
+    done_code,
+    dropped_report,
+    read_model,
+    write_json_report,
+)
 from .plotting import pyplot, save_figure
 
 __all__ = [
@@ -189,14 +198,16 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     from ..intersect import intersect
     inputs = tuple(p for p in (args.file_a, args.file_b) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
-    model_a = read(args.file_a)
-    model_b = read(args.file_b) if args.file_b is not None else None
+    model_a = read_model(args.file_a, console, strict=args.strict)
+    model_b = read_model(args.file_b, console, strict=args.strict) if args.file_b is not None \
+        else None
     start = time.perf_counter()
     results = intersect(model_a, model_b, tol=args.tol, method=args.method,
                         progress=lambda done, total: console.progress(done, total, "face pair"))
     elapsed = time.perf_counter() - start
     tol = results[0].tol if results else args.tol
     report = intersection_report(results, elapsed, tol, inputs)
+    report["dropped"] = dropped_report(model_a, model_b)
     if results:
         edges = [e for r in results for e in r.to_edges()]
         written = write(edges, args.output, overwrite=True)
@@ -230,7 +241,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if args.json_path is not None:
             path = write_json_report(report, args.json_path, console, protected=inputs)
             console.note(f"report written to {path}")
-    return 0
+    return done_code(model_a, model_b)
 
 
 COMMAND = Command(

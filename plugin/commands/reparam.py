@@ -8,8 +8,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import read, write
-from .base import STDOUT, Command, Console, check_outputs, write_json_report
+from ..io import write
+from .base import (
+    STDOUT,
+    Command,
+    Console,
+    check_outputs,
+    done_code,
+    dropped_report,
+    read_model,
+    write_json_report,
+)
 from .plotting import pyplot, save_figure
 
 __all__ = ["COMMAND", "face_entry", "plot_isolines"]
@@ -87,7 +96,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     from ..reparam import reparametrize_model
     inputs = (args.file,)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
-    model = read(args.file)
+    model = read_model(args.file, console, strict=args.strict)
     start = time.perf_counter()
     shape, entries = reparametrize_model(
         model, tol=args.tol, faces=args.faces,
@@ -97,7 +106,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     ok = [e for e in entries if e.done is not None]
     report = {"file": str(args.file), "output": str(written), "time_s": elapsed,
               "tol": ok[0].done.result.tol if ok else args.tol,
-              "faces": [face_entry(e) for e in entries]}
+              "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model)}
     if args.plot is not None:
         from OCP.BRep import BRep_Tool
         pairs = [(f"face {e.index}", surface_from_occ(BRep_Tool.Surface_s(model.faces[e.index])),
@@ -120,7 +129,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if args.json_path is not None:
             path = write_json_report(report, args.json_path, console, protected=inputs)
             console.note(f"report written to {path}")
-    return 0 if len(ok) == len(entries) else 1
+    return done_code(model, skipped=len(ok) != len(entries))
 
 
 COMMAND = Command(

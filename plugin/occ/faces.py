@@ -34,7 +34,6 @@ from OCP.Geom import Geom_BSplineSurface, Geom_TrimmedCurve
 from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_Face
-from OCP.Standard import Standard_Failure
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
@@ -45,6 +44,7 @@ from ...algorithms.tolerance import check_tolerance
 from ...algorithms.trimmed import DEFAULT_TOLERANCE, TrimEdge, TrimLoop, TrimmedFace, curve3d_points
 from ...errors import ConversionError, InvalidGeometryError, OpenCascadeError
 from .edges import EXACT_2D, EXACT_3D, build_trim_edge, converts_exactly, read_trim_edge
+from .failures import describe, is_occ_failure
 from .geom import surface_from_occ, surface_to_occ
 from .shapes import check_valid
 
@@ -79,8 +79,10 @@ def needs_nurbs_convert(face: TopoDS_Face) -> bool:
 def _nurbs_convert(face: TopoDS_Face) -> TopoDS_Face:
     try:
         converter = BRepBuilderAPI_NurbsConvert(face, True)
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepBuilderAPI_NurbsConvert failed: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"BRepBuilderAPI_NurbsConvert failed: {describe(exc)}") from exc
     if not converter.IsDone():
         raise OpenCascadeError("BRepBuilderAPI_NurbsConvert: IsDone() is false")
     return TopoDS.Face_s(converter.Shape())

@@ -27,12 +27,12 @@ from OCP.Geom2dConvert import Geom2dConvert
 from OCP.GeomConvert import GeomConvert
 from OCP.gp import gp_Pnt, gp_Pnt2d
 from OCP.Precision import Precision
-from OCP.Standard import Standard_Failure
 from OCP.TColgp import TColgp_Array1OfPnt, TColgp_Array1OfPnt2d, TColgp_Array2OfPnt
 from OCP.TColStd import TColStd_Array1OfInteger, TColStd_Array1OfReal, TColStd_Array2OfReal
 
 from ...algorithms import NurbsCurve, NurbsSurface
 from ...errors import ConversionError, OpenCascadeError
+from .failures import describe, is_occ_failure
 
 __all__ = [
     "surface_from_occ",
@@ -117,9 +117,11 @@ def _to_bspline_surface(surface: Geom_Surface, bounds) -> Geom_BSplineSurface:
         surface = Geom_RectangularTrimmedSurface(surface, u0, u1, v0, v1)
     try:
         out = GeomConvert.SurfaceToBSplineSurface_s(surface)
-    except Standard_Failure as exc:
-        raise ConversionError(
-            f"OpenCascade cannot convert {surface.DynamicType().Name()} to a B-spline: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise ConversionError(f"OpenCascade cannot convert {surface.DynamicType().Name()} "
+                              f"to a B-spline: {describe(exc)}") from exc
     if out is None:
         raise OpenCascadeError("GeomConvert.SurfaceToBSplineSurface returned no surface")
     return out
@@ -147,8 +149,10 @@ def surface_to_occ(surface: NurbsSurface) -> Geom_BSplineSurface:
             for j in range(nv):
                 w.SetValue(i + 1, j + 1, float(surface.weights[i, j]))
         return Geom_BSplineSurface(poles, w, uk, vk, um, vm, surface.degree_u, surface.degree_v)
-    except Standard_Failure as exc:
-        raise ConversionError(f"OpenCascade refused the surface: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise ConversionError(f"OpenCascade refused the surface: {describe(exc)}") from exc
 
 
 # -------------------------------------------------------------------- curves
@@ -193,9 +197,11 @@ def _to_bspline_curve(curve, bounds, is2d: bool):
             curve = trimmed_cls(curve, t0, t1)
         conv = Geom2dConvert if is2d else GeomConvert
         return conv.CurveToBSplineCurve_s(curve)
-    except Standard_Failure as exc:
-        raise ConversionError(
-            f"OpenCascade cannot convert {curve.DynamicType().Name()} to a B-spline: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise ConversionError(f"OpenCascade cannot convert {curve.DynamicType().Name()} "
+                              f"to a B-spline: {describe(exc)}") from exc
 
 
 def curve_to_occ(curve: NurbsCurve) -> Geom_BSplineCurve:
@@ -221,5 +227,7 @@ def _curve_to_occ(curve, dim, array_cls, point_cls, bspline_cls):
         if curve.weights is None:
             return bspline_cls(poles, knots, mults, curve.degree)
         return bspline_cls(poles, _array1(curve.weights), knots, mults, curve.degree)
-    except Standard_Failure as exc:
-        raise ConversionError(f"OpenCascade refused the curve: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise ConversionError(f"OpenCascade refused the curve: {describe(exc)}") from exc

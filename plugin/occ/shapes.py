@@ -22,7 +22,6 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
-from OCP.Standard import Standard_Failure
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
@@ -30,6 +29,7 @@ from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
 from ...errors import OpenCascadeError
+from .failures import describe, is_occ_failure
 
 __all__ = [
     "FaceNames",
@@ -120,8 +120,10 @@ def sew(faces: list[TopoDS_Shape], tol: float) -> tuple[TopoDS_Shape, BRepBuilde
         sewing.Add(f)
     try:
         sewing.Perform()
-    except Standard_Failure as exc:
-        raise OpenCascadeError(f"BRepBuilderAPI_Sewing failed: {exc}") from exc
+    except Exception as exc:
+        if not is_occ_failure(exc):
+            raise
+        raise OpenCascadeError(f"BRepBuilderAPI_Sewing failed: {describe(exc)}") from exc
     shape = sewing.SewedShape()
     if shape.IsNull():
         raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")

@@ -181,7 +181,7 @@ def test_unexpected_exception_exits_1_with_one_line(capsys, monkeypatch):
     def broken_read(*args, **kwargs):
         raise RuntimeError("boom\nsecond line")
 
-    monkeypatch.setattr(info_command, "read", broken_read)
+    monkeypatch.setattr(info_command, "read_model", broken_read)
     code, _, err = run(capsys, "info", str(FUSELAGE))
     assert code == 1
     lines = err.strip().splitlines()

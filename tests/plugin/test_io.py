@@ -453,7 +453,7 @@ def test_plain_reader_fallback_when_xde_fails(monkeypatch):
 def test_occt_static_parameters_are_restored(tmp_path):
     from OCP.Interface import Interface_Static
 
-    read(SYNTHETIC)  # makes sure the STEP controller (and its parameters) exist
+    read(SYNTHETIC, isolate=False)  # makes sure the STEP controller (and its parameters) exist here
     for key in ("read.stepcaf.subshapes.name", "write.stepcaf.subshapes.name"):
         assert Interface_Static.IsPresent_s(key)
     before = {k: Interface_Static.IVal_s(k)
