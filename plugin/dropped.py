@@ -6,10 +6,16 @@ line in a check list nobody reads: the model comes back with fewer faces and no
 word. After a transfer every entity's checks sit in the work session's
 transfer process; :func:`translation_checks` reads them once:
 
-* **dropped**: an entity of a surface, face or curve type with a *fail*, or with
-  the warning that it was "not mapped" to a shape: named by its file label
-  (``#55`` in STEP, the directory entry ``D17`` in IGES), its type, the names of
-  the STEP faces that used it, and OCCT's reason;
+* **dropped**: an entity of a face-level type (surface, face, shell,
+  representation...) with a *fail* or the warning that it was "not mapped" to a
+  shape, while translating or (a damaged parameter list) while the file was
+  loaded; an entity of an edge-level type (curve, edge, loop) the same way when
+  faces are missing: named by its file label (``#55`` in STEP, the directory
+  entry ``D17`` in IGES), its type, the names of the STEP faces that used it, and
+  OCCT's reason. A STEP file's faces are also counted in its text
+  (``ADVANCED_FACE``, ``FACE_SURFACE``): fewer translated faces than that is a
+  loss even when no check says so; when all are there, load fails and edge-level
+  fails are notes (an IGES file's faces cannot be counted: they always count);
 * **notes**: every other message, counted by entity type and text ("Surface
   forced to be periodic" x 23): what OCCT repaired on the way.
 
@@ -25,12 +31,17 @@ from dataclasses import dataclass
 
 __all__ = ["DroppedEntity", "TranslationChecks", "translation_checks"]
 
-#: entity types whose loss loses geometry (OCCT type names contain one of these)
-GEOMETRIC = ("Surface", "Face", "Curve", "Shell", "Solid", "Plane")
+#: entity types whose loss loses a face (OCCT type names contain one of these)
+FACE_LEVEL = ("Surface", "Face", "Shell", "Solid", "Plane", "Representation", "Brep", "Manifold",
+              "Group")
+#: entity types whose loss may lose a face (counted as dropped when faces are missing, or
+#: in an IGES file, where faces cannot be counted in the text)
+EDGE_LEVEL = ("Curve", "Edge", "Boundary", "Loop", "Wire")
 #: warnings that mean the entity produced no shape
 NOT_TRANSLATED = ("not mapped", "not translated", "no result", "failed")
 
 _STEP_STATEMENT = re.compile(rb"#(\d+)\s*=\s*([A-Za-z_0-9]*)")
+_STEP_FACE_ENTITY = re.compile(rb"=\s*(?:ADVANCED_FACE|FACE_SURFACE)\s*\(")
 _STEP_FACE = re.compile(rb"#(\d+)\s*=\s*(?:ADVANCED_FACE|FACE_SURFACE)\s*\(\s*'((?:[^']|'')*)'"
                         rb"\s*,\s*\((?:[^()]*)\)\s*,\s*#(\d+)")
 
@@ -81,32 +92,57 @@ def _messages(check) -> tuple[list[str], list[str]]:
     return fails, warnings
 
 
-def translation_checks(work_session, data: bytes, file_format: str) -> TranslationChecks:
+def translation_checks(work_session, data: bytes, file_format: str,
+                       translated_faces: int | None = None) -> TranslationChecks:
     """The dropped entities and the notes of the last transfer of ``work_session``
-    (an ``XSControl_WorkSession``), labelled from the file's bytes ``data``."""
-    process = work_session.TransferReader().TransientProcess()
-    if process is None:
-        return TranslationChecks()
-    checks = process.CheckList(False)
+    (an ``XSControl_WorkSession``), labelled from the file's bytes ``data``;
+    ``translated_faces`` is the number of distinct faces the transfer produced."""
     found, notes = [], Counter()
+    loaded = _entries(work_session.ModelCheckList(False), "load")
+    process = work_session.TransferReader().TransientProcess()
+    transferred = _entries(process.CheckList(False), "transfer") if process is not None else []
+    expected = None
+    if file_format == "STEP":
+        start = data.find(b"DATA;")
+        expected = len(_STEP_FACE_ENTITY.findall(data, start if start >= 0 else 0))
+    lost_faces = (expected is not None and translated_faces is not None
+                  and translated_faces < expected)
+    load_drops = file_format != "STEP" or lost_faces
+    for stage, number, kind, fails, warnings in loaded + transferred:
+        lost = [w for w in warnings if any(k in w.lower() for k in NOT_TRANSLATED)]
+        face_level = any(g in kind for g in FACE_LEVEL)
+        edge_level = any(g in kind for g in EDGE_LEVEL)
+        counts = (face_level and (stage == "transfer" or load_drops)) or (edge_level and load_drops)
+        if (face_level or edge_level) and (lost or fails) and counts:
+            found.append((number, kind, "; ".join(dict.fromkeys(fails + lost))))
+            fails, warnings = [], [w for w in warnings if w not in lost]
+        for message in fails + warnings:
+            if message not in lost:
+                notes[(kind, message)] += 1
+    labels, faces = _labels(data, file_format, [n for n, _, _ in found])
+    dropped = [DroppedEntity(labels.get(n, f"entity {n}"), kind, reason,
+                             tuple(faces.get(labels.get(n), ())))
+               for n, kind, reason in found]
+    if lost_faces:
+        dropped.append(DroppedEntity(
+            "faces", "ADVANCED_FACE / FACE_SURFACE",
+            f"{expected - translated_faces} of the file's {expected} faces were not translated"))
+    return TranslationChecks(tuple(dropped),
+                             tuple((k, m, c) for (k, m), c in notes.most_common()))
+
+
+def _entries(checks, stage: str) -> list[tuple[str, int, str, list[str], list[str]]]:
+    """``(stage, entity number, type, fails, warnings)`` of every check of a check list."""
+    out = []
     checks.Start()
     while checks.More():
-        check, number = checks.Value(), checks.Number()
+        check = checks.Value()
         entity = check.Entity()
         kind = entity.DynamicType().Name() if entity is not None else "entity"
         fails, warnings = _messages(check)
-        lost = [w for w in warnings if any(k in w.lower() for k in NOT_TRANSLATED)]
-        if any(g in kind for g in GEOMETRIC) and (fails or lost):
-            found.append((number, kind, "; ".join(dict.fromkeys(fails + lost))))
-        for message in fails + warnings:
-            if message not in lost and message not in fails:
-                notes[(kind, message)] += 1
+        out.append((stage, checks.Number(), kind, fails, warnings))
         checks.Next()
-    labels, faces = _labels(data, file_format, [n for n, _, _ in found])
-    dropped = tuple(DroppedEntity(labels.get(n, f"entity {n}"), kind, reason,
-                                  tuple(faces.get(labels.get(n), ())))
-                    for n, kind, reason in found)
-    return TranslationChecks(dropped, tuple((k, m, c) for (k, m), c in notes.most_common()))
+    return out
 
 
 def _labels(data: bytes, file_format: str, numbers: list[int]

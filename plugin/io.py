@@ -29,6 +29,7 @@ from __future__ import annotations
 import io
 import os
 import tempfile
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -54,7 +55,8 @@ from .occ.failures import describe, is_occ_failure
 from .occ.shapes import FaceNames, all_faces, compound
 from .step_iges import FileFormat, Rgb, TranslatedModel, TranslationError, read_file, write_file
 
-__all__ = ["CadModel", "FileFormat", "read", "write", "to_shape", "bounding_box", "sniff_format"]
+__all__ = ["CadModel", "FileFormat", "TranslationWarning", "read", "write", "to_shape",
+           "bounding_box", "sniff_format"]
 
 #: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
 MODEL_UNIT = "mm"
@@ -66,6 +68,10 @@ _STEP_TRAILER = b"END-ISO-10303-21"
 #: seconds an isolated translation may take (the largest file of the test data, 4 MB,
 #: reads in about 1 s)
 DEFAULT_READ_TIMEOUT = 120.0
+
+
+class TranslationWarning(UserWarning):
+    """The file was read, but not the way asked (e.g. without face names: see the message)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,10 +207,10 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
     return _healed(model) if heal else model
 
 
-def _translate(file: Path, fmt: FileFormat) -> TranslatedModel:
+def _translate(file: Path, fmt: FileFormat, xde: bool = True) -> TranslatedModel:
     """OCCT's translation of the file, its failures as :class:`InputFileError`."""
     try:
-        return read_file(file, fmt)
+        return read_file(file, fmt, xde=xde)
     except TranslationError as exc:
         raise InputFileError(f"cannot read {fmt.value} file {file}: {exc}") from None
     except Exception as exc:
@@ -214,9 +220,9 @@ def _translate(file: Path, fmt: FileFormat) -> TranslatedModel:
             f"cannot read {fmt.value} file {file}: OpenCascade failed: {describe(exc)}") from None
 
 
-def _portable(file: Path, fmt: FileFormat) -> dict:
+def _portable(file: Path, fmt: FileFormat, xde: bool) -> dict:
     """In the child: the translation as plain data (the shape in OCCT's binary format)."""
-    translated = _translate(file, fmt)
+    translated = _translate(file, fmt, xde)
     stream = io.BytesIO()
     BinTools.Write_s(translated.shape, stream, False, False,
                      BinTools_FormatVersion.BinTools_FormatVersion_CURRENT)
@@ -227,14 +233,22 @@ def _portable(file: Path, fmt: FileFormat) -> dict:
 
 
 def _translate_isolated(file: Path, fmt: FileFormat, timeout: float) -> TranslatedModel:
-    """:func:`_translate` in a child process (:func:`.isolation.call_isolated`)."""
+    """:func:`_translate` in a child process (:func:`.isolation.call_isolated`); when the
+    XDE reader crashes, the plain reader in another child (no names or colours, said)."""
     what = f"{fmt.value} file {file}"
     try:
-        data = isolation.call_isolated(_portable, file, fmt, timeout=timeout)
+        data = isolation.call_isolated(_portable, file, fmt, True, timeout=timeout)
     except isolation.ChildCrashed as exc:
-        how = f"crashed ({exc.signal_name})" if exc.signal_name else f"died ({exc})"
-        raise InputFileError(f"cannot read {what}: OpenCascade's reader {how}; the file "
-                             "is corrupt or holds what the reader cannot handle") from None
+        try:
+            data = isolation.call_isolated(_portable, file, fmt, False, timeout=timeout)
+        except (isolation.ChildCrashed, isolation.ChildTimedOut, InputFileError):
+            how = f"crashed ({exc.signal_name})" if exc.signal_name else f"died ({exc})"
+            raise InputFileError(f"cannot read {what}: OpenCascade's reader {how}; the file "
+                                 "is corrupt or holds what the reader cannot handle") from None
+        how = exc.signal_name or str(exc)
+        warnings.warn(f"{file.name}: OpenCascade's XDE reader crashed ({how}); read with the "
+                      "plain reader, without face names or colours", TranslationWarning,
+                      stacklevel=3)
     except isolation.ChildTimedOut:
         raise InputFileError(f"cannot read {what}: OpenCascade's reader did not finish within "
                              f"{timeout:g} s (stopped); the file is corrupt or far larger "

@@ -18,6 +18,7 @@ of the parent runs twice.
 
 from __future__ import annotations
 
+import faulthandler
 import os
 import pickle
 import select
@@ -64,6 +65,7 @@ def call_isolated(fn: Callable[..., Any], *args: Any, timeout: float) -> Any:
     pid = os.fork()
     if pid == 0:                           # pragma: no cover - the child (coverage ends here)
         os.close(read_end)
+        faulthandler.disable()             # a crash here is the parent's to report, not ours
         status = 0
         try:
             payload = pickle.dumps(("ok", fn(*args)), protocol=pickle.HIGHEST_PROTOCOL)

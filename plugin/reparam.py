@@ -380,6 +380,10 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
         raise OpenCascadeError("the copied shape has a different number of faces")
     if faces is None:
         chosen = [k for k, f in enumerate(copied) if is_bspline_face(f)]
+        if not chosen:
+            where = model.path.name if model.path is not None else "the model"
+            raise InvalidGeometryError(f"nothing to reparametrize: {where} has no B-spline face "
+                                       f"(of its {model.n_faces} faces)")
     else:
         bad = [k for k in faces if not 0 <= k < model.n_faces]
         if bad:

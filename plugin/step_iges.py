@@ -40,7 +40,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from .dropped import TranslationChecks, translation_checks
-from .occ.shapes import FaceNames, all_faces, compound
+from .occ.shapes import FaceNames, all_faces, compound, distinct_faces
 
 __all__ = [
     "FileFormat",
@@ -178,8 +178,9 @@ def _iges_length_unit(reader) -> str:
 
 
 # ----------------------------------------------------------------- reading
-def read_file(path: Path, fmt: FileFormat) -> TranslatedModel:
-    """Translate a STEP/IGES file; XDE first, plain reader if XDE fails.
+def read_file(path: Path, fmt: FileFormat, *, xde: bool = True) -> TranslatedModel:
+    """Translate a STEP/IGES file; XDE first, plain reader if XDE fails (only the plain
+    reader with ``xde=False``: after XDE crashed on the file).
 
     Raises
     ------
@@ -187,6 +188,8 @@ def read_file(path: Path, fmt: FileFormat) -> TranslatedModel:
         When neither reader produced a shape; the message names the failing step.
     """
     with _quiet_occt():
+        if not xde:
+            return _read_plain(path, fmt)
         try:
             return _read_xde(path, fmt)
         except TranslationError as xde_error:
@@ -245,7 +248,8 @@ def _read_xde(path: Path, fmt: FileFormat) -> TranslatedModel:
     face_names = tuple(names.get(f) for f in faces)
     face_colors = tuple(_face_color(color_tool, f) for f in faces)
     return TranslatedModel(shape, faces, face_names, face_colors, unit, used_xde=True,
-                           checks=translation_checks(session, path.read_bytes(), fmt.value))
+                           checks=translation_checks(session, path.read_bytes(), fmt.value,
+                                                    distinct_faces(faces)))
 
 
 def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
@@ -267,7 +271,8 @@ def _read_plain(path: Path, fmt: FileFormat) -> TranslatedModel:
     faces = all_faces(shape)
     return TranslatedModel(shape, faces, (None,) * len(faces), (None,) * len(faces), unit,
                            used_xde=False,
-                           checks=translation_checks(reader.WS(), path.read_bytes(), fmt.value))
+                           checks=translation_checks(reader.WS(), path.read_bytes(), fmt.value,
+                                                    distinct_faces(faces)))
 
 
 def _label_name(label: TDF_Label) -> str | None:

@@ -152,17 +152,34 @@ def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:
             raise OutputFileError(f"refusing to overwrite the input file {target}")
 
 
-def check_outputs(inputs: tuple[Path, ...], output: Path, *, plot: Path | None = None,
+def check_outputs(inputs: tuple[Path, ...], output: Path | None, *, plot: Path | None = None,
                   json_path: str | None = None) -> None:
-    """Fail before the work, not after: no output may be an input file, and ``--plot``
-    needs matplotlib (:class:`OutputFileError` either way)."""
+    """Fail before the work, not after (:class:`OutputFileError`): every output goes to an
+    existing, writable folder, is not a folder itself and not one of the ``inputs``; the
+    model ``output`` has a STEP/IGES extension; ``--plot`` needs matplotlib."""
+    from ..step_iges import FileFormat
     from .plotting import require_matplotlib
     report = None if json_path in (None, STDOUT) else Path(json_path)
-    for target in (output, plot, report):
+    for target, what in ((output, "output"), (plot, "--plot"), (report, "--json")):
         if target is not None:
-            refuse_overwriting_inputs(Path(target), inputs)
+            _check_target(Path(target), what, inputs)
+    if output is not None and FileFormat.from_suffix(Path(output)) is None:
+        known = ", ".join(s for fmt in FileFormat for s in fmt.suffixes)
+        raise OutputFileError(f"output {output} has unknown extension "
+                              f"{Path(output).suffix or '(none)'!r}; expected one of {known}")
     if plot is not None:
         require_matplotlib()
+
+
+def _check_target(target: Path, what: str, inputs: tuple[Path, ...]) -> None:
+    if target.is_dir():
+        raise OutputFileError(f"{what} {target} is a directory, not a file")
+    folder = target.resolve().parent
+    if not folder.is_dir():
+        raise OutputFileError(f"{what} {target}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputFileError(f"{what} {target}: the folder {folder} is not writable")
+    refuse_overwriting_inputs(target, inputs)
 
 
 #: dropped entities named in the warning line (the JSON report lists them all)

@@ -24,15 +24,15 @@ from .base import (
     STDOUT,
     Command,
     Console,
+    check_outputs,
     done_code,
     dropped_report,
     read_model,
-    refuse_overwriting_inputs,
     write_json_report,
 )
 
 __all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",
-           "format_table", "surface_kind", "face_area", "SPLINE_KINDS"]
+           "format_table", "surface_kind", "SPLINE_KINDS"]
 
 
 class SurfaceKind(enum.Enum):
@@ -228,8 +228,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    if args.json_path not in (None, STDOUT):  # fail before the work, not after
-        refuse_overwriting_inputs(Path(args.json_path), (args.file,))
+    check_outputs((Path(args.file),), None, json_path=args.json_path)  # before the work
     model = read_model(args.file, console, strict=args.strict, heal=args.heal)
     report = model_report(model, console)
     if args.json_path == STDOUT:

@@ -78,6 +78,7 @@ from .trim_back import trim_overlaps_of
 
 __all__ = [
     "DEFAULT_GAP_FACTOR",
+    "MIN_TOL_FACTOR",
     "TIGHT_FACTOR",
     "HealResult",
     "PatchOrigin",
@@ -91,6 +92,9 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
+#: smallest accepted ``tol`` and ``gap_tol``: this times the model's diagonal (double
+#: precision resolves about 2e-16 of it; the approximants' measures need room above)
+MIN_TOL_FACTOR = 1e-12
 
 
 @dataclass(frozen=True)
@@ -319,10 +323,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     model = _as_model(shape)
     faces, skipped = _read_faces(model)
     edges = face_edges(faces)
+    low, high = MIN_TOL_FACTOR * model.size, model.size
     gap_tol = (_default_gap_tol(model, edges) if gap_tol is None
-               else check_tolerance(gap_tol, "gap_tol", high=model.size))
+               else check_tolerance(gap_tol, "gap_tol", low=low, high=high))
     if tol is not None:
-        tol = check_tolerance(tol, "tol", high=model.size)
+        tol = check_tolerance(tol, "tol", low=low, high=high)
     directed = read_patch_spec(patches, faces) if patches is not None else []
     cut = cut_under_patches(model, faces, directed, [face_source(f) for f in faces if f],
                             tol=tol, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,

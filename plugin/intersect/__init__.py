@@ -56,7 +56,8 @@ from numpy.typing import NDArray
 
 from ...algorithms.characteristic import CharacteristicRecord
 from ...algorithms.intersection import IntersectionCurve, along_a_boundary, clip_curve, closed_in_space
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...algorithms.tolerance import check_tolerance
+from ...errors import InvalidGeometryError
 from ...inputs import ShapeLike
 from ..occ.edges import make_edge
 from .methods import (
@@ -220,7 +221,8 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     Raises
     ------
     InvalidToleranceError
-        ``tol`` not finite and positive, or below ``MIN_TOL_FACTOR`` times the size.
+        ``tol`` not finite and positive, below ``MIN_TOL_FACTOR`` times the size
+        (beyond what the refinement reaches reliably) or larger than the size.
     ConversionError
         An operand without faces or of an unsupported type.
     ValueError
@@ -250,18 +252,11 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     faces_b = faces_a if b is None else face_operands(b)
     boxes_a, boxes_b = _boxes(faces_a), _boxes(faces_b)
     size = _size(np.concatenate([boxes_a, boxes_b]))
+    if not size > 0:
+        raise InvalidGeometryError("the faces to intersect have no extent (a zero-size model)")
     if tol is None:
         tol = DEFAULT_TOL_FACTOR * size
-    try:
-        tol = float(tol)
-    except (TypeError, ValueError):
-        raise InvalidToleranceError(f"tol must be a number, got {tol!r}") from None
-    if not np.isfinite(tol) or tol <= 0:
-        raise InvalidToleranceError(f"tol must be finite and > 0, got {tol!r}")
-    if tol < MIN_TOL_FACTOR * size:
-        raise InvalidToleranceError(
-            f"tol={tol:g} is below {MIN_TOL_FACTOR:g} x the model size {size:g}; "
-            "the refinement cannot reach it reliably")
+    tol = check_tolerance(tol, "tol", low=MIN_TOL_FACTOR * size, high=size)
     pad = tol
     overlap = np.all((boxes_a[:, None, 0] <= boxes_b[None, :, 1] + pad)
                      & (boxes_b[None, :, 0] <= boxes_a[:, None, 1] + pad), axis=-1)

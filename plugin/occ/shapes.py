@@ -26,7 +26,7 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face, TopoDS_Shape
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ...errors import OpenCascadeError
 from .failures import describe, is_occ_failure
@@ -37,6 +37,7 @@ __all__ = [
     "check_valid",
     "compound",
     "count_free_edges",
+    "distinct_faces",
     "face_area",
     "is_valid",
     "max_edge_tolerance",
@@ -95,6 +96,15 @@ class FaceNames:
             if k.IsSame(key):
                 return name
         return None
+
+
+def distinct_faces(faces) -> int:
+    """How many distinct face definitions ``faces`` hold (occurrences of one face placed
+    elsewhere or reversed count once)."""
+    seen = TopTools_IndexedMapOfShape()
+    for face in faces:
+        seen.Add(face.Located(TopLoc_Location()).Oriented(TopAbs_FORWARD))
+    return seen.Extent()
 
 
 def face_area(shape: TopoDS_Shape, rel_tol: float | None = None) -> float:
