@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -13,6 +14,7 @@ import pytest
 from helpers.cli import run
 from helpers.paths import SAMPLES
 
+import surfprep
 from surfprep.plugin import cli
 from surfprep.plugin.commands import COMMANDS
 from surfprep.plugin.commands import info as info_command
@@ -353,3 +355,49 @@ def test_warnings_are_one_line_each(capsys, monkeypatch):
     with pytest.warns(UserWarning, match="left out"):       # --debug: Python's warning
         code, out, err = run(capsys, "noisy", "--debug")
     assert code == 0 and "surfprep: warning" not in err
+
+
+# ------------------------------------------------- checked before the work (issue 20)
+@pytest.mark.parametrize("argv, words", [
+    (["heal", FUSELAGE, "-o", "{tmp}/h.step", "--tol", "1e-300"], ["tol=1e-300", "below"]),
+    (["heal", FUSELAGE, "-o", "{tmp}/h.step", "--gap-tol", "1e9"], ["gap_tol=1e+09", "large"]),
+    (["intersect", FUSELAGE, "-o", "{tmp}/i.step", "--tol", "1e9"], ["tol=1e+09", "large"]),
+    (["intersect", FUSELAGE, "-o", "{tmp}/i.step", "--tol", "1e-300"], ["tol=1e-300", "below"]),
+    (["reparam", FUSELAGE, "-o", "{tmp}/r.step", "--tol", "1e-300"], ["tol=1e-300", "below"]),
+    (["info", FUSELAGE, "--json", "{tmp}/missing/r.json"], ["--json", "does not exist"]),
+    (["heal", FUSELAGE, "-o", "{tmp}/h.txt"], ["unknown extension", ".txt"]),
+    (["intersect", FUSELAGE, "-o", "{tmp}/i.step", "--json", "{tmp}/missing/r.json"],
+     ["--json", "does not exist"]),
+    (["reparam", FUSELAGE, "-o", "{tmp}"], ["is a directory"]),
+])
+def test_absurd_tolerances_and_bad_outputs_are_refused_before_the_work(argv, words, tmp_path,
+                                                                       capsys):
+    code, out, err = run(capsys, *[str(a).format(tmp=tmp_path) for a in argv])
+    assert code == 2
+    assert_one_line_error(err, *words)
+    assert list(tmp_path.iterdir()) == []                  # nothing written
+
+
+def test_an_unwritable_json_folder_is_refused_before_the_model_is_written(tmp_path, capsys,
+                                                                          monkeypatch):
+    """As root every folder is writable, so the check is told this one is not."""
+    from surfprep.plugin.commands import base
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(base.os, "access",
+                        lambda path, mode: False if Path(path) == locked else real_access(path, mode))
+    code, _, err = run(capsys, "heal", FUSELAGE, "-o", tmp_path / "h.step", "--json", locked / "r.json")
+    assert code == 2
+    assert_one_line_error(err, "not writable")
+    assert not (tmp_path / "h.step").exists()
+
+
+def test_a_model_without_b_spline_faces_has_nothing_to_reparametrize(tmp_path, capsys):
+    import cadquery as cq
+    box = tmp_path / "box.step"
+    surfprep.write(cq.Workplane().box(1, 2, 3).val(), box)
+    code, _, err = run(capsys, "reparam", box, "-o", tmp_path / "o.step")
+    assert code == 2
+    assert_one_line_error(err, "nothing to reparametrize", "no B-spline face")
+    assert not (tmp_path / "o.step").exists()
