@@ -20,7 +20,8 @@ distance function, characteristic points and characteristic curves
 * :mod:`.prefilter`: pairs with no possible loop nor contact point (the certificate skips them);
 * :mod:`.grid`: the roles of the two surfaces and the stage's sample grid;
 * :mod:`.crossing`: the flattest crossing angle on that grid;
-* :mod:`.auto`: the default ``auto`` method per pair (:func:`auto_intersection`).
+* :mod:`.auto`: the default ``auto`` method per pair (:func:`auto_intersection`);
+* :mod:`.coincidence`: where two trimmed faces coincide (:func:`face_coincidence`).
 """
 
 from .algorithm import (
@@ -35,6 +36,7 @@ from .algorithm import (
                         tangential_curves,
 )
 from .auto import FULL_COINCIDENCE, Route, auto_intersection, small_angle
+from .coincidence import face_coincidence
 from .crossing import grid_crossing_sine
 from .curves import CurveKind, EndReason, TracedCurve, trace_curves
 from .distance import DistanceField, DistanceJet, distance_jet
@@ -47,41 +49,42 @@ from .ridges import Ridge
 from .trace import to_intersection_curve, trace_intersections
 
 __all__ = [
-                        "FULL_COINCIDENCE",
-                        "CharacteristicAnalysis",
-                        "CharacteristicPoint",
-                        "CharacteristicRecord",
-                        "CoincidentRegion",
-                        "CurveKind",
-                        "DistanceField",
-                        "DistanceJet",
-                        "EndReason",
-                        "FoundBy",
-                        "NoLoopReason",
-                        "PatchEvaluator",
-                        "PointKind",
-                        "Projection",
-                        "ProjectionStatus",
-                        "Projector",
-                        "Ridge",
-                        "Route",
-                        "StageGrid",
-                        "TracedCurve",
-                        "auto_intersection",
-                        "certify",
-                        "characteristic_analysis",
-                        "characteristic_intersection",
-                        "choose_field",
-                        "classify_critical",
-                        "critical_points",
-                        "distance_jet",
-                        "grid_crossing_sine",
-                        "no_loop_reason",
-                        "small_angle",
-                        "stage_grid",
-                        "tangential_curves",
-                        "to_intersection_curve",
-                        "trace_curves",
-                        "trace_intersections",
-                        "uncertified_record",
+    "FULL_COINCIDENCE",
+    "CharacteristicAnalysis",
+    "CharacteristicPoint",
+    "CharacteristicRecord",
+    "CoincidentRegion",
+    "CurveKind",
+    "DistanceField",
+    "DistanceJet",
+    "EndReason",
+    "FoundBy",
+    "NoLoopReason",
+    "PatchEvaluator",
+    "PointKind",
+    "Projection",
+    "ProjectionStatus",
+    "Projector",
+    "Ridge",
+    "Route",
+    "StageGrid",
+    "TracedCurve",
+    "auto_intersection",
+    "certify",
+    "characteristic_analysis",
+    "characteristic_intersection",
+    "choose_field",
+    "classify_critical",
+    "critical_points",
+    "distance_jet",
+    "face_coincidence",
+    "grid_crossing_sine",
+    "no_loop_reason",
+    "small_angle",
+    "stage_grid",
+    "tangential_curves",
+    "to_intersection_curve",
+    "trace_curves",
+    "trace_intersections",
+    "uncertified_record",
 ]

@@ -231,8 +231,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             console.print(f"{len(report['isolated_points'])} isolated (tangential contact) "
                           "point(s)")
         for c in report.get("coincident", []):
-            console.print(f"faces {c['faces']} coincide over a region "
-                          f"({100 * c['share']:.0f} % of the first face's grid)")
+            console.print(f"faces {c['faces']} coincide over {100 * c['share']:.0f} % of one of "
+                          f"them (within {c['max_distance']:.2g})")
         if args.compare_occ:
             occ = report["occ"]
             h = "-" if occ["hausdorff"] is None else f"{occ['hausdorff']:.3g}"

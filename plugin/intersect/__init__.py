@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ...algorithms.characteristic import CharacteristicRecord
+from ...algorithms.characteristic import CharacteristicRecord, face_coincidence
 from ...algorithms.intersection import IntersectionCurve, along_a_boundary, clip_curve, closed_in_space
 from ...algorithms.tolerance import check_tolerance
 from ...errors import InvalidGeometryError
@@ -274,8 +274,10 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
                     continue
                 out.append(FaceIntersection(piece, fa, fb, tol, how))
         out.isolated_points += _contacts(record, fa, fb, tol, b is None)
-        if record is not None:
-            out.coincident += [CoincidentFaces(fa, fb, r) for r in record.coincident]
+        if record is not None and record.coincident:
+            region = face_coincidence(fa.region, fb.region, tol)    # the faces, not the surfaces
+            if region is not None:
+                out.coincident.append(CoincidentFaces(fa, fb, region))
         out.records.append(PairRecord(fa, fb, record, tuple(curves), time.perf_counter() - start))
         if progress is not None:
             progress(done, len(pairs))

@@ -79,7 +79,9 @@ class ContactPoint:
 
 @dataclass(frozen=True, eq=False)
 class CoincidentFaces:
-    """Two faces whose surfaces coincide within ``tol`` over ``region`` (no curves there)."""
+    """Two faces that coincide within ``tol`` over ``region`` (no curves there): the faces
+    themselves, measured densely both ways (:func:`~surfprep.algorithms.characteristic.
+    face_coincidence`); ``region.share`` is the larger of the two faces' coinciding shares."""
 
     face_a: FaceOperand
     face_b: FaceOperand
