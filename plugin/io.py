@@ -162,7 +162,7 @@ def bounding_box(shape: TopoDS_Shape) -> tuple[float, float, float, float, float
 
 # ===================================================================== read
 def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
-         timeout: float = DEFAULT_READ_TIMEOUT) -> CadModel:
+         timeout: float = DEFAULT_READ_TIMEOUT, require_faces: bool = True) -> CadModel:
     """Read a STEP (.step/.stp) or IGES (.igs/.iges) file.
 
     Parameters
@@ -180,6 +180,9 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
         does).
     timeout : float
         Seconds the isolated translation may take before it is killed.
+    require_faces : bool
+        Refuse a file without faces (the default); False returns it (a file of
+        curves only, as ``surfprep intersect`` writes, for ``surfprep info``).
 
     Raises
     ------
@@ -188,7 +191,7 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
         other format (a STEP file named .igs), truncated or unreadable file, a
         reader that crashed or did not finish within ``timeout``.
     NoFacesError
-        The file was read but holds no face.
+        The file was read but holds no face (with ``require_faces``).
     """
     file = Path(path)
     fmt = _check_input_file(file)
@@ -196,7 +199,7 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
         translated = _translate_isolated(file, fmt, timeout)
     else:
         translated = _translate(file, fmt)
-    if not translated.faces:
+    if not translated.faces and require_faces:
         kind = translated.shape.ShapeType().name.removeprefix("TopAbs_").lower()
         raise NoFacesError(f"{fmt.value} file {file} holds no faces (OpenCascade read it "
                            f"as a {kind} without faces)")

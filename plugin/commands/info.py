@@ -9,17 +9,20 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve
+from OCP.BRepGProp import BRepGProp
 from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
+from OCP.GProp import GProp_GProps
 from OCP.TopoDS import TopoDS_Face
 
 from ...algorithms.parametrization import parametrization_quality
-from ...errors import OpenCascadeError
+from ...errors import NoFacesError, OpenCascadeError
 from ..io import CadModel, bounding_box
 from ..occ.failures import describe, is_occ_failure
 from ..occ.geom import surface_from_occ
-from ..occ.shapes import face_area
+from ..occ.shapes import face_area, free_edges_of
 from .base import (
     STDOUT,
     Command,
@@ -145,6 +148,16 @@ def _finite(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
+def describe_edge(edge, index: int) -> dict:
+    """An edge that bounds no face: its curve type, length and whether it is closed."""
+    curve = BRepAdaptor_Curve(edge)
+    props = GProp_GProps()
+    BRepGProp.LinearProperties_s(edge, props)
+    kind = curve.GetType().name.removeprefix("GeomAbs_")
+    return {"index": index, "curve_type": kind, "length": float(props.Mass()),
+            "closed": bool(BRep_Tool.IsClosed_s(edge))}
+
+
 def model_report(model: CadModel, console: Console) -> dict:
     """The ``info`` report of a model: file data and one :class:`FaceInfo` dict per face."""
     faces = []
@@ -161,6 +174,7 @@ def model_report(model: CadModel, console: Console) -> dict:
         "bounding_box": {"min": [x0, y0, z0], "max": [x1, y1, z1]},
         "size": model.size,
         "faces": faces,
+        "edges": [describe_edge(e, k) for k, e in enumerate(free_edges_of(model.shape))],
         "dropped": dropped_report(model),
         "translation_notes": [{"type": kind, "message": message, "count": count}
                               for kind, message, count in model.translation_notes],
@@ -178,6 +192,12 @@ def _quality(face: dict) -> str:
         return "-"
     worse = "u" if (face["param_quality_u"] or 0) >= (face["param_quality_v"] or 0) else "v"
     return f"{q:.3g} ({worse})"
+
+
+def _table(rows: list[tuple[str, ...]], right: set[int]) -> list[str]:
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    return ["  ".join(r[c].rjust(widths[c]) if c in right else r[c].ljust(widths[c])
+                      for c in range(len(rows[0]))).rstrip() for r in rows]
 
 
 def format_table(report: dict) -> str:
@@ -204,12 +224,16 @@ def format_table(report: dict) -> str:
             _pair(f["degree"]), _pair(f["poles"]), _pair(f["knot_spans"]),
             "-" if f["rational"] is None else ("yes" if f["rational"] else "no"),
             f"{f['area']:.6g}", _quality(f)))
-    widths = [max(len(r[c]) for r in rows) for c in range(len(header))]
-    right = {0, 7}
-    for r in rows:
-        cells = [r[c].rjust(widths[c]) if c in right else r[c].ljust(widths[c])
-                 for c in range(len(header))]
-        lines.append("  ".join(cells).rstrip())
+    if faces:
+        lines += _table(rows, right={0, 7})
+    edges = report.get("edges", [])
+    if edges:
+        lines.append(f"edges bounding no face: {len(edges)}")
+        lines.append("")
+        rows = [("#", "curve", "length", "closed")]
+        rows += [(str(e["index"]), e["curve_type"], f"{e['length']:.6g}",
+                  "yes" if e["closed"] else "no") for e in edges]
+        lines += _table(rows, right={0, 2})
     lines.append("")
     lines.append("param: worst chord-length mismatch of eqs. 29.1/29.2 (1 = chord-length "
                  "parametrized), worse direction in brackets; '-' for analytic faces")
@@ -229,8 +253,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs((Path(args.file),), None, json_path=args.json_path)  # before the work
-    model = read_model(args.file, console, strict=args.strict, heal=args.heal)
+    model = read_model(args.file, console, strict=args.strict, heal=args.heal,
+                       require_faces=False)
     report = model_report(model, console)
+    if not report["faces"] and not report["edges"]:
+        raise NoFacesError(f"{args.file} holds neither faces nor curves to list")
     if args.json_path == STDOUT:
         write_json_report(report, STDOUT, console)
         return done_code(model)

@@ -25,7 +25,7 @@ from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Face, TopoDS_Shape
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ...errors import OpenCascadeError
@@ -39,6 +39,7 @@ __all__ = [
     "count_free_edges",
     "distinct_faces",
     "face_area",
+    "free_edges_of",
     "is_valid",
     "max_edge_tolerance",
     "sew",
@@ -96,6 +97,15 @@ class FaceNames:
             if k.IsSame(key):
                 return name
         return None
+
+
+def free_edges_of(shape: TopoDS_Shape) -> tuple[TopoDS_Edge, ...]:
+    """The edges of ``shape`` that bound no face (curves standing on their own), in
+    exploration order, each once."""
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    return tuple(TopoDS.Edge_s(edge_faces.FindKey(k)) for k in range(1, edge_faces.Extent() + 1)
+                 if edge_faces.FindFromIndex(k).Size() == 0)
 
 
 def distinct_faces(faces) -> int:

@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from helpers.cli import run
 from helpers.paths import SAMPLES
@@ -401,3 +402,22 @@ def test_a_model_without_b_spline_faces_has_nothing_to_reparametrize(tmp_path, c
     assert code == 2
     assert_one_line_error(err, "nothing to reparametrize", "no B-spline face")
     assert not (tmp_path / "o.step").exists()
+
+
+def test_info_lists_the_curves_of_a_file_without_faces(tmp_path, capsys):
+    """What `surfprep intersect` writes (edges only) reads back: the curves listed."""
+    import cadquery as cq
+    cuts = surfprep.intersect(cq.Workplane().sphere(10),
+                              cq.Workplane().box(30, 30, 1).translate((0, 0, 5)))
+    path = tmp_path / "curves.step"
+    surfprep.write(cuts.edges(), path)
+    code, out, err = run(capsys, "info", path, "--json", "-")
+    assert code == 0, err
+    report = json.loads(out)
+    assert report["n_faces"] == 0 and len(report["edges"]) == 2
+    lengths = sorted(e["length"] for e in report["edges"])
+    radii = sorted(np.sqrt(100 - z * z) for z in (5.5, 4.5))
+    np.testing.assert_allclose(lengths, 2 * np.pi * np.array(radii), rtol=1e-6)
+    assert all(e["closed"] for e in report["edges"])
+    code, out, _ = run(capsys, "info", path)
+    assert code == 0 and "edges bounding no face: 2" in out
