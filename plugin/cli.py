@@ -20,6 +20,7 @@ surfaces) are printed as one line ``surfprep: warning: <message>`` each.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import textwrap
 import traceback
@@ -112,9 +113,26 @@ def _one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """A warning as one line on stderr (``--debug`` keeps Python's form, with the place)."""
-    print(f"{PROG}: warning: {_one_line(message)}", file=sys.stderr)
+_NUMBER = re.compile(r"[-+]?\d+(?:\.\d*)?(?:e[-+]?\d+)?", re.I)
+
+
+def _warning_lines(caught: list[warnings.WarningMessage]) -> list[str]:
+    """One line per kind of warning: the first of its kind, with how many there were.
+
+    Kinds are the message with its numbers left out (a stray curve per face pair is one
+    kind); numpy's floating-point warnings (``RuntimeWarning``) say they are numerical.
+    """
+    groups: dict[str, list[str]] = {}
+    for w in caught:
+        text = _one_line(w.message)
+        if issubclass(w.category, RuntimeWarning) and "encountered" in text:
+            text = f"numerical: {text} (in a step whose result is checked against the tolerance)"
+        groups.setdefault(_NUMBER.sub("#", text), []).append(text)
+    lines = []
+    for texts in groups.values():
+        more = f" (and {len(texts) - 1} more like it)" if len(texts) > 1 else ""
+        lines.append(f"{PROG}: warning: {texts[0]}{more}")
+    return lines
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -135,35 +153,39 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{PROG}: error: no command given (try '{PROG} --help')", file=err)
         return EXIT_ERROR
     console = Console.for_streams(progress=True if args.progress else None)
+    caught: list[warnings.WarningMessage] = []
+
+    def finish(code: int, *lines: str) -> int:
+        """The warnings of the run (one line per kind), then ``lines``; ``code``."""
+        for line in (*_warning_lines(caught), *lines):
+            print(line, file=err)
+        return code
+
     try:
-        with warnings.catch_warnings():
-            if not args.debug:
-                warnings.showwarning = _show_warning      # restored when the block ends
-            return int(run(args, console))
+        with warnings.catch_warnings(record=not args.debug) as recorded:
+            if not args.debug:                            # --debug: Python's own warnings
+                caught = recorded
+                warnings.simplefilter("always")
+                for quiet in (DeprecationWarning, PendingDeprecationWarning, ImportWarning):
+                    warnings.simplefilter("ignore", quiet)
+            code = int(run(args, console))
+        return finish(code)
     except SurfprepError as exc:
         if args.debug:
             traceback.print_exc(file=err)
-        print(f"{PROG}: error: {_one_line(exc)}", file=err)
-        return EXIT_ERROR
+        return finish(EXIT_ERROR, f"{PROG}: error: {_one_line(exc)}")
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=err)
-        return EXIT_INTERRUPTED
+        return finish(EXIT_INTERRUPTED, f"{PROG}: interrupted")
     except BrokenPipeError:  # e.g. `surfprep info x.step | head`
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the CLI's last line of defence
-        if is_occ_failure(exc):   # an OpenCascade exception no command turned into ours
-            if args.debug:
-                traceback.print_exc(file=err)
-            print(f"{PROG}: error: OpenCascade failed: {describe(exc)}", file=err)
-            return EXIT_ERROR
         if args.debug:
             traceback.print_exc(file=err)
-            print(f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)}", file=err)
-        else:
-            print(f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)} "
-                  "(run with --debug for the traceback)", file=err)
-        return EXIT_FAILURE
-
+        if is_occ_failure(exc):   # an OpenCascade exception no command turned into ours
+            return finish(EXIT_ERROR, f"{PROG}: error: OpenCascade failed: {describe(exc)}")
+        hint = "" if args.debug else " (run with --debug for the traceback)"
+        return finish(EXIT_FAILURE,
+                      f"{PROG}: internal error: {type(exc).__name__}: {_one_line(exc)}{hint}")
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -421,3 +421,27 @@ def test_info_lists_the_curves_of_a_file_without_faces(tmp_path, capsys):
     assert all(e["closed"] for e in report["edges"])
     code, out, _ = run(capsys, "info", path)
     assert code == 0 and "edges bounding no face: 2" in out
+
+
+def test_warnings_of_one_kind_are_counted_and_numerical_ones_say_so(capsys, monkeypatch):
+    import dataclasses
+    import warnings
+
+    import numpy as np
+
+    def noisy(args, console):
+        for k in range(5):
+            warnings.warn(f"{k + 1} of 7 intersection curves left out", UserWarning)
+        with np.errstate(invalid="warn"):
+            np.array([np.inf]) * 0.0
+        return 0
+
+    fake = dataclasses.replace(COMMANDS[0], name="noisy", run=noisy,
+                               add_arguments=lambda parser: None)
+    monkeypatch.setattr(cli, "COMMANDS", (fake,))
+    code, _, err = run(capsys, "noisy")
+    assert code == 0
+    assert err.strip().splitlines() == [
+        "surfprep: warning: 1 of 7 intersection curves left out (and 4 more like it)",
+        "surfprep: warning: numerical: invalid value encountered in multiply (in a step whose "
+        "result is checked against the tolerance)"]
