@@ -26,7 +26,6 @@ from typing import TYPE_CHECKING
 
 from .algorithms import Direction, NurbsCurve, NurbsSurface
 from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
-from .algorithms.reparam import ReparametrizationResult
 from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
 from .errors import (
     ConversionError,
@@ -42,6 +41,7 @@ from .errors import (
 from .inputs import ShapeLike
 
 if TYPE_CHECKING:
+    from .algorithms.reparam import ReparametrizationResult
     from .plugin.convert import to_nurbs, to_occ
     from .plugin.heal import HealResult, heal
     from .plugin.intersect import FaceIntersection, IntersectionResult, intersect
@@ -93,8 +93,10 @@ __all__ = [
     "OpenCascadeError",
 ]
 
-#: Public names served by the OpenCascade side, and the module each comes from.
-_PLUGIN_EXPORTS = {
+#: Public names loaded on first use (the OpenCascade side, and what needs scipy beyond the
+#: NURBS core), and the module each comes from.
+_LAZY_EXPORTS = {
+    "ReparametrizationResult": "surfprep.algorithms.reparam",
     "read": "surfprep.plugin.io",
     "write": "surfprep.plugin.io",
     "CadModel": "surfprep.plugin.io",
@@ -114,12 +116,12 @@ _PLUGIN_EXPORTS = {
 
 
 def __getattr__(name: str):
-    """Load the OpenCascade-backed names on first access (PEP 562)."""
-    module = _PLUGIN_EXPORTS.get(name)
+    """Load the lazily served names on first access (PEP 562)."""
+    module = _LAZY_EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module 'surfprep' has no attribute {name!r}")
     return getattr(import_module(module), name)
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_PLUGIN_EXPORTS))
+    return sorted(set(globals()) | set(_LAZY_EXPORTS))

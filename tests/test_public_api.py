@@ -54,7 +54,7 @@ def test_all_is_a_literal_list_and_the_lazy_names_are_typed():
     typed = {alias.asname or alias.name
              for node in tree.body if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
              for imp in node.body if isinstance(imp, ast.ImportFrom) for alias in imp.names}
-    assert set(surfprep._PLUGIN_EXPORTS) <= typed
+    assert set(surfprep._LAZY_EXPORTS) <= typed
     assert (Path(surfprep.__file__).parent / "py.typed").is_file()
 
 
