@@ -272,6 +272,10 @@ def _rebuild(forward: TopoDS_Face, result: ReparametrizationResult, old: NurbsSu
     return checked_or_fixed(face, tol), worst
 
 
+#: how far from 1 a location's scale factor may be (a rigid motion's is 1 to rounding)
+LOCATION_SCALE_TOL = 1e-12
+
+
 def _vertices(edge):
     return [v for v in (TopExp.FirstVertex_s(edge), TopExp.LastVertex_s(edge)) if not v.IsNull()]
 
@@ -283,7 +287,9 @@ def reparametrize_face(face: TopoDS_Face, *, tol: float | None = None, copy: boo
     Parameters
     ----------
     face : TopoDS_Face
-        On a ``Geom_BSplineSurface``, without location.
+        On a ``Geom_BSplineSurface``. A located face (an assembly's part, a face
+        read back from STEP) is reparametrized in its own frame and the new face
+        carries the same location; a location that scales is refused.
     tol : float, optional
         Model units; default 1e-4 of the surface's control-net diagonal.
     copy : bool
@@ -296,7 +302,7 @@ def reparametrize_face(face: TopoDS_Face, *, tol: float | None = None, copy: boo
     Raises
     ------
     ConversionError
-        Not a B-spline face, or a face with a location.
+        Not a B-spline face, or a face whose location scales.
     InvalidGeometryError
         The tolerance was not reached within the limits.
     OpenCascadeError
@@ -307,9 +313,15 @@ def reparametrize_face(face: TopoDS_Face, *, tol: float | None = None, copy: boo
     if not is_bspline_face(face):
         raise ConversionError("only faces on B-spline surfaces are reparametrized, this one is "
                               f"on a {type(BRep_Tool.Surface_s(face)).__name__}")
-    if not face.Location().IsIdentity():
-        raise ConversionError("faces with a location are not supported; "
-                              "apply the location first (BRepBuilderAPI_Transform)")
+    location = face.Location()
+    if not location.IsIdentity():
+        scale = location.Transformation().ScaleFactor()
+        if abs(abs(scale) - 1.0) > LOCATION_SCALE_TOL:
+            raise ConversionError(f"the face's location scales it (factor {scale:.6g}); "
+                                  "tolerances and deviations would change units: apply the "
+                                  "location first (BRepBuilderAPI_Transform with copy)")
+        # in its own frame: the same TShape, surface and edges, distances unchanged
+        face = TopoDS.Face_s(face.Located(TopLoc_Location()))
     if copy:
         copier = BRepBuilderAPI_Copy(face)
         if not copier.IsDone():
@@ -324,6 +336,8 @@ def reparametrize_face(face: TopoDS_Face, *, tol: float | None = None, copy: boo
         new_face = TopoDS.Face_s(new_face.Reversed())
     if not BRepCheck_Analyzer(new_face).IsValid():
         raise OpenCascadeError("the reparametrized face is not valid (BRepCheck_Analyzer)")
+    if not location.IsIdentity():
+        face, new_face = (TopoDS.Face_s(f.Located(location)) for f in (face, new_face))
     return FaceReparametrization(
         face=new_face, result=result, area_before=face_area(face, AREA_REL_TOL),
         area_after=face_area(new_face, AREA_REL_TOL), pcurve_deviation=deviation,

@@ -137,6 +137,70 @@ def test_real_fuselage_face(fuselage):
     assert abs(done.area_after - done.area_before) <= 2 * tol * _boundary_length(face)
 
 
+def _moved(face: TopoDS_Face, *, scale: float = 1.0) -> TopoDS_Face:
+    """``face`` under a location (rotation about a skew axis, translation, optional scale):
+    the same surface and edges, placed elsewhere, as in an assembly."""
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+    trsf = gp_Trsf()
+    trsf.SetRotation(gp_Ax1(gp_Pnt(0.3, -0.2, 0.1), gp_Dir(1, 2, 3)), 0.7)
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(5.0, -3.0, 2.0))
+    trsf = move.Multiplied(trsf)
+    if scale != 1.0:
+        grow = gp_Trsf()
+        grow.SetScale(gp_Pnt(0, 0, 0), scale)
+        trsf = grow.Multiplied(trsf)
+    return TopoDS.Face_s(face.Moved(TopLoc_Location(trsf)))
+
+
+def test_a_located_face_is_reparametrized_where_it_lies():
+    """A face under a location (an assembly part, every face STEP gives back from a
+    compound): reparametrized in its own frame, the new face placed by the same location."""
+    face = _moved(_disk_face(_u_cubed_sheet()))
+    assert not face.Location().IsIdentity()
+    done = reparametrize_face(face)
+    tol, new_face = done.result.tol, done.face
+    assert BRepCheck_Analyzer(new_face).IsValid()
+    assert new_face.Location().IsEqual(face.Location())
+    old = surface_from_occ(BRep_Tool.Surface_s(face))        # with the location applied
+    new = surface_from_occ(BRep_Tool.Surface_s(new_face))
+    samples = new.evaluate_grid(np.linspace(*new.domain[:2], 60), np.linspace(*new.domain[2:], 60))
+    assert project_to_surface(old, samples).distance.max() <= tol
+    (edge,) = _edges(new_face)
+    curve = edge_to_nurbs(edge)
+    t = np.linspace(*curve.domain, 300)
+    assert project_to_surface(new, curve.evaluate(t)).distance.max() <= tol
+    assert done.area_after == pytest.approx(done.area_before, rel=1e-3)
+    assert done.area_before == pytest.approx(face_area(face))
+
+
+def test_a_model_of_located_faces_read_back_from_step(tmp_path):
+    """surfprep.write of a list of faces reads back with every face located: the
+    model is reparametrized (not 'faces with a location are not supported')."""
+    from surfprep.plugin.occ.faces import make_face
+    from surfprep.plugin.reparam import reparametrize_model
+    path = tmp_path / "two.step"
+    surfprep.write([make_face(_u_cubed_sheet()), _moved(make_face(_u_cubed_sheet()))], path)
+    model = surfprep.read(path)
+    assert not any(f.Location().IsIdentity() for f in model.faces)
+    shape, entries = reparametrize_model(model)
+    assert [e.error for e in entries] == [None, None]
+    faces = surfprep.plugin.occ.shapes.all_faces(shape)
+    for before, after, entry in zip(model.faces, faces, entries):
+        old = surface_from_occ(BRep_Tool.Surface_s(before))
+        new = surface_from_occ(BRep_Tool.Surface_s(after))
+        assert new.n_control == entry.done.result.surface.n_control
+        grid = new.evaluate_grid(np.linspace(*new.domain[:2], 40), np.linspace(*new.domain[2:], 40))
+        assert project_to_surface(old, grid).distance.max() <= entry.done.result.tol
+
+
+def test_a_location_that_scales_is_refused():
+    face = _moved(_disk_face(_u_cubed_sheet()), scale=2.0)
+    with pytest.raises(ConversionError, match="scales"):
+        reparametrize_face(face)
+
+
 def test_non_bspline_face_is_refused():
     import cadquery as cq
     box = cq.Workplane().box(1, 1, 1).val()
