@@ -30,7 +30,8 @@ import io
 import os
 import tempfile
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -55,8 +56,8 @@ from .occ.failures import describe, is_occ_failure
 from .occ.shapes import FaceNames, all_faces, compound
 from .step_iges import FileFormat, Rgb, TranslatedModel, TranslationError, read_file, write_file
 
-__all__ = ["CadModel", "FileFormat", "TranslationWarning", "read", "write", "to_shape",
-           "bounding_box", "sniff_format"]
+__all__ = ["CadModel", "FileFormat", "StagedFile", "TranslationWarning", "read", "write",
+           "staged_write", "to_shape", "bounding_box", "sniff_format"]
 
 #: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
 MODEL_UNIT = "mm"
@@ -407,6 +408,50 @@ def write(obj: ShapeLike, path: str | os.PathLike, *, overwrite: bool = False) -
         An object that cannot be turned into a shape.
     OpenCascadeError
         A face/edge builder failed.
+
+    See Also
+    --------
+    staged_write : the same, with the move into place left to the caller.
+    """
+    with staged_write(obj, path, overwrite=overwrite) as staged:
+        return staged.commit()
+
+
+@dataclass
+class StagedFile:
+    """A file written next to its target and not yet moved into place.
+
+    :meth:`commit` moves it there (``os.replace``, atomic on one file system);
+    leaving the :func:`staged_write` block without committing deletes it, so a
+    failure between writing and committing (a report that cannot be written, a
+    plot that fails) leaves neither a half result nor a temporary behind.
+    """
+
+    temporary: Path
+    target: Path
+    committed: bool = False
+
+    def commit(self) -> Path:
+        """Move the staged file onto its target; returns the target."""
+        if self.committed:
+            return self.target
+        try:
+            os.replace(self.temporary, self.target)
+        except OSError as exc:
+            raise OutputFileError(f"cannot write {self.target}: {exc.strerror or exc}") from None
+        self.committed = True
+        return self.target
+
+
+@contextmanager
+def staged_write(obj: ShapeLike, path: str | os.PathLike, *,
+                 overwrite: bool = False) -> Iterator[StagedFile]:
+    """Write ``obj`` to a temporary file beside ``path``; yields a :class:`StagedFile`.
+
+    The checks and the conversion are those of :func:`write`; the file appears
+    at ``path`` only when the caller calls :meth:`StagedFile.commit` inside the
+    block. The commands write their JSON report first and commit the model
+    after, so a report that cannot be written leaves no model without one.
     """
     target = Path(path)
     fmt = FileFormat.from_suffix(target)
@@ -429,23 +474,23 @@ def write(obj: ShapeLike, path: str | os.PathLike, *, overwrite: bool = False) -
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        write_file(tmp, fmt, model.shape, model.faces, model.face_names, model.face_colors)
-        if not tmp.is_file() or tmp.stat().st_size == 0:
-            raise TranslationError("the writer reported success but wrote nothing")
-        os.chmod(tmp, new_file_mode())
-        os.replace(tmp, target)
-    except TranslationError as exc:
-        raise OutputFileError(f"cannot write {fmt.value} file {target}: {exc}") from None
-    except Exception as exc:
-        if not is_occ_failure(exc):
-            raise
-        raise OutputFileError(
-            f"cannot write {fmt.value} file {target}: OpenCascade failed: {describe(exc)}") from None
-    except OSError as exc:
-        raise OutputFileError(f"cannot write {target}: {exc.strerror or exc}") from None
+        try:
+            write_file(tmp, fmt, model.shape, model.faces, model.face_names, model.face_colors)
+            if not tmp.is_file() or tmp.stat().st_size == 0:
+                raise TranslationError("the writer reported success but wrote nothing")
+            os.chmod(tmp, new_file_mode())
+        except TranslationError as exc:
+            raise OutputFileError(f"cannot write {fmt.value} file {target}: {exc}") from None
+        except OSError as exc:
+            raise OutputFileError(f"cannot write {target}: {exc.strerror or exc}") from None
+        except Exception as exc:
+            if not is_occ_failure(exc):
+                raise
+            raise OutputFileError(f"cannot write {fmt.value} file {target}: "
+                                  f"OpenCascade failed: {describe(exc)}") from None
+        yield StagedFile(tmp, target.resolve())
     finally:
         tmp.unlink(missing_ok=True)
-    return target.resolve()
 
 
 def _check_output_file(target: Path, obj: Any, overwrite: bool) -> None:

@@ -21,10 +21,10 @@ from pathlib import Path
 from typing import Any, Callable, TextIO
 
 from ...errors import InputFileError, OutputFileError
-from ..io import new_file_mode, read
+from ..io import StagedFile, new_file_mode, read
 
-__all__ = ["Command", "Console", "write_json_report", "to_jsonable", "STDOUT", "read_model",
-           "done_code", "dropped_report"]
+__all__ = ["Command", "Console", "write_json_report", "publish", "to_jsonable", "STDOUT",
+           "read_model", "done_code", "dropped_report"]
 
 #: Value of a report-path option meaning "print to standard output".
 STDOUT = "-"
@@ -141,6 +141,33 @@ def write_json_report(report: dict, destination: str | os.PathLike, console: Con
     finally:
         Path(tmp).unlink(missing_ok=True)
     return target.resolve()
+
+
+def publish(staged: StagedFile | None, report: dict, json_path: str | None, console: Console,
+            protected: tuple[Path, ...] = ()) -> Path | None:
+    """Put a command's results in place: the JSON report first, then the model.
+
+    ``staged`` is the model written beside its target (:func:`~surfprep.plugin.io.staged_write`),
+    None when there is none. The report file is written before the model is moved into
+    place, so a report that cannot be written leaves no model; if the move then fails,
+    the report is taken back. A report for standard output is printed after the move.
+    Returns the report's path (None for none or stdout).
+    """
+    if json_path is None or json_path == STDOUT:
+        if staged is not None:
+            staged.commit()
+        if json_path == STDOUT:
+            write_json_report(report, STDOUT, console)
+        return None
+    path = write_json_report(report, json_path, console, protected=protected)
+    if staged is not None:
+        try:
+            staged.commit()
+        except OutputFileError:
+            if path is not None:
+                path.unlink(missing_ok=True)
+            raise
+    return path
 
 
 def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:

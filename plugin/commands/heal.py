@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import write
+from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
@@ -16,8 +16,8 @@ from .base import (
     check_outputs,
     done_code,
     dropped_report,
+    publish,
     read_model,
-    write_json_report,
 )
 from .plotting import pyplot, save_figure
 
@@ -119,20 +119,20 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                   patches=args.patches, overlap=args.overlap,
                   split_faces=args.split_faces)
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model)}
-    report["output"] = str(write(result.model, args.output, overwrite=True))
-    if args.plot is not None:
-        report["plot"] = str(plot_deviation(result, args.plot))
+    with staged_write(result.model, args.output, overwrite=True) as staged:
+        report["output"] = str(staged.target)
+        if args.plot is not None:
+            report["plot"] = str(plot_deviation(result, args.plot))
+        report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path == STDOUT:
-        write_json_report(report, STDOUT, console)
         return done_code(model)
     for line in _summary(report):
         console.print(line)
     console.print(f"written to {report['output']}")
     for note in report["skipped"] + report["topology_violations"]:
         console.note(f"note: {note}")
-    if args.json_path is not None:
-        path = write_json_report(report, args.json_path, console, protected=inputs)
-        console.note(f"report written to {path}")
+    if report_path is not None:
+        console.note(f"report written to {report_path}")
     return done_code(model)
 
 

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
 
-from ..io import write
+from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
@@ -16,8 +17,8 @@ from .base import (
     check_outputs,
     done_code,
     dropped_report,
+    publish,
     read_model,
-    write_json_report,
 )
 from .plotting import pyplot, save_figure
 
@@ -208,39 +209,38 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     tol = results[0].tol if results else args.tol
     report = intersection_report(results, elapsed, tol, inputs)
     report["dropped"] = dropped_report(model_a, model_b)
-    if results:
-        edges = [e for r in results for e in r.to_edges()]
-        written = write(edges, args.output, overwrite=True)
-        report["output"] = str(written)
-    else:
-        report["output"] = None
-    if args.compare_occ:
-        report["occ"] = compare_with_occ(results, model_a, model_b)
-    if args.plot is not None:
-        report["plot"] = str(plot_curves(results, args.plot))
-    if args.json_path == STDOUT:
-        write_json_report(report, STDOUT, console)
-    else:
-        console.print(f"{len(results)} intersection curve(s) in {elapsed:.3f} s"
-                      + (f", written to {report['output']}" if results else
-                         f"; nothing written to {args.output}"))
-        added = sum(1 for c in report["curves"] if c["found_by"] == "characteristic")
-        if args.method == "auto" and added:
-            console.print(f"{added} of them found only by the characteristic method")
-        if report.get("isolated_points"):
-            console.print(f"{len(report['isolated_points'])} isolated (tangential contact) "
-                          "point(s)")
-        for c in report.get("coincident", []):
-            console.print(f"faces {c['faces']} coincide over {100 * c['share']:.0f} % of one of "
-                          f"them (within {c['max_distance']:.2g})")
+    with ExitStack() as stack:
+        staged = None
+        if results:
+            edges = [e for r in results for e in r.to_edges()]
+            staged = stack.enter_context(staged_write(edges, args.output, overwrite=True))
+        report["output"] = None if staged is None else str(staged.target)
         if args.compare_occ:
-            occ = report["occ"]
-            h = "-" if occ["hausdorff"] is None else f"{occ['hausdorff']:.3g}"
-            console.print(f"OpenCascade: {occ['branches']} branch(es) vs our "
-                          f"{occ['our_branches']}, Hausdorff {h}, {occ['time_s']:.3f} s")
-        if args.json_path is not None:
-            path = write_json_report(report, args.json_path, console, protected=inputs)
-            console.note(f"report written to {path}")
+            report["occ"] = compare_with_occ(results, model_a, model_b)
+        if args.plot is not None:
+            report["plot"] = str(plot_curves(results, args.plot))
+        report_path = publish(staged, report, args.json_path, console, protected=inputs)
+    if args.json_path == STDOUT:
+        return done_code(model_a, model_b)
+    console.print(f"{len(results)} intersection curve(s) in {elapsed:.3f} s"
+                  + (f", written to {report['output']}" if results else
+                     f"; nothing written to {args.output}"))
+    added = sum(1 for c in report["curves"] if c["found_by"] == "characteristic")
+    if args.method == "auto" and added:
+        console.print(f"{added} of them found only by the characteristic method")
+    if report.get("isolated_points"):
+        console.print(f"{len(report['isolated_points'])} isolated (tangential contact) "
+                      "point(s)")
+    for c in report.get("coincident", []):
+        console.print(f"faces {c['faces']} coincide over {100 * c['share']:.0f} % of one of "
+                      f"them (within {c['max_distance']:.2g})")
+    if args.compare_occ:
+        occ = report["occ"]
+        h = "-" if occ["hausdorff"] is None else f"{occ['hausdorff']:.3g}"
+        console.print(f"OpenCascade: {occ['branches']} branch(es) vs our "
+                      f"{occ['our_branches']}, Hausdorff {h}, {occ['time_s']:.3f} s")
+    if report_path is not None:
+        console.note(f"report written to {report_path}")
     return done_code(model_a, model_b)
 
 

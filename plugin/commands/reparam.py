@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import write
+from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
@@ -16,8 +16,8 @@ from .base import (
     check_outputs,
     done_code,
     dropped_report,
+    publish,
     read_model,
-    write_json_report,
 )
 from .plotting import pyplot, save_figure
 
@@ -102,19 +102,20 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         model, tol=args.tol, faces=args.faces,
         progress=lambda done, total: console.progress(done, total, "face"))
     elapsed = time.perf_counter() - start
-    written = write(shape, args.output, overwrite=True)
     ok = [e for e in entries if e.done is not None]
-    report = {"file": str(args.file), "output": str(written), "time_s": elapsed,
-              "tol": ok[0].done.result.tol if ok else args.tol,
-              "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model)}
-    if args.plot is not None:
-        from OCP.BRep import BRep_Tool
-        pairs = [(f"face {e.index}", surface_from_occ(BRep_Tool.Surface_s(model.faces[e.index])),
-                  e.done.result.surface) for e in ok[:PLOT_FACES]]
-        report["plot"] = str(plot_isolines(pairs, args.plot))
-    if args.json_path == STDOUT:
-        write_json_report(report, STDOUT, console)
-    else:
+    with staged_write(shape, args.output, overwrite=True) as staged:
+        written = staged.target
+        report = {"file": str(args.file), "output": str(written), "time_s": elapsed,
+                  "tol": ok[0].done.result.tol if ok else args.tol,
+                  "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model)}
+        if args.plot is not None:
+            from OCP.BRep import BRep_Tool
+            pairs = [(f"face {e.index}",
+                      surface_from_occ(BRep_Tool.Surface_s(model.faces[e.index])),
+                      e.done.result.surface) for e in ok[:PLOT_FACES]]
+            report["plot"] = str(plot_isolines(pairs, args.plot))
+        report_path = publish(staged, report, args.json_path, console, protected=inputs)
+    if args.json_path != STDOUT:
         for e in entries:
             if e.done is None:
                 console.print(f"face {e.index}: skipped: {e.error}")
@@ -126,9 +127,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                 f"{d.poles_before} -> {d.poles_after}, {e.time_s:.2f} s")
         console.print(f"{len(ok)} of {len(entries)} face(s) reparametrized in {elapsed:.2f} s, "
                       f"written to {written}")
-        if args.json_path is not None:
-            path = write_json_report(report, args.json_path, console, protected=inputs)
-            console.note(f"report written to {path}")
+        if report_path is not None:
+            console.note(f"report written to {report_path}")
     return done_code(model, skipped=len(ok) != len(entries))
 
 

@@ -394,6 +394,50 @@ def test_an_unwritable_json_folder_is_refused_before_the_model_is_written(tmp_pa
     assert not (tmp_path / "h.step").exists()
 
 
+@pytest.fixture(scope="module")
+def crossing_file(tmp_path_factory):
+    """Two B-spline patches over the unit square crossing along one curve."""
+    from surfprep.algorithms.fitting import interpolate_surface
+    from surfprep.plugin.occ.faces import make_face
+    g = np.linspace(0, 1, 6)
+    gx, gy = np.meshgrid(g, g, indexing="ij")
+    patches = [interpolate_surface(np.stack(
+        [gx, gy, 0.1 * np.sin(1.3 * gx) * np.cos(0.9 * gy) + dz + tilt * (gx - 0.5)], -1))
+        for dz, tilt in ((0.0, 0.0), (0.02, 0.5))]
+    path = tmp_path_factory.mktemp("crossing") / "crossing.step"
+    surfprep.write([make_face(p) for p in patches], path)
+    return path
+
+
+@pytest.mark.parametrize("command", ["heal", "intersect", "reparam"])
+def test_a_report_that_cannot_be_written_leaves_no_model(command, crossing_file, tmp_path,
+                                                         capsys, monkeypatch):
+    """The report is written before the model is moved into place: when writing it fails
+    (a disk full, a folder taken away during the run), no model is left without it."""
+    from surfprep.errors import OutputFileError
+    from surfprep.plugin.commands import base
+
+    def failing_report(report, destination, console, protected=()):
+        raise OutputFileError(f"cannot write report {destination}: No space left on device")
+
+    monkeypatch.setattr(base, "write_json_report", failing_report)
+    out = tmp_path / "out.step"
+    code, _, err = run(capsys, command, crossing_file, "-o", out, "--json", tmp_path / "r.json")
+    assert code == 2
+    assert_one_line_error(err, "No space left")
+    assert list(tmp_path.iterdir()) == []                  # neither model nor temporary
+
+
+@pytest.mark.parametrize("command", ["heal", "intersect", "reparam"])
+def test_model_and_report_are_both_written(command, crossing_file, tmp_path, capsys):
+    out, report = tmp_path / "out.step", tmp_path / "r.json"
+    code, _, err = run(capsys, command, crossing_file, "-o", out, "--json", report)
+    assert code == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.step", "r.json"]
+    assert json.loads(report.read_text())["output"] == str(out.resolve())
+    assert surfprep.read(out, require_faces=False).shape is not None
+
+
 def test_a_model_without_b_spline_faces_has_nothing_to_reparametrize(tmp_path, capsys):
     import cadquery as cq
     box = tmp_path / "box.step"

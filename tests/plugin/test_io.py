@@ -339,6 +339,27 @@ def test_successful_write_leaves_only_the_target(tmp_path):
     assert (tmp_path / "capsule.step").stat().st_mode & 0o044  # not owner-only
 
 
+def test_a_staged_file_appears_only_when_committed(tmp_path):
+    target = tmp_path / "staged.step"
+    with sio.staged_write(wavy_patch(), target) as staged:
+        assert not target.exists()
+        assert [p.parent for p in tmp_path.iterdir()] == [tmp_path]    # the temporary
+        assert staged.target == target.resolve()
+    assert list(tmp_path.iterdir()) == []                  # left without commit: gone
+    with sio.staged_write(wavy_patch(), target) as staged:
+        assert staged.commit() == target.resolve()
+    assert [p.name for p in tmp_path.iterdir()] == ["staged.step"]
+    assert read(target).n_faces == 1
+
+
+def test_a_failure_between_staging_and_commit_leaves_nothing(tmp_path):
+    target = tmp_path / "staged.step"
+    with pytest.raises(RuntimeError, match="report failed"), \
+            sio.staged_write(wavy_patch(), target):
+        raise RuntimeError("report failed")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_failed_writer_leaves_no_temp_file_and_keeps_old_target(tmp_path, monkeypatch):
     target = tmp_path / "out.step"
     target.write_text("previous content")
