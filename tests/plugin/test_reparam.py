@@ -195,6 +195,42 @@ def test_a_model_of_located_faces_read_back_from_step(tmp_path):
         assert project_to_surface(old, grid).distance.max() <= entry.done.result.tol
 
 
+def test_a_tiny_edge_read_back_as_degenerated_keeps_its_pcurve_on_the_edge(tmp_path, data_dir):
+    """occt_catia4_face_L1.igs written to STEP reads back with a 1.6e-4 mm edge inside
+    the face marked degenerated. Its pcurve was mapped through the inverse
+    reparametrization alone (right at a pole, 0.145 mm off here, tol 0.017): the new
+    pcurve is now projected where the mapped one is off the point."""
+    from surfprep.plugin.occ.edges import read_trim_edge
+    from surfprep.plugin.reparam import _unique_edges, reparametrize_model
+    path = tmp_path / "catia4.step"
+    surfprep.write(surfprep.read(data_dir / "occt_catia4_face_L1.igs"), path)
+    model = surfprep.read(path)
+    face = model.faces[0]
+    inside = [t for t in (read_trim_edge(e, face, []) for e in _unique_edges(face))
+              if t.degenerated]
+    assert inside, "the STEP round trip no longer makes the degenerated edge this test is about"
+    shape, (entry,) = reparametrize_model(model)
+    assert entry.error is None
+    done = entry.done
+    assert done.pcurve_deviation <= 0.5 * done.result.tol
+    # measured here too: every edge's new pcurve through the new surface, on its 3D curve
+    # (on the point, for the degenerated one)
+    from OCP.TopExp import TopExp
+    (new_face,) = surfprep.plugin.occ.shapes.all_faces(shape)
+    new = surface_from_occ(BRep_Tool.Surface_s(new_face))
+    for edge in _unique_edges(new_face):
+        trim = read_trim_edge(edge, new_face, [])
+        t = np.linspace(trim.t0, trim.t1, 101)
+        uv = trim.pcurve.evaluate(t)
+        on_new = new.evaluate(uv[:, 0], uv[:, 1])
+        if trim.curve3d is not None:
+            target = trim.curve3d.evaluate(t)
+        else:                                   # 1.6e-4 mm long: its vertex stands for it
+            vertex = BRep_Tool.Pnt_s(TopExp.FirstVertex_s(edge))
+            target = np.array([vertex.X(), vertex.Y(), vertex.Z()])
+        assert np.linalg.norm(on_new - target, axis=-1).max() <= 0.5 * done.result.tol
+
+
 def test_a_location_that_scales_is_refused():
     face = _moved(_disk_face(_u_cubed_sheet()), scale=2.0)
     with pytest.raises(ConversionError, match="scales"):
