@@ -23,6 +23,7 @@ from . import basis_kernels
 __all__ = [
     "basis_derivatives",
     "basis_functions",
+    "check_offset",
     "check_weights",
     "collocation_matrix",
     "distinct_knots",
@@ -107,6 +108,15 @@ def check_weights(weights: NDArray | None, shape: tuple[int, ...], name: str) ->
     if not np.all(np.isfinite(weights)) or np.any(weights <= 0):
         raise InvalidGeometryError(f"{name} must be finite and > 0")
     return weights
+
+
+def check_offset(offset: ArrayLike, dimension: int) -> NDArray:
+    """A translation as ``(dimension,)`` finite floats, or InvalidGeometryError."""
+    out = np.asarray(offset, dtype=float)
+    if out.shape != (dimension,) or not np.all(np.isfinite(out)):
+        raise InvalidGeometryError(
+            f"offset must be {dimension} finite numbers, got {np.asarray(offset)!r}")
+    return out
 
 
 def find_span(knots: NDArray, degree: int, t: ArrayLike) -> NDArray:

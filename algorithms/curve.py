@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
-from .basis import basis_derivatives, check_weights, find_span, frozen_array, owned_array, validate_knots
+from .basis import basis_derivatives, check_offset, check_weights, find_span, frozen_array, owned_array, validate_knots
 from .rational import curve_derivatives_from_homogeneous
 
 __all__ = ["NurbsCurve"]
@@ -206,6 +206,12 @@ class NurbsCurve:
         """Control-point bounding box ``(2, d)`` (:func:`.measure.bounding_box`)."""
         from .measure import bounding_box
         return bounding_box(self)
+
+    def translated(self, offset: ArrayLike) -> NurbsCurve:
+        """The same curve moved by ``offset`` ``(d,)``: control points shifted; knots,
+        degree and weights kept (exact for rational curves too)."""
+        return type(self).construct_fast(self.control_points + check_offset(offset, self.dimension),
+                                         self.knots, self.degree, self.weights)
 
     def arc_length(self, t0: float | None = None, t1: float | None = None,
                    tol: float = 1e-12) -> float:

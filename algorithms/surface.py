@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from . import basis_kernels
-from .basis import basis_derivatives, check_weights, find_span, frozen_array, owned_array, validate_knots
+from .basis import basis_derivatives, check_offset, check_weights, find_span, frozen_array, owned_array, validate_knots
 from .rational import surface_derivatives_from_homogeneous
 
 __all__ = ["NurbsSurface"]
@@ -288,6 +288,15 @@ class NurbsSurface:
         from .measure import bounding_box
         return bounding_box(self)
 
+    def translated(self, offset: ArrayLike) -> NurbsSurface:
+        """The same surface moved by ``offset`` ``(d,)``: control points shifted; knots,
+        degrees and weights kept (exact for rational surfaces too, as a NURBS is
+        affinely invariant). Algorithms work on a far-off surface moved to its own box
+        centre, where coordinates keep their low bits."""
+        return type(self).construct_fast(self.control_points + check_offset(offset, self.dimension),
+                                         self.knots_u, self.knots_v, self.degree_u,
+                                         self.degree_v, self.weights)
+
     def normals(self, u: ArrayLike, v: ArrayLike) -> NDArray:
         """Unit normals ``(..., 3)``, limit direction at degenerate points."""
         from .measure import normals
@@ -306,3 +315,4 @@ class NurbsSurface:
         kind = "rational" if self.weights is not None else "polynomial"
         return (f"NurbsSurface(degree=({self.degree_u}, {self.degree_v}), "
                 f"n_control={self.n_control}, {kind}, domain={self.domain})")
+

@@ -50,6 +50,7 @@ from scipy.interpolate import RegularGridInterpolator
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..isocurve import isocurve
+from ..measure import box_centre
 from ..parametrization import parametrization_quality
 from ..surface import NurbsSurface
 from ..tensor import Direction
@@ -402,6 +403,11 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
     tol = check_tolerance(tol, "tol", low=MIN_RELATIVE_TOL * size, high=MAX_RELATIVE_TOL * size)
     if per_span < 10:
         raise InvalidGeometryError(f"per_span must be >= 10, got {per_span}")
+    # worked on about its own box centre: 1e6 away from the origin, a surface 169 across
+    # kept only ~1e-10 of its coordinates' bits, the arc lengths (converged to 1e-12 of
+    # the length) bisected to their cap and the fit took 3x as long
+    centre = box_centre(surface)
+    surface = surface.translated(-centre)
     creases_u, creases_v = crease_knots(surface)
     du, fu = _direction(surface, Direction.U, creases_u, creases_v, tol)
     dv, fv = _direction(surface, Direction.V, creases_v, du.breaks, tol)
@@ -467,7 +473,8 @@ def reparametrize_surface(surface: NurbsSurface, *, tol: float | None = None,
         worst = best.worst
         removed = int((~best.keep_u).sum() + (~best.keep_v).sum())
     return ReparametrizationResult(
-        surface=new, tol=tol, max_deviation=worst, within_tolerance=bool(done),
+        surface=new.translated(centre), tol=tol, max_deviation=worst,
+        within_tolerance=bool(done),
         mismatch_before=_mismatch(surface), mismatch_after=_mismatch(new),
         iterations=iteration, knots_inserted=inserted, relocation_sweeps=sweeps,
         relocation_converged=bool(settled), params_u=pu, params_v=pv, uv=uv,

@@ -215,6 +215,40 @@ def test_cumulative_arc_length(curve):
     np.testing.assert_allclose(cumulative_arc_length(refined, t), s, rtol=1e-10, atol=1e-12)
 
 
+@pytest.mark.parametrize("offset", [0.0, 1e6])
+def test_a_tiny_end_span_far_away_keeps_the_length(offset):
+    """A quarter circle (radius 3) and a straight last knot span 2e-8 wide and 2e-8
+    long, as a STEP file written at 1e6 gives it: the speed on that span is known only
+    to the rounding of its control-point differences; the length is still right (and
+    the estimate no longer bisects that span to the cap)."""
+    r, h, length = 3.0, 2e-8, 2e-8
+    end = np.array([0.0, r, 0.0])
+    points = np.array([[r, 0, 0], [r, r, 0], end, end + [-0.5 * length, 0, 0],
+                       end + [-length, 0, 0]]) + offset
+    curve = NurbsCurve(points, [0, 0, 0, 1, 1, 1 + h, 1 + h, 1 + h], 2, [1, S2, 1, 1, 1])
+    quarter = 0.5 * np.pi * r
+    rel = 1e-12 if offset == 0 else 1e-10     # poles at 1e6 are themselves rounded to 1e-10
+    assert arc_length(curve) == pytest.approx(quarter + length, rel=rel)
+    s = cumulative_arc_length(curve, np.array([0.5, 1.0, 1.0 + 0.5 * h, 1.0 + h]))
+    np.testing.assert_allclose(s, [0.5 * quarter, quarter, quarter + 0.5 * length,
+                                   quarter + length], rtol=rel)
+
+
+def test_translated_curves_and_surfaces_are_moved_exactly():
+    circle = nurbs_circle(2.0, (1.0, 2.0, 3.0))
+    moved = circle.translated([10.0, 0.0, -5.0])
+    t = np.linspace(*circle.domain, 50)
+    np.testing.assert_allclose(moved.evaluate(t), circle.evaluate(t) + [10.0, 0.0, -5.0],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(moved.weights, circle.weights)
+    assert arc_length(moved.translated([1e6, 1e6, 1e6])) == pytest.approx(arc_length(circle),
+                                                                             rel=1e-10)
+    with pytest.raises(InvalidGeometryError, match="3 finite numbers"):
+        circle.translated([1.0, np.nan, 0.0])
+    with pytest.raises(InvalidGeometryError, match="3 finite numbers"):
+        circle.translated([1.0, 2.0])
+
+
 def test_arc_length_rejects_bad_arguments():
     curve = make_curve(0, 3, 1, 1, False)
     lo, hi = curve.domain

@@ -92,6 +92,26 @@ def test_within_tol_and_chord_length(warp):
     assert v1 - v0 == pytest.approx(1.5, rel=0.05)
 
 
+def test_a_far_off_surface_gets_the_same_answer():
+    """The surface 1e6 away from the origin (169 across in the issue's file, 2.4 here):
+    worked on about its own box centre, so the answer is the near one moved, not a
+    different fit of coordinates that lost their low bits."""
+    offset = np.array([1e6, -1e6, 1e6])
+    original, near = reparametrized(u_cubed)
+    far_original = original.translated(offset)
+    far = reparametrize_surface(far_original, tol=near.tol)
+    assert far.within_tolerance
+    assert far.surface.n_control == near.surface.n_control
+    assert far.iterations == near.iterations
+    assert far.mismatch_after == pytest.approx(near.mismatch_after, rel=1e-6)
+    assert far.max_deviation == pytest.approx(near.max_deviation, rel=1e-4)
+    # the same surface, moved (coordinates at 1e6 are rounded to ~1e-10; the relocation,
+    # converged to its own threshold, carries that to ~1e-8)
+    np.testing.assert_allclose(far.surface.control_points - offset, near.surface.control_points,
+                               rtol=0, atol=1e-3 * near.tol)
+    assert dense_deviation(far_original, far) <= far.tol
+
+
 def test_shear_needs_the_interior_relocation():
     """Per-direction arc length (straight lines in the original domain) leaves the
     shear in; the penalty relocation removes it."""
