@@ -32,6 +32,7 @@ from .errors import (
     DegenerateGeometryError,
     InputFileError,
     InvalidGeometryError,
+    InvalidShapeWarning,
     InvalidToleranceError,
     NoFacesError,
     OpenCascadeError,
@@ -91,6 +92,7 @@ __all__ = [
     "NoFacesError",
     "OutputFileError",
     "OpenCascadeError",
+    "InvalidShapeWarning",
 ]
 
 #: Public names loaded on first use (the OpenCascade side, and what needs scipy beyond the

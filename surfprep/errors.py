@@ -18,6 +18,7 @@ __all__ = [
     "NoFacesError",
     "OutputFileError",
     "OpenCascadeError",
+    "InvalidShapeWarning",
 ]
 
 
@@ -56,3 +57,8 @@ class OutputFileError(SurfprepError, OSError):
 
 class OpenCascadeError(SurfprepError, RuntimeError):
     """An OpenCascade builder or reader reported failure (``IsDone()`` false, bad status)."""
+
+
+class InvalidShapeWarning(UserWarning):
+    """The input shape already fails OpenCascade's check (``BRepCheck_Analyzer``): the
+    result keeps those faults (it adds none) instead of being refused for them."""

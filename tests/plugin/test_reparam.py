@@ -231,6 +231,38 @@ def test_a_tiny_edge_read_back_as_degenerated_keeps_its_pcurve_on_the_edge(tmp_p
         assert np.linalg.norm(on_new - target, axis=-1).max() <= 0.5 * done.result.tol
 
 
+def _face_off_its_edge() -> TopoDS_Face:
+    """A plane face bounded by a circle 0.5 above the plane: BRepCheck rejects it
+    (the edge is not on the surface), as the two faces occt_b1_euclid.stp comes with."""
+    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pln, gp_Pnt
+    from OCP.Geom import Geom_Plane
+    circle = BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0.5), gp_Dir(0, 0, 1)), 1.0))
+    wire = BRepBuilderAPI_MakeWire(circle.Edge()).Wire()
+    builder = BRepBuilderAPI_MakeFace(Geom_Plane(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))),
+                                      wire, True)
+    assert builder.IsDone()
+    face = builder.Face()
+    assert not BRepCheck_Analyzer(face).IsValid()
+    return face
+
+
+def test_a_model_that_comes_invalid_is_reparametrized_with_a_warning():
+    """The faults of the input are not ours: the B-spline face is done, the invalid
+    plane face kept as it was, a warning names it (not 'the shape ... is not valid')."""
+    from surfprep.plugin.io import CadModel
+    from surfprep.plugin.occ.shapes import compound
+    from surfprep.plugin.reparam import reparametrize_model
+    model = CadModel.from_shape(compound([_disk_face(_u_cubed_sheet()), _face_off_its_edge()]))
+    with pytest.warns(surfprep.InvalidShapeWarning, match=r"faces \[1\] fail the check alone"):
+        shape, (entry,) = reparametrize_model(model)
+    assert entry.index == 0 and entry.error is None
+    after = surfprep.plugin.occ.shapes.all_faces(shape)
+    assert BRepCheck_Analyzer(after[0]).IsValid()
+    assert not BRepCheck_Analyzer(after[1]).IsValid()
+    assert surface_from_occ(BRep_Tool.Surface_s(after[0])).n_control == \
+        entry.done.result.surface.n_control
+
+
 def test_a_location_that_scales_is_refused():
     face = _moved(_disk_face(_u_cubed_sheet()), scale=2.0)
     with pytest.raises(ConversionError, match="scales"):
