@@ -255,3 +255,30 @@ def test_bundled_fuselage_does_not_self_intersect():
     model = surfprep.read(SAMPLES / "occt_fuselage.stp")
     result = intersect(model)
     assert list(result) == []
+
+
+def test_a_tangential_contact_with_clustered_singular_points_ends(data_dir, monkeypatch):
+    """pyocc_ventilator_catia5.stp faces 235 x 244 touch along a curve with their
+    normals parallel: 27 singular points found close together on it. Re-splitting every
+    trace at all of them every round multiplied the traces (60 -> 514951 in 7 rounds;
+    the whole-model intersect sat there for good). Each trace is now split once per
+    point, and nothing of OpenCascade's section curve is missed."""
+    from surfprep.algorithms.characteristic import singular
+    sizes = []
+    real = singular._split_at_found
+
+    def counted(*args):
+        work, new = real(*args)
+        sizes.append(len(work))
+        if len(work) > 1000:
+            raise AssertionError(f"the traces multiply round after round: {sizes}")
+        return work, new
+
+    monkeypatch.setattr(singular, "_split_at_found", counted)
+    model = surfprep.read(data_dir / "pyocc_ventilator_catia5.stp")
+    operands = face_operands(model)
+    result = intersect(operands[235].trimmed, operands[244].trimmed)
+    assert sizes and max(sizes) <= 2 * sizes[0]
+    check_result(result)
+    (occ,) = section_faces_occ(model.faces[235], model.faces[244])
+    assert polyline_distance(occ.points, [c.curve for c in result]).max() <= result.tol
