@@ -38,6 +38,7 @@ from .errors import (
     OpenCascadeError,
     OutputFileError,
     SurfprepError,
+    TimeLimitExceeded,
 )
 from .inputs import ShapeLike
 
@@ -92,6 +93,7 @@ __all__ = [
     "NoFacesError",
     "OutputFileError",
     "OpenCascadeError",
+    "TimeLimitExceeded",
     "InvalidShapeWarning",
 ]
 

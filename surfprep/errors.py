@@ -18,6 +18,7 @@ __all__ = [
     "NoFacesError",
     "OutputFileError",
     "OpenCascadeError",
+    "TimeLimitExceeded",
     "InvalidShapeWarning",
 ]
 
@@ -57,6 +58,12 @@ class OutputFileError(SurfprepError, OSError):
 
 class OpenCascadeError(SurfprepError, RuntimeError):
     """An OpenCascade builder or reader reported failure (``IsDone()`` false, bad status)."""
+
+
+class TimeLimitExceeded(SurfprepError):
+    """A step stopped by the caller's time limit (``surfprep intersect --pair-time-limit``
+    raises it into the face pair running too long): the verb records what it stopped,
+    says so, and goes on with the rest."""
 
 
 class InvalidShapeWarning(UserWarning):

@@ -21,6 +21,7 @@ from .base import (
     read_model,
 )
 from .plotting import pyplot, save_figure
+from .time_limit import step_time_limit
 
 __all__ = [
     "COMMAND",
@@ -32,6 +33,8 @@ __all__ = [
 
 #: values of --method (plugin.intersect_methods.Method; not imported to build the parser)
 METHODS = ("auto", "mesh", "characteristic")
+#: default --pair-time-limit (s): the slowest pair of the real files takes 14 s
+DEFAULT_PAIR_TIME_LIMIT = 120.0
 #: samples per OpenCascade section edge (chord sag about 3e-7 of a unit circle)
 OCC_SAMPLES = 4001
 
@@ -170,6 +173,17 @@ def _characteristic_pairs(results, limit: int = 4) -> list:
     return with_points[:limit]
 
 
+def _seconds(text: str) -> float:
+    """``--pair-time-limit``: a finite number of seconds >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number of seconds: {text!r}") from None
+    if not (value >= 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text}")
+    return value
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file_a", type=Path, metavar="A", help="STEP or IGES file")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
@@ -193,6 +207,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              "characteristic method for pairs that cross at a small angle; "
                              "mesh: triangles only; characteristic: the characteristic-curve "
                              "method only")
+    parser.add_argument("--pair-time-limit", type=_seconds, default=DEFAULT_PAIR_TIME_LIMIT,
+                        metavar="S",
+                        help="stop a face pair that runs longer than S seconds, report it "
+                             "(its curves are missing, exit 1) and go on with the others; "
+                             f"0 for no limit (default {DEFAULT_PAIR_TIME_LIMIT:g})")
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
@@ -203,8 +222,12 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     model_b = read_model(args.file_b, console, strict=args.strict) if args.file_b is not None \
         else None
     start = time.perf_counter()
-    results = intersect(model_a, model_b, tol=args.tol, method=args.method,
-                        progress=lambda done, total: console.progress(done, total, "face pair"))
+    with step_time_limit(args.pair_time_limit, "a face pair") as restart:
+        def progress(done: int, total: int) -> None:
+            restart()
+            console.progress(done, total, "face pair")
+        results = intersect(model_a, model_b, tol=args.tol, method=args.method,
+                            progress=progress)
     elapsed = time.perf_counter() - start
     tol = results[0].tol if results else args.tol
     report = intersection_report(results, elapsed, tol, inputs)
@@ -221,7 +244,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             report["plot"] = str(plot_curves(results, args.plot))
         report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path == STDOUT:
-        return done_code(model_a, model_b)
+        return done_code(model_a, model_b, skipped=bool(results.stopped))
     console.print(f"{len(results)} intersection curve(s) in {elapsed:.3f} s"
                   + (f", written to {report['output']}" if results else
                      f"; nothing written to {args.output}"))
@@ -239,9 +262,12 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         h = "-" if occ["hausdorff"] is None else f"{occ['hausdorff']:.3g}"
         console.print(f"OpenCascade: {occ['branches']} branch(es) vs our "
                       f"{occ['our_branches']}, Hausdorff {h}, {occ['time_s']:.3f} s")
+    for p in results.stopped:
+        console.note(f"note: faces {p.faces[0]} and {p.faces[1]} stopped after "
+                     f"{p.time_s:.0f} s (--pair-time-limit): their curves are missing")
     if report_path is not None:
         console.note(f"report written to {report_path}")
-    return done_code(model_a, model_b)
+    return done_code(model_a, model_b, skipped=bool(results.stopped))
 
 
 COMMAND = Command(

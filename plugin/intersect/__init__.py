@@ -48,6 +48,7 @@ plots).
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -57,7 +58,7 @@ from numpy.typing import NDArray
 from ...algorithms.characteristic import CharacteristicRecord, face_coincidence
 from ...algorithms.intersection import IntersectionCurve, along_a_boundary, clip_curve, closed_in_space
 from ...algorithms.tolerance import check_tolerance
-from ...errors import InvalidGeometryError
+from ...errors import InvalidGeometryError, TimeLimitExceeded
 from ...inputs import ShapeLike
 from ..occ.edges import make_edge
 from .methods import (
@@ -67,6 +68,7 @@ from .methods import (
     IntersectionResult,
     Method,
     PairRecord,
+    StoppedPair,
     pair_curves,
 )
 from .operands import FaceOperand, face_operands
@@ -82,6 +84,7 @@ __all__ = [
     "IntersectionResult",
     "Method",
     "PairRecord",
+    "StoppedPair",
     "face_operands",
     "intersect",
 ]
@@ -183,6 +186,23 @@ def _contacts(record: CharacteristicRecord | None, fa: FaceOperand, fb: FaceOper
     return out
 
 
+def _one_pair(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
+              method: Method, within: bool):
+    """The curves of one face pair clipped to both faces (not those along a shared edge
+    ``within`` one operand), its contact points, coincident regions and its record."""
+    curves, found_by, record = pair_curves(fa, fb, tol, mesh_tol, method)
+    pieces = [FaceIntersection(piece, fa, fb, tol, how)
+              for curve, how in zip(curves, found_by)
+              for piece in clip_curve(curve, fa.region, fb.region, tol)
+              if not (within and along_a_boundary(piece, fa.region, fb.region, tol))]
+    coincident = []
+    if record is not None and record.coincident:
+        region = face_coincidence(fa.region, fb.region, tol)    # the faces, not the surfaces
+        if region is not None:
+            coincident.append(CoincidentFaces(fa, fb, region))
+    return pieces, _contacts(record, fa, fb, tol, within), coincident, (record, tuple(curves))
+
+
 def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = None,
               mesh_tol: float | None = None, method: Method | str = Method.AUTO,
               progress: Callable[[int, int], None] | None = None) -> IntersectionResult:
@@ -205,7 +225,11 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     method : Method or str
         ``"auto"`` (default), ``"mesh"`` or ``"characteristic"`` (module docstring).
     progress : callable(done, total), optional
-        Called after each face pair whose boxes overlap.
+        Called with ``done = 0`` once the face pairs whose boxes overlap are
+        known, then after each of them. A pair interrupted by
+        :class:`~surfprep.errors.TimeLimitExceeded` (raised into it by the caller,
+        as ``surfprep intersect --pair-time-limit`` does from a timer) is recorded
+        in ``stopped`` with a warning, and the run goes on.
 
     Returns
     -------
@@ -264,21 +288,26 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
         overlap &= np.triu(np.ones_like(overlap), k=1).astype(bool)
     pairs = np.argwhere(overlap)
     out = IntersectionResult(method=method, tol=tol)
+    if progress is not None:
+        progress(0, len(pairs))
     for done, (i, j) in enumerate(pairs, start=1):
         fa, fb = faces_a[i], faces_b[j]
         start = time.perf_counter()
-        curves, found_by, record = pair_curves(fa, fb, tol, mesh_tol, method)
-        for curve, how in zip(curves, found_by):
-            for piece in clip_curve(curve, fa.region, fb.region, tol):
-                if b is None and along_a_boundary(piece, fa.region, fb.region, tol):
-                    continue
-                out.append(FaceIntersection(piece, fa, fb, tol, how))
-        out.isolated_points += _contacts(record, fa, fb, tol, b is None)
-        if record is not None and record.coincident:
-            region = face_coincidence(fa.region, fb.region, tol)    # the faces, not the surfaces
-            if region is not None:
-                out.coincident.append(CoincidentFaces(fa, fb, region))
-        out.records.append(PairRecord(fa, fb, record, tuple(curves), time.perf_counter() - start))
+        try:
+            pieces, contacts, coincident, record = _one_pair(fa, fb, tol, mesh_tol, method,
+                                                             within=b is None)
+        except TimeLimitExceeded:
+            stopped = StoppedPair(fa, fb, time.perf_counter() - start)
+            out.stopped.append(stopped)
+            warnings.warn(f"faces {fa.index} and {fb.index}: stopped by the time limit after "
+                          f"{stopped.time_s:.0f} s; the curves of this pair are missing",
+                          stacklevel=2)
+        else:                  # a pair counts whole or not at all
+            out.extend(pieces)
+            out.isolated_points += contacts
+            out.coincident += coincident
+            out.records.append(PairRecord(fa, fb, record[0], record[1],
+                                          time.perf_counter() - start))
         if progress is not None:
             progress(done, len(pairs))
     out.time_s = time.perf_counter() - start_time

@@ -104,6 +104,20 @@ class PairRecord:
     time_s: float
 
 
+@dataclass(frozen=True)
+class StoppedPair:
+    """A face pair stopped by the caller's time limit (:class:`~surfprep.errors.TimeLimitExceeded`):
+    its curves are missing from the result."""
+
+    face_a: FaceOperand
+    face_b: FaceOperand
+    time_s: float
+
+    @property
+    def faces(self) -> tuple[int, int]:
+        return self.face_a.index, self.face_b.index
+
+
 class IntersectionResult(list):
     """What :func:`surfprep.intersect` found: a ``list`` of :class:`FaceIntersection` (the
     curves, clipped to both faces) and everything else it measured.
@@ -114,7 +128,9 @@ class IntersectionResult(list):
         Tangential contact points inside both faces.
     coincident : list of CoincidentFaces
     records : list of PairRecord
-        One per face pair whose boxes overlap.
+        One per face pair whose boxes overlap and that ran to its end.
+    stopped : list of StoppedPair
+        Face pairs stopped by the caller's time limit (their curves are missing).
     method : Method
     tol : float or None
         The tolerance the curves were computed to (model units).
@@ -123,12 +139,13 @@ class IntersectionResult(list):
     """
 
     def __init__(self, curves=(), *, isolated_points=(), coincident=(), records=(),
-                 method: Method = Method.AUTO, tol: float | None = None,
+                 stopped=(), method: Method = Method.AUTO, tol: float | None = None,
                  time_s: float = 0.0) -> None:
         super().__init__(curves)
         self.isolated_points = list(isolated_points)
         self.coincident = list(coincident)
         self.records = list(records)
+        self.stopped = list(stopped)
         self.method = Method(method)
         self.tol = tol
         self.time_s = time_s
@@ -194,6 +211,8 @@ class IntersectionResult(list):
                             "box_a": c.region.box_a.tolist(), "box_b": c.region.box_b.tolist(),
                             "max_distance": c.region.max_distance} for c in self.coincident],
             "pairs": pairs,
+            "stopped_pairs": [{"faces": list(p.faces), "time_s": p.time_s}
+                              for p in self.stopped],
         }
 
 

@@ -115,3 +115,44 @@ def test_refuses_to_overwrite_an_input(files, capsys):
 def test_listed_in_help(capsys):
     code, stdout, _ = run(capsys, "--help")
     assert code == 0 and "intersect" in stdout
+
+
+def test_a_pair_over_the_time_limit_is_stopped_and_the_run_goes_on(files, tmp_path, capsys,
+                                                                   monkeypatch):
+    """The first face pair hangs (as a pathological pair would); --pair-time-limit stops
+    it, the other pairs give their curves, the report names the stopped pair, exit 1."""
+    import time as clock
+
+    import surfprep.plugin.intersect as verb
+    real = verb.pair_curves
+    calls = []
+
+    def first_hangs(fa, fb, *args):
+        calls.append((fa.index, fb.index))
+        if len(calls) == 1:
+            clock.sleep(60)
+        return real(fa, fb, *args)
+
+    monkeypatch.setattr(verb, "pair_curves", first_hangs)
+    report = tmp_path / "r.json"
+    start = clock.perf_counter()
+    code, stdout, err = run(capsys, "intersect", files["sphere"], files["slab"], "-o",
+                            tmp_path / "c.step", "--json", report, "--pair-time-limit", "0.5")
+    assert clock.perf_counter() - start < 30
+    assert code == 1, err
+    r = json.loads(report.read_text())
+    (stopped,) = r["stopped_pairs"]
+    assert stopped["faces"] == list(calls[0]) and 0.45 <= stopped["time_s"] < 10
+    assert len(calls) > 1 and len(r["pairs"]) == len(calls) - 1
+    assert "stopped after" in err and "--pair-time-limit" in err
+    assert "Traceback" not in err
+    import signal
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)        # disarmed afterwards
+
+
+@pytest.mark.parametrize("value", ["-1", "nan", "inf", "soon"])
+def test_a_bad_pair_time_limit_is_a_usage_error(value, files, tmp_path, capsys):
+    code, _, err = run(capsys, "intersect", files["sphere"], "-o", tmp_path / "c.step",
+                       "--pair-time-limit", value)
+    assert code == 2
+    assert "--pair-time-limit" in err

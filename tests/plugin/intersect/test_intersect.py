@@ -205,7 +205,7 @@ def test_progress_is_reported():
     calls = []
     intersect(unit_sphere(), cq.Face.makePlane(4, 4, basePnt=(0, 0, 0.3)),
               progress=lambda done, total: calls.append((done, total)))
-    assert calls == [(1, 1)]
+    assert calls == [(0, 1), (1, 1)]                 # the pairs known, then each done
 
 
 @pytest.mark.parametrize("tol", [0.0, -1.0, float("nan"), 1e-15, "x"])
@@ -282,3 +282,28 @@ def test_a_tangential_contact_with_clustered_singular_points_ends(data_dir, monk
     check_result(result)
     (occ,) = section_faces_occ(model.faces[235], model.faces[244])
     assert polyline_distance(occ.points, [c.curve for c in result]).max() <= result.tol
+
+
+def test_a_pair_stopped_by_the_callers_time_limit_is_recorded_and_the_run_goes_on(monkeypatch):
+    """TimeLimitExceeded raised into a pair (as the CLI's timer does): that pair is in
+    ``stopped`` with a warning and none of its curves, the others are complete."""
+    import surfprep.plugin.intersect as verb
+    from surfprep.errors import TimeLimitExceeded
+    real = verb.pair_curves
+    seen = []
+
+    def second_is_stopped(fa, fb, *args):
+        seen.append((fa.index, fb.index))
+        if len(seen) == 2:
+            raise TimeLimitExceeded("a face pair ran longer than 1 s")
+        return real(fa, fb, *args)
+
+    monkeypatch.setattr(verb, "pair_curves", second_is_stopped)
+    sphere = unit_sphere()
+    planes = [cq.Face.makePlane(4, 4, basePnt=(0, 0, z)) for z in (0.3, 0.5, -0.4)]
+    with pytest.warns(UserWarning, match="stopped by the time limit"):
+        result = intersect(sphere, planes)
+    assert [p.faces for p in result.stopped] == [seen[1]]
+    assert len(result.records) == len(seen) - 1 == 2
+    assert sorted(r.faces for r in result) == sorted(p for p in (seen[0], seen[2]))
+    assert result.report()["stopped_pairs"][0]["faces"] == list(seen[1])
