@@ -231,6 +231,51 @@ def test_a_tiny_edge_read_back_as_degenerated_keeps_its_pcurve_on_the_edge(tmp_p
         assert np.linalg.norm(on_new - target, axis=-1).max() <= 0.5 * done.result.tol
 
 
+def _edge_deviations(face) -> dict:
+    """Per edge with a 3D curve, keyed by its length: (pcurve knot count, largest
+    distance of the pcurve mapped through the face's surface from the 3D curve, largest
+    distance of the 3D curve from the surface by closest-point projection), on 2001
+    samples."""
+    from surfprep.plugin.occ.edges import read_trim_edge
+    from surfprep.plugin.reparam import _unique_edges
+    surface = surface_from_occ(BRep_Tool.Surface_s(face))
+    out = {}
+    for edge in _unique_edges(face):
+        trim = read_trim_edge(edge, face, [])
+        if trim.curve3d is None:
+            continue
+        t = np.linspace(trim.t0, trim.t1, 2001)
+        uv = trim.pcurve.evaluate(t)
+        target = trim.curve3d.evaluate(t)
+        gap = np.linalg.norm(surface.evaluate(uv[:, 0], uv[:, 1]) - target, axis=1).max()
+        foot = project_to_surface(surface, target, guess=uv).distance.max()
+        out[round(trim.curve3d.arc_length(), 6)] = (trim.pcurve.knots.size, float(gap),
+                                                    float(foot))
+    return out
+
+
+def test_new_pcurves_have_few_knots_and_stay_on_their_edges(data_dir):
+    """Face 21 of occt_k1_catia_debis.stp: its new pcurves interpolated every sample
+    (5278 spans on one edge, on which OpenCascade's adaptive area then failed). Now
+    least squares on as few knots as the tolerance allows: no more knots than the old
+    pcurves, each within tol / 2 of its 3D curve or within tol / 4 beyond what no
+    pcurve can reach (the 3D curve's distance from the new surface: one edge lies
+    6e-3 off the surface in the file, at tol 1.4e-3)."""
+    face = surfprep.read(data_dir / "occt_k1_catia_debis.stp").faces[21]
+    before = _edge_deviations(face)
+    done = reparametrize_face(face)
+    after = _edge_deviations(done.face)
+    tol = done.result.tol
+    assert after.keys() == before.keys()
+    for length, (knots, gap, foot) in after.items():
+        old_knots, old_gap, old_foot = before[length]
+        assert knots <= old_knots
+        assert foot <= old_foot + tol              # the surface moved by tol at most
+        assert gap <= max(0.5 * tol, foot + 0.25 * tol) * (1 + 1e-6)
+    assert done.pcurve_deviation == pytest.approx(max(g for _, g, _ in after.values()),
+                                                  rel=1e-2)
+
+
 def _face_off_its_edge() -> TopoDS_Face:
     """A plane face bounded by a circle 0.5 above the plane: BRepCheck rejects it
     (the edge is not on the surface), as the two faces occt_b1_euclid.stp comes with."""
