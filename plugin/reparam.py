@@ -56,8 +56,8 @@ from ..errors import (
 from .convert import unwrap
 from .occ.edges import read_trim_edge
 from .occ.faces import checked_or_fixed, face_to_nurbs, trimmed_face_to_occ
-from .occ.geom import curve2d_to_occ, surface_from_occ, surface_to_occ
 from .occ.failures import describe, is_occ_failure
+from .occ.geom import curve2d_to_occ, surface_from_occ, surface_to_occ
 from .occ.shapes import all_faces, face_area, is_valid
 
 __all__ = [

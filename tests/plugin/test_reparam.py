@@ -268,7 +268,7 @@ def test_new_pcurves_have_few_knots_and_stay_on_their_edges(data_dir):
     tol = done.result.tol
     assert after.keys() == before.keys()
     for length, (knots, gap, foot) in after.items():
-        old_knots, old_gap, old_foot = before[length]
+        old_knots, _, old_foot = before[length]
         assert knots <= old_knots
         assert foot <= old_foot + tol              # the surface moved by tol at most
         assert gap <= max(0.5 * tol, foot + 0.25 * tol) * (1 + 1e-6)
@@ -279,8 +279,8 @@ def test_new_pcurves_have_few_knots_and_stay_on_their_edges(data_dir):
 def _face_off_its_edge() -> TopoDS_Face:
     """A plane face bounded by a circle 0.5 above the plane: BRepCheck rejects it
     (the edge is not on the surface), as the two faces occt_b1_euclid.stp comes with."""
-    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pln, gp_Pnt
     from OCP.Geom import Geom_Plane
+    from OCP.gp import gp_Ax2, gp_Circ, gp_Dir, gp_Pln, gp_Pnt
     circle = BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0.5), gp_Dir(0, 0, 1)), 1.0))
     wire = BRepBuilderAPI_MakeWire(circle.Edge()).Wire()
     builder = BRepBuilderAPI_MakeFace(Geom_Plane(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))),
