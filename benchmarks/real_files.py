@@ -1,0 +1,141 @@
+"""Every real file in ``../shared/data`` through every command, as a user runs it.
+
+Each cell is one fresh ``surfprep`` process (``python -m surfprep.plugin``, what
+the ``surfprep`` script runs): ``info FILE``, ``intersect FILE`` (the model
+against itself), ``heal FILE`` and ``reparam FILE``, each with ``--json`` to a
+temporary file and outputs into a temporary folder. For each run: the wall time
+(process start to exit, imports and reading included), the peak resident memory
+(``ru_maxrss`` of the process and the reader's child, from ``wait4``), and the
+outcome: the exit code (0 done, 1 done with something skipped, 2 nothing done)
+with what the report says (faces, curves, free edges, faces done), ``timeout``
+when the run passed ``--timeout`` seconds (it is killed), ``signal N`` when it
+died. A cell must never be a signal or a traceback.
+
+Run:  python benchmarks/real_files.py [--timeout 300] [--files k1 fuselage]
+      [--commands info reparam]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data"
+COMMANDS = ("info", "intersect", "heal", "reparam")
+SUFFIXES = {".stp", ".step", ".igs", ".iges"}
+
+
+@dataclass(frozen=True)
+class Run:
+    """One ``surfprep`` process: exit code (None on timeout), time, memory, report."""
+
+    code: int | None
+    signal: int | None
+    time_s: float
+    peak_mb: float
+    report: dict | None
+    error: str
+
+
+def run(command: str, file: Path, workdir: Path, timeout: float) -> Run:
+    """``surfprep COMMAND FILE`` in a fresh process, killed after ``timeout`` seconds."""
+    report_path = workdir / f"{command}.json"
+    argv = [sys.executable, "-m", "surfprep.plugin", command, str(file),
+            "--json", str(report_path)]
+    if command != "info":
+        argv += ["-o", str(workdir / f"{command}.step")]
+    start = time.perf_counter()
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               start_new_session=True)
+    timed_out = threading.Event()
+
+    def kill() -> None:
+        timed_out.set()
+        os.killpg(process.pid, signal.SIGKILL)
+
+    timer = threading.Timer(timeout, kill)
+    timer.start()
+    stderr = process.stderr.read().decode("utf-8", "replace")
+    _, status, usage = os.wait4(process.pid, 0)
+    elapsed = time.perf_counter() - start
+    timer.cancel()
+    process.returncode = 0                       # reaped by wait4: keep Popen quiet
+    report = None
+    if report_path.is_file():
+        report = json.loads(report_path.read_text())
+    errors = [line for line in stderr.splitlines() if line.startswith("surfprep: error:")]
+    if "Traceback" in stderr:
+        errors.insert(0, "TRACEBACK")
+    return Run(code=None if timed_out.is_set() else
+               (os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else None),
+               signal=os.WTERMSIG(status) if os.WIFSIGNALED(status) and not timed_out.is_set()
+               else None,
+               time_s=elapsed, peak_mb=usage.ru_maxrss / 1024, report=report,
+               error=errors[0].removeprefix("surfprep: error: ") if errors else "")
+
+
+def outcome(command: str, result: Run, timeout: float) -> str:
+    """A short cell: exit code and the report's headline, or what went wrong."""
+    if result.signal is not None:
+        return f"**signal {result.signal}**"
+    if result.code is None:
+        return f"timeout (> {timeout:.0f} s)"
+    r = result.report
+    if result.code == 2 or r is None:
+        return f"exit {result.code}: {result.error[:60]}"
+    dropped = len(r.get("dropped", []))
+    tail = f", {dropped} dropped" if dropped else ""
+    if command == "info":
+        return f"exit {result.code}: {r['n_faces']} faces{tail}"
+    if command == "intersect":
+        coincident = len(r.get("coincident", []))
+        return (f"exit {result.code}: {len(r['curves'])} curves"
+                + (f", {coincident} coincident" if coincident else "") + tail)
+    if command == "heal":
+        free = r["free_edges"]
+        skipped = len(r.get("skipped", []))
+        return (f"exit {result.code}: free edges {free['before']} -> {free['after']}, "
+                f"{len(r['patches'])} patches" + (f", {skipped} skipped" if skipped else "")
+                + tail)
+    done = sum(1 for f in r["faces"] if f.get("error") is None)
+    return f"exit {result.code}: {done}/{len(r['faces'])} faces{tail}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--timeout", type=float, default=300.0,
+                        help="seconds before a run is killed and reported as a timeout")
+    parser.add_argument("--files", nargs="+", default=None,
+                        help="only files whose name contains one of these")
+    parser.add_argument("--commands", nargs="+", choices=COMMANDS, default=list(COMMANDS))
+    args = parser.parse_args()
+    files = sorted(p for p in DATA.iterdir() if p.suffix.lower() in SUFFIXES)
+    if args.files:
+        files = [p for p in files if any(key in p.name for key in args.files)]
+    print(f"{len(files)} files x {args.commands}, timeout {args.timeout:.0f} s, "
+          f"one fresh process per cell\n")
+    print("| file | MB | " + " | ".join(args.commands) + " |")
+    print("|---|---:|" + "---|" * len(args.commands))
+    for file in files:
+        cells = []
+        for command in args.commands:
+            with tempfile.TemporaryDirectory(prefix="surfprep_bench_") as tmp:
+                result = run(command, file, Path(tmp), args.timeout)
+            cells.append(f"{outcome(command, result, args.timeout)}; "
+                         f"{result.time_s:.1f} s, {result.peak_mb:.0f} MB")
+        print(f"| {file.name} | {file.stat().st_size / 1e6:.2f} | " + " | ".join(cells) + " |",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
