@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from .face_region_kernels import ray_crossings
 from .surface import NurbsSurface
@@ -36,6 +37,7 @@ from .trimmed import TrimmedFace
 
 __all__ = [
     "EDGE_SAMPLES",
+    "JOIN_ENDS",
     "NEAR_BOUNDARY",
     "ON_BOUNDARY",
     "FaceRegion",
@@ -53,6 +55,8 @@ NEAR_BOUNDARY = 1e-2
 
 #: samples per trimming edge for the point-in-face test
 EDGE_SAMPLES = 64
+#: edge ends closer than this (relative to the domain diagonal) are one polygon vertex
+JOIN_ENDS = 1e-12
 
 
 def loop_segments(face: TrimmedFace) -> tuple[NDArray, NDArray, NDArray]:
@@ -78,7 +82,22 @@ def loop_segments(face: TrimmedFace) -> tuple[NDArray, NDArray, NDArray]:
         params.append(np.stack([t[:-1], t[1:]], axis=1))
     if not segments:
         return np.zeros((0, 2, 2)), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
+    _join_edge_ends(segments, JOIN_ENDS * diagonal)
     return np.concatenate(segments), np.concatenate(owners), np.concatenate(params)
+
+
+def _join_edge_ends(segments: list[NDArray], eps: float) -> None:
+    """Make the ends of consecutive edges one point (in place): two pcurves meeting at
+    a vertex end a rounding error apart (an arc from 3 pi / 2 to 2 pi ends at
+    ``v + 1e-16``, the next one starts at ``v``), and a ray at exactly that ``v``
+    passes between them and the even-odd count is off by one. Ends within ``eps``
+    of each other take the value of the first of them."""
+    ends = np.concatenate([[s[0, 0], s[-1, 1]] for s in segments])      # (2 edges, 2)
+    first = np.arange(ends.shape[0])
+    for i, j in sorted(cKDTree(ends).query_pairs(eps)):
+        first[j] = min(first[j], first[i])
+    for k, s in enumerate(segments):
+        s[0, 0], s[-1, 1] = ends[first[2 * k]], ends[first[2 * k + 1]]
 
 
 def is_rectangle(seg: NDArray, domain, eps: float) -> bool:

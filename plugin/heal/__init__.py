@@ -61,6 +61,7 @@ from ...algorithms.healing.adjacency import (
     pair_edges,
 )
 from ...algorithms.healing.clipping import face_source
+from ...algorithms.healing.fidelity import InputFaces, surface_deviation
 from ...algorithms.healing.snap import snap_to_originals
 from ...algorithms.healing.strip_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from ...algorithms.projection import project_to_surface
@@ -72,7 +73,14 @@ from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs, make_face
 from ..occ.shapes import FaceNames, all_faces, count_free_edges, is_valid, max_edge_tolerance, sew
 from .cut import covered_holes_dropped, cut_under_patches, inner_edges
-from .jobs import PatchOrigin, approximate, directed_jobs, plan_jobs, replaced_faces
+from .jobs import (
+    INPUT_CHECK_TOL,
+    PatchOrigin,
+    approximate,
+    directed_jobs,
+    plan_jobs,
+    replaced_faces,
+)
 from .spec import read_patch_spec
 from .trim_back import trim_overlaps_of
 
@@ -100,7 +108,9 @@ MIN_TOL_FACTOR = 1e-12
 @dataclass(frozen=True)
 class PatchReport:
     """One approximant: origin, name, resolution ``(M, N)``, errors of §7 (model
-    units), artificial share, whether ``tol`` was met."""
+    units), artificial share, whether ``tol`` was met, and ``deviation``: the largest
+    distance of the joined patch from the input faces on a dense sample (its
+    four sides only for a hole; :mod:`surfprep.algorithms.healing.fidelity`)."""
 
     origin: PatchOrigin
     name: str | None
@@ -109,13 +119,16 @@ class PatchReport:
     rms_error: float
     artificial_share: float
     converged: bool
+    tol: float = float("nan")
+    deviation: float = float("nan")
 
     def as_dict(self) -> dict:
         return {"kind": self.origin.kind, "faces": list(self.origin.faces),
                 "index": self.origin.index, "name": self.name,
                 "resolution": list(self.resolution), "max_error": self.max_error,
                 "rms_error": self.rms_error, "artificial_share": self.artificial_share,
-                "converged": self.converged}
+                "converged": self.converged, "tol": self.tol,
+                "deviation_from_input": self.deviation}
 
 
 @dataclass(frozen=True, eq=False)
@@ -354,8 +367,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         raise InvalidGeometryError("heal: no face of the input could be read")
     jobs = plan_jobs(faces, kept, holes, trimmed, unions, split_faces=split_faces, gap_tol=gap_tol,
                  skipped=skipped)
+    inputs = InputFaces.of(faces)
     done = approximate(jobs, sources,
-                        {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped)
+                        {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped, inputs)
     done += directed_jobs(directed, cut)
     network = None
     if done:
@@ -366,8 +380,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
             network, [e for e in edges if e.face not in replaced]
             + inner_edges(faces, replaced | gone), gap_tol,
             TIGHT_FACTOR * model.size)
+    deviations = _deviations(done, network, inputs, gap_tol, skipped)
     result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
-                       start)
+                       start, deviations)
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped if network is not None else 0
@@ -375,6 +390,32 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
+
+
+def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list[str]
+                ) -> list[float]:
+    """Per patch of ``done``, joined as ``network`` holds it: its largest distance from
+    the input faces (dense; a hole's along its four sides). Joining moves a patch by
+    up to the gap it closes (at most ``gap_tol``) beyond its tol; patches off by more
+    than their tol are named in one note, and those off by more than that in
+    another."""
+    out, moved, off = [], [], []
+    for (job, la), surface in zip(done, network.patches if network else ()):
+        deviation = surface_deviation(surface, inputs, tol=INPUT_CHECK_TOL * la.tol,
+                                      rim_only=job.origin.kind == "hole").max_distance
+        if job.origin.kind != "directed" and deviation > la.tol:
+            (moved if deviation <= la.tol + gap_tol else off).append((job, deviation, la.tol))
+        out.append(deviation)
+    joined = f"the joins moved them to close gaps (up to gap_tol {gap_tol:.3g} beyond tol)"
+    for group, why in ((moved, joined), (off, f"more than tol + gap_tol ({gap_tol:.3g}) off")):
+        if group:
+            names = ", ".join(f"{job.origin.kind} {job.origin.index}"
+                              + (f" ({job.name})" if job.name else "") for job, _, _ in group)
+            worst = max(group, key=lambda g: g[1])
+            skipped.append(f"{len(group)} patches lie farther than their tol from the input "
+                           f"faces after the joins, up to {worst[1]:.3g} (tol {worst[2]:.3g}): "
+                           f"{why}: {names}")
+    return out
 
 
 def _without_faces(edges: list, pairs: list[tuple[int, int]], gone: set[int]
@@ -387,8 +428,8 @@ def _without_faces(edges: list, pairs: list[tuple[int, int]], gone: set[int]
             [(new[a], new[b]) for a, b in pairs if a in new and b in new])
 
 
-def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start
-              ) -> HealResult:
+def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,
+              deviations) -> HealResult:
     """The output from ``work`` (the input with faces under directed patches cut) and the
     approximants; figures before from ``model`` (the input)."""
     gone = replaced_faces(done) | {b for _, b in dropped}
@@ -413,7 +454,8 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
     tight_before, _ = sew(list(model.faces), tight)
     tight_after, _ = sew(originals + new_faces, tight)       # the output faces, unsewn
     reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
-                                la.artificial_share, la.converged) for job, la in done)
+                                la.artificial_share, la.converged, la.tol, deviation)
+                    for (job, la), deviation in zip(done, deviations))
     return HealResult(
         model=result_model, patches=reports, approximants=tuple(la for _, la in done),
         network=network, dropped=tuple(dropped), skipped=tuple(skipped),

@@ -13,7 +13,7 @@ preferred source) and keeps a face whole unless every sub-patch of it fits;
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -21,12 +21,19 @@ import numpy as np
 from ...algorithms.healing import LocalApproximant, local_approximant
 from ...algorithms.healing.adjacency import four_sided_boundary
 from ...algorithms.healing.decompose import quad_boundaries, why_not_decomposable
+from ...algorithms.healing.fidelity import InputFaces, surface_deviation
 from ...algorithms.trimmed import TrimmedFace
 from ...errors import SurfprepError
 from .cut import CutModel
 from .spec import DirectedPatch
 
-__all__ = ["Job", "PatchOrigin", "approximate", "directed_jobs", "plan_jobs", "replaced_faces"]
+__all__ = ["INPUT_CHECK_TOL", "RETRY_MARGIN", "Job", "PatchOrigin", "approximate",
+           "directed_jobs", "plan_jobs", "replaced_faces"]
+
+#: the dense check against the input projects to this times the patch's tol
+INPUT_CHECK_TOL = 1e-3
+#: a patch off the input is rebuilt once to its own error times tol / deviation, times this
+RETRY_MARGIN = 0.8
 
 
 @dataclass(frozen=True)
@@ -114,17 +121,27 @@ def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[Jo
 
 
 def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_tol,
-                skipped: list[str]) -> list[tuple[Job, LocalApproximant]]:
+                skipped: list[str], inputs: InputFaces | None = None
+                ) -> list[tuple[Job, LocalApproximant]]:
     """One approximant per job; a face's own surface is its preferred source (other
-    faces only where it is missed), so long segments do not pick far-away faces."""
+    faces only where it is missed), so long segments do not pick far-away faces.
+
+    With ``inputs`` (the input faces), the approximant of a face or union is measured
+    densely against them (:func:`~surfprep.algorithms.healing.fidelity.surface_deviation`):
+    its own error is measured only where its grid landed on the sources and misses a
+    bulge over a hole. One off by more than its tol is rebuilt once to a tighter
+    error, and if still off the face is kept as it was, and said so."""
     out, failed = [], set()
     for job in jobs:
         if job.split and job.origin.index in failed:
             continue              # the face is kept whole: its other sub-patches are moot
         own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
+
+        def build(target, job=job, own=own):
+            return local_approximant(job.boundary, sources, tol=target, gap_tol=gap_tol,
+                                     preferred_source=own, side_error=job.split)
         try:
-            la = local_approximant(job.boundary, sources, tol=tol, gap_tol=gap_tol,
-                                   preferred_source=own, side_error=job.split)
+            la = build(tol)
         except (SurfprepError, np.linalg.LinAlgError) as exc:
             skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
                            f"({type(exc).__name__}: {exc}); left as it was")
@@ -145,8 +162,43 @@ def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_to
                            f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
                            "left open")
             continue
+        if job.origin.kind in ("face", "union") and inputs is not None:
+            la = _held_to_input(job, la, build, inputs, skipped)
+            if la is None:
+                failed |= {job.origin.index} if job.split else set()
+                continue
         out.append((job, la))
     return _whole_faces_only(jobs, out, skipped, failed)
+
+
+def _held_to_input(job: Job, la: LocalApproximant, build, inputs: InputFaces,
+                   skipped: list[str]) -> LocalApproximant | None:
+    """``la`` if it lies within its tol of the input faces densely, else the approximant
+    rebuilt to a tighter error if that one does, else None (with a note)."""
+    tol = la.tol
+    deviation = surface_deviation(la.surface, inputs, tol=INPUT_CHECK_TOL * tol)
+    if deviation.max_distance <= tol:
+        return la
+    first, retried = deviation, ""
+    if la.max_error > 0:
+        target = la.max_error * RETRY_MARGIN * tol / deviation.max_distance
+        try:
+            again = build(target)
+        except (SurfprepError, np.linalg.LinAlgError):
+            again = None
+        if again is not None and again.converged:
+            deviation = surface_deviation(again.surface, inputs, tol=INPUT_CHECK_TOL * tol)
+            if deviation.max_distance <= tol:
+                # held to the caller's tol, not to the tighter target it was built to
+                return replace(again, tol=tol, converged=again.max_error <= tol)
+            retried = f", {deviation.max_distance:.3g} at a finer resolution"
+    where = ", ".join(f"{x:.6g}" for x in first.worst_point)
+    what = "sub-patch of face" if job.split else job.origin.kind
+    skipped.append(f"{what} {job.origin.index}: its approximant lies {first.max_distance:.3g} "
+                   f"from the input faces at ({where}) on a dense sample ({first.samples} "
+                   f"points; tol {tol:.3g}, its own error measure {la.max_error:.3g})"
+                   f"{retried}; kept as it was")
+    return None
 
 
 def _whole_faces_only(jobs: list[Job], out: list, skipped: list[str],

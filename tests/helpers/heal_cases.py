@@ -19,6 +19,7 @@ from surfprep.algorithms.intersection.tessellation import tessellate
 from surfprep.algorithms.projection import project_to_surface
 from surfprep.algorithms.surface import NurbsSurface
 from surfprep.algorithms.tensor import Direction
+from surfprep.algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
 
 
 def graph_surface(height, samples: int = 13) -> NurbsSurface:
@@ -211,13 +212,31 @@ def outline_uv(edges):
     return np.concatenate([e.pcurve.evaluate(np.linspace(0, 1, 200))[:-1] for e in edges])
 
 
-__all__ = ["NurbsCurve", "disc", "edge_from_uv", "notched", "outline_uv", "pentagon",
-           "polygon_loop", "six_edges_two_smooth", "triangle", "wavy_surface"]
+# ------------------------------------------------------------ a face with a hole
+HOLE_CENTRE, HOLE_RADIUS = np.array([0.5, 0.5]), 0.3
+
+
+def _loop(edges) -> TrimLoop:
+    return TrimLoop([TrimEdge(e.curve, e.pcurve, 0.0, 1.0) for e in edges])
+
+
+def plane_with_hole() -> TrimmedFace:
+    """z = 0 trimmed to the square [0.1, 0.9]^2 with a disc hole (radius 0.3) inside."""
+    plane = graph_surface(lambda x, y: 0.0 * x, samples=9)
+    outer = polygon_loop(plane, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)])
+    # the hole clockwise, in four arcs
+    hole = [edge_from_uv(plane, lambda t, k=k: HOLE_CENTRE + HOLE_RADIUS * np.column_stack(
+        [np.cos(-(k + t) * np.pi / 2), np.sin(-(k + t) * np.pi / 2)]), n=129) for k in range(4)]
+    return TrimmedFace(plane, (_loop(outer), _loop(hole)))
+
+
+__all__ = ["HOLE_CENTRE", "HOLE_RADIUS", "NurbsCurve", "disc", "edge_from_uv", "graph_surface",
+           "notched", "outline_uv", "pentagon", "plane_with_hole", "polygon_loop",
+           "six_edges_two_smooth", "triangle", "wavy_surface"]
 
 
 def occ_triangle_face():
     """A ``TopoDS_Face`` on :func:`wavy_surface` trimmed to :func:`triangle` (three edges)."""
-    from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
     from surfprep.plugin.occ.faces import make_face
 
     surface = wavy_surface()
