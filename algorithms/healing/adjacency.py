@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from ..curve import NurbsCurve
-from ..projection import distance_to_surface
+from ..projection import distance_to_curve, distance_to_surface
 from ..trimmed import TrimmedFace
 
 __all__ = [
@@ -31,6 +31,7 @@ __all__ = [
     "four_sided_boundary",
     "hole_loops",
     "pair_edges",
+    "pair_gaps",
     "polyline_distance",
 ]
 
@@ -137,6 +138,17 @@ def pair_edges(edges: list[FaceEdge], gap_tol: float) -> list[tuple[int, int]]:
     keep = _pairs_within(samples, dense, i, j, gap_tol) & _pairs_within(samples, dense, j, i,
                                                                          gap_tol)
     return [(int(a), int(b)) for a, b in zip(i[keep], j[keep])]
+
+
+def pair_gaps(edges: list[FaceEdge], pairs: list[tuple[int, int]]) -> NDArray:
+    """``(len(pairs),)``: the largest distance between the two edges of each pair, both
+    ways, from each edge's samples to the other's 3D curve by closest-point projection
+    (exact: the polyline of :func:`pair_edges` is off the curve by its chord sag)."""
+    out = np.zeros(len(pairs))
+    for n, (a, b) in enumerate(pairs):
+        out[n] = max(distance_to_curve(edges[b].curve, edges[a].samples).max(),
+                     distance_to_curve(edges[a].curve, edges[b].samples).max())
+    return out
 
 
 def _box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:

@@ -76,6 +76,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also replace faces that are not four-sided, split into "
                              "four-sided sub-patches on the face (default; "
                              "--no-split-faces keeps them as they are)")
+    parser.add_argument("--replace", choices=("defects", "all"), default="defects",
+                        help="re-approximate only the faces with a gap, a hole or an "
+                             "overlap at their edges (default; the others keep their exact "
+                             "geometry) or every face")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
@@ -117,7 +121,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     model = read_model(args.input, console, strict=args.strict)
     result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                   patches=args.patches, overlap=args.overlap,
-                  split_faces=args.split_faces)
+                  split_faces=args.split_faces, replace=args.replace)
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model)}
     with staged_write(result.model, args.output, overwrite=True) as staged:
         report["output"] = str(staged.target)

@@ -59,6 +59,7 @@ from ...algorithms.healing.adjacency import (
     four_sided_boundary,
     hole_loops,
     pair_edges,
+    pair_gaps,
 )
 from ...algorithms.healing.clipping import face_source
 from ...algorithms.healing.fidelity import InputFaces, surface_deviation
@@ -218,6 +219,7 @@ class HealResult:
                            "tight_after": self.tight_free_edges_after},
             "valid": {"before": self.valid_before, "after": self.valid_after},
             "max_edge_tolerance": self.max_edge_tolerance,
+            "replace": self.extra.get("replace"),
         }
 
 
@@ -275,7 +277,8 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 # ---------------------------------------------------------------------- heal
 def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
-         overlap: OverlapRepair | str = "trim", split_faces: bool = True) -> HealResult:
+         overlap: OverlapRepair | str = "trim", split_faces: bool = True,
+         replace: str = "defects") -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -306,6 +309,14 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         longer approximant sides they meet (:mod:`surfprep.algorithms.healing.snap`).
         On by default; False keeps every face that is not four-sided as it is
         (faster: its sub-patches are not built).
+    replace : "defects" or "all"
+        Which faces are re-approximated: "defects" (default) those with a defect,
+        an edge paired with another face's edge (within ``gap_tol``) but not closed
+        in the geometry (the two 3D curves farther apart than ``TIGHT_FACTOR`` x
+        size), an edge on a hole, or an overlap; the others keep their exact
+        geometry (an approximant in their place could only open gaps that were
+        closed). "all": every face, as 001's network of approximants (also what
+        "defects" does when directed patches or trimmed-back overlaps cut faces).
 
     Returns
     -------
@@ -365,8 +376,18 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     sources = [face_source(faces[i]) for i in kept]
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
-    jobs = plan_jobs(faces, kept, holes, trimmed, unions, split_faces=split_faces, gap_tol=gap_tol,
-                 skipped=skipped)
+    if replace not in ("defects", "all"):
+        raise InvalidGeometryError(f"replace must be 'defects' or 'all', got {replace!r}")
+    if replace == "defects" and (cut.cuts or partial):
+        # the pieces of cut faces are not traced back to the input's edges yet
+        skipped.append("faces were cut under directed patches or trimmed back: every face "
+                       "is re-approximated (replace='all')")
+        replace = "all"
+    defective = kept if replace == "all" else _defective(
+        kept, edges, pairs, holes, {o.kept for o in overlaps} | set(trimmed) | set(unions)
+        | {j for j, _ in unions.values()}, TIGHT_FACTOR * model.size, skipped)
+    jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
+                     gap_tol=gap_tol, skipped=skipped)
     inputs = InputFaces.of(faces)
     done = approximate(jobs, sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped, inputs)
@@ -383,6 +404,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     deviations = _deviations(done, network, inputs, gap_tol, skipped)
     result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
                        start, deviations)
+    result.extra["replace"] = replace
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped if network is not None else 0
@@ -415,6 +437,22 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
             skipped.append(f"{len(group)} patches lie farther than their tol from the input "
                            f"faces after the joins, up to {worst[1]:.3g} (tol {worst[2]:.3g}): "
                            f"{why}: {names}")
+    return out
+
+
+def _defective(kept: list[int], edges, pairs, holes, overlapping: set[int], tight: float,
+               skipped: list[str]) -> list[int]:
+    """The kept faces with a defect: an edge paired with another face's edge but not
+    closed in the geometry (:func:`pair_gaps` above ``tight``), an edge on a hole, or
+    an overlap to repair (``overlapping``); a note counts the others."""
+    gaps = pair_gaps(edges, pairs)
+    faulty = {edges[k].face for pair, gap in zip(pairs, gaps) if gap > tight for k in pair}
+    faulty |= {e.face for loop in holes for e in loop}
+    faulty |= overlapping
+    out = [i for i in kept if i in faulty]
+    if len(out) < len(kept):
+        skipped.append(f"{len(kept) - len(out)} faces without a gap, hole or overlap at their "
+                       "edges kept as they are (replace='all' re-approximates them too)")
     return out
 
 

@@ -106,13 +106,14 @@ def test_heal_split_faces_replaces_a_triangle_by_three_patches():
     # surfprep.heal(split_faces=True): the three-sided face becomes three sub-patches
     # that follow it (dense check against the surface), keep its area and outline, and
     # are joined G0 into one valid face set (the default); with split_faces=False the
-    # face is kept
+    # face is kept, and so it is with the default replace="defects" (it has no defect)
     from surfprep.algorithms.healing.adjacency import face_edges, polyline_distance
     from surfprep.plugin.heal import heal
     shape = occ_triangle_face()
-    kept = heal(shape, split_faces=False)
+    kept = heal(shape, split_faces=False, replace="all")
     assert kept.patches == () and kept.model.n_faces == 1
-    r = heal(shape)
+    assert heal(shape).patches == ()
+    r = heal(shape, replace="all")
     assert [p.origin.kind for p in r.patches] == ["face"] * 3
     assert {p.origin.faces for p in r.patches} == {(0,)}
     assert r.valid_after and r.model.n_faces == 3

@@ -103,12 +103,15 @@ def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
 
 
 def test_heal_split_faces_option(tmp_path, capsys):
-    # a three-sided face: three sub-patches by default (--split-faces), kept as it is
-    # with --no-split-faces
+    # a three-sided face with no defect: kept by default (--replace defects); with
+    # --replace all three sub-patches (--split-faces, the default), kept as it is with
+    # --no-split-faces
     from helpers.heal_cases import occ_triangle_face
     src = tmp_path / "triangle.step"
     surfprep.write([occ_triangle_face()], src)
-    for flags, faces_out in (((), 3), (("--split-faces",), 3), (("--no-split-faces",), 1)):
+    every = ("--replace", "all")
+    for flags, faces_out in (((), 1), (every, 3), (("--split-faces", *every), 3),
+                             (("--no-split-faces", *every), 1)):
         out = tmp_path / f"out{'_'.join(flags)}.step"
         code, _, err = run(capsys, "heal", src, "-o", out, *flags)
         assert code == 0, err

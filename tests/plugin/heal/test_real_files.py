@@ -25,15 +25,16 @@ def test_marscapsule_duplicates_dropped(data_dir):
 def test_microstation_gaps_fewer_geometric_free_edges(data_dir):
     """occt_k1geo_microstation.stp: a face soup with real gaps of 0.01-0.1 mm. Free edges
     when the faces are sewn at 1e-7 x size (i.e. not closed in the geometry) drop
-    (measured 70 -> 32), free edges at gap_tol do not grow (5 -> 5: the loop of free edges
+    (measured 70 -> 28 replacing the faces with a defect, the default; 70 -> 24 replacing
+    every face), free edges at gap_tol do not grow (5 -> 5: the loop of free edges
     around the mouth of a slot is no hole and stays open), the shape stays valid and joins
     between approximants are closed."""
     path = data_dir / "occt_k1geo_microstation.stp"
     r = surfprep.heal(path)
-    assert r.tight_free_edges_after < r.tight_free_edges_before
+    assert r.tight_free_edges_after < r.tight_free_edges_before / 2
     assert r.free_edges_after <= r.free_edges_before
     assert r.valid_after
-    assert len(r.joins) > 10 and all(j.max_gap < 1e-9 for j in r.joins)
+    assert len(r.joins) >= 5 and all(j.max_gap < 1e-9 for j in r.joins)
     assert any("not a hole" in s for s in r.skipped)
 
 
@@ -52,12 +53,17 @@ def test_heartvalve_every_face_approximated(data_dir):
     where a side meets two edges of one face, with shared corners moved onto the edge ends).
     The two flat faces at z = +-50 that are not four-sided were replaced by sub-patches
     bulging 4.07 mm off them (their own error measure said 0.157, the output's box grew
-    to z = +-54): measured densely against the input they are now kept as they were."""
+    to z = +-54): measured densely against the input they are now kept as they were.
+    Every face is re-approximated here (replace="all"); by default the three four-sided
+    faces without a gap keep their geometry and the gaps close all the same."""
     from surfprep.algorithms.healing.adjacency import four_sided_boundary
     from surfprep.plugin.io import read
 
     path = data_dir / "overture_heartvalve_rhino.igs"
-    r = surfprep.heal(path)
+    default = surfprep.heal(path)
+    assert default.tight_free_edges_before == 24 and default.tight_free_edges_after == 0
+    assert 0 < len(default.patches) < 23
+    r = surfprep.heal(path, replace="all")
     four = {i for i, f in enumerate(_faces_of(read(path))) if f and four_sided_boundary(f)}
     faces = [p for p in r.patches if p.origin.kind == "face"]
     assert len(four) == 11 and four <= {p.origin.index for p in faces}
