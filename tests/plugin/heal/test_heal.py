@@ -198,3 +198,27 @@ def test_mouth_of_a_shallow_pocket_is_not_a_hole():
     assert not any(p.origin.kind == "hole" for p in r.patches)
     assert any("not a hole" in s for s in r.skipped)
     assert r.free_edges_after == 4 and r.valid_after
+
+
+def test_only_faces_with_a_defect_are_replaced_by_default():
+    """A gap of 1e-3 between A and B, and C sharing A's other edge exactly: by default
+    A and B are re-approximated and the gap closes, C keeps its exact geometry (an
+    approximant in its place could only open the closed edge); replace="all" takes C
+    too."""
+    c = graph_patch(-1.0, 0.0, 0.0, 1.0)
+    faces = [make_face(graph_patch(0.0, 1.0, 0.0, 1.0)), make_face(graph_patch(1.001, 2.0, 0.0, 1.0)),
+             make_face(c)]
+    r = heal(faces, gap_tol=0.01)
+    assert sorted(p.origin.faces for p in r.patches) == [(0,), (1,)]
+    assert r.report()["replace"] == "defects"
+    assert any("1 faces without a gap" in s for s in r.skipped)
+    surfaces = [to_nurbs(f).surface for f in r.model.faces]
+    kept = [s for s in surfaces if s.n_control == c.n_control
+            and np.allclose(s.control_points, c.control_points)]
+    assert len(kept) == 1 and np.array_equal(kept[0].control_points, c.control_points)
+    assert r.tight_free_edges_after < r.tight_free_edges_before
+    assert r.valid_after
+    every = heal(faces, gap_tol=0.01, replace="all")
+    assert sorted(p.origin.faces for p in every.patches) == [(0,), (1,), (2,)]
+    with pytest.raises(InvalidGeometryError, match="replace"):
+        heal(faces, replace="some")
