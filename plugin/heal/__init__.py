@@ -15,7 +15,9 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; free
    edges chained into loops of four from two or more faces are holes;
-3. every four-sided face (one loop of four real edges, trimmed or not) gets a
+3. every four-sided face with a defect (``replace="defects"``, the default: an
+   edge paired with another face's but not closed in the geometry, an edge on a
+   hole, an overlap; every face with ``replace="all"``) gets a
    :func:`~surfprep.algorithms.healing.local_approximant` over its own four
    edges, projected onto all original faces (trimmed faces as the part inside
    their loops, :func:`~surfprep.algorithms.healing.clipping.face_source`; the
@@ -33,7 +35,12 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    :func:`connect` does not join) to that part, so those gaps close up to the
    fit error too (:mod:`surfprep.algorithms.healing.snap`);
 5. approximant faces and the untouched faces are sewn at ``gap_tol`` into a
-   shell (a solid when closed) and checked with ``BRepCheck_Analyzer``;
+   shell (a solid when closed) and checked with ``BRepCheck_Analyzer``; every
+   joined patch is measured densely against the input faces
+   (:mod:`surfprep.algorithms.healing.fidelity`), and when the result has more
+   free edges than the input, the approximants that left a free edge where the
+   input's edges were paired are taken back and the rest joined again (at most
+   ``ROLLBACK_ROUNDS`` times);
    untouched faces keep their names (a replaced face passes its name to its
    approximant; holes are named ``heal_hole_<k>``).
 
@@ -52,8 +59,10 @@ from typing import Any
 import numpy as np
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
+from ...algorithms.face_region import SegmentTree
 from ...algorithms.healing import Continuity, JoinReport, LocalApproximant, Network, connect
 from ...algorithms.healing.adjacency import (
+    dense_edge,
     duplicate_faces,
     face_edges,
     four_sided_boundary,
@@ -72,7 +81,15 @@ from ...errors import InvalidGeometryError, SurfprepError
 from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs, make_face
-from ..occ.shapes import FaceNames, all_faces, count_free_edges, is_valid, max_edge_tolerance, sew
+from ..occ.shapes import (
+    FaceNames,
+    all_faces,
+    boundary_edge_points,
+    count_free_edges,
+    is_valid,
+    max_edge_tolerance,
+    sew,
+)
 from .cut import covered_holes_dropped, cut_under_patches, inner_edges
 from .jobs import (
     INPUT_CHECK_TOL,
@@ -101,6 +118,8 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
+#: times heal takes back the approximants that opened gaps and joins the rest again
+ROLLBACK_ROUNDS = 2
 #: smallest accepted ``tol`` and ``gap_tol``: this times the model's diagonal (double
 #: precision resolves about 2e-16 of it; the approximants' measures need room above)
 MIN_TOL_FACTOR = 1e-12
@@ -392,18 +411,20 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     done = approximate(jobs, sources,
                         {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped, inputs)
     done += directed_jobs(directed, cut)
-    network = None
-    if done:
-        network = connect([la.surface for _, la in done], continuity=continuity,
-                          gap_tol=gap_tol, strict=False)
-        replaced = replaced_faces(done)
-        network, snapped = snap_to_originals(
-            network, [e for e in edges if e.face not in replaced]
-            + inner_edges(faces, replaced | gone), gap_tol,
-            TIGHT_FACTOR * model.size)
-    deviations = _deviations(done, network, inputs, gap_tol, skipped)
-    result = _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity,
-                       start, deviations)
+    for round_ in range(ROLLBACK_ROUNDS + 1):
+        notes: list[str] = []
+        network, snapped = _joined(done, edges, faces, gone, gap_tol, continuity,
+                                   TIGHT_FACTOR * model.size)
+        deviations = _deviations(done, network, inputs, gap_tol, notes)
+        result = _assemble(model, work, done, network, dropped, skipped + notes, gap_tol, tol,
+                           continuity, start, deviations)
+        if result.free_edges_after <= result.free_edges_before or round_ == ROLLBACK_ROUNDS:
+            break
+        opening = _opening(result.shape, done, network, edges, pairs, gap_tol)
+        if not opening:
+            break
+        skipped.append(_rolled_back(done, opening))
+        done = _without_jobs(done, opening)
     result.extra["replace"] = replace
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
@@ -412,6 +433,72 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
+
+
+def _joined(done, edges, faces, gone, gap_tol, continuity, tight):
+    """The approximants of ``done`` joined (:func:`connect`) and their sides fitted to the
+    kept faces' edges (:func:`snap_to_originals`): ``(network or None, sides snapped)``."""
+    if not done:
+        return None, 0
+    network = connect([la.surface for _, la in done], continuity=continuity, gap_tol=gap_tol,
+                      strict=False)
+    replaced = replaced_faces(done)
+    return snap_to_originals(network, [e for e in edges if e.face not in replaced]
+                             + inner_edges(faces, replaced | gone), gap_tol, tight)
+
+
+def _opening(shape, done, network, edges, pairs, gap_tol: float) -> set[int]:
+    """Jobs of ``done`` that left a free edge in the result where the input had two edges
+    paired within ``gap_tol`` (a gap opened, not closed): the free edge runs along one
+    of the paired input edges, and the job is the approximant whose rim it runs along,
+    or one replacing the face on the other side of that pair. The caller's directed
+    patches are never taken back."""
+    if network is None:
+        return set()
+    free = boundary_edge_points(shape)
+    paired = sorted({k for pair in pairs for k in pair})
+    if not paired or not free:
+        return set()
+    partners: dict[int, set[int]] = {}
+    for a, b in pairs:
+        partners.setdefault(a, set()).add(edges[b].face)
+        partners.setdefault(b, set()).add(edges[a].face)
+    lines = [SegmentTree.from_polylines([dense_edge(edges[k])]) for k in paired]
+    rims = []
+    t = np.linspace(0.0, 1.0, 129)
+    for surface in network.patches:
+        u0, u1, v0, v1 = surface.domain
+        u, v = u0 + (u1 - u0) * t, v0 + (v1 - v0) * t
+        rims.append(SegmentTree.from_polylines([
+            surface.evaluate(u, np.full_like(u, v0)), surface.evaluate(u, np.full_like(u, v1)),
+            surface.evaluate(np.full_like(v, u0), v), surface.evaluate(np.full_like(v, u1), v)]))
+    jobs_of: dict[int, set[int]] = {}
+    for k, (job, _) in enumerate(done):
+        if job.origin.kind in ("face", "union"):
+            for f in job.origin.faces:
+                jobs_of.setdefault(f, set()).add(k)
+    out = set()
+    for points in free:
+        on = [k for k, line in zip(paired, lines) if line.distance(points).max() <= gap_tol]
+        if not on:
+            continue                          # a free edge of the input, not opened
+        out |= {j for k in on for f in partners[k] for j in jobs_of.get(f, ())}
+        out |= {j for j, rim in enumerate(rims) if rim.distance(points).max() <= gap_tol}
+    return {j for j in out if done[j][0].origin.kind != "directed"}
+
+
+def _rolled_back(done, opening: set[int]) -> str:
+    what = sorted({f"{done[k][0].origin.kind} {done[k][0].origin.index}" for k in opening})
+    return (f"approximants taken back (faces kept as they were, holes left open): "
+            f"{', '.join(what)}: each left a free edge where the input's edges were paired "
+            "within gap_tol (more free edges after than before)")
+
+
+def _without_jobs(done, opening: set[int]) -> list:
+    """``done`` without the jobs in ``opening``; a face split into sub-patches goes whole."""
+    faces = {done[k][0].origin.index for k in opening if done[k][0].origin.kind == "face"}
+    return [(job, la) for k, (job, la) in enumerate(done) if k not in opening
+            and not (job.origin.kind == "face" and job.origin.index in faces)]
 
 
 def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list[str]

@@ -16,7 +16,9 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
@@ -34,6 +36,7 @@ from .failures import describe, is_occ_failure
 __all__ = [
     "FaceNames",
     "all_faces",
+    "boundary_edge_points",
     "check_valid",
     "compound",
     "count_free_edges",
@@ -187,6 +190,22 @@ def count_free_edges(shape: TopoDS_Shape) -> int:
         if edge_faces.FindFromIndex(k).Size() == 1:
             count += 1
     return count
+
+
+def boundary_edge_points(shape: TopoDS_Shape, samples: int = 5) -> list:
+    """Per edge used by exactly one face (degenerated edges left out): ``(samples, 3)``
+    points along it, ends included."""
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    out = []
+    for k in range(1, edge_faces.Extent() + 1):
+        edge = TopoDS.Edge_s(edge_faces.FindKey(k))
+        if BRep_Tool.Degenerated_s(edge) or edge_faces.FindFromIndex(k).Size() != 1:
+            continue
+        curve = BRepAdaptor_Curve(edge)
+        t = np.linspace(curve.FirstParameter(), curve.LastParameter(), samples)
+        out.append(np.array([[p.X(), p.Y(), p.Z()] for p in map(curve.Value, t)]))
+    return out
 
 
 def is_valid(shape: TopoDS_Shape) -> bool:

@@ -222,3 +222,14 @@ def test_only_faces_with_a_defect_are_replaced_by_default():
     assert sorted(p.origin.faces for p in every.patches) == [(0,), (1,), (2,)]
     with pytest.raises(InvalidGeometryError, match="replace"):
         heal(faces, replace="some")
+
+
+def test_taking_back_a_sub_patch_takes_back_its_whole_face():
+    from surfprep.plugin.heal import _without_jobs
+    from surfprep.plugin.heal.jobs import Job, PatchOrigin
+
+    def job(kind, index):
+        return (Job(PatchOrigin(kind, (index,), index), None, None, None), None)
+    done = [job("face", 3), job("face", 3), job("hole", 0), job("face", 5), job("directed", 1)]
+    kept = _without_jobs(done, {1, 2})
+    assert [(j.origin.kind, j.origin.index) for j, _ in kept] == [("face", 5), ("directed", 1)]
