@@ -90,9 +90,11 @@ def _summary(report: dict) -> list[str]:
     free, valid = report["free_edges"], report["valid"]
     worst_err = max((p["max_error"] for p in patches if p["max_error"] is not None),
                     default=float("nan"))
+    worst_dev = max((p["deviation_from_input"] for p in patches), default=float("nan"))
     lines = [(f"{len(patches)} approximant(s) "
              f"({sum(p['kind'] == 'hole' for p in patches)} hole(s) filled), "
-             f"largest error {worst_err:.3g} mm, {len(report['dropped_overlaps'])} duplicate "
+             f"largest error {worst_err:.3g} mm (largest distance from the input faces, "
+             f"dense: {worst_dev:.3g} mm), {len(report['dropped_overlaps'])} duplicate "
              f"face(s) dropped, {report['time_s']:.2f} s")]
     cuts, partial = report.get("cuts", []), report.get("partial_overlaps", [])
     if cuts:
@@ -144,8 +146,11 @@ COMMAND = Command(
     name="heal",
     summary="replace gaps, holes, overlaps and crossings by joined bicubic approximants",
     description=(
-        "Every four-sided face gets a bicubic B-spline approximant over its own four "
-        "edges, projected onto all original faces (Hamann & Jean 1996); four-sided holes "
+        "Every four-sided face with a defect (a gap to a neighbour not closed in the "
+        "geometry, an edge on a hole, an overlap; every face with --replace all) gets a "
+        "bicubic B-spline approximant over its own four edges, projected onto all "
+        "original faces (Hamann & Jean 1996), and is kept as it was where the "
+        "approximant lies farther than tol from the input faces; four-sided holes "
         "bounded by free edges of neighbouring faces are filled the same way (Hardy's "
         "multiquadric over the hole); faces lying on other faces are dropped, a face "
         "lying partly on another is trimmed back to the other's boundary; directed "
@@ -153,9 +158,11 @@ COMMAND = Command(
         "them are cut away). The approximants are joined G0 (shared control "
         "rows averaged) or G1 (tangent planes at corners, collinear control triples "
         "along edges), the result is sewn into a shell (a solid when closed) and checked "
-        "with BRepCheck. The report gives per patch its resolution, error (max, RMS) and "
-        "share of artificial points, per shared edge the measured gap and normal angle, "
-        "and free edges and validity before and after."),
+        "with BRepCheck; approximants that leave more free edges than the input had are "
+        "taken back. The report gives per patch its resolution, error (max, RMS), "
+        "largest distance from the input faces on a dense sample and share of "
+        "artificial points, per shared edge the measured gap and normal angle, and free "
+        "edges and validity before and after."),
     epilog=(
         "examples:\n"
         "  surfprep heal hull.igs -o healed.step\n"
