@@ -58,6 +58,7 @@ from typing import Any
 
 import numpy as np
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+from scipy.spatial import cKDTree
 
 from ...algorithms.face_region import SegmentTree
 from ...algorithms.healing import Continuity, JoinReport, LocalApproximant, Network, connect
@@ -332,9 +333,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         Which faces are re-approximated: "defects" (default) those with a defect,
         an edge paired with another face's edge (within ``gap_tol``) but not closed
         in the geometry (the two 3D curves farther apart than ``TIGHT_FACTOR`` x
-        size), an edge on a hole, or an overlap; the others keep their exact
-        geometry (an approximant in their place could only open gaps that were
-        closed). "all": every face, as 001's network of approximants (also what
+        size), an edge on a hole, or an overlap (with G1 also the faces with a
+        corner at such an edge's end); the others keep their exact geometry (an
+        approximant in their place could only open gaps that were closed). "all": every face, as 001's network of approximants (also what
         "defects" does when directed patches or trimmed-back overlaps cut faces).
 
     Returns
@@ -404,7 +405,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         replace = "all"
     defective = kept if replace == "all" else _defective(
         kept, edges, pairs, holes, {o.kept for o in overlaps} | set(trimmed) | set(unions)
-        | {j for j, _ in unions.values()}, TIGHT_FACTOR * model.size, skipped)
+        | {j for j, _ in unions.values()}, TIGHT_FACTOR * model.size, gap_tol, continuity,
+        skipped)
     jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
                      gap_tol=gap_tol, skipped=skipped)
     inputs = InputFaces.of(faces)
@@ -528,14 +530,20 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
 
 
 def _defective(kept: list[int], edges, pairs, holes, overlapping: set[int], tight: float,
-               skipped: list[str]) -> list[int]:
+               gap_tol: float, continuity: Continuity, skipped: list[str]) -> list[int]:
     """The kept faces with a defect: an edge paired with another face's edge but not
     closed in the geometry (:func:`pair_gaps` above ``tight``), an edge on a hole, or
-    an overlap to repair (``overlapping``); a note counts the others."""
+    an overlap to repair (``overlapping``); with G1 also the faces with a corner at an
+    end of such an edge (the tangent plane there is shared: a hole's diagonal
+    neighbours); a note counts the others."""
     gaps = pair_gaps(edges, pairs)
-    faulty = {edges[k].face for pair, gap in zip(pairs, gaps) if gap > tight for k in pair}
-    faulty |= {e.face for loop in holes for e in loop}
-    faulty |= overlapping
+    bad = {k for pair, gap in zip(pairs, gaps) if gap > tight for k in pair}
+    bad |= {k for loop in holes for k, e in enumerate(edges) if any(e is x for x in loop)}
+    faulty = {edges[k].face for k in bad} | overlapping
+    if continuity == Continuity.G1 and bad:
+        ends = cKDTree(np.concatenate([edges[k].ends for k in sorted(bad)]))
+        near = ends.query(np.concatenate([e.ends for e in edges]))[0].reshape(-1, 2)
+        faulty |= {e.face for e, d in zip(edges, near) if d.min() <= gap_tol}
     out = [i for i in kept if i in faulty]
     if len(out) < len(kept):
         skipped.append(f"{len(kept) - len(out)} faces without a gap, hole or overlap at their "

@@ -98,6 +98,12 @@ def test_hole_in_grid_filled_g1(grid_with_hole):
     assert max(j.max_angle for j in r.joins) < 0.1
     # the filled hole follows the graph (Hardy over the hole, paper's Fig. 6 kind)
     assert deviation_from_graph(r) < 5e-3
+    # with G1 the faces at the hole's corners are rebuilt too (they share its tangent
+    # planes there): all eight; with G0 only the four along its edges
+    assert len([p for p in r.patches if p.origin.kind == "face"]) == 8
+    g0 = heal(grid_with_hole, continuity="G0")
+    assert sorted(p.origin.index for p in g0.patches if p.origin.kind == "face") == [1, 3, 4, 6]
+    assert g0.tight_free_edges_after == 12 and g0.valid_after
 
 
 def test_duplicate_face_dropped(gap_pair):
