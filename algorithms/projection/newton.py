@@ -39,6 +39,7 @@ __all__ = [
     "best_per_query",
     "check_count",
     "check_points",
+    "equidistributed",
     "pick_seeds",
     "projection_tolerance",
     "sample_counts",
@@ -92,6 +93,26 @@ def span_samples(knots: NDArray, degree: int, counts: NDArray) -> NDArray:
     frac = (np.arange(span.size) - start[span]) / counts[span]
     inner = breaks[span] + np.diff(breaks)[span] * frac
     return np.concatenate([inner, breaks[-1:]])
+
+
+#: share of the parameter in the equidistributed sample spacing (the rest chord length)
+_PARAMETER_SHARE = 0.25
+
+
+def equidistributed(params: NDArray, chords: NDArray, knots: NDArray, degree: int) -> NDArray:
+    """As many samples as ``params (s,)`` spread evenly in a blend of chord length
+    (``chords (s - 1,)``, the longest leg of each interval over the other direction)
+    and parameter (:data:`_PARAMETER_SHARE`), the knots of the domain kept among
+    them (creases lie there): (s',) float, increasing."""
+    lo, hi = params[0], params[-1]
+    total = chords.sum()
+    if total <= 0 or hi <= lo:
+        return params
+    measure = (1 - _PARAMETER_SHARE) * np.concatenate([[0.0], np.cumsum(chords)]) / total \
+        + _PARAMETER_SHARE * (params - lo) / (hi - lo)
+    spread = np.interp(np.linspace(0.0, 1.0, params.size), measure, params)
+    breaks, _ = distinct_knots(knots, degree)
+    return np.unique(np.concatenate([spread, breaks]))
 
 
 def span_extents(net: NDArray, knots: NDArray, degree: int) -> NDArray:

@@ -27,6 +27,7 @@ from .newton import (
     best_per_query,
     check_count,
     check_points,
+    equidistributed,
     pick_seeds,
     projection_tolerance,
     sample_counts,
@@ -36,7 +37,11 @@ from .newton import (
     span_samples,
 )
 
-__all__ = ["ProjectionResult", "distance_to_surface", "project_to_surface"]
+__all__ = ["NONUNIFORM", "ProjectionResult", "distance_to_surface", "project_to_surface"]
+
+#: a sample grid whose longest cell leg is this many times the median gets samples
+#: spread by chord length added (:func:`_surface_seeds`)
+NONUNIFORM = 8.0
 
 
 @dataclass(frozen=True)
@@ -148,8 +153,23 @@ def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
                                       samples_per_span, MIN_SAMPLES)
         su = span_samples(surface.knots_u, surface.degree_u, per_u)
         sv = span_samples(surface.knots_v, surface.degree_v, per_v)
-        return ((su, sv), surface.evaluate_grid(su, sv),
-                [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
+        grid = surface.evaluate_grid(su, sv)
+        # a rational surface can cross most of a span in a sliver of its parameters
+        # (large weight ratios): samples even in the parameter leave cells as long as
+        # the model there and the seeds miss basins; where the longest cell leg is
+        # NONUNIFORM times the median, samples spread by chord length are added
+        chords = (np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(axis=1),
+                  np.linalg.norm(np.diff(grid, axis=1), axis=-1).max(axis=0))
+        uneven = [c.size and c.max() > NONUNIFORM * np.median(c) for c in chords]
+        if uneven[0]:
+            su = np.unique(np.concatenate(
+                [su, equidistributed(su, chords[0], surface.knots_u, surface.degree_u)]))
+        if uneven[1]:
+            sv = np.unique(np.concatenate(
+                [sv, equidistributed(sv, chords[1], surface.knots_v, surface.degree_v)]))
+        if any(uneven):
+            grid = surface.evaluate_grid(su, sv)
+        return ((su, sv), grid, [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
 
     seeds = seed_grid(surface, ("surface", samples_per_span), build)
     su, sv = seeds.params
