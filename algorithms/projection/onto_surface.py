@@ -39,8 +39,8 @@ from .newton import (
 
 __all__ = ["NONUNIFORM", "ProjectionResult", "distance_to_surface", "project_to_surface"]
 
-#: a sample grid whose longest cell leg is this many times the median gets samples
-#: spread by chord length added (:func:`_surface_seeds`)
+#: a sample grid whose longest cell leg is this many times the median gets seeds from a
+#: second grid spread by chord length added (:func:`_surface_seeds`)
 NONUNIFORM = 8.0
 
 
@@ -145,6 +145,13 @@ def project_to_surface(surface: NurbsSurface, points: ArrayLike, *, tol: float |
 
 def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
                    samples_per_span: int | None, pieces: CreasePieces) -> tuple[NDArray, NDArray]:
+    """Newton starts ``(rows, uv)`` from the sample grid (samples even in the parameter
+    within each span, spans shared by control-polygon extent). A rational surface can
+    cross most of a span in a sliver of its parameters (large weight ratios): there
+    the grid's cells are as long as the model and a basin can be missed, so when the
+    grid's longest cell leg is :data:`NONUNIFORM` times its median, seeds from a
+    second grid spread by chord length are added (every start is solved and the best
+    foot per point kept, so the first grid's answers can only improve)."""
     def build():
         net = surface.control_points
         extents = [span_extents(net, surface.knots_u, surface.degree_u),
@@ -153,25 +160,29 @@ def _surface_seeds(surface: NurbsSurface, targets: NDArray, n_seeds: int,
                                       samples_per_span, MIN_SAMPLES)
         su = span_samples(surface.knots_u, surface.degree_u, per_u)
         sv = span_samples(surface.knots_v, surface.degree_v, per_v)
-        grid = surface.evaluate_grid(su, sv)
-        # a rational surface can cross most of a span in a sliver of its parameters
-        # (large weight ratios): samples even in the parameter leave cells as long as
-        # the model there and the seeds miss basins; where the longest cell leg is
-        # NONUNIFORM times the median, samples spread by chord length are added
-        chords = (np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(axis=1),
-                  np.linalg.norm(np.diff(grid, axis=1), axis=-1).max(axis=0))
-        uneven = [c.size and c.max() > NONUNIFORM * np.median(c) for c in chords]
-        if uneven[0]:
-            su = np.unique(np.concatenate(
-                [su, equidistributed(su, chords[0], surface.knots_u, surface.degree_u)]))
-        if uneven[1]:
-            sv = np.unique(np.concatenate(
-                [sv, equidistributed(sv, chords[1], surface.knots_v, surface.degree_v)]))
-        if any(uneven):
-            grid = surface.evaluate_grid(su, sv)
-        return ((su, sv), grid, [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
+        return ((su, sv), surface.evaluate_grid(su, sv),
+                [pieces.axis_index(0, su), pieces.axis_index(1, sv)])
 
     seeds = seed_grid(surface, ("surface", samples_per_span), build)
+    rows, uv = _picked(seeds, targets, n_seeds)
+    su, sv = seeds.params
+    chords = (np.linalg.norm(np.diff(seeds.grid, axis=0), axis=-1).max(axis=1),
+              np.linalg.norm(np.diff(seeds.grid, axis=1), axis=-1).max(axis=0))
+    if not any(c.size and c.max() > NONUNIFORM * np.median(c) for c in chords):
+        return rows, uv
+
+    def spread():
+        cu = equidistributed(su, chords[0], surface.knots_u, surface.degree_u)
+        cv = equidistributed(sv, chords[1], surface.knots_v, surface.degree_v)
+        return ((cu, cv), surface.evaluate_grid(cu, cv),
+                [pieces.axis_index(0, cu), pieces.axis_index(1, cv)])
+
+    more_rows, more_uv = _picked(seed_grid(surface, ("surface by chord", samples_per_span),
+                                           spread), targets, n_seeds)
+    return np.concatenate([rows, more_rows]), np.concatenate([uv, more_uv])
+
+
+def _picked(seeds, targets: NDArray, n_seeds: int) -> tuple[NDArray, NDArray]:
     su, sv = seeds.params
     rows, sample = pick_seeds(seeds, targets, n_seeds)
     iu, iv = np.unravel_index(sample, (su.size, sv.size))
