@@ -441,6 +441,9 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
     faces : list of int, optional
         Face indices (file order); default every face on a B-spline surface.
     progress : callable(done, total), optional
+        Called with 0 before the first face and after each face (a caller's time
+        limit per face raises :class:`~surfprep.errors.TimeLimitExceeded` into the face
+        running: that face is kept, with the reason in its entry).
 
     Returns
     -------
@@ -472,6 +475,8 @@ def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | N
             raise InvalidGeometryError(f"face indices {bad} out of range 0..{model.n_faces - 1}")
         chosen = list(dict.fromkeys(faces))
     reshape, entries = BRepTools_ReShape(), []
+    if progress is not None:
+        progress(0, len(chosen))
     for count, k in enumerate(chosen):
         start = time.perf_counter()
         try:

@@ -21,7 +21,7 @@ from .base import (
     read_model,
 )
 from .plotting import pyplot, save_figure
-from .time_limit import step_time_limit
+from .time_limit import seconds_argument, step_time_limit
 
 __all__ = [
     "COMMAND",
@@ -173,17 +173,6 @@ def _characteristic_pairs(results, limit: int = 4) -> list:
     return with_points[:limit]
 
 
-def _seconds(text: str) -> float:
-    """``--pair-time-limit``: a finite number of seconds >= 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number of seconds: {text!r}") from None
-    if not (value >= 0 and value < float("inf")):
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text}")
-    return value
-
-
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file_a", type=Path, metavar="A", help="STEP or IGES file")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
@@ -207,7 +196,7 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              "characteristic method for pairs that cross at a small angle; "
                              "mesh: triangles only; characteristic: the characteristic-curve "
                              "method only")
-    parser.add_argument("--pair-time-limit", type=_seconds, default=DEFAULT_PAIR_TIME_LIMIT,
+    parser.add_argument("--pair-time-limit", type=seconds_argument, default=DEFAULT_PAIR_TIME_LIMIT,
                         metavar="S",
                         help="stop a face pair that runs longer than S seconds, report it "
                              "(its curves are missing, exit 1) and go on with the others; "
@@ -224,7 +213,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     start = time.perf_counter()
     with step_time_limit(args.pair_time_limit, "a face pair") as restart:
         def progress(done: int, total: int) -> None:
-            restart()
+            restart(last=done >= total)
             console.progress(done, total, "face pair")
         results = intersect(model_a, model_b, tol=args.tol, method=args.method,
                             progress=progress)

@@ -20,6 +20,7 @@ from .base import (
     read_model,
 )
 from .plotting import pyplot, save_figure
+from .time_limit import seconds_argument, step_time_limit
 
 __all__ = ["COMMAND", "face_entry", "plot_isolines"]
 
@@ -77,6 +78,10 @@ def plot_isolines(pairs, path: Path) -> Path:
     return save_figure(fig, path)
 
 
+#: default --face-time-limit (s): faces of the real files take seconds each
+DEFAULT_FACE_TIME_LIMIT = 120.0
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="IN", help="STEP or IGES file")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
@@ -85,6 +90,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tolerance in mm (default 1e-4 x the model's bounding-box diagonal)")
     parser.add_argument("--faces", type=int, nargs="+", metavar="K",
                         help="face indices (file order, from 0); default every B-spline face")
+    parser.add_argument("--face-time-limit", type=seconds_argument,
+                        default=DEFAULT_FACE_TIME_LIMIT, metavar="S", dest="face_time_limit",
+                        help="stop a face that runs longer than S seconds, keep it as it "
+                             "was with that reason (exit 1) and go on with the others; 0 for "
+                             f"no limit (default {DEFAULT_FACE_TIME_LIMIT:g})")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG",
@@ -98,9 +108,12 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read_model(args.file, console, strict=args.strict)
     start = time.perf_counter()
-    shape, entries = reparametrize_model(
-        model, tol=args.tol, faces=args.faces,
-        progress=lambda done, total: console.progress(done, total, "face"))
+    with step_time_limit(args.face_time_limit, "a face") as restart:
+        def progress(done: int, total: int) -> None:
+            restart(last=done >= total)
+            console.progress(done, total, "face")
+        shape, entries = reparametrize_model(model, tol=args.tol, faces=args.faces,
+                                             progress=progress)
     elapsed = time.perf_counter() - start
     ok = [e for e in entries if e.done is not None]
     with staged_write(shape, args.output, overwrite=True) as staged:

@@ -75,3 +75,20 @@ def test_plot_without_matplotlib(data_dir, tmp_path, capsys, monkeypatch):
                  "--faces", "0", "--plot", str(tmp_path / "p.png")])
     assert code != 0 and "matplotlib" in capsys.readouterr().err
     assert not (tmp_path / "o.step").exists()
+
+
+def test_a_face_over_the_time_limit_is_kept_and_the_run_goes_on(data_dir, tmp_path, capsys):
+    """--face-time-limit: a face running longer is stopped, kept as it was with that
+    reason, and the next faces run (exit 1); the timer is off again afterwards."""
+    import signal
+    out, report = tmp_path / "out.step", tmp_path / "r.json"
+    code = main(["reparam", str(data_dir / "occt_fuselage.stp"), "-o", str(out), "--faces",
+                 "0", "1", "--face-time-limit", "0.05", "--json", str(report)])
+    assert code == 1
+    faces = json.loads(report.read_text())["faces"]
+    assert [f["index"] for f in faces] == [0, 1]
+    assert all("a face ran longer than 0.05 s" in f["error"] for f in faces)
+    assert out.is_file() and BRepCheck_Analyzer(surfprep.read(out).shape).IsValid()
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    assert main(["reparam", str(data_dir / "occt_fuselage.stp"), "-o", str(out),
+                 "--face-time-limit", "-1"]) == 2

@@ -26,6 +26,15 @@ def test_a_step_over_the_limit_is_interrupted_and_the_handler_put_back():
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
 
 
+def test_after_the_last_step_nothing_is_timed():
+    """What a verb does after its steps (building its result) is not a step."""
+    with step_time_limit(0.1, "a step") as restart:
+        restart()
+        restart(last=True)
+        assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+        time.sleep(0.3)                                   # no TimeLimitExceeded
+
+
 @pytest.mark.parametrize("seconds", [None, 0])
 def test_no_limit(seconds):
     with step_time_limit(seconds, "a step") as restart:
