@@ -20,6 +20,7 @@ from .base import (
     read_model,
 )
 from .plotting import pyplot, save_figure
+from .time_limit import seconds_argument, step_time_limit
 
 __all__ = ["COMMAND", "plot_deviation"]
 
@@ -54,6 +55,10 @@ def plot_deviation(result, path: Path) -> Path:
     return save_figure(fig, path)
 
 
+#: default --job-time-limit (s): approximants of the real files take seconds each
+DEFAULT_JOB_TIME_LIMIT = 120.0
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", type=Path, metavar="IN", help="STEP or IGES file")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
@@ -80,6 +85,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="re-approximate only the faces with a gap, a hole or an "
                              "overlap at their edges (default; the others keep their exact "
                              "geometry) or every face")
+    parser.add_argument("--job-time-limit", type=seconds_argument,
+                        default=DEFAULT_JOB_TIME_LIMIT, metavar="S", dest="job_time_limit",
+                        help="stop an approximant that takes longer than S seconds to build, "
+                             "keep its face as it was (or leave its hole open) with a note "
+                             f"and go on; 0 for no limit (default {DEFAULT_JOB_TIME_LIMIT:g})")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
@@ -121,9 +131,13 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     inputs = tuple(p for p in (args.input, args.patches) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     model = read_model(args.input, console, strict=args.strict)
-    result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
-                  patches=args.patches, overlap=args.overlap,
-                  split_faces=args.split_faces, replace=args.replace)
+    with step_time_limit(args.job_time_limit, "an approximant") as restart:
+        def progress(done: int, total: int) -> None:
+            restart(last=done >= total)
+            console.progress(done, total, "approximant")
+        result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
+                      patches=args.patches, overlap=args.overlap,
+                      split_faces=args.split_faces, replace=args.replace, progress=progress)
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model)}
     with staged_write(result.model, args.output, overwrite=True) as staged:
         report["output"] = str(staged.target)

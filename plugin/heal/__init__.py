@@ -298,7 +298,7 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True,
-         replace: str = "defects") -> HealResult:
+         replace: str = "defects", progress=None) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -410,8 +410,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
                      gap_tol=gap_tol, skipped=skipped)
     inputs = InputFaces.of(faces)
-    done = approximate(jobs, sources,
-                        {i: k for k, i in enumerate(kept)}, tol, gap_tol, skipped, inputs)
+    done = approximate(jobs, sources, {i: k for k, i in enumerate(kept)}, tol, gap_tol,
+                       skipped, inputs, progress)
     done += directed_jobs(directed, cut)
     for round_ in range(ROLLBACK_ROUNDS + 1):
         notes: list[str] = []

@@ -23,7 +23,7 @@ from ...algorithms.healing.adjacency import four_sided_boundary
 from ...algorithms.healing.decompose import quad_boundaries, why_not_decomposable
 from ...algorithms.healing.fidelity import InputFaces, surface_deviation
 from ...algorithms.trimmed import TrimmedFace
-from ...errors import SurfprepError
+from ...errors import SurfprepError, TimeLimitExceeded
 from .cut import CutModel
 from .spec import DirectedPatch
 
@@ -121,7 +121,7 @@ def directed_jobs(directed: list[DirectedPatch], cut: CutModel) -> list[tuple[Jo
 
 
 def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_tol,
-                skipped: list[str], inputs: InputFaces | None = None
+                skipped: list[str], inputs: InputFaces | None = None, progress=None
                 ) -> list[tuple[Job, LocalApproximant]]:
     """One approximant per job; a face's own surface is its preferred source (other
     faces only where it is missed), so long segments do not pick far-away faces.
@@ -130,45 +130,65 @@ def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_to
     densely against them (:func:`~surfprep.algorithms.healing.fidelity.surface_deviation`):
     its own error is measured only where its grid landed on the sources and misses a
     bulge over a hole. One off by more than its tol is rebuilt once to a tighter
-    error, and if still off the face is kept as it was, and said so."""
+    error, and if still off the face is kept as it was, and said so.
+
+    ``progress(done, total)`` is called before each job and after the last; a job
+    the caller stops by raising :class:`~surfprep.errors.TimeLimitExceeded` into it
+    is left as it was (its face kept whole), with a note."""
     out, failed = [], set()
-    for job in jobs:
+    for n, job in enumerate(jobs):
+        if progress is not None:
+            progress(n, len(jobs))
         if job.split and job.origin.index in failed:
             continue              # the face is kept whole: its other sub-patches are moot
-        own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
-
-        def build(target, job=job, own=own):
-            return local_approximant(job.boundary, sources, tol=target, gap_tol=gap_tol,
-                                     preferred_source=own, side_error=job.split)
         try:
-            la = build(tol)
-        except (SurfprepError, np.linalg.LinAlgError) as exc:
-            skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
-                           f"({type(exc).__name__}: {exc}); left as it was")
+            la = _one_job(job, sources, source_of, tol, gap_tol, skipped, inputs)
+        except TimeLimitExceeded as exc:
+            la = None
+            skipped.append(f"{job.origin.kind} {job.origin.index}: stopped ({exc}); left as "
+                           "it was")
+        if la is None:
             failed |= {job.origin.index} if job.split else set()
             continue
-        if job.origin.kind in ("face", "union") and not la.converged:
-            skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
-                           f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
-                           "kept as it was")
-            failed |= {job.origin.index} if job.split else set()
-            continue
-        if job.origin.kind == "hole" and not la.converged:
-            # the error is measured only where segments land on the originals: over a real
-            # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
-            # of a slot, an open end) is no hole, and a patch over it would not fit them
-            skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
-                           f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
-                           f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
-                           "left open")
-            continue
-        if job.origin.kind in ("face", "union") and inputs is not None:
-            la = _held_to_input(job, la, build, inputs, skipped)
-            if la is None:
-                failed |= {job.origin.index} if job.split else set()
-                continue
         out.append((job, la))
+    if progress is not None:
+        progress(len(jobs), len(jobs))
     return _whole_faces_only(jobs, out, skipped, failed)
+
+
+def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped: list[str],
+             inputs: InputFaces | None) -> LocalApproximant | None:
+    """The approximant of one job (:func:`approximate`), or None with a note."""
+    own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
+
+    def build(target):
+        return local_approximant(job.boundary, sources, tol=target, gap_tol=gap_tol,
+                                 preferred_source=own, side_error=job.split)
+    try:
+        la = build(tol)
+    except TimeLimitExceeded:
+        raise
+    except (SurfprepError, np.linalg.LinAlgError) as exc:
+        skipped.append(f"{job.origin.kind} {job.origin.index}: no approximant "
+                       f"({type(exc).__name__}: {exc}); left as it was")
+        return None
+    if job.origin.kind in ("face", "union") and not la.converged:
+        skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
+                       f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
+                       "kept as it was")
+        return None
+    if job.origin.kind == "hole" and not la.converged:
+        # the error is measured only where segments land on the originals: over a real
+        # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
+        # of a slot, an open end) is no hole, and a patch over it would not fit them
+        skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
+                       f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
+                       f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
+                       "left open")
+        return None
+    if job.origin.kind in ("face", "union") and inputs is not None:
+        return _held_to_input(job, la, build, inputs, skipped)
+    return la
 
 
 def _held_to_input(job: Job, la: LocalApproximant, build, inputs: InputFaces,
@@ -184,6 +204,8 @@ def _held_to_input(job: Job, la: LocalApproximant, build, inputs: InputFaces,
         target = la.max_error * RETRY_MARGIN * tol / deviation.max_distance
         try:
             again = build(target)
+        except TimeLimitExceeded:
+            raise
         except (SurfprepError, np.linalg.LinAlgError):
             again = None
         if again is not None and again.converged:

@@ -116,3 +116,22 @@ def test_heal_split_faces_option(tmp_path, capsys):
         code, _, err = run(capsys, "heal", src, "-o", out, *flags)
         assert code == 0, err
         assert surfprep.read(out).n_faces == faces_out
+
+
+def test_an_approximant_over_the_time_limit_is_left_out(gap_file, tmp_path, capsys):
+    """--job-time-limit: an approximant taking longer is stopped, its face kept as it
+    was with a note, and the run goes on to a written, valid model; the timer is off
+    afterwards."""
+    import signal
+    out, report = tmp_path / "out.step", tmp_path / "r.json"
+    code, _, err = run(capsys, "heal", gap_file, "-o", out, "--job-time-limit", "0.001",
+                       "--json", report)
+    assert code == 0, err
+    r = json.loads(report.read_text())
+    stopped = [s for s in r["skipped"] if "an approximant ran longer than 0.001 s" in s]
+    assert len(stopped) == 2 and r["patches"] == []
+    assert surfprep.read(out).n_faces == 2 and r["valid"]["after"]
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    code, _, err = run(capsys, "heal", gap_file, "-o", tmp_path / "x.step",
+                       "--job-time-limit", "nan")
+    assert code == 2 and "job-time-limit" in err
