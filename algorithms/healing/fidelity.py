@@ -13,12 +13,13 @@ union of the trimmed input faces is found by closest-point projection
 The distance to a trimmed face is the distance to its surface when the foot lies
 inside the face (:meth:`~surfprep.algorithms.face_region.FaceRegion.contains`),
 else the distance to its trimming edges in space (an upper bound, exact when the
-nearest point of the face is on its boundary). Each face keeps a grid of its
-surface in a k-d tree: the nearest grid point seeds Newton's point inversion,
-and, less the largest cell diagonal (or the control-net box's distance, if
-larger), bounds the distance from below, so a face is projected onto only for
-the samples that bound lies below the best distance found so far, nearest faces
-first: the cost follows the few faces near each sample, not the model.
+nearest point of the face is on its boundary). Faces are taken nearest
+control-net box first; a face's box distance bounds its distance from below,
+and only for the samples that bound lies below the best distance found so far
+is its grid (its surface sampled, in a k-d tree) queried: the nearest grid
+point seeds Newton's point inversion and, less the largest cell diagonal, gives
+a closer bound, and only below that bound is the face projected onto. The cost
+follows the few faces near each sample, not the model.
 """
 
 from __future__ import annotations
@@ -64,12 +65,6 @@ class SurfaceDeviation:
 
 #: samples per direction of the grid each face keeps for seeds and culling
 FACE_GRID = 48
-
-
-def _box_distance(points: NDArray, box: NDArray) -> NDArray:
-    """Distance ``(n,)`` of ``points (n, 3)`` to the axis-aligned ``box (2, 3)``."""
-    outside = np.maximum(np.maximum(box[0] - points, 0.0), points - box[1])
-    return np.linalg.norm(outside, axis=1)
 
 
 @dataclass(frozen=True)
@@ -138,21 +133,25 @@ class InputFaces:
         if points.shape[0] == 0 or not self.regions:
             return best
         grids = self._grids
-        # per face: a lower bound of the distance (its nearest grid point less the
-        # reach, or its box) and the seed; nearest faces first
-        lower, seeds = [], []
-        for g in grids:
-            dg, idx = g.tree.query(points)
-            lower.append(np.maximum(dg - g.reach, _box_distance(points, g.box)))
-            seeds.append(g.uv[idx])
-        lower = np.array(lower)
-        for k in np.argsort(lower.min(axis=1), kind="stable"):
-            todo = np.flatnonzero(lower[k] < best)
+        boxes = np.stack([g.box for g in grids])                            # (F, 2, 3)
+        outside = np.maximum(np.maximum(boxes[:, None, 0] - points, 0.0),
+                             points - boxes[:, None, 1])
+        box_lower = np.linalg.norm(outside, axis=-1)                        # (F, n)
+        # nearest boxes first; a face's grid is queried only for the points its box
+        # could still beat the best distance for, and projected onto only where its
+        # grid's bound (nearest grid point less the reach) could too
+        for k in np.argsort(box_lower.min(axis=1), kind="stable"):
+            near = np.flatnonzero(box_lower[k] < best)
+            if near.size == 0:
+                continue
+            g = grids[k]
+            dg, idx = g.tree.query(points[near])
+            keep = np.maximum(dg - g.reach, box_lower[k, near]) < best[near]
+            todo, seeds = near[keep], g.uv[idx[keep]]
             if todo.size == 0:
                 continue
             region = self.regions[k]
-            foot = project_to_surface(region.surface, points[todo], tol=tol,
-                                      guess=seeds[k][todo])
+            foot = project_to_surface(region.surface, points[todo], tol=tol, guess=seeds)
             inside = region.contains(foot.uv, tol)
             distance = foot.distance.copy()
             if not inside.all():

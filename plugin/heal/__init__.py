@@ -413,13 +413,14 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     done = approximate(jobs, sources, {i: k for k, i in enumerate(kept)}, tol, gap_tol,
                        skipped, inputs, progress)
     done += directed_jobs(directed, cut)
+    before = _Before.of(model, gap_tol)
     for round_ in range(ROLLBACK_ROUNDS + 1):
         notes: list[str] = []
         network, snapped = _joined(done, edges, faces, gone, gap_tol, continuity,
                                    TIGHT_FACTOR * model.size)
         deviations = _deviations(done, network, inputs, gap_tol, notes)
         result = _assemble(model, work, done, network, dropped, skipped + notes, gap_tol, tol,
-                           continuity, start, deviations)
+                           continuity, start, deviations, before)
         if result.free_edges_after <= result.free_edges_before or round_ == ROLLBACK_ROUNDS:
             break
         opening = _opening(result.shape, done, network, edges, pairs, gap_tol)
@@ -465,28 +466,49 @@ def _opening(shape, done, network, edges, pairs, gap_tol: float) -> set[int]:
     for a, b in pairs:
         partners.setdefault(a, set()).add(edges[b].face)
         partners.setdefault(b, set()).add(edges[a].face)
-    lines = [SegmentTree.from_polylines([dense_edge(edges[k])]) for k in paired]
-    rims = []
+    lines = [dense_edge(edges[k]) for k in paired]
     t = np.linspace(0.0, 1.0, 129)
+    rims = []
     for surface in network.patches:
         u0, u1, v0, v1 = surface.domain
         u, v = u0 + (u1 - u0) * t, v0 + (v1 - v0) * t
-        rims.append(SegmentTree.from_polylines([
-            surface.evaluate(u, np.full_like(u, v0)), surface.evaluate(u, np.full_like(u, v1)),
-            surface.evaluate(np.full_like(v, u0), v), surface.evaluate(np.full_like(v, u1), v)]))
+        rims.append([surface.evaluate(u, np.full_like(u, v0)),
+                     surface.evaluate(u, np.full_like(u, v1)),
+                     surface.evaluate(np.full_like(v, u0), v),
+                     surface.evaluate(np.full_like(v, u1), v)])
     jobs_of: dict[int, set[int]] = {}
     for k, (job, _) in enumerate(done):
         if job.origin.kind in ("face", "union"):
             for f in job.origin.faces:
                 jobs_of.setdefault(f, set()).add(k)
+    near_line = _polylines_along(lines, free, gap_tol)
+    near_rim = _polylines_along([np.concatenate(r) for r in rims], free, gap_tol,
+                                pieces=rims)
     out = set()
-    for points in free:
-        on = [k for k, line in zip(paired, lines) if line.distance(points).max() <= gap_tol]
+    for n in range(len(free)):
+        on = [paired[i] for i in near_line[n]]
         if not on:
             continue                          # a free edge of the input, not opened
         out |= {j for k in on for f in partners[k] for j in jobs_of.get(f, ())}
-        out |= {j for j, rim in enumerate(rims) if rim.distance(points).max() <= gap_tol}
+        out |= set(near_rim[n])
     return {j for j in out if done[j][0].origin.kind != "directed"}
+
+
+def _polylines_along(lines: list, free: list, gap_tol: float, pieces: list | None = None
+                     ) -> list[list[int]]:
+    """Per free edge (its points ``(k, 3)``), the indices of the polylines (``(m, 3)``
+    each; or made of ``pieces[i]``, several polylines) it runs along: every point
+    within ``gap_tol``. Polylines whose box grown by ``gap_tol`` misses a point are
+    not measured."""
+    lo = np.stack([q.min(axis=0) for q in lines]) - gap_tol
+    hi = np.stack([q.max(axis=0) for q in lines]) + gap_tol
+    out = []
+    for points in free:
+        fits = np.flatnonzero(np.all(lo <= points.min(axis=0), axis=1)
+                              & np.all(points.max(axis=0) <= hi, axis=1))
+        out.append([int(i) for i in fits if SegmentTree.from_polylines(
+            pieces[i] if pieces is not None else [lines[i]]).distance(points).max() <= gap_tol])
+    return out
 
 
 def _rolled_back(done, opening: set[int]) -> str:
@@ -538,7 +560,8 @@ def _defective(kept: list[int], edges, pairs, holes, overlapping: set[int], tigh
     neighbours); a note counts the others."""
     gaps = pair_gaps(edges, pairs)
     bad = {k for pair, gap in zip(pairs, gaps) if gap > tight for k in pair}
-    bad |= {k for loop in holes for k, e in enumerate(edges) if any(e is x for x in loop)}
+    on_holes = {id(e) for loop in holes for e in loop}
+    bad |= {k for k, e in enumerate(edges) if id(e) in on_holes}
     faulty = {edges[k].face for k in bad} | overlapping
     if continuity == Continuity.G1 and bad:
         ends = cKDTree(np.concatenate([edges[k].ends for k in sorted(bad)]))
@@ -561,10 +584,26 @@ def _without_faces(edges: list, pairs: list[tuple[int, int]], gone: set[int]
             [(new[a], new[b]) for a, b in pairs if a in new and b in new])
 
 
+@dataclass(frozen=True)
+class _Before:
+    """The input's figures: free edges sewn at ``gap_tol`` and at ``TIGHT_FACTOR`` x size,
+    validity."""
+
+    free_edges: int
+    tight_free_edges: int
+    valid: bool
+
+    @classmethod
+    def of(cls, model: CadModel, gap_tol: float) -> _Before:
+        sewn, _ = sew(list(model.faces), gap_tol)
+        tight, _ = sew(list(model.faces), TIGHT_FACTOR * model.size)
+        return cls(count_free_edges(sewn), count_free_edges(tight), is_valid(model.shape))
+
+
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,
-              deviations) -> HealResult:
+              deviations, before: _Before) -> HealResult:
     """The output from ``work`` (the input with faces under directed patches cut) and the
-    approximants; figures before from ``model`` (the input)."""
+    approximants; ``before``: the figures of ``model`` (the input)."""
     gone = replaced_faces(done) | {b for _, b in dropped}
     untouched = [i for i in range(work.n_faces) if i not in gone]
     new_faces, names = [], FaceNames()
@@ -582,20 +621,17 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
     out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
     result_model = CadModel(shape, out_faces, out_names, (None,) * len(out_faces),
                             model.length_unit, None, model.file_format)
-    tight = TIGHT_FACTOR * model.size
-    before_sewn, _ = sew(list(model.faces), gap_tol)
-    tight_before, _ = sew(list(model.faces), tight)
-    tight_after, _ = sew(originals + new_faces, tight)       # the output faces, unsewn
+    tight_after, _ = sew(originals + new_faces, TIGHT_FACTOR * model.size)   # unsewn output
     reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
                                 la.artificial_share, la.converged, la.tol, deviation)
                     for (job, la), deviation in zip(done, deviations))
     return HealResult(
         model=result_model, patches=reports, approximants=tuple(la for _, la in done),
         network=network, dropped=tuple(dropped), skipped=tuple(skipped),
-        free_edges_before=count_free_edges(before_sewn), free_edges_after=count_free_edges(shape),
-        tight_free_edges_before=count_free_edges(tight_before),
+        free_edges_before=before.free_edges, free_edges_after=count_free_edges(shape),
+        tight_free_edges_before=before.tight_free_edges,
         tight_free_edges_after=count_free_edges(tight_after),
-        valid_before=is_valid(model.shape), valid_after=is_valid(shape),
+        valid_before=before.valid, valid_after=is_valid(shape),
         max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
         continuity=continuity, time_s=time.perf_counter() - start,
         extra={"faces_in": model.n_faces})

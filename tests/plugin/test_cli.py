@@ -337,19 +337,24 @@ def test_parametrization_figure_of_occ_converted_cylinder_and_sphere():
     assert 1.0 < face.param_quality_u < 1.2 and 1.0 < face.param_quality_v < 1.2
 
 
+def _only_command(monkeypatch, name: str, run_it) -> None:
+    """The CLI with one command, ``name``, that runs ``run_it(args, console)``."""
+    import dataclasses
+    fake = dataclasses.replace(COMMANDS[0], name=name, run=run_it,
+                               add_arguments=lambda parser: None)
+    monkeypatch.setattr(cli, "COMMANDS", (fake,))
+
+
 def test_warnings_are_one_line_each(capsys, monkeypatch):
     """A warning raised while a command runs is printed as ``surfprep: warning: ...`` (no
     file, line or source echo); with --debug it stays a Python warning."""
-    import dataclasses
     import warnings
 
     def noisy(args, console):
         warnings.warn("3 of 7 intersection curves left out:\n  they stray", UserWarning)
         return 0
 
-    fake = dataclasses.replace(COMMANDS[0], name="noisy", run=noisy,
-                               add_arguments=lambda parser: None)
-    monkeypatch.setattr(cli, "COMMANDS", (fake,))
+    _only_command(monkeypatch, "noisy", noisy)
     code, out, err = run(capsys, "noisy")
     assert code == 0
     assert err.strip() == "surfprep: warning: 3 of 7 intersection curves left out: they stray"
@@ -468,7 +473,6 @@ def test_info_lists_the_curves_of_a_file_without_faces(tmp_path, capsys):
 
 
 def test_warnings_of_one_kind_are_counted_and_numerical_ones_say_so(capsys, monkeypatch):
-    import dataclasses
     import warnings
 
     import numpy as np
@@ -480,9 +484,7 @@ def test_warnings_of_one_kind_are_counted_and_numerical_ones_say_so(capsys, monk
             np.array([np.inf]) * 0.0
         return 0
 
-    fake = dataclasses.replace(COMMANDS[0], name="noisy", run=noisy,
-                               add_arguments=lambda parser: None)
-    monkeypatch.setattr(cli, "COMMANDS", (fake,))
+    _only_command(monkeypatch, "noisy", noisy)
     code, _, err = run(capsys, "noisy")
     assert code == 0
     assert err.strip().splitlines() == [
