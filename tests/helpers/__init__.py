@@ -6,6 +6,10 @@
   comparisons of two of them;
 * :mod:`.heal_cases`: the healing geometry (001's figure kinds, faces to decompose);
 * :mod:`.measure`: intersection curves measured densely against exact answers;
+* :mod:`.grid_cases`: surfaces whose structured grids are known (warped planes, a
+  warped cylinder, a pole);
+* :mod:`.cgns_library`: the CGNS library VTK ships, called through ctypes, to read
+  back the CGNS files surfprep writes;
 * :mod:`.paths`: the repository's folders (samples, stored reports);
 * :mod:`.cli`: the command line run in-process.
 

@@ -1,0 +1,295 @@
+"""A structured grid on one four-sided surface: redistribution, TFI, elliptic refinement.
+
+:func:`grid_surface` is the whole grid step of 003 on a :class:`NurbsSurface`:
+
+1. **edge distributions**: the nodes of each side placed by the :class:`Spacing`
+   law in exact arc length (:mod:`.distribution`), so a first spacing asked for
+   in model units is the distance between the first two nodes in space;
+2. **redistribution**: the side nodes' parameters, normalized, span the
+   arc-length *distribution mesh* (:func:`.tfi.distribution_mesh`, 003), the
+   start grid ``(s, t)``; on a chord-length parametrized face it is close to the
+   final grid, on a badly parametrized one it is only a start;
+3. **elliptic refinement** on the surface's metric (:func:`.elliptic.refine`,
+   003 eqs. 5-9), boundary nodes held, folds refused;
+4. **quality** of the start grid and of the result, on the surface (:mod:`.quality`).
+
+The i direction runs along the surface's u, the j direction along v.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import DegenerateGeometryError, InvalidGeometryError
+from ..curve import NurbsCurve
+from ..measure import normals as surface_normals
+from ..surface import NurbsSurface
+from ..tensor import Direction
+from . import distribution
+from .elliptic import EllipticResult, refine
+from .quality import GridQuality, grid_quality
+from .tfi import distribution_mesh
+
+__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_surface"]
+
+#: cells along the longest side when neither ``dims`` nor ``size`` is given
+DEFAULT_CELLS = 40
+#: a side shorter than this fraction of the surface's box diagonal is collapsed (a pole)
+COLLAPSED = 1e-9
+LAWS = ("uniform", "geometric", "tanh", "curvature")
+SIDES = ("j0", "j1", "i0", "i1")
+
+
+@dataclass(frozen=True)
+class Spacing:
+    """How the nodes are spread along the lines of one grid direction.
+
+    Attributes
+    ----------
+    law : {"uniform", "geometric", "tanh", "curvature"}
+        Default ``"uniform"``, or ``"tanh"`` when a first/last spacing is given,
+        ``"geometric"`` when a growth ratio is.
+    first, last : float, optional
+        Length of the first / last interval of each side, in model units.
+    growth : float, optional
+        Ratio of consecutive intervals (geometric law).
+    strength : float
+        Weight of the curvature in the ``"curvature"`` law.
+    """
+
+    law: str | None = None
+    first: float | None = None
+    last: float | None = None
+    growth: float | None = None
+    strength: float = 1.0
+
+    def __post_init__(self) -> None:
+        law = self.law
+        if law is None:
+            law = "geometric" if self.growth is not None else (
+                "tanh" if self.first is not None or self.last is not None else "uniform")
+        if law not in LAWS:
+            raise InvalidGeometryError(f"unknown spacing law {law!r}; expected one of {', '.join(LAWS)}")
+        object.__setattr__(self, "law", law)
+        for name in ("first", "last", "growth"):
+            value = getattr(self, name)
+            if value is not None and (not math.isfinite(float(value)) or float(value) <= 0.0):
+                raise InvalidGeometryError(f"spacing {name} must be a positive number, got {value!r}")
+        if law == "tanh" and self.first is None and self.last is None:
+            raise InvalidGeometryError("the tanh law needs a first or a last spacing")
+        if law == "geometric" and (self.growth is None) == (self.first is None):
+            raise InvalidGeometryError("the geometric law needs a growth ratio or a first spacing")
+
+    def fractions(self, n: int, curve: NurbsCurve, length: float) -> NDArray:
+        """``(n,)`` fractions of the arc length of ``curve`` (of ``length``) for this law."""
+        if self.law == "uniform":
+            return distribution.uniform(n)
+        if self.law == "curvature":
+            return distribution.by_curvature(curve, n, strength=self.strength)
+        if self.law == "geometric":
+            if self.growth is not None:
+                return distribution.geometric(n, growth=self.growth)
+            return distribution.geometric(n, first=self.first / length)
+        return distribution.stretched(
+            n, first=None if self.first is None else self.first / length,
+            last=None if self.last is None else self.last / length)
+
+
+@dataclass(frozen=True)
+class SurfaceGrid:
+    """A structured grid block on a surface.
+
+    Attributes
+    ----------
+    points : (ni, nj, 3) float
+        The nodes, on the surface (i along u, j along v).
+    parameters : (ni, nj, 2) float
+        The ``(u, v)`` of each node.
+    quality : GridQuality
+        Of the result.
+    start_quality : GridQuality
+        Of the algebraic start grid (the distribution mesh), before smoothing.
+    elliptic : EllipticResult or None
+        The refinement's residual history; None when not smoothed.
+    collapsed_sides : tuple of str
+        Sides of zero length (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``).
+    spacing_error : float
+        Largest relative deviation of the first/last side intervals from the
+        spacing asked for (0 when none was asked).
+    time_s : float
+    """
+
+    points: NDArray
+    parameters: NDArray
+    quality: GridQuality
+    start_quality: GridQuality
+    elliptic: EllipticResult | None
+    collapsed_sides: tuple[str, ...] = ()
+    spacing_error: float = 0.0
+    time_s: float = field(default=0.0, compare=False)
+
+    @property
+    def dims(self) -> tuple[int, int]:
+        return tuple(self.points.shape[:2])
+
+    def report(self) -> dict:
+        """Plain-JSON figures of the block."""
+        out = {"dims": list(self.dims), "collapsed_sides": list(self.collapsed_sides),
+               "quality": self.quality.report(), "start_quality": self.start_quality.report(),
+               "spacing_error": self.spacing_error, "time_s": self.time_s}
+        if self.elliptic is not None:
+            out["elliptic"] = {"converged": self.elliptic.converged, "sweeps": self.elliptic.sweeps,
+                               "refused_steps": self.elliptic.refused,
+                               "residuals": list(self.elliptic.residuals)}
+        return out
+
+
+def _sides(surface: NurbsSurface) -> dict[str, NurbsCurve]:
+    u0, u1, v0, v1 = surface.domain
+    return {"j0": surface.isocurve(v0, Direction.V), "j1": surface.isocurve(v1, Direction.V),
+            "i0": surface.isocurve(u0, Direction.U), "i1": surface.isocurve(u1, Direction.U)}
+
+
+def _dims(lengths: dict[str, float], dims, size) -> tuple[int, int]:
+    if dims is not None:
+        if size is not None:
+            raise InvalidGeometryError("give dims or size, not both")
+        try:
+            ni, nj = (int(d) for d in dims)
+        except (TypeError, ValueError):
+            raise InvalidGeometryError(f"dims must be two node counts, got {dims!r}") from None
+        if ni < 2 or nj < 2 or (ni, nj) != tuple(dims):
+            raise InvalidGeometryError(f"dims must be two integers >= 2, got {dims!r}")
+        return ni, nj
+    long_i = max(lengths["j0"], lengths["j1"])
+    long_j = max(lengths["i0"], lengths["i1"])
+    if size is None:
+        size = max(long_i, long_j) / DEFAULT_CELLS
+    size = float(size)
+    if not math.isfinite(size) or size <= 0.0:
+        raise InvalidGeometryError(f"size must be a positive length, got {size!r}")
+    cells = max(long_i, long_j) / size
+    if cells > 1e5:
+        raise InvalidGeometryError(f"size {size:g} asks for {cells:.3g} cells along a side; at most 1e5")
+    return max(2, math.ceil(long_i / size - 1e-9) + 1), max(2, math.ceil(long_j / size - 1e-9) + 1)
+
+
+def _side_fractions(sides: dict[str, NurbsCurve], lengths: dict[str, float], collapsed: set[str],
+                    ni: int, nj: int, spacing: tuple[Spacing, Spacing]) -> dict[str, NDArray]:
+    """Normalized parameters of the side nodes, by the spacing laws in arc length."""
+    out = {}
+    for name, other, n, law in (("j0", "j1", ni, spacing[0]), ("j1", "j0", ni, spacing[0]),
+                                ("i0", "i1", nj, spacing[1]), ("i1", "i0", nj, spacing[1])):
+        if name in collapsed:
+            if other in collapsed:
+                raise DegenerateGeometryError(f"sides {name} and {other} are both collapsed")
+            continue
+        curve = sides[name]
+        lo, hi = curve.domain
+        out[name] = (distribution.points_along(curve, law.fractions(n, curve, lengths[name])) - lo) / (hi - lo)
+    for name, other in (("j0", "j1"), ("j1", "j0"), ("i0", "i1"), ("i1", "i0")):
+        if name in collapsed:
+            out[name] = out[other]          # the pole's nodes coincide; keep the lines straight in (u, v)
+    return out
+
+
+def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed: set[str]) -> float:
+    worst = 0.0
+    for law, lines in ((spacing[0], {"j0": points[:, 0], "j1": points[:, -1]}),
+                       (spacing[1], {"i0": points[0], "i1": points[-1]})):
+        for name, line in lines.items():
+            if name in collapsed or line.shape[0] < 3:
+                continue
+            legs = np.linalg.norm(np.diff(line, axis=0), axis=1)
+            for asked, got in ((law.first, legs[0]), (law.last, legs[-1])):
+                if asked is not None and law.law in ("tanh", "geometric"):
+                    worst = max(worst, abs(got - asked) / asked)
+    return worst
+
+
+def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
+                 spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
+                 control: bool = True, tol: float = 1e-5, max_sweeps: int = 2000) -> SurfaceGrid:
+    """A structured grid on a four-sided surface (003: redistribution, TFI, elliptic).
+
+    Parameters
+    ----------
+    surface : NurbsSurface (3D)
+    dims : (int, int), optional
+        Nodes along i (the u direction) and j (v). Default from ``size``.
+    size : float, optional
+        Target cell size in model units; default the longest side over
+        :data:`DEFAULT_CELLS`. Each direction gets ``ceil(L / size) + 1`` nodes,
+        ``L`` the longer of its two sides.
+    spacing : Spacing or (Spacing, Spacing)
+        The law along i and along j (one for both when a single one is given).
+    smooth : {"elliptic", "none"}
+        Elliptic refinement on the surface metric (default), or the algebraic grid.
+    control, tol, max_sweeps
+        Passed to :func:`.elliptic.refine`.
+
+    Returns
+    -------
+    SurfaceGrid
+
+    Raises
+    ------
+    InvalidGeometryError
+        Bad dims/size/spacing, a spacing no law of that many nodes can reach.
+    DegenerateGeometryError
+        Two opposite sides collapsed, or a surface of zero size.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from surfprep import NurbsSurface
+    >>> k = [0, 0, 1, 1]
+    >>> plane = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[2, 0, 0], [2, 1, 0]]], float), k, k, 1, 1)
+    >>> grid = grid_surface(plane, dims=(5, 3))
+    >>> grid.points.shape, round(grid.quality.max_skewness, 12)
+    ((5, 3, 3), 0.0)
+    """
+    started = time.perf_counter()
+    if not isinstance(surface, NurbsSurface) or surface.dimension != 3:
+        raise InvalidGeometryError("grid_surface needs a 3D NurbsSurface")
+    if smooth not in ("elliptic", "none"):
+        raise InvalidGeometryError(f"smooth must be 'elliptic' or 'none', got {smooth!r}")
+    if isinstance(spacing, Spacing):
+        spacing = (spacing, spacing)
+    elif not (isinstance(spacing, tuple) and len(spacing) == 2
+              and all(isinstance(s, Spacing) for s in spacing)):
+        raise InvalidGeometryError("spacing must be a Spacing or a pair of them (along i, along j)")
+    sides = _sides(surface)
+    lengths = {name: curve.arc_length() for name, curve in sides.items()}
+    diag = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
+    if not diag > 0.0:
+        raise DegenerateGeometryError("the surface has zero size")
+    collapsed = {name for name, length in lengths.items() if length <= COLLAPSED * diag}
+    ni, nj = _dims(lengths, dims, size)
+    fractions = _side_fractions(sides, lengths, collapsed, ni, nj, spacing)
+    s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
+    u0, u1, v0, v1 = surface.domain
+    st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
+    st[..., 0] = np.clip(st[..., 0], u0, u1)
+    st[..., 1] = np.clip(st[..., 1], v0, v1)
+
+    def measured(params: NDArray) -> tuple[NDArray, GridQuality]:
+        points = surface.evaluate(params[..., 0], params[..., 1])
+        return points, grid_quality(points, surface_normals(surface, params[..., 0], params[..., 1]))
+
+    start_points, start_quality = measured(st)
+    result = None
+    points, quality = start_points, start_quality
+    if smooth == "elliptic":
+        result = refine(surface, st, control=control, tol=tol, max_sweeps=max_sweeps)
+        st = result.parameters
+        points, quality = measured(st)
+    return SurfaceGrid(points=points, parameters=st, quality=quality, start_quality=start_quality,
+                       elliptic=result, collapsed_sides=tuple(sorted(collapsed)),
+                       spacing_error=_spacing_error(points, spacing, collapsed),
+                       time_s=time.perf_counter() - started)
