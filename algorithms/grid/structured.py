@@ -35,7 +35,7 @@ from .elliptic import EllipticResult, refine
 from .quality import GridQuality, grid_quality
 from .tfi import distribution_mesh
 
-__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_surface"]
+__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_surface", "side_curves"]
 
 #: cells along the longest side when neither ``dims`` nor ``size`` is given
 DEFAULT_CELLS = 40
@@ -116,6 +116,9 @@ class SurfaceGrid:
         Of the algebraic start grid (the distribution mesh), before smoothing.
     elliptic : EllipticResult or None
         The refinement's residual history; None when not smoothed.
+    kept_start : str or None
+        Why the algebraic grid was kept although smoothing was asked: the refined
+        grid folded a cell or, not converged, was more skewed (never returned worse).
     collapsed_sides : tuple of str
         Sides of zero length (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``).
     spacing_error : float
@@ -129,6 +132,7 @@ class SurfaceGrid:
     quality: GridQuality
     start_quality: GridQuality
     elliptic: EllipticResult | None
+    kept_start: str | None = None
     collapsed_sides: tuple[str, ...] = ()
     spacing_error: float = 0.0
     time_s: float = field(default=0.0, compare=False)
@@ -145,11 +149,14 @@ class SurfaceGrid:
         if self.elliptic is not None:
             out["elliptic"] = {"converged": self.elliptic.converged, "sweeps": self.elliptic.sweeps,
                                "refused_steps": self.elliptic.refused,
-                               "residuals": list(self.elliptic.residuals)}
+                               "residuals": list(self.elliptic.residuals),
+                               "kept_start": self.kept_start}
         return out
 
 
-def _sides(surface: NurbsSurface) -> dict[str, NurbsCurve]:
+def side_curves(surface: NurbsSurface) -> dict[str, NurbsCurve]:
+    """The four sides of a surface as curves: ``"j0"`` (v = v0) and ``"j1"`` (v = v1) run
+    in u, ``"i0"`` (u = u0) and ``"i1"`` (u = u1) run in v."""
     u0, u1, v0, v1 = surface.domain
     return {"j0": surface.isocurve(v0, Direction.V), "j1": surface.isocurve(v1, Direction.V),
             "i0": surface.isocurve(u0, Direction.U), "i1": surface.isocurve(u1, Direction.U)}
@@ -214,7 +221,8 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
 
 def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
                  spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                 control: bool = True, tol: float = 1e-5, max_sweeps: int = 2000) -> SurfaceGrid:
+                 control: bool = True, tol: float = 1e-5, max_sweeps: int = 2000,
+                 sides: dict[str, NDArray] | None = None) -> SurfaceGrid:
     """A structured grid on a four-sided surface (003: redistribution, TFI, elliptic).
 
     Parameters
@@ -232,6 +240,11 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         Elliptic refinement on the surface metric (default), or the algebraic grid.
     control, tol, max_sweeps
         Passed to :func:`.elliptic.refine`.
+    sides : dict, optional
+        Nodes of some sides given, instead of by the law: side name (``"j0"``,
+        ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side curve's
+        parameters normalized to [0, 1], increasing from 0 to 1 (a network uses it
+        to give two faces the same nodes along their shared edge).
 
     Returns
     -------
@@ -264,14 +277,24 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     elif not (isinstance(spacing, tuple) and len(spacing) == 2
               and all(isinstance(s, Spacing) for s in spacing)):
         raise InvalidGeometryError("spacing must be a Spacing or a pair of them (along i, along j)")
-    sides = _sides(surface)
-    lengths = {name: curve.arc_length() for name, curve in sides.items()}
+    curves = side_curves(surface)
+    lengths = {name: curve.arc_length() for name, curve in curves.items()}
     diag = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
     if not diag > 0.0:
         raise DegenerateGeometryError("the surface has zero size")
     collapsed = {name for name, length in lengths.items() if length <= COLLAPSED * diag}
     ni, nj = _dims(lengths, dims, size)
-    fractions = _side_fractions(sides, lengths, collapsed, ni, nj, spacing)
+    fractions = _side_fractions(curves, lengths, collapsed, ni, nj, spacing)
+    for name, given in (sides or {}).items():
+        if name not in SIDES:
+            raise InvalidGeometryError(f"unknown side {name!r}; expected one of {', '.join(SIDES)}")
+        given = np.asarray(given, dtype=float)
+        n = ni if name in ("j0", "j1") else nj
+        if given.shape != (n,) or not np.all(np.isfinite(given)) or given[0] != 0.0 \
+                or given[-1] != 1.0 or np.any(np.diff(given) <= 0.0):
+            raise InvalidGeometryError(
+                f"side {name}: need {n} increasing normalized parameters from 0 to 1")
+        fractions[name] = given
     s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
     u0, u1, v0, v1 = surface.domain
     st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
@@ -285,11 +308,21 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     start_points, start_quality = measured(st)
     result = None
     points, quality = start_points, start_quality
+    kept_start = None
     if smooth == "elliptic":
         result = refine(surface, st, control=control, tol=tol, max_sweeps=max_sweeps)
-        st = result.parameters
-        points, quality = measured(st)
+        refined_points, refined = measured(result.parameters)
+        worse = refined.folded_cells > start_quality.folded_cells or (
+            not result.converged and refined.max_skewness > start_quality.max_skewness)
+        if worse:
+            kept_start = (f"the elliptic refinement stopped at residual {result.residuals[-1]:.3g} "
+                          f"with max skewness {refined.max_skewness:.3g} and {refined.folded_cells} "
+                          f"folded cell(s), worse than the algebraic grid's "
+                          f"{start_quality.max_skewness:.3g} and {start_quality.folded_cells}: "
+                          "the algebraic grid is kept")
+        else:
+            st, points, quality = result.parameters, refined_points, refined
     return SurfaceGrid(points=points, parameters=st, quality=quality, start_quality=start_quality,
-                       elliptic=result, collapsed_sides=tuple(sorted(collapsed)),
+                       elliptic=result, kept_start=kept_start, collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started)

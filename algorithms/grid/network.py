@@ -1,0 +1,495 @@
+"""Point-matched structured grids over a network of four-sided surfaces.
+
+A network is a list of surfaces (the faces of a healed model, one block each)
+whose sides meet edge to edge. :func:`grid_network`
+
+1. finds the sides two surfaces share (:func:`match_sides`: ends and samples
+   within ``gap`` of each other, in either direction);
+2. gives every set of sides linked through the blocks (opposite sides of a
+   block, matched sides of two blocks) one node count, from ``dims`` or from
+   the longest side of the set over ``size``;
+3. places the nodes of a shared side once, on the first block that has it, and
+   gives the other block the same nodes (the first block's nodes projected on
+   its side, so both grids stand on their own surfaces);
+4. grids every block (:func:`.structured.grid_surface`);
+5. with elliptic smoothing, lets the interface nodes slide along their edge
+   until the grid lines cross it smoothly (the Winslow stencil of both blocks
+   together moves them; the blocks are refined again around them);
+6. copies the first block's coordinates onto the other's side, so matched nodes
+   are identical to the bit, and reports how far that moved them (the gap
+   between the surfaces);
+7. measures the kink of the grid lines that cross each interface: the angle
+   between the last cell leg in one block and the first in the other.
+
+Blocks are in the surfaces' order; each block's sides are ``"i0"`` (u = u0),
+``"i1"``, ``"j0"`` (v = v0), ``"j1"`` as in :mod:`.structured`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import InvalidGeometryError
+from ..projection import project_to_curve
+from ..surface import NurbsSurface
+from .io.blocks import Interface, side_nodes
+from .structured import DEFAULT_CELLS, SIDES, Spacing, SurfaceGrid, grid_surface, side_curves
+
+__all__ = ["NetworkGrid", "grid_network", "match_sides"]
+
+#: samples compared along two sides to call them one edge
+MATCH_SAMPLES = 9
+#: rounds of sliding interface nodes at most, the move (in cells) they stop at, and
+#: the share of each move taken
+INTERFACE_ROUNDS = 12
+INTERFACE_TOL = 1e-3
+INTERFACE_RELAXATION = 0.8
+#: an interface whose surfaces' normals differ by more than this (degrees) is a crease:
+#: its nodes do not slide and its kink is not counted in the summary
+SMOOTH_INTERFACE = 15.0
+
+
+@dataclass(frozen=True)
+class NetworkGrid:
+    """Grids of a network of surfaces, one block per surface.
+
+    Attributes
+    ----------
+    blocks : tuple of SurfaceGrid
+    interfaces : tuple of Interface
+        Matched sides (their nodes are identical).
+    snap : float
+        Largest move of a node copied from one block onto its neighbour's side.
+    kink : float
+        Largest angle (degrees) between the grid lines on the two sides of a smooth
+        interface (one whose surfaces' normals agree within :data:`SMOOTH_INTERFACE`).
+    interface_rounds : int
+        Rounds of sliding the interface nodes (0 without elliptic smoothing).
+    interface_angles : tuple of (float, float)
+        Per interface: the kink of the grid lines and the crease (normals' angle), degrees.
+    """
+
+    blocks: tuple[SurfaceGrid, ...]
+    interfaces: tuple[Interface, ...]
+    snap: float = 0.0
+    kink: float = 0.0
+    interface_rounds: int = 0
+    interface_angles: tuple[tuple[float, float], ...] = ()
+    time_s: float = field(default=0.0, compare=False)
+
+    def report(self) -> dict:
+        return {"blocks": [b.report() for b in self.blocks],
+                "interfaces": [{"block": f.block, "side": f.side, "other": f.other,
+                                "other_side": f.other_side, "reversed": f.reversed,
+                                "kink_deg": k, "crease_deg": c}
+                               for f, (k, c) in zip(self.interfaces, self.interface_angles, strict=True)],
+                "snap": self.snap, "kink_deg": self.kink, "interface_rounds": self.interface_rounds,
+                "time_s": self.time_s}
+
+
+def _direction(side: str) -> int:
+    """0 for the sides that run in i (``j0``, ``j1``), 1 for those that run in j."""
+    return 0 if side in ("j0", "j1") else 1
+
+
+def match_sides(surfaces: list[NurbsSurface], *, gap: float) -> list[Interface]:
+    """Sides of different surfaces (or of one closed surface) that are one edge.
+
+    Two sides match when their samples at equal fractions of their parameters
+    (in the same or the opposite direction) are within ``gap`` of each other's
+    curve; collapsed sides never match. Each side matches at most once (the
+    first one found, in block order).
+
+    Returns
+    -------
+    list of Interface
+    """
+    curves = [side_curves(s) for s in surfaces]
+    samples, lengths = {}, {}
+    for b, sides in enumerate(curves):
+        for name, curve in sides.items():
+            lo, hi = curve.domain
+            pts = curve.evaluate(np.linspace(lo, hi, MATCH_SAMPLES))
+            samples[b, name] = pts
+            lengths[b, name] = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+    keys = [k for k in samples if lengths[k] > gap]
+    used: set[tuple[int, str]] = set()
+    out = []
+    for x, key_a in enumerate(keys):
+        if key_a in used:
+            continue
+        a = samples[key_a]
+        for key_b in keys[x + 1:]:
+            if key_b in used:
+                continue
+            b = samples[key_b]
+            for reverse in (False, True):
+                other = b[::-1] if reverse else b
+                if np.max(np.linalg.norm(a - other, axis=1)) <= gap:
+                    out.append(Interface(key_a[0], key_a[1], key_b[0], key_b[1], reverse))
+                    used.update((key_a, key_b))
+                    break
+            if key_a in used:
+                break
+    return out
+
+
+class _Classes:
+    """Union-find over the directions ``(block, 0 | 1)``."""
+
+    def __init__(self, n: int) -> None:
+        self.parent = {(b, d): (b, d) for b in range(n) for d in (0, 1)}
+
+    def find(self, x):
+        while self.parent[x] != x:
+            self.parent[x] = self.parent[self.parent[x]]
+            x = self.parent[x]
+        return x
+
+    def union(self, a, b) -> None:
+        self.parent[self.find(a)] = self.find(b)
+
+
+def _counts(surfaces, interfaces, dims, size) -> dict[tuple[int, int], int]:
+    """Node count of every direction ``(block, 0 | 1)``: one per linked set."""
+    classes = _Classes(len(surfaces))
+    for f in interfaces:
+        classes.union((f.block, _direction(f.side)), (f.other, _direction(f.other_side)))
+    if dims is not None:
+        ni, nj = dims
+        counts = {}
+        for key in classes.parent:
+            root = classes.find(key)
+            want = ni if key[1] == 0 else nj
+            if counts.setdefault(root, want) != want:
+                raise InvalidGeometryError(
+                    f"dims {tuple(dims)} cannot match the network: block {key[0]}'s "
+                    f"{'i' if key[1] == 0 else 'j'} direction meets another block's "
+                    "other direction along a shared edge (give size instead)")
+        return {key: counts[classes.find(key)] for key in classes.parent}
+    longest: dict = {}
+    for b, s in enumerate(surfaces):
+        for name, curve in side_curves(s).items():
+            root = classes.find((b, _direction(name)))
+            longest[root] = max(longest.get(root, 0.0), curve.arc_length())
+    size = float(size)
+    return {key: max(2, math.ceil(longest[classes.find(key)] / size - 1e-9) + 1) for key in classes.parent}
+
+
+def _transfer(curves_a, side_a: str, fractions_a: NDArray, curves_b, side_b: str, reverse: bool,
+              guess: NDArray | None = None) -> NDArray:
+    """Normalized parameters on side ``b`` of the nodes of side ``a`` (projected).
+
+    ``guess`` (normalized parameters on ``b``) starts the projection; by default the
+    fractions of ``a`` themselves (the two curves are one edge: their parameters
+    run alike). Raises InvalidGeometryError when the feet are not in order.
+    """
+    ca, cb = curves_a[side_a], curves_b[side_b]
+    lo, hi = ca.domain
+    points = ca.evaluate(lo + fractions_a * (hi - lo))
+    start = fractions_a if guess is None else guess
+    if reverse:
+        points = points[::-1]
+        if guess is None:
+            start = 1.0 - fractions_a[::-1]
+    lo_b, hi_b = cb.domain
+    t = (project_to_curve(cb, points, guess=lo_b + start * (hi_b - lo_b)).t - lo_b) / (hi_b - lo_b)
+    t[0], t[-1] = 0.0, 1.0
+    t = np.clip(t, 0.0, 1.0)
+    if np.any(np.diff(t) <= 0.0):
+        raise InvalidGeometryError(f"the nodes of a shared edge do not project in order onto side {side_b}")
+    return t
+
+
+def _side_parameters(grid: SurfaceGrid, surface: NurbsSurface, side: str) -> NDArray:
+    """Normalized parameters of a gridded block's side nodes along that side."""
+    u0, u1, v0, v1 = surface.domain
+    nodes = side_nodes(grid.parameters, side)
+    if side in ("j0", "j1"):
+        return (nodes[:, 0] - u0) / (u1 - u0)
+    return (nodes[:, 1] - v0) / (v1 - v0)
+
+
+def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, int] | None = None,
+                 size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
+                 smooth: str = "elliptic", tol: float = 1e-5, max_sweeps: int = 2000,
+                 progress=None) -> NetworkGrid:
+    """Point-matched grids over a network of four-sided surfaces (see the module doc).
+
+    Parameters
+    ----------
+    surfaces : list of NurbsSurface
+    gap : float
+        Largest distance between two sides called one edge (model units).
+    dims : (int, int), optional
+        Nodes along i and j of every block; must be consistent across shared edges.
+    size : float, optional
+        Target cell size; default the median over the blocks of their longest side
+        over :data:`~.structured.DEFAULT_CELLS`.
+    spacing, smooth, tol, max_sweeps
+        As in :func:`~.structured.grid_surface` (default spacing: uniform in arc length).
+    progress : callable(done, total), optional
+
+    Returns
+    -------
+    NetworkGrid
+    """
+    import time
+    started = time.perf_counter()
+    if not surfaces:
+        raise InvalidGeometryError("a network needs at least one surface")
+    if dims is not None and size is not None:
+        raise InvalidGeometryError("give dims or size, not both")
+    spacing = Spacing() if spacing is None else spacing
+    interfaces = match_sides(surfaces, gap=gap)
+    curves = [side_curves(s) for s in surfaces]
+    if dims is None and size is None:
+        size = float(np.median([max(c.arc_length() for c in sides.values()) for sides in curves])) \
+            / DEFAULT_CELLS
+    counts = _counts(surfaces, interfaces, dims, size)
+    partner = {}
+    for f in interfaces:
+        partner[f.block, f.side] = (f.other, f.other_side, f.reversed)
+        partner[f.other, f.other_side] = (f.block, f.side, f.reversed)
+    blocks: list[SurfaceGrid] = []
+    if progress is not None:
+        progress(0, len(surfaces))
+    for b, surface in enumerate(surfaces):
+        given = {}
+        for side in SIDES:
+            if (b, side) in partner and partner[b, side][0] < b:
+                a, side_a, reverse = partner[b, side]
+                fractions = _side_parameters(blocks[a], surfaces[a], side_a)
+                given[side] = _transfer(curves[a], side_a, fractions, curves[b], side, reverse)
+        blocks.append(grid_surface(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
+                                   smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given))
+        if progress is not None:
+            progress(b + 1, len(surfaces))
+    rounds = 0
+    if smooth == "elliptic" and interfaces:
+        blocks, rounds = _slide_interfaces(surfaces, curves, blocks, interfaces, tol=tol,
+                                           max_sweeps=max_sweeps)
+    return _snapped(surfaces, blocks, interfaces, started, rounds)
+
+
+def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...]:
+    """Nodes of an interface and of the lines beside it in both blocks, in block a's order."""
+    a, b = blocks[f.block].points, blocks[f.other].points
+    edge = side_nodes(a, f.side)
+    before = _inner_line(a, f.side)
+    after = _inner_line(b, f.other_side)
+    if f.reversed:
+        after = after[::-1]
+    return edge, before, after
+
+
+def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
+    """Jacobi moves of the inner nodes of an interface along it (model units), from the
+    Winslow stencil of the two blocks together (:mod:`.elliptic_kernels`'s update, with
+    xi across the interface and eta along it), ``(n - 2,)``."""
+    r_xi = 0.5 * (after[1:-1] - before[1:-1])
+    r_eta = 0.5 * (edge[2:] - edge[:-2])
+    r_xe = 0.25 * (after[2:] - after[:-2] - before[2:] + before[:-2])
+    g11 = np.einsum("ij,ij->i", r_xi, r_xi)
+    g22 = np.einsum("ij,ij->i", r_eta, r_eta)
+    g12 = np.einsum("ij,ij->i", r_xi, r_eta)
+    diag = 2.0 * (g11 + g22)
+    diag = np.where(diag > 0, diag, 1.0)
+    move = (g22[:, None] * (after[1:-1] + before[1:-1]) + g11[:, None] * (edge[2:] + edge[:-2])
+            - 2.0 * g12[:, None] * r_xe) / diag[:, None] - edge[1:-1]
+    tangent = r_eta / np.maximum(np.linalg.norm(r_eta, axis=1), 1e-300)[:, None]
+    return np.einsum("ij,ij->i", move, tangent)
+
+
+def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: list[Interface], *,
+                      tol: float, max_sweeps: int) -> tuple[list[SurfaceGrid], int]:
+    """Let the nodes of every interface slide along it until the grid lines cross it
+    smoothly: each round moves them by the Winslow stencil of both blocks together
+    (:func:`_edge_moves`), gives both blocks the new side nodes and refines the
+    blocks again from where they were. Stops when no node would move more than
+    :data:`INTERFACE_TOL` of its cell, or after :data:`INTERFACE_ROUNDS` rounds."""
+    from ..measure import normals
+    from .elliptic import refine
+    from .quality import grid_quality
+    params = [b.parameters.copy() for b in blocks]
+    grids = list(blocks)
+    # creases do not slide, nor do blocks that kept their algebraic grid
+    interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
+                  and blocks[f.block].kept_start is None and blocks[f.other].kept_start is None]
+    touched: set[int] = set()
+    rounds = 0
+    for rounds in range(1, INTERFACE_ROUNDS + 1):
+        worst = 0.0
+        changed: set[int] = set()
+        for f in interfaces:
+            edge, before, after = _edge_stencil(grids, f)
+            if edge.shape[0] < 3:
+                continue
+            move = _edge_moves(edge, before, after)
+            legs = np.linalg.norm(np.diff(edge, axis=0), axis=1)
+            cell = np.maximum(np.minimum(legs[1:], legs[:-1]), 1e-300)
+            worst = max(worst, float(np.max(np.abs(move) / cell)))
+            # along block a's side curve: arc length to parameter by the local chord
+            t = _side_parameters(grids[f.block], surfaces[f.block], f.side)
+            dt = np.diff(t)
+            step = move / np.where(move > 0, legs[1:], legs[:-1]) * np.where(move > 0, dt[1:], dt[:-1])
+            step = np.clip(INTERFACE_RELAXATION * step, -0.5 * dt[:-1], 0.5 * dt[1:])
+            t_new = t.copy()
+            t_new[1:-1] += step
+            current_b = _side_parameters(grids[f.other], surfaces[f.other], f.other_side)
+            try:
+                t_b = _transfer(curves[f.block], f.side, t_new, curves[f.other], f.other_side,
+                                f.reversed, guess=current_b)
+            except InvalidGeometryError:
+                continue                      # this edge's nodes stay where they are this round
+            for block, side, values in ((f.block, f.side, t_new), (f.other, f.other_side, t_b)):
+                _set_side_parameters(params[block], surfaces[block], side, values)
+                changed.add(block)
+        if worst < INTERFACE_TOL:
+            break
+        for k in changed:
+            result = refine(surfaces[k], params[k], tol=tol, max_sweeps=max_sweeps)
+            params[k] = result.parameters.copy()
+            points = surfaces[k].evaluate(params[k][..., 0], params[k][..., 1])
+            g = grids[k]
+            grids[k] = SurfaceGrid(points=points, parameters=params[k], quality=g.quality,
+                                   start_quality=g.start_quality, elliptic=result,
+                                   kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
+                                   time_s=g.time_s)
+            touched.add(k)
+    for k in touched:
+        g, p = grids[k], params[k]
+        quality = grid_quality(g.points, normals(surfaces[k], p[..., 0], p[..., 1]))
+        grids[k] = SurfaceGrid(points=g.points, parameters=p, quality=quality,
+                               start_quality=g.start_quality, elliptic=g.elliptic,
+                               kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
+                               time_s=g.time_s)
+    return grids, rounds
+
+
+def _set_side_parameters(params: NDArray, surface: NurbsSurface, side: str, values: NDArray) -> None:
+    """Put normalized side parameters back into a block's ``(u, v)`` array."""
+    u0, u1, v0, v1 = surface.domain
+    column = 0 if side in ("j0", "j1") else 1
+    lo, hi = (u0, u1) if column == 0 else (v0, v1)
+    axis, index = _SIDE_INDEX[side]
+    if axis == 0:
+        params[index, :, column] = lo + values * (hi - lo)
+    else:
+        params[:, index, column] = lo + values * (hi - lo)
+
+
+def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], started: float,
+             rounds: int) -> NetworkGrid:
+    """Copy the first block's side nodes onto the second's; measure the moves and kinks."""
+    import time
+
+    from ..measure import normals
+    points = [b.points.copy() for b in blocks]
+    snap = kink = 0.0
+    figures: list[tuple[float, float]] = []
+    for f in interfaces:
+        a, b = points[f.block], points[f.other]
+        nodes_a = side_nodes(a, f.side)
+        nodes_b = side_nodes(b, f.other_side)
+        if f.reversed:
+            nodes_a = nodes_a[::-1]
+        snap = max(snap, float(np.max(np.linalg.norm(nodes_a - nodes_b, axis=1))))
+        _set_side(b, f.other_side, nodes_a)
+        uv = side_nodes(blocks[f.block].parameters, f.side)
+        k = _kink(a, f.side, b, f.other_side, f.reversed, normals(surfaces[f.block], uv[:, 0], uv[:, 1]))
+        c = _crease(surfaces, blocks, f)
+        figures.append((k, c))
+        if c <= SMOOTH_INTERFACE:
+            kink = max(kink, k)
+    out = tuple(SurfaceGrid(points=p, parameters=g.parameters, quality=g.quality,
+                            start_quality=g.start_quality, elliptic=g.elliptic,
+                            kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
+                            time_s=g.time_s) for p, g in zip(points, blocks, strict=True))
+    return NetworkGrid(out, tuple(interfaces), snap, kink, rounds, tuple(figures),
+                       time.perf_counter() - started)
+
+
+_SIDE_INDEX = {"i0": (0, 0), "i1": (0, -1), "j0": (1, 0), "j1": (1, -1)}
+
+
+def _set_side(block: NDArray, side: str, nodes: NDArray) -> None:
+    axis, index = _SIDE_INDEX[side]
+    if axis == 0:
+        block[index] = nodes
+    else:
+        block[:, index] = nodes
+
+
+def _inner_line(block: NDArray, side: str, depth: int = 1) -> NDArray:
+    """The line of nodes ``depth`` steps inside a side."""
+    axis, index = _SIDE_INDEX[side]
+    inner = depth if index == 0 else -1 - depth
+    return block[inner] if axis == 0 else block[:, inner]
+
+
+#: direction of each side in its block's boundary loop (counter-clockwise in (i, j))
+_LOOP_DIRECTION = {"j0": 1, "i1": 1, "j1": -1, "i0": -1}
+
+
+def _same_orientation(f: Interface) -> bool:
+    """True when the two blocks of an interface are oriented alike (their boundary
+    loops run along the shared edge in opposite directions)."""
+    along = _LOOP_DIRECTION[f.side] * _LOOP_DIRECTION[f.other_side] * (-1 if f.reversed else 1)
+    return along == -1
+
+
+def _crease(surfaces, blocks: list[SurfaceGrid], f: Interface) -> float:
+    """Largest angle (degrees) between the two surfaces' normals along an interface,
+    the second block's taken with the first's orientation."""
+    from ..measure import normals
+    ends = []
+    for block, side in ((f.block, f.side), (f.other, f.other_side)):
+        uv = side_nodes(blocks[block].parameters, side)
+        ends.append(normals(surfaces[block], uv[:, 0], uv[:, 1]))
+    na, nb = ends
+    if f.reversed:
+        nb = nb[::-1]
+    if not _same_orientation(f):
+        nb = -nb
+    cos = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
+    return float(np.degrees(np.arccos(cos)).max())
+
+
+def _turn(a: NDArray, b: NDArray, c: NDArray, normals: NDArray) -> NDArray:
+    """Signed turning angle (radians) of the polylines ``a -> b -> c`` about ``normals``."""
+    d1, d2 = b - a, c - b
+    return np.arctan2(np.einsum("ij,ij->i", np.cross(d1, d2), normals), np.einsum("ij,ij->i", d1, d2))
+
+
+def _kink(a: NDArray, side_a: str, b: NDArray, side_b: str, reverse: bool,
+          normals: NDArray) -> float:
+    """Largest kink (degrees) of the lines crossing an interface, ends left out.
+
+    The turning of each crossing line at the interface node, in the tangent plane
+    (about the surface normal ``normals`` (n, 3)), less the mean of its turning at
+    the nodes just before and after: a line that bends as it did inside both
+    blocks (a ring round a pole turns at every node) has no kink; a line that
+    breaks at the interface has one. Blocks of fewer than 3 lines across count the
+    turning alone.
+    """
+    edge = side_nodes(a, side_a)
+    before = _inner_line(a, side_a)
+    after = _inner_line(b, side_b)
+    if reverse:
+        after = after[::-1]
+    turn = _turn(before, edge, after, normals)
+    deep = min(a.shape[0 if side_a[0] == "i" else 1], b.shape[0 if side_b[0] == "i" else 1]) >= 3
+    if deep:
+        before2 = _inner_line(a, side_a, 2)
+        after2 = _inner_line(b, side_b, 2)
+        if reverse:
+            after2 = after2[::-1]
+        turn = turn - 0.5 * (_turn(before2, before, edge, normals) + _turn(edge, after, after2, normals))
+    inner = np.abs(turn[1:-1])
+    inner = inner[np.isfinite(inner)]
+    return float(np.degrees(inner.max())) if inner.size else 0.0

@@ -1,0 +1,74 @@
+"""Point-matched grids over a network of four-sided surfaces."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.grid_cases import warped_plane
+
+from surfprep import NurbsSurface
+from surfprep.algorithms.grid.io import side_nodes
+from surfprep.algorithms.grid.network import grid_network, match_sides
+from surfprep.errors import InvalidGeometryError
+
+
+def _flip_u(s: NurbsSurface) -> NurbsSurface:
+    ku = (s.knots_u[0] + s.knots_u[-1]) - s.knots_u[::-1]
+    return NurbsSurface(s.control_points[::-1], ku, s.knots_v, s.degree_u, s.degree_v,
+                        None if s.weights is None else s.weights[::-1])
+
+
+def _quarters(flip_last: bool = False) -> list[NurbsSurface]:
+    """The warped plane cut into four by its iso-lines u = 0.5 and v = 0.4."""
+    a, b = warped_plane().split(0.5, "u")
+    a1, a2 = a.split(0.4, "v")
+    b1, b2 = b.split(0.4, "v")
+    return [a1, a2, b1, _flip_u(b2) if flip_last else b2]
+
+
+@pytest.mark.parametrize("flip_last", [False, True])
+def test_shared_sides_are_found_in_either_direction(flip_last):
+    interfaces = match_sides(_quarters(flip_last), gap=1e-9)
+    pairs = {frozenset([(f.block, f.side), (f.other, f.other_side)]): f.reversed for f in interfaces}
+    assert len(pairs) == 4
+    assert pairs[frozenset([(0, "j1"), (1, "j0")])] is False
+    assert pairs[frozenset([(0, "i1"), (2, "i0")])] is False
+    # block 3 runs against u when flipped: its side i1 (not i0) meets block 1, and the
+    # side it shares with block 2 runs the other way
+    assert pairs[frozenset([(1, "i1"), (3, "i1" if flip_last else "i0")])] is False
+    assert pairs[frozenset([(2, "j1"), (3, "j0")])] is flip_last
+
+
+@pytest.mark.parametrize("flip_last", [False, True])
+def test_shared_nodes_are_identical_and_lines_cross_smoothly(flip_last):
+    net = grid_network(_quarters(flip_last), gap=1e-9, size=0.05)
+    assert len(net.interfaces) == 4
+    for f in net.interfaces:
+        a = side_nodes(net.blocks[f.block].points, f.side)
+        b = side_nodes(net.blocks[f.other].points, f.other_side)
+        assert np.array_equal(a[::-1] if f.reversed else a, b)            # bit for bit
+    assert net.snap < 1e-12                   # the quarters are cut from one surface
+    # the whole plane: every block flat and unfolded, the lines crossing each cut
+    # without a kink beyond a few degrees away from the corner where four blocks meet
+    for block in net.blocks:
+        assert block.quality.folded_cells == 0
+        assert np.abs(block.points[..., 2]).max() < 1e-12
+    assert all(crease < 1e-6 for _, crease in net.interface_angles)
+    assert net.interface_rounds >= 1
+
+
+def test_node_counts_follow_the_shared_edges():
+    net = grid_network(_quarters(), gap=1e-9, size=0.1)
+    dims = [b.dims for b in net.blocks]
+    assert dims[0][0] == dims[1][0] and dims[2][0] == dims[3][0]        # i counts across the v cut
+    assert dims[0][1] == dims[2][1] and dims[1][1] == dims[3][1]        # j counts across the u cut
+
+
+def test_dims_that_cannot_match_are_refused():
+    quarters = _quarters()
+    turned = NurbsSurface(np.transpose(quarters[1].control_points, (1, 0, 2)), quarters[1].knots_v,
+                          quarters[1].knots_u, quarters[1].degree_v, quarters[1].degree_u)
+    with pytest.raises(InvalidGeometryError, match="cannot match"):
+        grid_network([quarters[0], turned], gap=1e-9, dims=(9, 5))
+    with pytest.raises(InvalidGeometryError, match="not both"):
+        grid_network(quarters, gap=1e-9, dims=(5, 5), size=0.1)
