@@ -56,8 +56,19 @@ from .occ.failures import describe, is_occ_failure
 from .occ.shapes import FaceNames, all_faces, compound
 from .step_iges import FileFormat, Rgb, TranslatedModel, TranslationError, read_file, write_file
 
-__all__ = ["CadModel", "FileFormat", "StagedFile", "TranslationWarning", "read", "write",
-           "staged_write", "to_shape", "bounding_box", "sniff_format"]
+__all__ = [
+    "CadModel",
+    "FileFormat",
+    "StagedFile",
+    "TranslationWarning",
+    "as_model",
+    "bounding_box",
+    "read",
+    "sniff_format",
+    "staged_write",
+    "to_shape",
+    "write",
+]
 
 #: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
 MODEL_UNIT = "mm"
@@ -527,6 +538,15 @@ def new_file_mode() -> int:
 
 
 # ========================================================== object -> shape
+def as_model(obj: ShapeLike | str | os.PathLike) -> CadModel:
+    """A :class:`CadModel` for a path (read), a model (itself) or anything :func:`to_shape` takes."""
+    if isinstance(obj, CadModel):
+        return obj
+    if isinstance(obj, (str, os.PathLike)):
+        return read(obj)
+    return CadModel.from_shape(to_shape(obj))
+
+
 def to_shape(obj: ShapeLike) -> TopoDS_Shape:
     """One ``TopoDS_Shape`` for anything :func:`write` accepts (lists become a compound)."""
     if isinstance(obj, CadModel):

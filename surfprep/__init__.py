@@ -7,7 +7,8 @@ loads on first use, so numpy-only code does not pay for importing OCP.
 
 Every verb returns a result object with the geometry (``.geometry``) and its
 plain-JSON report (``.report()``): :class:`IntersectionResult` (also the list
-of curves), :class:`ReparametrizeResult`, :class:`HealResult`.
+of curves), :class:`ReparametrizeResult`, :class:`HealResult`; :func:`grid`
+returns a :class:`GridResult` (the blocks, ``.write(path)`` for Plot3D, CGNS, VTK).
 
 >>> import surfprep
 >>> model = surfprep.read("step_samples/occt_fuselage.stp")     # doctest: +SKIP
@@ -43,8 +44,10 @@ from .errors import (
 from .inputs import ShapeLike
 
 if TYPE_CHECKING:
+    from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
     from .algorithms.reparam import ReparametrizationResult
     from .plugin.convert import to_nurbs, to_occ
+    from .plugin.grid import GridResult, grid
     from .plugin.heal import HealResult, heal
     from .plugin.intersect import FaceIntersection, IntersectionResult, intersect
     from .plugin.io import CadModel, FileFormat, read, write
@@ -83,6 +86,12 @@ __all__ = [
     "ReparametrizationResult",
     "heal",
     "HealResult",
+    "grid",
+    "GridResult",
+    # structured grids (numpy only)
+    "grid_surface",
+    "SurfaceGrid",
+    "Spacing",
     # errors
     "SurfprepError",
     "InvalidGeometryError",
@@ -116,6 +125,11 @@ _LAZY_EXPORTS = {
     "ReparametrizeResult": "surfprep.plugin.reparam",
     "heal": "surfprep.plugin.heal",
     "HealResult": "surfprep.plugin.heal",
+    "grid": "surfprep.plugin.grid",
+    "GridResult": "surfprep.plugin.grid",
+    "grid_surface": "surfprep.algorithms.grid",
+    "SurfaceGrid": "surfprep.algorithms.grid",
+    "Spacing": "surfprep.algorithms.grid",
 }
 
 

@@ -28,7 +28,7 @@ Blocks are in the surfaces' order; each block's sides are ``"i0"`` (u = u0),
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -355,19 +355,12 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
             result = refine(surfaces[k], params[k], tol=tol, max_sweeps=max_sweeps)
             params[k] = result.parameters.copy()
             points = surfaces[k].evaluate(params[k][..., 0], params[k][..., 1])
-            g = grids[k]
-            grids[k] = SurfaceGrid(points=points, parameters=params[k], quality=g.quality,
-                                   start_quality=g.start_quality, elliptic=result,
-                                   kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
-                                   time_s=g.time_s)
+            grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result)
             touched.add(k)
     for k in touched:
         g, p = grids[k], params[k]
         quality = grid_quality(g.points, normals(surfaces[k], p[..., 0], p[..., 1]))
-        grids[k] = SurfaceGrid(points=g.points, parameters=p, quality=quality,
-                               start_quality=g.start_quality, elliptic=g.elliptic,
-                               kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
-                               time_s=g.time_s)
+        grids[k] = replace(g, parameters=p, quality=quality)
     return grids, rounds
 
 
@@ -406,10 +399,7 @@ def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], s
         figures.append((k, c))
         if c <= SMOOTH_INTERFACE:
             kink = max(kink, k)
-    out = tuple(SurfaceGrid(points=p, parameters=g.parameters, quality=g.quality,
-                            start_quality=g.start_quality, elliptic=g.elliptic,
-                            kept_start=g.kept_start, collapsed_sides=g.collapsed_sides, spacing_error=g.spacing_error,
-                            time_s=g.time_s) for p, g in zip(points, blocks, strict=True))
+    out = tuple(replace(g, points=p) for p, g in zip(points, blocks, strict=True))
     return NetworkGrid(out, tuple(interfaces), snap, kink, rounds, tuple(figures),
                        time.perf_counter() - started)
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["SKEWNESS_BANDS", "GridQuality", "grid_quality"]
+__all__ = ["SKEWNESS_BANDS", "GridQuality", "cell_skewness", "grid_quality"]
 
 #: (upper bound, name) of the skewness bands
 SKEWNESS_BANDS = ((0.5, "good"), (0.8, "acceptable"), (1.0, "poor"))
@@ -182,3 +182,27 @@ def grid_quality(points: NDArray, normals: NDArray) -> GridQuality:
         collapsed_corners=int(degenerate.sum()),
         max_area_ratio=area_ratio,
     )
+
+
+def cell_skewness(points: NDArray) -> NDArray:
+    """Equiangle skewness of every cell of a grid, ``(ni - 1, nj - 1)``.
+
+    Corners where an edge has zero length (a collapsed side) are left out, as in
+    :func:`grid_quality`; ``points`` is ``(ni, nj, d)``, ``d`` 2 or 3.
+    """
+    x = np.asarray(points, dtype=float)
+    if x.shape[-1] == 2:
+        x = np.concatenate([x, np.zeros(x.shape[:-1] + (1,))], axis=-1)
+    c = [x[:-1, :-1], x[1:, :-1], x[1:, 1:], x[:-1, 1:]]
+    legs = np.linalg.norm(np.diff(x, axis=0), axis=-1)
+    short = COLLAPSED_EDGE * float(np.mean(legs)) if legs.size else 0.0
+    amax = np.full(c[0].shape[:2], -np.inf)
+    amin = np.full(c[0].shape[:2], np.inf)
+    for k in range(4):
+        e1, l1 = _unit(c[(k + 1) % 4] - c[k])
+        e2, l2 = _unit(c[(k + 3) % 4] - c[k])
+        angle = np.degrees(np.arccos(np.clip(np.einsum("...k,...k->...", e1, e2), -1.0, 1.0)))
+        real = (l1 > short) & (l2 > short)
+        amax = np.where(real, np.maximum(amax, angle), amax)
+        amin = np.where(real, np.minimum(amin, angle), amin)
+    return np.maximum((amax - 90.0) / 90.0, (90.0 - amin) / 90.0)

@@ -125,6 +125,8 @@ class SurfaceGrid:
         Largest relative deviation of the first/last side intervals from the
         spacing asked for (0 when none was asked).
     time_s : float
+    start_points, start_parameters : (ni, nj, 3), (ni, nj, 2) float or None
+        The algebraic start grid (to show what the refinement changed).
     """
 
     points: NDArray
@@ -136,6 +138,8 @@ class SurfaceGrid:
     collapsed_sides: tuple[str, ...] = ()
     spacing_error: float = 0.0
     time_s: float = field(default=0.0, compare=False)
+    start_points: NDArray | None = field(default=None, repr=False, compare=False)
+    start_parameters: NDArray | None = field(default=None, repr=False, compare=False)
 
     @property
     def dims(self) -> tuple[int, int]:
@@ -306,6 +310,7 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         return points, grid_quality(points, surface_normals(surface, params[..., 0], params[..., 1]))
 
     start_points, start_quality = measured(st)
+    start_params = st
     result = None
     points, quality = start_points, start_quality
     kept_start = None
@@ -325,4 +330,5 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     return SurfaceGrid(points=points, parameters=st, quality=quality, start_quality=start_quality,
                        elliptic=result, kept_start=kept_start, collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
-                       time_s=time.perf_counter() - started)
+                       time_s=time.perf_counter() - started, start_points=start_points,
+                       start_parameters=start_params)

@@ -16,15 +16,25 @@ import math
 import os
 import sys
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, TextIO
+from typing import Any, TextIO
 
 from ...errors import InputFileError, OutputFileError
 from ..io import StagedFile, new_file_mode, read
 
-__all__ = ["Command", "Console", "write_json_report", "publish", "to_jsonable", "STDOUT",
-           "read_model", "done_code", "dropped_report"]
+__all__ = [
+    "STDOUT",
+    "Command",
+    "Console",
+    "done_code",
+    "dropped_report",
+    "publish",
+    "read_model",
+    "to_jsonable",
+    "write_json_report",
+]
 
 #: Value of a report-path option meaning "print to standard output".
 STDOUT = "-"
@@ -180,17 +190,18 @@ def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:
 
 
 def check_outputs(inputs: tuple[Path, ...], output: Path | None, *, plot: Path | None = None,
-                  json_path: str | None = None) -> None:
+                  json_path: str | None = None, model: bool = True) -> None:
     """Fail before the work, not after (:class:`OutputFileError`): every output goes to an
     existing, writable folder, is not a folder itself and not one of the ``inputs``; the
-    model ``output`` has a STEP/IGES extension; ``--plot`` needs matplotlib."""
+    model ``output`` has a STEP/IGES extension (``model=False``: any output the caller
+    checks itself, a grid file); ``--plot`` needs matplotlib."""
     from ..step_iges import FileFormat
     from .plotting import require_matplotlib
     report = None if json_path in (None, STDOUT) else Path(json_path)
     for target, what in ((output, "output"), (plot, "--plot"), (report, "--json")):
         if target is not None:
             _check_target(Path(target), what, inputs)
-    if output is not None and FileFormat.from_suffix(Path(output)) is None:
+    if model and output is not None and FileFormat.from_suffix(Path(output)) is None:
         known = ", ".join(s for fmt in FileFormat for s in fmt.suffixes)
         raise OutputFileError(f"output {output} has unknown extension "
                               f"{Path(output).suffix or '(none)'!r}; expected one of {known}")

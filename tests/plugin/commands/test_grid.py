@@ -1,0 +1,73 @@
+"""``surfprep grid``: files, report, exit codes, outputs checked before the work."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from helpers.cli import run
+from helpers.paths import SAMPLES
+
+from surfprep.algorithms.grid.io import read_plot3d
+
+FUSELAGE = SAMPLES / "occt_fuselage.stp"
+CATIA_FACE = SAMPLES / "occt_catia4_face_L1.igs"
+
+
+def test_grid_writes_plot3d_and_a_report(tmp_path, capsys):
+    out, report = tmp_path / "f.xyz", tmp_path / "f.json"
+    code, stdout, _ = run(capsys, "grid", FUSELAGE, "-o", out, "--size", "2000", "--json", report)
+    assert code == 0, stdout
+    data = json.loads(report.read_text())
+    blocks = read_plot3d(out)
+    assert len(blocks) == len(data["blocks"]) == 8
+    for block, entry in zip(blocks, data["blocks"], strict=True):
+        assert list(block.shape[:2]) == entry["dims"]
+        assert entry["quality"]["folded_cells"] == 0
+    assert "8 block(s), 14 shared edge(s)" in stdout
+
+
+def test_dims_and_spacing_reach_the_file(tmp_path, capsys):
+    out = tmp_path / "c.xyz"
+    code, stdout, _ = run(capsys, "grid", CATIA_FACE, "-o", out, "--whole-surfaces", "--dims", "21",
+                          "17", "--first-spacing", "2.0", "--binary")
+    assert code == 0, stdout
+    (block,) = read_plot3d(out)
+    assert block.shape == (21, 17, 3)
+    assert np.linalg.norm(block[1, 0] - block[0, 0]) == pytest.approx(2.0, rel=1e-3)
+
+
+def test_nothing_to_grid_is_one_line_and_exit_2(tmp_path, capsys):
+    out = tmp_path / "c.xyz"
+    code, _, err = run(capsys, "grid", CATIA_FACE, "-o", out)
+    assert code == 2
+    assert "trimmed inside its surface" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["-o", "{tmp}/g.step"], "unknown extension"),
+    (["-o", "{tmp}/missing/g.xyz"], "does not exist"),
+    (["-o", "{tmp}/g.cgns", "--binary"], "--binary is for Plot3D"),
+    (["-o", "{tmp}/g.xyz", "--growth", "1.2", "--first-spacing", "1"], "not both"),
+])
+def test_outputs_and_options_are_checked_before_the_work(tmp_path, capsys, argv, message):
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    code, _, err = run(capsys, "grid", FUSELAGE, *argv)
+    assert code == 2 and message in err
+    assert not [p for p in tmp_path.iterdir() if p.is_file()]
+
+
+def test_plot_draws_the_grids(tmp_path, capsys):
+    pytest.importorskip("matplotlib", reason="--plot needs matplotlib")
+    out, png = tmp_path / "f.vtm", tmp_path / "f.png"
+    code, _, _ = run(capsys, "grid", FUSELAGE, "-o", out, "--size", "3000", "--plot", png)
+    assert code == 0 and png.stat().st_size > 10_000
+
+
+def test_the_input_is_never_overwritten(tmp_path, capsys):
+    copy = tmp_path / "f.xyz"
+    copy.write_bytes(FUSELAGE.read_bytes())
+    code, _, err = run(capsys, "grid", copy, "-o", copy)
+    assert code == 2 and "refusing to overwrite" in err

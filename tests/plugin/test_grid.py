@@ -1,0 +1,113 @@
+"""surfprep.grid on models, faces and surfaces: blocks, orientation, refusals, files."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from helpers.grid_cases import warped_plane
+from helpers.paths import SAMPLES
+
+import surfprep
+from surfprep.algorithms.grid.io import read_plot3d, side_nodes
+from surfprep.errors import InvalidGeometryError, OutputFileError
+
+FUSELAGE = SAMPLES / "occt_fuselage.stp"
+CATIA_FACE = SAMPLES / "occt_catia4_face_L1.igs"
+
+
+@pytest.fixture(scope="module")
+def fuselage():
+    return surfprep.grid(FUSELAGE, size=1500.0)
+
+
+def test_every_face_of_the_fuselage_is_a_point_matched_block(fuselage):
+    model = surfprep.read(FUSELAGE)
+    assert fuselage.faces == tuple(range(model.n_faces)) and not fuselage.skipped
+    assert len(fuselage.network.interfaces) == 14
+    for f in fuselage.network.interfaces:
+        a = side_nodes(fuselage.blocks[f.block], f.side)
+        b = side_nodes(fuselage.blocks[f.other], f.other_side)
+        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    # the faces are sewn: the nodes moved onto a neighbour's side by a rounding only
+    assert fuselage.network.snap < 1e-6 * model.size
+    worst = fuselage.report()["worst"]
+    assert worst["folded_cells"] == 0 and worst["max_skewness"] < 0.5
+
+
+def test_blocks_follow_the_faces_outward_normals(fuselage):
+    model = surfprep.read(FUSELAGE)
+    for k, block in zip(fuselage.faces, fuselage.blocks, strict=True):
+        face = surfprep.to_nurbs(model.faces[k])
+        mid = tuple(n // 2 for n in block.shape[:2])
+        x = block
+        cross = np.cross(x[mid[0] + 1, mid[1]] - x[mid[0] - 1, mid[1]],
+                         x[mid[0], mid[1] + 1] - x[mid[0], mid[1] - 1])
+        uv = fuselage.network.blocks[fuselage.faces.index(k)].parameters[mid]
+        if face.reversed:                                  # the block's surface is v-reversed
+            v0, v1 = face.surface.domain[2:]
+            uv = (uv[0], v0 + v1 - uv[1])
+        normal = face.surface.normals(uv[0], uv[1]) * (-1 if face.reversed else 1)
+        assert np.dot(cross, normal) > 0
+
+
+def test_a_trimmed_face_is_refused_with_its_reason_or_gridded_whole():
+    with pytest.raises(InvalidGeometryError, match="trimmed inside its surface"):
+        surfprep.grid(CATIA_FACE)
+    result = surfprep.grid(CATIA_FACE, whole_surfaces=True, dims=(61, 41))
+    block = result.network.blocks[0]
+    assert block.dims == (61, 41)
+    assert block.start_quality.max_skewness > 0.9          # the surface's parameters are awful
+    assert block.quality.max_skewness < 0.3 and block.quality.folded_cells == 0
+
+
+def test_surfaces_and_lists_of_surfaces():
+    one = surfprep.grid(warped_plane(), dims=(9, 7))
+    assert one.faces == (0,) and one.blocks[0].shape == (9, 7, 3)
+    a, b = warped_plane().split(0.5, "u")
+    two = surfprep.grid([a, b], size=0.1)
+    assert len(two.network.interfaces) == 1
+
+
+def test_bad_face_indices_and_arguments():
+    with pytest.raises(InvalidGeometryError, match="out of range"):
+        surfprep.grid(FUSELAGE, faces=[99])
+    with pytest.raises(InvalidGeometryError, match="gap"):
+        surfprep.grid(FUSELAGE, gap=-1.0)
+
+
+@pytest.mark.parametrize("name, reader", [("g.xyz", "plot3d"), ("g.x", "plot3d-binary"),
+                                          ("g.cgns", "cgns"), ("g.vtm", "vtm")])
+def test_written_files_hold_the_blocks(tmp_path, fuselage, name, reader):
+    path = fuselage.write(tmp_path / name, binary=reader == "plot3d-binary")
+    assert path.exists()
+    if reader.startswith("plot3d"):
+        blocks = read_plot3d(path)
+        assert len(blocks) == len(fuselage.blocks)
+        for got, want in zip(blocks, fuselage.blocks, strict=True):
+            np.testing.assert_array_equal(got, want)
+    elif reader == "cgns":
+        from vtkmodules.vtkIOCGNSReader import vtkCGNSReader
+        r = vtkCGNSReader()
+        r.SetFileName(str(path))
+        r.Update()
+        base = r.GetOutput().GetBlock(0)
+        assert base.GetNumberOfBlocks() == len(fuselage.blocks)
+    else:
+        assert len(list((tmp_path / "g_blocks").glob("*.vts"))) == len(fuselage.blocks)
+
+
+def test_a_single_block_format_refuses_many_blocks(tmp_path, fuselage):
+    with pytest.raises(OutputFileError, match="one block"):
+        fuselage.write(tmp_path / "g.vts")
+    with pytest.raises(OutputFileError, match="unknown extension"):
+        fuselage.write(tmp_path / "g.step")
+    assert not list(tmp_path.iterdir())
+
+
+def test_report_is_plain_json(fuselage):
+    report = fuselage.report()
+    json.dumps(report, allow_nan=False)
+    assert {b["face"] for b in report["blocks"]} == set(fuselage.faces)
+    assert all("residuals" in b["elliptic"] for b in report["blocks"])
