@@ -2,7 +2,7 @@
 
 A face is gridded as one block when its boundary is the whole parameter
 rectangle of its surface: one loop, every edge's pcurve on a side of the
-rectangle, and all four sides reached (a collapsed side, a pole, is a
+rectangle (within the edge's tolerance, measured in space), and all four sides reached (a collapsed side, a pole, is a
 degenerated edge or no edge at all). Anything else -- a face with holes, a face
 trimmed inside its surface, an n-sided face -- is refused with the reason, so a
 user knows to heal or split it first.
@@ -18,8 +18,9 @@ __all__ = ["four_sided_reason"]
 
 #: pcurve samples per edge checked against the rectangle
 SAMPLES = 9
-#: how close to a side of the rectangle (fraction of the domain's span) a pcurve must run
-SIDE_TOL = 1e-6
+#: how close to a side of the rectangle a pcurve must run in space, at least (fraction of
+#: the surface's box diagonal; an edge's own tolerance, doubled, where that is larger)
+SIDE_TOL = 1e-7
 
 
 def four_sided_reason(face: TrimmedFace) -> str | None:
@@ -37,15 +38,24 @@ def four_sided_reason(face: TrimmedFace) -> str | None:
         return None                                          # the natural boundary
     if len(face.loops) > 1:
         return f"it has {len(face.loops) - 1} hole(s): not four-sided"
-    u0, u1, v0, v1 = face.surface.domain
-    span = max(u1 - u0, v1 - v0)
-    tol = SIDE_TOL * span
+    surface = face.surface
+    u0, u1, v0, v1 = surface.domain
+    box = surface.bounding_box()
+    floor = SIDE_TOL * float(np.linalg.norm(box[1] - box[0]))
     reached = set()
     for edge in face.loops[0].edges:
         uv = edge.pcurve.evaluate(np.linspace(edge.t0, edge.t1, SAMPLES))
-        on = {"u0": np.abs(uv[:, 0] - u0) <= tol, "u1": np.abs(uv[:, 0] - u1) <= tol,
-              "v0": np.abs(uv[:, 1] - v0) <= tol, "v1": np.abs(uv[:, 1] - v1) <= tol}
-        sides = [name for name, mask in on.items() if np.all(mask)]
+        points = surface.evaluate(uv[:, 0], uv[:, 1])
+        # on a side when the pcurve's points are within the edge's tolerance of the
+        # side in space (a reparametrized face keeps its edges with refitted pcurves)
+        allowed = max(2.0 * edge.tolerance, floor)
+        sides = []
+        for name, column, value in (("u0", 0, u0), ("u1", 0, u1), ("v0", 1, v0), ("v1", 1, v1)):
+            moved = uv.copy()
+            moved[:, column] = value
+            gap = np.linalg.norm(points - surface.evaluate(moved[:, 0], moved[:, 1]), axis=1)
+            if np.all(gap <= allowed):
+                sides.append(name)
         if not sides:
             if edge.degenerated:
                 continue
