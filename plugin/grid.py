@@ -245,5 +245,8 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         raise InvalidGeometryError(f"gap must be a positive length, got {gap!r}")
     network = grid_network(surfaces, gap=gap, dims=dims, size=size, spacing=spacing,
                            smooth=smooth, tol=tol, max_sweeps=max_sweeps, progress=progress)
-    return GridResult(network, tuple(kept), tuple(kept_names), tuple(flips), tuple(skipped),
+    skipped += [(kept[b], why) for b, why in network.failed]
+    return GridResult(network, tuple(kept[b] for b in network.indices),
+                      tuple(kept_names[b] for b in network.indices),
+                      tuple(flips[b] for b in network.indices), tuple(sorted(skipped)),
                       time.perf_counter() - started)

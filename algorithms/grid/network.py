@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError
+from ...errors import InvalidGeometryError, SurfprepError
 from ..projection import project_to_curve
 from ..surface import NurbsSurface
 from .io.blocks import Interface, side_nodes
@@ -71,6 +71,11 @@ class NetworkGrid:
         Rounds of sliding the interface nodes (0 without elliptic smoothing).
     interface_angles : tuple of (float, float)
         Per interface: the kink of the grid lines and the crease (normals' angle), degrees.
+    indices : tuple of int
+        The position of each block's surface in the list given.
+    failed : tuple of (int, str)
+        Surfaces that could not be gridded (a degenerate surface...), with the reason;
+        the others are gridded without them.
     """
 
     blocks: tuple[SurfaceGrid, ...]
@@ -79,6 +84,8 @@ class NetworkGrid:
     kink: float = 0.0
     interface_rounds: int = 0
     interface_angles: tuple[tuple[float, float], ...] = ()
+    indices: tuple[int, ...] = ()
+    failed: tuple[tuple[int, str], ...] = ()
     time_s: float = field(default=0.0, compare=False)
 
     def report(self) -> dict:
@@ -154,8 +161,9 @@ class _Classes:
         self.parent[self.find(a)] = self.find(b)
 
 
-def _counts(surfaces, interfaces, dims, size) -> dict[tuple[int, int], int]:
-    """Node count of every direction ``(block, 0 | 1)``: one per linked set."""
+def _counts(surfaces, interfaces, dims, size, skip: set[int] = frozenset()) -> dict[tuple[int, int], int]:
+    """Node count of every direction ``(block, 0 | 1)``: one per linked set (blocks in
+    ``skip`` get none)."""
     classes = _Classes(len(surfaces))
     for f in interfaces:
         classes.union((f.block, _direction(f.side)), (f.other, _direction(f.other_side)))
@@ -163,6 +171,8 @@ def _counts(surfaces, interfaces, dims, size) -> dict[tuple[int, int], int]:
         ni, nj = dims
         counts = {}
         for key in classes.parent:
+            if key[0] in skip:
+                continue
             root = classes.find(key)
             want = ni if key[1] == 0 else nj
             if counts.setdefault(root, want) != want:
@@ -170,14 +180,17 @@ def _counts(surfaces, interfaces, dims, size) -> dict[tuple[int, int], int]:
                     f"dims {tuple(dims)} cannot match the network: block {key[0]}'s "
                     f"{'i' if key[1] == 0 else 'j'} direction meets another block's "
                     "other direction along a shared edge (give size instead)")
-        return {key: counts[classes.find(key)] for key in classes.parent}
+        return {key: counts[classes.find(key)] for key in classes.parent if key[0] not in skip}
     longest: dict = {}
     for b, s in enumerate(surfaces):
+        if b in skip:
+            continue
         for name, curve in side_curves(s).items():
             root = classes.find((b, _direction(name)))
             longest[root] = max(longest.get(root, 0.0), curve.arc_length())
     size = float(size)
-    return {key: max(2, math.ceil(longest[classes.find(key)] / size - 1e-9) + 1) for key in classes.parent}
+    return {key: max(2, math.ceil(longest[classes.find(key)] / size - 1e-9) + 1)
+            for key in classes.parent if key[0] not in skip}
 
 
 def _transfer(curves_a, side_a: str, fractions_a: NDArray, curves_b, side_b: str, reverse: bool,
@@ -245,35 +258,64 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
     if dims is not None and size is not None:
         raise InvalidGeometryError("give dims or size, not both")
     spacing = Spacing() if spacing is None else spacing
-    interfaces = match_sides(surfaces, gap=gap)
-    curves = [side_curves(s) for s in surfaces]
+    failed: dict[int, str] = {}
+    for b, surface in enumerate(surfaces):
+        try:
+            for curve in side_curves(surface).values():
+                curve.arc_length()
+        except SurfprepError as exc:
+            failed[b] = str(exc)
+    usable = [b for b in range(len(surfaces)) if b not in failed]
+    found = match_sides([surfaces[b] for b in usable], gap=gap)
+    interfaces = [Interface(usable[f.block], f.side, usable[f.other], f.other_side, f.reversed)
+                  for f in found]
+    curves = [None if b in failed else side_curves(s) for b, s in enumerate(surfaces)]
     if dims is None and size is None:
-        size = float(np.median([max(c.arc_length() for c in sides.values()) for sides in curves])) \
-            / DEFAULT_CELLS
-    counts = _counts(surfaces, interfaces, dims, size)
+        size = float(np.median([max(c.arc_length() for c in sides.values())
+                                for sides in curves if sides is not None] or [1.0])) / DEFAULT_CELLS
+    counts = _counts(surfaces, interfaces, dims, size, skip=set(failed))
     partner = {}
     for f in interfaces:
         partner[f.block, f.side] = (f.other, f.other_side, f.reversed)
         partner[f.other, f.other_side] = (f.block, f.side, f.reversed)
-    blocks: list[SurfaceGrid] = []
+    blocks: list[SurfaceGrid | None] = []
     if progress is not None:
         progress(0, len(surfaces))
     for b, surface in enumerate(surfaces):
-        given = {}
-        for side in SIDES:
-            if (b, side) in partner and partner[b, side][0] < b:
-                a, side_a, reverse = partner[b, side]
-                fractions = _side_parameters(blocks[a], surfaces[a], side_a)
-                given[side] = _transfer(curves[a], side_a, fractions, curves[b], side, reverse)
-        blocks.append(grid_surface(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
-                                   smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given))
+        if b in failed:
+            blocks.append(None)
+            continue
+        try:
+            given = {}
+            for side in SIDES:
+                if (b, side) in partner and partner[b, side][0] < b \
+                        and blocks[partner[b, side][0]] is not None:
+                    a, side_a, reverse = partner[b, side]
+                    fractions = _side_parameters(blocks[a], surfaces[a], side_a)
+                    given[side] = _transfer(curves[a], side_a, fractions, curves[b], side, reverse)
+            blocks.append(grid_surface(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
+                                       smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given))
+        except SurfprepError as exc:
+            failed[b] = str(exc)
+            blocks.append(None)
         if progress is not None:
             progress(b + 1, len(surfaces))
+    if len(failed) == len(surfaces):
+        raise InvalidGeometryError("no surface could be gridded: " + "; ".join(
+            f"surface {b}: {why}" for b, why in sorted(failed.items())[:3]))
+    keep = [b for b in range(len(surfaces)) if b not in failed]
+    index = {b: k for k, b in enumerate(keep)}
+    interfaces = [Interface(index[f.block], f.side, index[f.other], f.other_side, f.reversed)
+                  for f in interfaces if f.block in index and f.other in index]
+    surfaces = [surfaces[b] for b in keep]
+    curves = [curves[b] for b in keep]
+    blocks = [blocks[b] for b in keep]
     rounds = 0
     if smooth == "elliptic" and interfaces:
         blocks, rounds = _slide_interfaces(surfaces, curves, blocks, interfaces, tol=tol,
                                            max_sweeps=max_sweeps)
-    return _snapped(surfaces, blocks, interfaces, started, rounds)
+    net = _snapped(surfaces, blocks, interfaces, started, rounds)
+    return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())))
 
 
 def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...]:

@@ -12,7 +12,9 @@ Steps (later features append theirs to :func:`run_demo`):
 3. rebuild each face on the converted surface (with its trimming loops through
    :mod:`surfprep.plugin.occ.faces`, or with natural boundaries if that fails),
    write them to ``OUTDIR/<sample>-rebuilt.step`` and read that file back;
-4. write ``OUTDIR/<sample>-report.json`` and print a summary.
+4. grid every four-sided face (:func:`surfprep.grid`: point-matched blocks, elliptic
+   refinement on the surface metric) and write ``OUTDIR/<sample>-grid.xyz`` (Plot3D);
+5. write ``OUTDIR/<sample>-report.json`` and print a summary.
 """
 
 from __future__ import annotations
@@ -180,6 +182,8 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
         written = write(rebuilt_model, step_path, overwrite=True)
         reread_faces = read(written).n_faces
 
+    grid_report, grid_ok = _grid_step(model, outdir / f"{stem}-grid.xyz", inputs, console)
+
     tolerance = DEVIATION_TOLERANCE * model.size
     worst_eval = max((t.max_dev_nurbs_vs_occ for t in trips), default=0.0)
     worst_rebuilt = max((t.max_dev_rebuilt_vs_occ for t in trips), default=0.0)
@@ -187,6 +191,7 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
         "nurbs_matches_occ": worst_eval <= tolerance,
         "rebuilt_surface_matches_occ": worst_rebuilt <= tolerance,
         "rebuilt_file_face_count": reread_faces == len(rebuilt_faces),
+        "grid_without_folds": grid_ok,
     }
     quality = [(f["param_quality"], f["index"]) for f in info["faces"]
                if f["param_quality"] is not None]
@@ -200,6 +205,7 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
             "max_dev_rebuilt_vs_occ": worst_rebuilt,
             "faces": [asdict(t) for t in trips],
         },
+        "grid": grid_report,
         "outputs": {"rebuilt_step": str(written) if written else None,
                     "rebuilt_step_faces_read_back": reread_faces,
                     "report": str(report_path.resolve())},
@@ -222,11 +228,38 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
     if written:
         console.print(f"  rebuilt faces ({n_trimmed} trimmed, {len(trips) - n_trimmed} "
                       f"natural boundary): {written} ({reread_faces} faces read back)")
+    if grid_report.get("output"):
+        worst = grid_report["worst"]
+        console.print(f"  structured grid: {grid_report['blocks']} block(s), point-matched on "
+                      f"{grid_report['interfaces']} shared edge(s), max skewness "
+                      f"{worst['max_skewness']:.3f}, {worst['folded_cells']} folded cell(s): "
+                      f"{grid_report['output']}")
+    else:
+        console.print(f"  structured grid: none ({grid_report.get('reason')})")
     console.print(f"  report: {report_path.resolve()}")
     failed = [name for name, ok in checks.items() if not ok]
     if failed:
         console.note(f"surfprep demo: check failed: {', '.join(failed)}")
     return report, not failed
+
+
+def _grid_step(model: CadModel, target: Path, inputs, console: Console) -> tuple[dict, bool]:
+    """Grid the four-sided faces (elliptic, default sizes) and write Plot3D to ``target``."""
+    from ..grid import grid
+    refuse_overwriting_inputs(target, inputs)
+    console.progress(0, 1, "grid")
+    try:
+        result = grid(model)
+    except SurfprepError as exc:
+        return {"output": None, "reason": str(exc)}, True
+    written = result.write(target)
+    console.progress(1, 1, "grid")
+    report = result.report()
+    worst = report["worst"]
+    return ({"output": str(written), "blocks": len(result.blocks),
+             "interfaces": len(result.network.interfaces), "worst": worst,
+             "skipped": report["skipped"], "time_s": result.time_s},
+            worst["folded_cells"] == 0)
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -254,9 +287,10 @@ COMMAND = Command(
         "patches), print its info table, convert every B-spline face to surfprep's "
         "NurbsSurface and back to OpenCascade, measure on a 50x50 grid per face the "
         "largest distance between surfprep's and OpenCascade's evaluation, write the "
-        "rebuilt faces as STEP and a JSON report to OUTDIR, and print a summary. "
-        "Exit code 1 if a check fails (deviation above 1e-9 x model size, or the "
-        "written STEP does not read back with the same face count)."),
+        "rebuilt faces as STEP, grid every four-sided face (surfprep grid: point-matched "
+        "blocks, elliptic refinement) to Plot3D, write a JSON report to OUTDIR, and print a "
+        "summary. Exit code 1 if a check fails (deviation above 1e-9 x model size, the "
+        "written STEP does not read back with the same face count, or a grid cell folds)."),
     epilog=(
         "examples:\n"
         "  surfprep demo                          outputs in ./surfprep-demo-out\n"
@@ -264,7 +298,8 @@ COMMAND = Command(
         "  surfprep demo --sample overture_marscapsule_proe.igs\n"
         "  surfprep demo --input part.step -o out/\n"
         "\n"
-        "outputs: OUTDIR/<sample>-rebuilt.step, OUTDIR/<sample>-report.json"),
+        "outputs: OUTDIR/<sample>-rebuilt.step, OUTDIR/<sample>-grid.xyz, "
+        "OUTDIR/<sample>-report.json"),
     add_arguments=_add_arguments,
     run=_run,
 )

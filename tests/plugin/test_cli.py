@@ -209,9 +209,12 @@ def test_demo_writes_step_and_report(capsys, tmp_path):
     step = outdir / "occt_fuselage-rebuilt.step"
     report_path = outdir / "occt_fuselage-report.json"
     assert step.is_file() and report_path.is_file()
-    assert sorted(p.name for p in outdir.iterdir()) == sorted([step.name, report_path.name])
+    grid = outdir / "occt_fuselage-grid.xyz"
+    assert sorted(p.name for p in outdir.iterdir()) == sorted([step.name, report_path.name, grid.name])
     report = json.loads(report_path.read_text())
     assert all(report["checks"].values())
+    assert report["grid"]["blocks"] == 8 and report["grid"]["interfaces"] == 14
+    assert report["grid"]["worst"]["folded_cells"] == 0
     assert report["info"]["n_faces"] == 8
     assert len(report["round_trip"]["faces"]) == 8
     assert report["round_trip"]["max_dev_nurbs_vs_occ"] < 1e-6

@@ -72,3 +72,18 @@ def test_dims_that_cannot_match_are_refused():
         grid_network([quarters[0], turned], gap=1e-9, dims=(9, 5))
     with pytest.raises(InvalidGeometryError, match="not both"):
         grid_network(quarters, gap=1e-9, dims=(5, 5), size=0.1)
+
+
+def test_a_surface_that_cannot_be_gridded_is_left_out_and_said():
+    """A surface whose normal vanishes to second order at a corner (all its control
+    points but one row on a point) is reported; the other blocks are gridded."""
+    quarters = _quarters()
+    bad = quarters[3].control_points.copy()
+    bad[:, :] = bad[0, 0]
+    bad[-1, -1] += [1.0, 1.0, 0.0]
+    degenerate = NurbsSurface(bad, quarters[3].knots_u, quarters[3].knots_v, 3, 3)
+    net = grid_network([quarters[0], quarters[1], degenerate], gap=1e-9, size=0.1)
+    assert net.indices == (0, 1) and [b for b, _ in net.failed] == [2]
+    assert len(net.interfaces) == 1
+    with pytest.raises(InvalidGeometryError, match="no surface could be gridded"):
+        grid_network([degenerate], gap=1e-9, size=0.1)
