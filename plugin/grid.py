@@ -168,7 +168,7 @@ def _faces_of(obj: Any) -> tuple[list[TrimmedFace | NurbsSurface | None], list[s
 
 def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | None = None,
          size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
-         smooth: str = "elliptic", tol: float = 1e-5, gap: float | None = None,
+         smooth: str = "elliptic", tol: float = 1e-4, gap: float | None = None,
          whole_surfaces: bool = False, max_sweeps: int = 2000, progress=None) -> GridResult:
     """Structured grids on the four-sided faces of a model (or on surfaces), one block each.
 

@@ -118,6 +118,8 @@ class EllipticResult:
     residuals : tuple of float
         Residual after each evaluation of the surface on the finest grid: the
         largest move a Jacobi step would make, in units of the local cell size.
+        Without convergence the grid returned is the iterate of the smallest
+        residual, whose residual ends the history.
     converged : bool
         The last residual is below the tolerance.
     refused : int
@@ -268,7 +270,7 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, tol: float,
 
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
-           tol: float = 1e-5, max_sweeps: int = 2000,
+           tol: float = 1e-4, max_sweeps: int = 2000,
            relaxation: float | None = None) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
 
@@ -320,6 +322,7 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     box = surface.domain
     residuals: list[float] = []
     refused = sweeps = 0
+    best = (math.inf, s, t)
     while sweeps < max_sweeps:
         d = surface.derivatives(s, t, 1)
         x, rs, rt = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
@@ -327,10 +330,13 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         residual = sweep(s, t, x, rs, rt, P, Q, omega, box)
         sweeps += 1
         residuals.append(residual)
+        if residual < best[0]:
+            best = (residual, *saved)
         if residual < tol:
             s, t = saved                 # converged on the exact nodes: keep them
             break
         if _stalled(residuals):
+            s, t = best[1], best[2]      # not converging: the iterate nearest to a solution
             break
         for _ in range(SWEEPS_PER_EVALUATION - 1):
             sweep(s, t, x, rs, rt, P, Q, omega, box)
@@ -341,5 +347,9 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
             omega *= 0.5
             if omega < _MIN_RELAXATION:
                 break
+    converged = bool(residuals and residuals[-1] < tol)
+    if not converged and residuals:
+        s, t = best[1], best[2]
+        residuals.append(best[0])        # the history ends with the residual of the grid returned
     out = np.stack([s, t], axis=-1)
-    return EllipticResult(out, tuple(residuals), bool(residuals and residuals[-1] < tol), refused, sweeps)
+    return EllipticResult(out, tuple(residuals), converged, refused, sweeps)

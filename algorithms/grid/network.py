@@ -229,7 +229,7 @@ def _side_parameters(grid: SurfaceGrid, surface: NurbsSurface, side: str) -> NDA
 
 def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, int] | None = None,
                  size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
-                 smooth: str = "elliptic", tol: float = 1e-5, max_sweeps: int = 2000,
+                 smooth: str = "elliptic", tol: float = 1e-4, max_sweeps: int = 2000,
                  progress=None) -> NetworkGrid:
     """Point-matched grids over a network of four-sided surfaces (see the module doc).
 

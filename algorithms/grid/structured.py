@@ -225,7 +225,7 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
 
 def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
                  spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                 control: bool = True, tol: float = 1e-5, max_sweeps: int = 2000,
+                 control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
                  sides: dict[str, NDArray] | None = None) -> SurfaceGrid:
     """A structured grid on a four-sided surface (003: redistribution, TFI, elliptic).
 
