@@ -5,6 +5,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -22,3 +24,7 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert namespace["touch"] == [] and len(namespace["touch"].isolated_points) == 1
     assert abs(namespace["contact"][1] - 10) < 1e-6
     assert namespace["network"].joins_before[0].max_gap > 1e-3 > 1e3 * namespace["join"].max_gap
+    assert len(namespace["blocks"]) == 8 and namespace["worst"]["folded_cells"] == 0
+    assert (tmp_path / "fuselage.cgns").stat().st_size > 0
+    first = namespace["wall"].points[1, 0] - namespace["wall"].points[0, 0]
+    assert abs(float(np.linalg.norm(first)) - 5.0) < 5e-3

@@ -271,7 +271,7 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, tol: float,
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
            tol: float = 1e-4, max_sweeps: int = 2000,
-           relaxation: float | None = None) -> EllipticResult:
+           relaxation: float | None = None, warm: bool = False) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
 
     Parameters
@@ -288,7 +288,10 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     max_sweeps : int
         Most SOR sweeps on the finest grid.
     relaxation : float, optional
-        SOR factor; default ``min(1.8, 2 / (1 + sin(pi / n)))``, ``n`` the longer side.
+        SOR factor; default ``min(1.95, 2 / (1 + sin(pi / n)))``, ``n`` the longer side.
+    warm : bool
+        The start is already nearly a solution (a grid refined before, its boundary
+        moved a little): iterate on it directly, without the coarse-grid start.
 
     Returns
     -------
@@ -308,7 +311,7 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     start_jac = sign * corner_jacobians(st[..., 0], st[..., 1])
     if np.any(start_jac <= 0.0):
         raise InvalidGeometryError("the start grid has folded or degenerate cells in the parameters")
-    if max(ni, nj) > COARSEN_ABOVE:
+    if max(ni, nj) > COARSEN_ABOVE and not warm:
         st = _coarse_start(surface, st, control, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
             st = _check_grid(surface, parameters)          # the coarse start folded: plain start

@@ -28,6 +28,7 @@ Blocks are in the surfaces' order; each block's sides are ``"i0"`` (u = u0),
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -48,6 +49,8 @@ MATCH_SAMPLES = 9
 INTERFACE_ROUNDS = 12
 INTERFACE_TOL = 1e-3
 INTERFACE_RELAXATION = 0.8
+#: the rounds stop when the largest move has not shrunk below this share of the round before
+INTERFACE_PROGRESS = 0.95
 #: an interface whose surfaces' normals differ by more than this (degrees) is a crease:
 #: its nodes do not slide and its kink is not counted in the summary
 SMOOTH_INTERFACE = 15.0
@@ -251,7 +254,6 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
     -------
     NetworkGrid
     """
-    import time
     started = time.perf_counter()
     if not surfaces:
         raise InvalidGeometryError("a network needs at least one surface")
@@ -312,8 +314,9 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
     blocks = [blocks[b] for b in keep]
     rounds = 0
     if smooth == "elliptic" and interfaces:
+        budget = time.perf_counter() - started          # sliding may at most double the work
         blocks, rounds = _slide_interfaces(surfaces, curves, blocks, interfaces, tol=tol,
-                                           max_sweeps=max_sweeps)
+                                           max_sweeps=max_sweeps, budget=budget)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
     return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())))
 
@@ -348,12 +351,14 @@ def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
 
 
 def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: list[Interface], *,
-                      tol: float, max_sweeps: int) -> tuple[list[SurfaceGrid], int]:
+                      tol: float, max_sweeps: int, budget: float = math.inf) -> tuple[list[SurfaceGrid], int]:
     """Let the nodes of every interface slide along it until the grid lines cross it
     smoothly: each round moves them by the Winslow stencil of both blocks together
     (:func:`_edge_moves`), gives both blocks the new side nodes and refines the
     blocks again from where they were. Stops when no node would move more than
-    :data:`INTERFACE_TOL` of its cell, or after :data:`INTERFACE_ROUNDS` rounds."""
+    :data:`INTERFACE_TOL` of its cell, when the moves stop shrinking
+    (:data:`INTERFACE_PROGRESS`), after :data:`INTERFACE_ROUNDS` rounds, or once the
+    rounds took ``budget`` seconds (the caller's: as long as gridding the blocks did)."""
     from ..measure import normals
     from .elliptic import refine
     from .quality import grid_quality
@@ -364,6 +369,8 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
                   and blocks[f.block].kept_start is None and blocks[f.other].kept_start is None]
     touched: set[int] = set()
     rounds = 0
+    previous = math.inf
+    began = time.perf_counter()
     for rounds in range(1, INTERFACE_ROUNDS + 1):
         worst = 0.0
         changed: set[int] = set()
@@ -391,10 +398,12 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
             for block, side, values in ((f.block, f.side, t_new), (f.other, f.other_side, t_b)):
                 _set_side_parameters(params[block], surfaces[block], side, values)
                 changed.add(block)
-        if worst < INTERFACE_TOL:
-            break
+        if worst < INTERFACE_TOL or worst > INTERFACE_PROGRESS * previous \
+                or time.perf_counter() - began > budget:
+            break                             # converged, the moves no longer shrink, or out of time
+        previous = worst
         for k in changed:
-            result = refine(surfaces[k], params[k], tol=tol, max_sweeps=max_sweeps)
+            result = refine(surfaces[k], params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
             params[k] = result.parameters.copy()
             points = surfaces[k].evaluate(params[k][..., 0], params[k][..., 1])
             grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result)
@@ -421,8 +430,6 @@ def _set_side_parameters(params: NDArray, surface: NurbsSurface, side: str, valu
 def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], started: float,
              rounds: int) -> NetworkGrid:
     """Copy the first block's side nodes onto the second's; measure the moves and kinks."""
-    import time
-
     from ..measure import normals
     points = [b.points.copy() for b in blocks]
     snap = kink = 0.0
