@@ -91,7 +91,7 @@ from ..occ.shapes import (
     max_edge_tolerance,
     sew,
 )
-from .cut import covered_holes_dropped, cut_under_patches, inner_edges
+from .cut import covered_holes_dropped, cut_under_patches
 from .jobs import (
     INPUT_CHECK_TOL,
     PatchOrigin,
@@ -416,8 +416,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     before = _Before.of(model, gap_tol)
     for round_ in range(ROLLBACK_ROUNDS + 1):
         notes: list[str] = []
-        network, snapped = _joined(done, edges, faces, gone, gap_tol, continuity,
-                                   TIGHT_FACTOR * model.size)
+        network, snapped = _joined(done, edges, gap_tol, continuity, TIGHT_FACTOR * model.size)
         deviations = _deviations(done, network, inputs, gap_tol, notes)
         result = _assemble(model, work, done, network, dropped, skipped + notes, gap_tol, tol,
                            continuity, start, deviations, before)
@@ -438,16 +437,17 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     return result
 
 
-def _joined(done, edges, faces, gone, gap_tol, continuity, tight):
+def _joined(done, edges, gap_tol, continuity, tight):
     """The approximants of ``done`` joined (:func:`connect`) and their sides fitted to the
-    kept faces' edges (:func:`snap_to_originals`): ``(network or None, sides snapped)``."""
+    kept faces' edges, every loop's (:func:`snap_to_originals`): ``(network or None, sides
+    snapped)``."""
     if not done:
         return None, 0
     network = connect([la.surface for _, la in done], continuity=continuity, gap_tol=gap_tol,
                       strict=False)
     replaced = replaced_faces(done)
-    return snap_to_originals(network, [e for e in edges if e.face not in replaced]
-                             + inner_edges(faces, replaced | gone), gap_tol, tight)
+    return snap_to_originals(network, [e for e in edges if e.face not in replaced], gap_tol,
+                             tight)
 
 
 def _opening(shape, done, network, edges, pairs, gap_tol: float) -> set[int]:

@@ -239,3 +239,17 @@ def test_taking_back_a_sub_patch_takes_back_its_whole_face():
     done = [job("face", 3), job("face", 3), job("hole", 0), job("face", 5), job("directed", 1)]
     kept = _without_jobs(done, {1, 2})
     assert [(j.origin.kind, j.origin.index) for j, _ in kept] == [("face", 5), ("directed", 1)]
+
+
+def test_a_slot_through_a_plate_is_no_hole():
+    """The walls of a slot meet the plate's faces along their inner loops: paired, no
+    defect, nothing replaced. With the outer loops alone the walls' edges looked free,
+    the slot's two mouths were "holes" given patches, and those put a third face on each
+    mouth edge: 0 -> 12 free edges (occt_cornetta.stp 0 -> 18, occt_k1_alias.stp 0 -> 8)."""
+    from helpers.heal_cases import slotted_plate
+
+    r = heal(slotted_plate())
+    assert r.patches == ()
+    assert r.free_edges_before == r.free_edges_after == 0
+    assert r.tight_free_edges_after == 0 and r.valid_after
+
