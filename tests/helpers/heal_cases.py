@@ -312,3 +312,13 @@ def slotted_plate():
     return cq.Workplane().box(2.0, 2.0, 0.5).faces(">Z").workplane().rect(0.6, 0.6) \
         .cutThruAll().val().wrapped
 
+
+def boxes_sharing_a_wall():
+    """Two unit cubes side by side as two solids of one compound: the wall between them is
+    there twice, one face of each solid (as in occt_s1_ideas.stp's 11 solids). Sewn, no
+    edge is free."""
+    import cadquery as cq
+
+    a = cq.Workplane().box(1.0, 1.0, 1.0).val()
+    b = cq.Workplane().box(1.0, 1.0, 1.0).translate((1.0, 0.0, 0.0)).val()
+    return cq.Compound.makeCompound([a, b]).wrapped

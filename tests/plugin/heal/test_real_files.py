@@ -166,3 +166,18 @@ def test_turbine_no_more_free_edges_than_given(data_dir):
     (note,) = [s for s in r.skipped if "taken back" in s]
     assert all(f"face {i}" in note for i in (10, 24, 31))
     assert r.valid_after
+
+
+@pytest.mark.slow
+def test_s1_ideas_no_more_free_edges_than_given(data_dir):
+    """occt_s1_ideas.stp (the smallest of the four files heal left with more free edges:
+    cornetta 0 -> 18, k1_alias 0 -> 8, s1_ideas 0 -> 9, kcs_hull 24 -> 33): faces 103,
+    124 and 110 lie on faces 0, 32 and 35, walls two of its 11 solids share; dropping them
+    left three faces on each of their edges (0 -> 9). The drops are taken back: 0 -> 0."""
+    r = surfprep.heal(data_dir / "occt_s1_ideas.stp")
+    assert r.free_edges_after <= r.free_edges_before == 0
+    assert r.dropped == ()
+    (note,) = [s for s in r.skipped if "taken back" in s]
+    assert all(f"face {b} (duplicate of face {a})" in note for a, b in ((0, 103), (32, 124),
+                                                                         (35, 110)))
+    assert r.valid_after
