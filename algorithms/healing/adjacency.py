@@ -42,8 +42,8 @@ _PAIR_CHUNK = 128             # edge pairs per batch of the pairing test
 
 @dataclass(frozen=True, eq=False)
 class FaceEdge:
-    """One edge of one face: ``face`` index, position ``k`` in its outer loop,
-    the 3D curve and its samples ``(EDGE_SAMPLES, 3)``."""
+    """One edge of one face: ``face`` index, position ``k`` in its outer loop (an inner
+    loop's edges count from -1 down), the 3D curve and its samples ``(EDGE_SAMPLES, 3)``."""
 
     face: int
     k: int
@@ -66,12 +66,23 @@ def four_sided_boundary(face: TrimmedFace) -> list[NurbsCurve] | None:
 
 
 def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
-    """Every real edge of the faces' outer loops, sampled."""
+    """Every real edge of the faces' loops, sampled: the outer loop's (``k`` its position
+    there), then the inner loops' (``k`` counting from -1 down, as
+    :func:`surfprep.plugin.heal.cut.inner_edges`).
+
+    The inner loops count: the walls of a slot through a face meet that face along
+    its inner loop (occt_cornetta.stp, occt_k1_alias.stp). Left out, the walls' edges
+    looked free, chained into a four-sided "hole" at the slot's mouth, and its patch
+    put a third face on each of those edges."""
     out = []
     for i, face in enumerate(faces):
         if face is None or not face.loops:
             continue
-        for k, e in enumerate(face.loops[face.outer_loop_index].edges):
+        outer = face.loops[face.outer_loop_index].edges
+        inner = [e for n, loop in enumerate(face.loops) if n != face.outer_loop_index
+                 for e in loop.edges]
+        numbered = list(enumerate(outer)) + [(-1 - n, e) for n, e in enumerate(inner)]
+        for k, e in numbered:
             if e.degenerated or e.curve3d is None or e.is_seam:
                 continue
             t0, t1 = e.curve3d.domain

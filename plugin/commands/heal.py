@@ -172,11 +172,11 @@ COMMAND = Command(
         "them are cut away). The approximants are joined G0 (shared control "
         "rows averaged) or G1 (tangent planes at corners, collinear control triples "
         "along edges), the result is sewn into a shell (a solid when closed) and checked "
-        "with BRepCheck; approximants that leave more free edges than the input had are "
-        "taken back. The report gives per patch its resolution, error (max, RMS), "
-        "largest distance from the input faces on a dense sample and share of "
-        "artificial points, per shared edge the measured gap and normal angle, and free "
-        "edges and validity before and after."),
+        "with BRepCheck; approximants (and duplicate drops) that leave more free edges "
+        "than the input had are taken back, all of them if need be. The report gives per "
+        "patch its resolution, error (max, RMS), largest distance from the input faces "
+        "on a dense sample and share of artificial points, per shared edge the measured "
+        "gap and normal angle, and free edges and validity before and after."),
     epilog=(
         "examples:\n"
         "  surfprep heal hull.igs -o healed.step\n"

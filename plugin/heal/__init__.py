@@ -38,9 +38,15 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    shell (a solid when closed) and checked with ``BRepCheck_Analyzer``; every
    joined patch is measured densely against the input faces
    (:mod:`surfprep.algorithms.healing.fidelity`), and when the result has more
-   free edges than the input, the approximants that left a free edge where the
-   input's edges were paired are taken back and the rest joined again (at most
-   ``ROLLBACK_ROUNDS`` times);
+   free edges (at ``gap_tol``) than the input, what left the new ones is taken back
+   and the rest joined again (:func:`_opening`): the approximants and duplicate
+   drops along a free edge that runs along no free edge of the input, else the
+   approximants cutting one of the input's free edges into several; after
+   ``ROLLBACK_ROUNDS`` rounds, or with nothing to blame, every approximant and drop
+   (the caller's directed patches stay). More free edges than the input are left only
+   with a note saying why: edges only a dropped duplicate of their own face closed in
+   the input, a free border cut into the sides of sub-patches with ``replace="all"``,
+   or directed patches;
    untouched faces keep their names (a replaced face passes its name to its
    approximant; holes are named ``heal_hole_<k>``).
 
@@ -51,6 +57,7 @@ to build are planned in :mod:`.jobs`.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -91,7 +98,7 @@ from ..occ.shapes import (
     max_edge_tolerance,
     sew,
 )
-from .cut import covered_holes_dropped, cut_under_patches, inner_edges
+from .cut import covered_holes_dropped, cut_under_patches
 from .jobs import (
     INPUT_CHECK_TOL,
     PatchOrigin,
@@ -119,7 +126,8 @@ DEFAULT_GAP_FACTOR = 1e-3
 _GAP_FACTOR_EDGE = 0.01
 #: free edges are also counted after sewing at this times the diagonal (geometric closure)
 TIGHT_FACTOR = 1e-7
-#: times heal takes back the approximants that opened gaps and joins the rest again
+#: times heal takes back the approximants and drops that opened free edges and joins the
+#: rest again, before it takes back all of them
 ROLLBACK_ROUNDS = 2
 #: smallest accepted ``tol`` and ``gap_tol``: this times the model's diagonal (double
 #: precision resolves about 2e-16 of it; the approximants' measures need room above)
@@ -385,6 +393,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     dropped = duplicate_faces(faces, edges, pairs, gap_tol)
     gone = {b for _, b in dropped}
     kept = [i for i, f in enumerate(faces) if f is not None and i not in gone]
+    every_edge = edges                      # the dropped faces' too: a drop may be taken back
     edges, pairs = _without_faces(edges, pairs, gone)
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
@@ -414,84 +423,171 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
                        skipped, inputs, progress)
     done += directed_jobs(directed, cut)
     before = _Before.of(model, gap_tol)
-    for round_ in range(ROLLBACK_ROUNDS + 1):
-        notes: list[str] = []
-        network, snapped = _joined(done, edges, faces, gone, gap_tol, continuity,
-                                   TIGHT_FACTOR * model.size)
-        deviations = _deviations(done, network, inputs, gap_tol, notes)
-        result = _assemble(model, work, done, network, dropped, skipped + notes, gap_tol, tol,
-                           continuity, start, deviations, before)
-        if result.free_edges_after <= result.free_edges_before or round_ == ROLLBACK_ROUNDS:
-            break
-        opening = _opening(result.shape, done, network, edges, pairs, gap_tol)
-        if not opening:
-            break
-        skipped.append(_rolled_back(done, opening))
-        done = _without_jobs(done, opening)
+    result, done, snapped = _no_worse_than_before(
+        done, dropped, skipped, before, every_edge=every_edge, model=model, work=work,
+        inputs=inputs, gap_tol=gap_tol, tol=tol, continuity=continuity, start=start,
+        keep_split=replace == "all")
     result.extra["replace"] = replace
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
-    result.extra["snapped_sides"] = snapped if network is not None else 0
+    result.extra["snapped_sides"] = snapped
     result.extra["trimmed_overlaps"] = [
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
 
 
-def _joined(done, edges, faces, gone, gap_tol, continuity, tight):
+def _no_worse_than_before(done, dropped, skipped: list[str], before: _Before, *, every_edge,
+                          model, work, inputs, gap_tol, tol, continuity, start,
+                          keep_split: bool):
+    """The approximants of ``done`` joined and sewn with the untouched faces, taking back
+    what leaves more free edges (at ``gap_tol``) than the input had (:func:`_opening`) and
+    joining the rest again; after ``ROLLBACK_ROUNDS`` rounds, or with nothing to blame,
+    every approximant and drop. Not taken back, with a note: free edges only a dropped
+    duplicate of their own face closed in the input, and with ``keep_split``
+    (``replace="all"``) a free border of the input cut into the sides of sub-patches. The
+    caller's directed patches stay: if they alone leave more free edges, the round with
+    the fewest is returned, with a note. Returns ``(result, done, sides snapped)``."""
+    best = None
+    for round_ in range(ROLLBACK_ROUNDS + 2):
+        notes: list[str] = []
+        network, snapped = _joined(done, every_edge, {b for _, b in dropped}, gap_tol,
+                                   continuity, TIGHT_FACTOR * model.size)
+        deviations = _deviations(done, network, inputs, gap_tol, notes)
+        result = _assemble(model, work, done, network, dropped, skipped + notes, gap_tol, tol,
+                           continuity, start, deviations, before)
+        more = result.free_edges_after - result.free_edges_before
+        if more <= 0:
+            return result, done, snapped
+        if best is None or result.free_edges_after < best[0].free_edges_after:
+            best = (result, done, snapped)
+        blame = _opening(result.shape, done, network, every_edge, dropped, before.free_lines,
+                         gap_tol)
+        excused = blame.revealed + (blame.split_pieces if keep_split else 0)
+        if not blame.jobs and not blame.drops and excused >= more:
+            note = _excused(result, blame, keep_split)
+            return dataclasses.replace(result, skipped=result.skipped + (note,)), done, snapped
+        jobs, drops = blame.jobs, blame.drops
+        if not jobs and not drops:
+            jobs = blame.split_jobs
+        if round_ >= ROLLBACK_ROUNDS or not (jobs or drops):
+            # still worse after ROLLBACK_ROUNDS, or nothing to blame: everything back
+            jobs = {k for k, (job, _) in enumerate(done) if job.origin.kind != "directed"}
+            drops = set(dropped)
+        if not jobs and not drops:
+            break
+        skipped.append(_rolled_back(done, jobs, drops, result))
+        done = _without_jobs(done, jobs)
+        dropped = [d for d in dropped if d not in drops]
+    result, done, snapped = best
+    note = (f"free edges {result.free_edges_before} -> {result.free_edges_after}: more after "
+            "than before; taking back the approximants and drops did not lower it (the "
+            "directed patches are never taken back): the result with the fewest is returned")
+    return dataclasses.replace(result, skipped=result.skipped + (note,)), done, snapped
+
+
+def _excused(result: HealResult, blame: _Blame, keep_split: bool) -> str:
+    why = []
+    if blame.revealed:
+        why.append(f"{blame.revealed} are edges of a face that only its duplicate (dropped) "
+                   "closed in the input")
+    if keep_split and blame.split_pieces:
+        why.append(f"{blame.split_pieces} more come from free edges of the input cut into "
+                   "the sides of several sub-patches (replace='all'; no gap opened)")
+    return (f"free edges {result.free_edges_before} -> {result.free_edges_after}, kept: "
+            + "; ".join(why))
+
+
+def _joined(done, edges, gone, gap_tol, continuity, tight):
     """The approximants of ``done`` joined (:func:`connect`) and their sides fitted to the
-    kept faces' edges (:func:`snap_to_originals`): ``(network or None, sides snapped)``."""
+    edges (every loop's) of the faces neither replaced nor dropped (in ``gone``)
+    (:func:`snap_to_originals`): ``(network or None, sides snapped)``."""
     if not done:
         return None, 0
     network = connect([la.surface for _, la in done], continuity=continuity, gap_tol=gap_tol,
                       strict=False)
-    replaced = replaced_faces(done)
-    return snap_to_originals(network, [e for e in edges if e.face not in replaced]
-                             + inner_edges(faces, replaced | gone), gap_tol, tight)
+    out = replaced_faces(done) | gone
+    return snap_to_originals(network, [e for e in edges if e.face not in out], gap_tol, tight)
 
 
-def _opening(shape, done, network, edges, pairs, gap_tol: float) -> set[int]:
-    """Jobs of ``done`` that left a free edge in the result where the input had two edges
-    paired within ``gap_tol`` (a gap opened, not closed): the free edge runs along one
-    of the paired input edges, and the job is the approximant whose rim it runs along,
-    or one replacing the face on the other side of that pair. The caller's directed
-    patches are never taken back."""
-    if network is None:
-        return set()
-    free = boundary_edge_points(shape)
-    paired = sorted({k for pair in pairs for k in pair})
-    if not paired or not free:
-        return set()
-    partners: dict[int, set[int]] = {}
-    for a, b in pairs:
-        partners.setdefault(a, set()).add(edges[b].face)
-        partners.setdefault(b, set()).add(edges[a].face)
-    lines = [dense_edge(edges[k]) for k in paired]
-    t = np.linspace(0.0, 1.0, 129)
-    rims = []
-    for surface in network.patches:
-        u0, u1, v0, v1 = surface.domain
-        u, v = u0 + (u1 - u0) * t, v0 + (v1 - v0) * t
-        rims.append([surface.evaluate(u, np.full_like(u, v0)),
-                     surface.evaluate(u, np.full_like(u, v1)),
-                     surface.evaluate(np.full_like(v, u0), v),
-                     surface.evaluate(np.full_like(v, u1), v)])
+@dataclass(frozen=True)
+class _Blame:
+    """What :func:`_opening` found: approximants (indices of ``done``) and duplicate drops
+    that opened free edges; free edges only a dropped duplicate of their own face closed
+    in the input (``revealed``); free edges more than the input's along its free edges
+    (``split_pieces``: a free border cut into the sides of several patches)."""
+
+    jobs: set
+    drops: set
+    revealed: int = 0
+    split_pieces: int = 0
+    split_jobs: set = field(default_factory=set)     # the approximants along those
+
+
+def _opening(shape, done, network, edges, dropped, input_free: list, gap_tol: float) -> _Blame:
+    """What to take back when the result ``shape`` has more free edges than the input.
+
+    A free edge of the result is *opened* when it runs along no free edge of the input
+    (``input_free``: the input sewn at ``gap_tol`` by OpenCascade, the figure the result
+    is compared with; our own pairing misses edges OpenCascade pairs, as a long edge
+    against two shorter ones). An opened edge is blamed on the approximants whose rim it
+    runs along, on those replacing a face with an input edge (any loop) it runs along, and
+    on the dropped duplicates with such an edge when two or more kept faces meet there (a
+    wall two solids share: its edges were left with three faces). One that runs along a
+    single kept face's edge and its dropped duplicates' is *revealed*, not opened: only
+    the duplicate closed it. Where nothing was opened, the approximants along free edges
+    that share a free edge of the input are blamed (``split_jobs``: a free border cut
+    into the sides of several sub-patches). The caller's directed patches are never
+    taken back."""
+    free = boundary_edge_points(shape, 9)
+    if not free:
+        return _Blame(set(), set())
     jobs_of: dict[int, set[int]] = {}
     for k, (job, _) in enumerate(done):
         if job.origin.kind in ("face", "union"):
             for f in job.origin.faces:
                 jobs_of.setdefault(f, set()).add(k)
-    near_line = _polylines_along(lines, free, gap_tol)
-    near_rim = _polylines_along([np.concatenate(r) for r in rims], free, gap_tol,
-                                pieces=rims)
-    out = set()
+    twin_of = {b: a for a, b in dropped}
+    rims = [_rim(surface) for surface in network.patches] if network is not None else []
+    near_rim = (_polylines_along([np.concatenate(r) for r in rims], free, gap_tol, pieces=rims)
+                if rims else [[] for _ in free])
+    # an approximant's side lies up to its tol off the input edges it follows
+    along = gap_tol + max((la.tol for _, la in done), default=0.0)
+    lines = [dense_edge(e) for e in edges]
+    near_edge = _polylines_along(lines, free, along) if lines else [[] for _ in free]
+    near_input = (_polylines_along(input_free, free, along) if input_free
+                  else [[] for _ in free])
+    jobs, drops, revealed = set(), set(), 0
     for n in range(len(free)):
-        on = [paired[i] for i in near_line[n]]
-        if not on:
-            continue                          # a free edge of the input, not opened
-        out |= {j for k in on for f in partners[k] for j in jobs_of.get(f, ())}
-        out |= set(near_rim[n])
-    return {j for j in out if done[j][0].origin.kind != "directed"}
+        if near_input[n]:
+            continue                          # along a free edge of the input
+        faces = {edges[i].face for i in near_edge[n]}
+        kept = faces - set(twin_of)
+        if len(kept) == 1 and faces != kept and all(twin_of[f] in kept for f in faces - kept):
+            revealed += 1
+            continue
+        jobs |= {j for f in faces for j in jobs_of.get(f, ())} | set(near_rim[n])
+        if len(kept) > 1:
+            drops |= {(twin_of[f], f) for f in faces - kept}
+    shared: dict[int, list[int]] = {}
+    for n, lines_along in enumerate(near_input):
+        for i in lines_along[:1]:
+            shared.setdefault(i, []).append(n)
+    pieces = [group for group in shared.values() if len(group) > 1]
+
+    def undirected(js):
+        return {j for j in js if done[j][0].origin.kind != "directed"}
+    return _Blame(undirected(jobs), drops, revealed, sum(len(g) - 1 for g in pieces),
+                  undirected({j for g in pieces for n in g for j in near_rim[n]}))
+
+
+def _rim(surface, samples: int = 129) -> list:
+    """The four sides of ``surface`` as polylines ``(samples, 3)``."""
+    t = np.linspace(0.0, 1.0, samples)
+    u0, u1, v0, v1 = surface.domain
+    u, v = u0 + (u1 - u0) * t, v0 + (v1 - v0) * t
+    return [surface.evaluate(u, np.full_like(u, v0)), surface.evaluate(u, np.full_like(u, v1)),
+            surface.evaluate(np.full_like(v, u0), v), surface.evaluate(np.full_like(v, u1), v)]
 
 
 def _polylines_along(lines: list, free: list, gap_tol: float, pieces: list | None = None
@@ -511,11 +607,12 @@ def _polylines_along(lines: list, free: list, gap_tol: float, pieces: list | Non
     return out
 
 
-def _rolled_back(done, opening: set[int]) -> str:
+def _rolled_back(done, opening: set[int], undropped: set, result: HealResult) -> str:
     what = sorted({f"{done[k][0].origin.kind} {done[k][0].origin.index}" for k in opening})
-    return (f"approximants taken back (faces kept as they were, holes left open): "
-            f"{', '.join(what)}: each left a free edge where the input's edges were paired "
-            "within gap_tol (more free edges after than before)")
+    what += [f"face {b} (duplicate of face {a})" for a, b in sorted(undropped)]
+    return (f"free edges {result.free_edges_before} -> {result.free_edges_after}: more after "
+            f"than before, so taken back (faces kept as they were, holes left open, "
+            f"duplicates kept): {', '.join(what)}")
 
 
 def _without_jobs(done, opening: set[int]) -> list:
@@ -592,12 +689,14 @@ class _Before:
     free_edges: int
     tight_free_edges: int
     valid: bool
+    free_lines: list = field(default_factory=list)   # the free edges at gap_tol, (129, 3) each
 
     @classmethod
     def of(cls, model: CadModel, gap_tol: float) -> _Before:
         sewn, _ = sew(list(model.faces), gap_tol)
         tight, _ = sew(list(model.faces), TIGHT_FACTOR * model.size)
-        return cls(count_free_edges(sewn), count_free_edges(tight), is_valid(model.shape))
+        return cls(count_free_edges(sewn), count_free_edges(tight), is_valid(model.shape),
+                   boundary_edge_points(sewn, 129))
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,

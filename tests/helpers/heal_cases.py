@@ -300,3 +300,25 @@ def crossings(surfaces, n=41, near=0.02) -> int:
                 rim = polyline_distance(foot.points[close], _outline(other))
                 count += int(np.sum(rim > 2 * near))
     return count
+
+
+# ------------------------------------------------------------ closed solids heal must not open
+def slotted_plate():
+    """A 2 x 2 x 0.5 plate with a 0.6 x 0.6 square slot through it, as one solid: the top
+    and bottom faces have an inner loop, met along it by the slot's four walls (the
+    geometry of occt_cornetta.stp's and occt_k1_alias.stp's slots). Closed: no free edge."""
+    import cadquery as cq
+
+    return cq.Workplane().box(2.0, 2.0, 0.5).faces(">Z").workplane().rect(0.6, 0.6) \
+        .cutThruAll().val().wrapped
+
+
+def boxes_sharing_a_wall():
+    """Two unit cubes side by side as two solids of one compound: the wall between them is
+    there twice, one face of each solid (as in occt_s1_ideas.stp's 11 solids). Sewn, no
+    edge is free."""
+    import cadquery as cq
+
+    a = cq.Workplane().box(1.0, 1.0, 1.0).val()
+    b = cq.Workplane().box(1.0, 1.0, 1.0).translate((1.0, 0.0, 0.0)).val()
+    return cq.Compound.makeCompound([a, b]).wrapped

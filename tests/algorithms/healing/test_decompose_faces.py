@@ -117,6 +117,8 @@ def test_heal_split_faces_replaces_a_triangle_by_three_patches():
     assert [p.origin.kind for p in r.patches] == ["face"] * 3
     assert {p.origin.faces for p in r.patches} == {(0,)}
     assert r.valid_after and r.model.n_faces == 3
+    # its three free edges are now six sides: kept with replace="all", and said so
+    assert any("free edges 3 -> 6, kept" in s and "sub-patches" in s for s in r.skipped)
     for la in r.approximants:
         u0, u1, v0, v1 = la.surface.domain
         uu, vv = np.meshgrid(np.linspace(u0, u1, 25), np.linspace(v0, v1, 25), indexing="ij")

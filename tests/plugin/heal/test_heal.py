@@ -118,6 +118,10 @@ def test_duplicate_face_dropped(gap_pair):
     assert r.model.n_faces == 2
     assert sorted(n for n in r.model.face_names) == ["left", "right"]
     assert r.tight_free_edges_after == 6 and r.valid_after
+    # the copy closed the left face's other three edges in the input (4 free edges):
+    # more after, said so, and the drop stays (it is no gap opened)
+    (note,) = [s for s in r.skipped if "free edges 4 -> 6" in s]
+    assert "3 are edges of a face that only its duplicate (dropped) closed" in note
 
 
 def test_directed_patch_and_names(tmp_path):
@@ -239,3 +243,50 @@ def test_taking_back_a_sub_patch_takes_back_its_whole_face():
     done = [job("face", 3), job("face", 3), job("hole", 0), job("face", 5), job("directed", 1)]
     kept = _without_jobs(done, {1, 2})
     assert [(j.origin.kind, j.origin.index) for j, _ in kept] == [("face", 5), ("directed", 1)]
+
+
+def test_a_slot_through_a_plate_is_no_hole():
+    """The walls of a slot meet the plate's faces along their inner loops: paired, no
+    defect, nothing replaced. With the outer loops alone the walls' edges looked free,
+    the slot's two mouths were "holes" given patches, and those put a third face on each
+    mouth edge: 0 -> 12 free edges (occt_cornetta.stp 0 -> 18, occt_k1_alias.stp 0 -> 8)."""
+    from helpers.heal_cases import slotted_plate
+
+    r = heal(slotted_plate())
+    assert r.patches == ()
+    assert r.free_edges_before == r.free_edges_after == 0
+    assert r.tight_free_edges_after == 0 and r.valid_after
+
+
+def test_a_wall_two_solids_share_is_not_dropped():
+    """Two boxes side by side, as two solids: their common wall is there twice and one of
+    the two was dropped as a duplicate, leaving three faces on each of its four edges:
+    0 -> 4 free edges (occt_s1_ideas.stp 0 -> 9). The drop is taken back, and said so."""
+    from helpers.heal_cases import boxes_sharing_a_wall
+
+    r = heal(boxes_sharing_a_wall())
+    assert r.free_edges_after <= r.free_edges_before == 0
+    assert r.dropped == () and r.report()["faces_out"] == 12
+    (note,) = [s for s in r.skipped if "taken back" in s]
+    assert "free edges 0 -> 4" in note and "face 6 (duplicate of face 1)" in note
+
+
+def test_free_edges_the_pairing_misses_are_taken_back(monkeypatch):
+    """The rollback compares the result with the input's free edges as OpenCascade's
+    sewing finds them, not with our pairing: with the pairing blind to inner loops (as it
+    was), the slot's mouths are patched and their walls replaced (0 -> 12 free edges),
+    and all of those approximants are taken back."""
+    from helpers.heal_cases import slotted_plate
+
+    import surfprep.plugin.heal as heal_module
+    from surfprep.algorithms.healing.adjacency import face_edges
+
+    monkeypatch.setattr(heal_module, "face_edges",
+                        lambda faces: [e for e in face_edges(faces) if e.k >= 0])
+    r = heal(slotted_plate())
+    assert r.free_edges_after <= r.free_edges_before == 0
+    assert r.patches == () and r.valid_after
+    (note,) = [s for s in r.skipped if "taken back" in s]
+    assert "free edges 0 -> 12" in note
+    assert all(f"face {i}" in note for i in (6, 7, 8, 9)) and "hole 0" in note
+
