@@ -166,10 +166,31 @@ def _faces_of(obj: Any) -> tuple[list[TrimmedFace | NurbsSurface | None], list[s
     return faces, list(model.face_names), unreadable, model.size
 
 
+def _assign_held(surfaces: list[NurbsSurface], curves: list, gap: float) -> dict[int, list]:
+    """The surface each held curve lies on and crosses (the first that takes it)."""
+    from ..algorithms.grid.held import held_line
+    out: dict[int, list] = {}
+    for k, curve in enumerate(curves):
+        reasons = []
+        for b, surface in enumerate(surfaces):
+            try:
+                held_line(surface, curve, tol=gap)
+            except InvalidGeometryError as exc:
+                reasons.append(str(exc))
+                continue
+            out.setdefault(b, []).append(curve)
+            break
+        else:
+            raise InvalidGeometryError(
+                f"held curve {k} runs across no gridded face from side to side within {gap:.3g} "
+                f"({reasons[0] if reasons else 'no face'})")
+    return out
+
+
 def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | None = None,
          size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
          smooth: str = "elliptic", tol: float = 1e-4, gap: float | None = None,
-         whole_surfaces: bool = False, max_sweeps: int = 2000, progress=None) -> GridResult:
+         whole_surfaces: bool = False, hold=(), max_sweeps: int = 2000, progress=None) -> GridResult:
     """Structured grids on the four-sided faces of a model (or on surfaces), one block each.
 
     Parameters
@@ -193,6 +214,10 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
     whole_surfaces : bool
         Grid the whole parameter rectangle of a trimmed face's surface instead of
         refusing the face (the trims are ignored; said in the report).
+    hold : sequence of NurbsCurve (3D) or (m, 3) points
+        Curves to keep as grid lines (an intersection curve, a crease): each must lie
+        on one gridded face within ``gap`` and run from a side of it to the opposite
+        side; it becomes a line of that face's block.
     max_sweeps : int
     progress : callable(done, total), optional
 
@@ -243,8 +268,10 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
     gap = DEFAULT_RELATIVE_GAP * model_size if gap is None else float(gap)
     if not np.isfinite(gap) or gap <= 0:
         raise InvalidGeometryError(f"gap must be a positive length, got {gap!r}")
+    held = _assign_held(surfaces, list(hold), gap)
     network = grid_network(surfaces, gap=gap, dims=dims, size=size, spacing=spacing,
-                           smooth=smooth, tol=tol, max_sweeps=max_sweeps, progress=progress)
+                           smooth=smooth, tol=tol, max_sweeps=max_sweeps, hold=held,
+                           progress=progress)
     skipped += [(kept[b], why) for b, why in network.failed]
     return GridResult(network, tuple(kept[b] for b in network.indices),
                       tuple(kept_names[b] for b in network.indices),

@@ -233,7 +233,7 @@ def _side_parameters(grid: SurfaceGrid, surface: NurbsSurface, side: str) -> NDA
 def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, int] | None = None,
                  size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
                  smooth: str = "elliptic", tol: float = 1e-4, max_sweeps: int = 2000,
-                 progress=None) -> NetworkGrid:
+                 hold: dict[int, list] | None = None, progress=None) -> NetworkGrid:
     """Point-matched grids over a network of four-sided surfaces (see the module doc).
 
     Parameters
@@ -248,6 +248,9 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
         over :data:`~.structured.DEFAULT_CELLS`.
     spacing, smooth, tol, max_sweeps
         As in :func:`~.structured.grid_surface` (default spacing: uniform in arc length).
+    hold : dict, optional
+        Surface index to the curves held as grid lines on it (see
+        :func:`~.structured.grid_surface`; tolerance ``gap``).
     progress : callable(done, total), optional
 
     Returns
@@ -296,7 +299,8 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
                     fractions = _side_parameters(blocks[a], surfaces[a], side_a)
                     given[side] = _transfer(curves[a], side_a, fractions, curves[b], side, reverse)
             blocks.append(grid_surface(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
-                                       smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given))
+                                       smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
+                                       hold=(hold or {}).get(b, ()), hold_tol=gap))
         except SurfprepError as exc:
             failed[b] = str(exc)
             blocks.append(None)
@@ -364,9 +368,11 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
     from .quality import grid_quality
     params = [b.parameters.copy() for b in blocks]
     grids = list(blocks)
-    # creases do not slide, nor do blocks that kept their algebraic grid
+    # creases do not slide, nor do blocks that kept their algebraic grid or hold curves
+    # (refined piece by piece between them)
+    still = {k for k, b in enumerate(blocks) if b.kept_start is not None or b.held}
     interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
-                  and blocks[f.block].kept_start is None and blocks[f.other].kept_start is None]
+                  and f.block not in still and f.other not in still]
     touched: set[int] = set()
     rounds = 0
     previous = math.inf

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,7 @@ from ..surface import NurbsSurface
 from ..tensor import Direction
 from . import distribution
 from .elliptic import EllipticResult, refine
+from .held import HeldLine, held_line, split_along
 from .quality import GridQuality, grid_quality
 from .tfi import distribution_mesh
 
@@ -119,6 +121,8 @@ class SurfaceGrid:
     kept_start : str or None
         Why the algebraic grid was kept although smoothing was asked: the refined
         grid folded a cell or, not converged, was more skewed (never returned worse).
+    held : tuple of (str, int)
+        The grid lines that are held curves: ``("i", 14)`` is the i-line 14.
     collapsed_sides : tuple of str
         Sides of zero length (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``).
     spacing_error : float
@@ -135,6 +139,7 @@ class SurfaceGrid:
     start_quality: GridQuality
     elliptic: EllipticResult | None
     kept_start: str | None = None
+    held: tuple[tuple[str, int], ...] = ()
     collapsed_sides: tuple[str, ...] = ()
     spacing_error: float = 0.0
     time_s: float = field(default=0.0, compare=False)
@@ -148,6 +153,7 @@ class SurfaceGrid:
     def report(self) -> dict:
         """Plain-JSON figures of the block."""
         out = {"dims": list(self.dims), "collapsed_sides": list(self.collapsed_sides),
+               "held_lines": [f"{family}={index}" for family, index in self.held],
                "quality": self.quality.report(), "start_quality": self.start_quality.report(),
                "spacing_error": self.spacing_error, "time_s": self.time_s}
         if self.elliptic is not None:
@@ -223,10 +229,53 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
     return worst
 
 
+def _transposed(surface: NurbsSurface) -> NurbsSurface:
+    """The surface with its u and v swapped (exact)."""
+    weights = None if surface.weights is None else surface.weights.T
+    return NurbsSurface(np.transpose(surface.control_points, (1, 0, 2)), surface.knots_v,
+                        surface.knots_u, surface.degree_v, surface.degree_u, weights)
+
+
+def _held_start(surface: NurbsSurface, hold: Sequence, fractions: dict[str, NDArray],
+                tol: float) -> tuple[NDArray, list[tuple[int, int]], int]:
+    """Start grid (normalized) with held lines, its pieces and the axis they split."""
+    lines = [held_line(surface, curve, tol=tol) for curve in hold]
+    families = {h.family for h in lines}
+    if len(families) > 1:
+        raise InvalidGeometryError("held curves must all run the same way (all from j0 to j1, or "
+                                   "all from i0 to i1); crossing held lines are not supported")
+    if families == {"i"}:
+        xy, pieces = split_along(surface, lines, fractions["j0"], fractions["j1"], fractions["i0"],
+                                 fractions["i1"])
+        return xy, pieces, 0
+    turned = [HeldLine("i", h.path[:, ::-1], h.distance, h.curve) for h in lines]
+    xy, pieces = split_along(_transposed(surface), turned, fractions["i0"], fractions["i1"],
+                             fractions["j0"], fractions["j1"])
+    return np.transpose(xy, (1, 0, 2))[..., ::-1], pieces, 1
+
+
+def _refine_pieces(surface: NurbsSurface, st: NDArray, pieces: list[tuple[int, int]], axis: int,
+                   **options) -> EllipticResult:
+    """Refine each piece between held lines with its boundary fixed; one result for all."""
+    out = st.copy()
+    results = []
+    for p, q in pieces:
+        cut = (slice(p, q + 1), slice(None)) if axis == 0 else (slice(None), slice(p, q + 1))
+        r = refine(surface, st[cut], **options)
+        out[cut] = r.parameters
+        results.append(r)
+    if len(results) == 1:
+        return results[0]
+    worst = max(results, key=lambda r: r.residuals[-1] if r.residuals else 0.0)
+    return EllipticResult(out, worst.residuals, all(r.converged for r in results),
+                          sum(r.refused for r in results), sum(r.sweeps for r in results))
+
+
 def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
                  spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
                  control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
-                 sides: dict[str, NDArray] | None = None) -> SurfaceGrid:
+                 sides: dict[str, NDArray] | None = None, hold: Sequence = (),
+                 hold_tol: float | None = None) -> SurfaceGrid:
     """A structured grid on a four-sided surface (003: redistribution, TFI, elliptic).
 
     Parameters
@@ -249,6 +298,13 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side curve's
         parameters normalized to [0, 1], increasing from 0 to 1 (a network uses it
         to give two faces the same nodes along their shared edge).
+    hold : sequence of NurbsCurve (3D) or (m, 3) points
+        Curves on the surface to hold as grid lines (:mod:`.held`): each runs from a
+        side to the opposite one and becomes a line of the grid (from ``j0`` to
+        ``j1``: an i-line); the pieces between are gridded and refined with the held
+        lines fixed. All held curves must run the same way.
+    hold_tol : float, optional
+        How far a held curve may lie from the surface; default 1e-4 of its box diagonal.
 
     Returns
     -------
@@ -299,8 +355,14 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
             raise InvalidGeometryError(
                 f"side {name}: need {n} increasing normalized parameters from 0 to 1")
         fractions[name] = given
-    s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
     u0, u1, v0, v1 = surface.domain
+    pieces, axis = [(0, ni - 1)], 0
+    if hold:
+        xy, pieces, axis = _held_start(surface, hold, fractions,
+                                       1e-4 * diag if hold_tol is None else float(hold_tol))
+        s, t = xy[..., 0], xy[..., 1]
+    else:
+        s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
     st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
     st[..., 0] = np.clip(st[..., 0], u0, u1)
     st[..., 1] = np.clip(st[..., 1], v0, v1)
@@ -315,7 +377,8 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     points, quality = start_points, start_quality
     kept_start = None
     if smooth == "elliptic":
-        result = refine(surface, st, control=control, tol=tol, max_sweeps=max_sweeps)
+        result = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
+                                max_sweeps=max_sweeps)
         refined_points, refined = measured(result.parameters)
         worse = refined.folded_cells > start_quality.folded_cells or (
             not result.converged and refined.max_skewness > start_quality.max_skewness)
@@ -327,8 +390,10 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
                           "the algebraic grid is kept")
         else:
             st, points, quality = result.parameters, refined_points, refined
+    held = tuple(("i" if axis == 0 else "j", q) for _, q in pieces[:-1]) if hold else ()
     return SurfaceGrid(points=points, parameters=st, quality=quality, start_quality=start_quality,
-                       elliptic=result, kept_start=kept_start, collapsed_sides=tuple(sorted(collapsed)),
+                       elliptic=result, kept_start=kept_start, held=held,
+                       collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started, start_points=start_points,
                        start_parameters=start_params)

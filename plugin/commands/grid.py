@@ -46,6 +46,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--whole-surfaces", action="store_true", dest="whole_surfaces",
                         help="grid the whole surface of a trimmed face (its trims ignored) "
                              "instead of leaving the face out")
+    parser.add_argument("--hold", type=Path, metavar="CURVES",
+                        help="STEP/IGES file of curves (edges) to keep as grid lines: each must "
+                             "cross one face from a side to the opposite side (e.g. the curves "
+                             "surfprep intersect wrote)")
     parser.add_argument("--gap", type=float, metavar="G",
                         help="largest gap in mm between two face sides taken as one shared "
                              "edge (default 1e-4 x the model's size)")
@@ -64,18 +68,38 @@ def _spacing(args: argparse.Namespace):
     return Spacing(first=args.first, last=args.last, growth=args.growth)
 
 
+def _held_curves(path: Path, console: Console) -> list:
+    """The edges of a STEP/IGES file as 3D NURBS curves."""
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    from ...errors import InputFileError
+    from ..occ.edges import edge_to_nurbs
+    model = read_model(path, console, require_faces=False)
+    curves, explorer = [], TopExp_Explorer(model.shape, TopAbs_EDGE)
+    while explorer.More():
+        curves.append(edge_to_nurbs(TopoDS.Edge_s(explorer.Current())))
+        explorer.Next()
+    if not curves:
+        raise InputFileError(f"--hold file {path} holds no curve")
+    return curves
+
+
 def _run(args: argparse.Namespace, console: Console) -> int:
     from ..grid import grid, grid_format
-    inputs = (args.file,)
+    inputs = (args.file,) + ((args.hold,) if args.hold is not None else ())
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path, model=False)
     fmt = grid_format(args.output, args.format)
     if args.binary and fmt != "plot3d":
         raise OutputFileError("--binary is for Plot3D output only")
     spacing = _spacing(args)
+    held = _held_curves(args.hold, console) if args.hold is not None else []
     model = read_model(args.file, console, strict=args.strict)
     start = time.perf_counter()
     result = grid(model, faces=args.faces, dims=tuple(args.dims) if args.dims else None, size=args.size,
                   spacing=spacing, smooth=args.smooth, gap=args.gap, whole_surfaces=args.whole_surfaces,
+                  hold=held,
                   progress=lambda done, total: console.progress(done, total, "face"))
     elapsed = time.perf_counter() - start
     report = {"file": str(args.file), "output": str(args.output), "format": fmt,

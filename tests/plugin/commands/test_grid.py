@@ -71,3 +71,30 @@ def test_the_input_is_never_overwritten(tmp_path, capsys):
     copy.write_bytes(FUSELAGE.read_bytes())
     code, _, err = run(capsys, "grid", copy, "-o", copy)
     assert code == 2 and "refusing to overwrite" in err
+
+
+def test_held_curves_from_a_file_become_grid_lines(tmp_path, capsys):
+    import surfprep
+    from surfprep.algorithms.projection import distance_to_curve
+    face = surfprep.to_nurbs(surfprep.read(FUSELAGE).faces[0])
+    held = face.surface.isocurve(1.7, "u")                  # across face 0, from v0 to v1
+    curves = tmp_path / "held.step"
+    surfprep.write(held, curves)
+    out, report = tmp_path / "f.xyz", tmp_path / "f.json"
+    code, _, err = run(capsys, "grid", FUSELAGE, "-o", out, "--size", "2000", "--hold", curves,
+                       "--json", report)
+    assert code == 0, err
+    block = read_plot3d(out)[0]
+    on = [i for i, line in enumerate(block) if distance_to_curve(held, line).max() < 1e-6 * 47000]
+    assert len(on) == 1
+    assert json.loads(report.read_text())["blocks"][0]["held_lines"] == [f"i={on[0]}"]
+
+
+def test_a_held_curve_on_no_face_is_refused(tmp_path, capsys):
+    import surfprep
+    from surfprep import NurbsCurve
+    stray = NurbsCurve(np.array([[0.0, 0.0, 1e5], [1.0, 0.0, 1e5]]), [0, 0, 1, 1], 1)
+    curves = tmp_path / "stray.step"
+    surfprep.write(stray, curves)
+    code, _, err = run(capsys, "grid", FUSELAGE, "-o", tmp_path / "f.xyz", "--hold", curves)
+    assert code == 2 and "held curve 0 runs across no gridded face" in err
