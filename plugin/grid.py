@@ -25,10 +25,11 @@ from typing import Any
 import numpy as np
 
 from ..algorithms import NurbsSurface
-from ..algorithms.grid.faces import four_sided_reason
+from ..algorithms.grid.faces import face_region
 from ..algorithms.grid.io import write_cgns, write_plot3d, write_vtm, write_vts
 from ..algorithms.grid.network import NetworkGrid, grid_network
 from ..algorithms.grid.quality import cell_skewness
+from ..algorithms.grid.region import Region
 from ..algorithms.grid.structured import Spacing
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import InvalidGeometryError, OutputFileError, SurfprepError
@@ -166,13 +167,16 @@ def _faces_of(obj: Any) -> tuple[list[TrimmedFace | NurbsSurface | None], list[s
     return faces, list(model.face_names), unreadable, model.size
 
 
-def _assign_held(surfaces: list[NurbsSurface], curves: list, gap: float) -> dict[int, list]:
-    """The surface each held curve lies on and crosses (the first that takes it)."""
+def _assign_held(surfaces: list, curves: list, gap: float) -> dict[int, list]:
+    """The surface each held curve lies on and crosses (the first that takes it; whole
+    rectangles only)."""
     from ..algorithms.grid.held import held_line
     out: dict[int, list] = {}
     for k, curve in enumerate(curves):
         reasons = []
         for b, surface in enumerate(surfaces):
+            if not isinstance(surface, NurbsSurface):
+                continue
             try:
                 held_line(surface, curve, tol=gap)
             except InvalidGeometryError as exc:
@@ -247,17 +251,26 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         if k in unreadable or item is None:
             continue
         if isinstance(item, NurbsSurface):
-            surface, flip = item, False
-        else:
-            reason = four_sided_reason(item)
-            if reason is not None and not whole_surfaces:
-                skipped.append((k, reason))
+            region, flip = item, False
+            if item.dimension != 3:
+                skipped.append((k, "not a 3D surface"))
                 continue
-            surface, flip = item.surface, bool(item.reversed)
-        if surface.dimension != 3:
-            skipped.append((k, "not a 3D surface"))
-            continue
-        surfaces.append(reversed_v(surface) if flip else surface)
+        else:
+            flip = bool(item.reversed)
+            if item.surface.dimension != 3:
+                skipped.append((k, "not a 3D surface"))
+                continue
+            region = face_region(item)
+            if isinstance(region, str):
+                if not whole_surfaces:
+                    skipped.append((k, region))
+                    continue
+                region = Region.rectangle(item.surface)
+            if region.is_rectangle:
+                region = reversed_v(item.surface) if flip else item.surface
+            else:
+                flip = False                 # a loop's region is oriented by the loop's direction
+        surfaces.append(region)
         kept.append(k)
         kept_names.append(names[k] if k < len(names) else None)
         flips.append(flip)

@@ -37,7 +37,7 @@ from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..measure import cumulative_arc_length
 
-__all__ = ["by_curvature", "geometric", "points_along", "stretched", "uniform"]
+__all__ = ["by_curvature", "by_curvature_points", "geometric", "points_along", "stretched", "uniform"]
 
 #: parameter samples per knot span when a curve's arc length is tabulated
 _SAMPLES_PER_SPAN = 24
@@ -264,6 +264,34 @@ def by_curvature(curve: NurbsCurve, n: int, *, strength: float = 1.0) -> NDArray
     weight = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(s))])
     targets = np.linspace(0.0, weight[-1], n)
     x = np.interp(targets, weight, s) / length
+    x[0], x[-1] = 0.0, 1.0
+    return x
+
+
+def by_curvature_points(points: ArrayLike, n: int, *, strength: float = 1.0) -> NDArray:
+    """:func:`by_curvature` for a curve given by dense points ``(m, 3)`` (discrete
+    curvature: the turning angle at each point over the mean of its two legs).
+
+    Returns
+    -------
+    (n,) float, fractions of the polyline's length.
+    """
+    n = _check_count(n)
+    p = np.asarray(points, dtype=float)
+    legs = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(legs)])
+    if not s[-1] > 0.0:
+        raise DegenerateGeometryError("the curve has zero length: it cannot carry a distribution")
+    d1, d2 = np.diff(p, axis=0)[:-1], np.diff(p, axis=0)[1:]
+    n1, n2 = np.linalg.norm(d1, axis=1), np.linalg.norm(d2, axis=1)
+    ok = (n1 > 0) & (n2 > 0)
+    cos = np.einsum("ij,ij->i", d1, d2) / np.where(ok, n1 * n2, 1.0)
+    turn = np.where(ok, np.arccos(np.clip(cos, -1.0, 1.0)), 0.0)
+    kappa = np.concatenate([[0.0], turn / np.maximum(0.5 * (n1 + n2), 1e-300), [0.0]])
+    kappa[0], kappa[-1] = kappa[1], kappa[-2]
+    w = 1.0 + float(strength) * s[-1] * kappa
+    weight = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * legs)])
+    x = np.interp(np.linspace(0.0, weight[-1], n), weight, s) / s[-1]
     x[0], x[-1] = 0.0, 1.0
     return x
 

@@ -13,8 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..trimmed import TrimmedFace
+from .region import Region
 
-__all__ = ["four_sided_reason"]
+__all__ = ["face_region", "four_sided_reason"]
 
 #: pcurve samples per edge checked against the rectangle
 SAMPLES = 9
@@ -67,3 +68,23 @@ def four_sided_reason(face: TrimmedFace) -> str | None:
         return (f"its boundary leaves side(s) {', '.join(sorted(missing))} of the parameter "
                 "rectangle uncovered: not four-sided")
     return None
+
+
+def face_region(face: TrimmedFace) -> Region | str:
+    """The four-sided region a block covers on a face, or why there is none.
+
+    The face's whole rectangle (:func:`four_sided_reason`), else the region inside
+    one loop of four edges (:meth:`Region.from_loop`, trimmed inside its surface);
+    a face used reversed in its shell gets its loop taken clockwise so the block's
+    normal follows the face's. Faces with holes or with more or fewer sides get the
+    reason.
+    """
+    reason = four_sided_reason(face)
+    if reason is None:
+        return Region.rectangle(face.surface)
+    if len(face.loops) == 1 and len(face.loops[0].edges) == 4:
+        return Region.from_loop(face, clockwise=bool(face.reversed))
+    if len(face.loops) == 1:
+        return (f"it has {len(face.loops[0].edges)} edges, not four: heal or split it into "
+                "four-sided faces first")
+    return reason

@@ -35,10 +35,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError, SurfprepError
-from ..projection import project_to_curve
 from ..surface import NurbsSurface
 from .io.blocks import Interface, side_nodes
-from .structured import DEFAULT_CELLS, SIDES, Spacing, SurfaceGrid, grid_surface, side_curves
+from .region import Region
+from .structured import DEFAULT_CELLS, SIDES, Spacing, SurfaceGrid, grid_region
 
 __all__ = ["NetworkGrid", "grid_network", "match_sides"]
 
@@ -106,24 +106,27 @@ def _direction(side: str) -> int:
     return 0 if side in ("j0", "j1") else 1
 
 
-def match_sides(surfaces: list[NurbsSurface], *, gap: float) -> list[Interface]:
-    """Sides of different surfaces (or of one closed surface) that are one edge.
+def match_sides(regions: list[NurbsSurface | Region], *, gap: float) -> list[Interface]:
+    """Sides of different blocks (or of one closed surface) that are one edge.
 
     Two sides match when their samples at equal fractions of their parameters
     (in the same or the opposite direction) are within ``gap`` of each other's
     curve; collapsed sides never match. Each side matches at most once (the
     first one found, in block order).
 
+    Parameters
+    ----------
+    regions : list of NurbsSurface (their whole rectangles) or Region
+
     Returns
     -------
     list of Interface
     """
-    curves = [side_curves(s) for s in surfaces]
+    regions = [_as_region(r) for r in regions]
     samples, lengths = {}, {}
-    for b, sides in enumerate(curves):
-        for name, curve in sides.items():
-            lo, hi = curve.domain
-            pts = curve.evaluate(np.linspace(lo, hi, MATCH_SAMPLES))
+    for b, region in enumerate(regions):
+        for name, side in region.sides.items():
+            pts = side.points(np.linspace(0.0, 1.0, MATCH_SAMPLES))
             samples[b, name] = pts
             lengths[b, name] = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
     keys = [k for k in samples if lengths[k] > gap]
@@ -146,6 +149,10 @@ def match_sides(surfaces: list[NurbsSurface], *, gap: float) -> list[Interface]:
             if key_a in used:
                 break
     return out
+
+
+def _as_region(item: NurbsSurface | Region) -> Region:
+    return item if isinstance(item, Region) else Region.rectangle(item)
 
 
 class _Classes:
@@ -185,35 +192,27 @@ def _counts(surfaces, interfaces, dims, size, skip: set[int] = frozenset()) -> d
                     "other direction along a shared edge (give size instead)")
         return {key: counts[classes.find(key)] for key in classes.parent if key[0] not in skip}
     longest: dict = {}
-    for b, s in enumerate(surfaces):
+    for b, region in enumerate(surfaces):
         if b in skip:
             continue
-        for name, curve in side_curves(s).items():
+        for name, side in region.sides.items():
             root = classes.find((b, _direction(name)))
-            longest[root] = max(longest.get(root, 0.0), curve.arc_length())
+            longest[root] = max(longest.get(root, 0.0), side.length)
     size = float(size)
     return {key: max(2, math.ceil(longest[classes.find(key)] / size - 1e-9) + 1)
             for key in classes.parent if key[0] not in skip}
 
 
-def _transfer(curves_a, side_a: str, fractions_a: NDArray, curves_b, side_b: str, reverse: bool,
-              guess: NDArray | None = None) -> NDArray:
-    """Normalized parameters on side ``b`` of the nodes of side ``a`` (projected).
+def _transfer(region_a: Region, side_a: str, fractions_a: NDArray, region_b: Region, side_b: str,
+              reverse: bool) -> NDArray:
+    """Normalized parameters on side ``b`` of the nodes of side ``a`` (their nearest points).
 
-    ``guess`` (normalized parameters on ``b``) starts the projection; by default the
-    fractions of ``a`` themselves (the two curves are one edge: their parameters
-    run alike). Raises InvalidGeometryError when the feet are not in order.
+    Raises InvalidGeometryError when the feet are not in order.
     """
-    ca, cb = curves_a[side_a], curves_b[side_b]
-    lo, hi = ca.domain
-    points = ca.evaluate(lo + fractions_a * (hi - lo))
-    start = fractions_a if guess is None else guess
+    points = region_a.sides[side_a].points(fractions_a)
     if reverse:
         points = points[::-1]
-        if guess is None:
-            start = 1.0 - fractions_a[::-1]
-    lo_b, hi_b = cb.domain
-    t = (project_to_curve(cb, points, guess=lo_b + start * (hi_b - lo_b)).t - lo_b) / (hi_b - lo_b)
+    t = region_b.sides[side_b].locate(points)
     t[0], t[-1] = 0.0, 1.0
     t = np.clip(t, 0.0, 1.0)
     if np.any(np.diff(t) <= 0.0):
@@ -221,16 +220,12 @@ def _transfer(curves_a, side_a: str, fractions_a: NDArray, curves_b, side_b: str
     return t
 
 
-def _side_parameters(grid: SurfaceGrid, surface: NurbsSurface, side: str) -> NDArray:
+def _side_parameters(grid: SurfaceGrid, side: str) -> NDArray:
     """Normalized parameters of a gridded block's side nodes along that side."""
-    u0, u1, v0, v1 = surface.domain
-    nodes = side_nodes(grid.parameters, side)
-    if side in ("j0", "j1"):
-        return (nodes[:, 0] - u0) / (u1 - u0)
-    return (nodes[:, 1] - v0) / (v1 - v0)
+    return np.asarray(grid.side_params[side], dtype=float)
 
 
-def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, int] | None = None,
+def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tuple[int, int] | None = None,
                  size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
                  smooth: str = "elliptic", tol: float = 1e-4, max_sweeps: int = 2000,
                  hold: dict[int, list] | None = None, progress=None) -> NetworkGrid:
@@ -238,7 +233,7 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
 
     Parameters
     ----------
-    surfaces : list of NurbsSurface
+    surfaces : list of NurbsSurface (their whole rectangles) or Region (a trimmed face's)
     gap : float
         Largest distance between two sides called one edge (model units).
     dims : (int, int), optional
@@ -264,20 +259,20 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
         raise InvalidGeometryError("give dims or size, not both")
     spacing = Spacing() if spacing is None else spacing
     failed: dict[int, str] = {}
-    for b, surface in enumerate(surfaces):
+    surfaces = [_as_region(s) for s in surfaces]
+    for b, region in enumerate(surfaces):
         try:
-            for curve in side_curves(surface).values():
-                curve.arc_length()
+            if not all(np.isfinite(side.length) for side in region.sides.values()):
+                raise InvalidGeometryError("a side of no finite length")
         except SurfprepError as exc:
             failed[b] = str(exc)
     usable = [b for b in range(len(surfaces)) if b not in failed]
     found = match_sides([surfaces[b] for b in usable], gap=gap)
     interfaces = [Interface(usable[f.block], f.side, usable[f.other], f.other_side, f.reversed)
                   for f in found]
-    curves = [None if b in failed else side_curves(s) for b, s in enumerate(surfaces)]
     if dims is None and size is None:
-        size = float(np.median([max(c.arc_length() for c in sides.values())
-                                for sides in curves if sides is not None] or [1.0])) / DEFAULT_CELLS
+        size = float(np.median([max(side.length for side in surfaces[b].sides.values())
+                                for b in usable] or [1.0])) / DEFAULT_CELLS
     counts = _counts(surfaces, interfaces, dims, size, skip=set(failed))
     partner = {}
     for f in interfaces:
@@ -296,11 +291,11 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
                 if (b, side) in partner and partner[b, side][0] < b \
                         and blocks[partner[b, side][0]] is not None:
                     a, side_a, reverse = partner[b, side]
-                    fractions = _side_parameters(blocks[a], surfaces[a], side_a)
-                    given[side] = _transfer(curves[a], side_a, fractions, curves[b], side, reverse)
-            blocks.append(grid_surface(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
-                                       smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
-                                       hold=(hold or {}).get(b, ()), hold_tol=gap))
+                    fractions = _side_parameters(blocks[a], side_a)
+                    given[side] = _transfer(surfaces[a], side_a, fractions, surface, side, reverse)
+            blocks.append(grid_region(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
+                                      smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
+                                      hold=(hold or {}).get(b, ()), hold_tol=gap))
         except SurfprepError as exc:
             failed[b] = str(exc)
             blocks.append(None)
@@ -314,12 +309,11 @@ def grid_network(surfaces: list[NurbsSurface], *, gap: float, dims: tuple[int, i
     interfaces = [Interface(index[f.block], f.side, index[f.other], f.other_side, f.reversed)
                   for f in interfaces if f.block in index and f.other in index]
     surfaces = [surfaces[b] for b in keep]
-    curves = [curves[b] for b in keep]
     blocks = [blocks[b] for b in keep]
     rounds = 0
     if smooth == "elliptic" and interfaces:
         budget = time.perf_counter() - started          # sliding may at most double the work
-        blocks, rounds = _slide_interfaces(surfaces, curves, blocks, interfaces, tol=tol,
+        blocks, rounds = _slide_interfaces(surfaces, blocks, interfaces, tol=tol,
                                            max_sweeps=max_sweeps, budget=budget)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
     return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())))
@@ -354,7 +348,7 @@ def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
     return np.einsum("ij,ij->i", move, tangent)
 
 
-def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: list[Interface], *,
+def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfaces: list[Interface], *,
                       tol: float, max_sweeps: int, budget: float = math.inf) -> tuple[list[SurfaceGrid], int]:
     """Let the nodes of every interface slide along it until the grid lines cross it
     smoothly: each round moves them by the Winslow stencil of both blocks together
@@ -367,6 +361,7 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
     from .elliptic import refine
     from .quality import grid_quality
     params = [b.parameters.copy() for b in blocks]
+    side_params = [dict(b.side_params) for b in blocks]
     grids = list(blocks)
     # creases do not slide, nor do blocks that kept their algebraic grid or hold curves
     # (refined piece by piece between them)
@@ -389,67 +384,90 @@ def _slide_interfaces(surfaces, curves, blocks: list[SurfaceGrid], interfaces: l
             cell = np.maximum(np.minimum(legs[1:], legs[:-1]), 1e-300)
             worst = max(worst, float(np.max(np.abs(move) / cell)))
             # along block a's side curve: arc length to parameter by the local chord
-            t = _side_parameters(grids[f.block], surfaces[f.block], f.side)
+            t = _side_parameters(grids[f.block], f.side)
             dt = np.diff(t)
             step = move / np.where(move > 0, legs[1:], legs[:-1]) * np.where(move > 0, dt[1:], dt[:-1])
             step = np.clip(INTERFACE_RELAXATION * step, -0.5 * dt[:-1], 0.5 * dt[1:])
             t_new = t.copy()
             t_new[1:-1] += step
-            current_b = _side_parameters(grids[f.other], surfaces[f.other], f.other_side)
             try:
-                t_b = _transfer(curves[f.block], f.side, t_new, curves[f.other], f.other_side,
-                                f.reversed, guess=current_b)
+                t_b = _transfer(surfaces[f.block], f.side, t_new, surfaces[f.other], f.other_side,
+                                f.reversed)
             except InvalidGeometryError:
                 continue                      # this edge's nodes stay where they are this round
             for block, side, values in ((f.block, f.side, t_new), (f.other, f.other_side, t_b)):
                 _set_side_parameters(params[block], surfaces[block], side, values)
+                side_params[block][side] = values
                 changed.add(block)
         if worst < INTERFACE_TOL or worst > INTERFACE_PROGRESS * previous \
                 or time.perf_counter() - began > budget:
             break                             # converged, the moves no longer shrink, or out of time
         previous = worst
         for k in changed:
-            result = refine(surfaces[k], params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
+            result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
             params[k] = result.parameters.copy()
-            points = surfaces[k].evaluate(params[k][..., 0], params[k][..., 1])
-            grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result)
+            points = surfaces[k].surface.evaluate(params[k][..., 0], params[k][..., 1])
+            grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result,
+                               side_params=dict(side_params[k]))
             touched.add(k)
     for k in touched:
         g, p = grids[k], params[k]
-        quality = grid_quality(g.points, normals(surfaces[k], p[..., 0], p[..., 1]))
+        quality = grid_quality(g.points, g.orientation * normals(surfaces[k].surface, p[..., 0], p[..., 1]))
         grids[k] = replace(g, parameters=p, quality=quality)
     return grids, rounds
 
 
-def _set_side_parameters(params: NDArray, surface: NurbsSurface, side: str, values: NDArray) -> None:
-    """Put normalized side parameters back into a block's ``(u, v)`` array."""
-    u0, u1, v0, v1 = surface.domain
-    column = 0 if side in ("j0", "j1") else 1
-    lo, hi = (u0, u1) if column == 0 else (v0, v1)
+def _set_side_parameters(params: NDArray, region: Region, side: str, values: NDArray) -> None:
+    """Put a side's nodes, given by normalized side parameters, into a block's ``(u, v)``
+    (inside the domain: a trimmed face's pcurves may run off it by a rounding)."""
+    u0, u1, v0, v1 = region.surface.domain
+    uv = np.clip(region.sides[side].uv(values), [u0, v0], [u1, v1])
     axis, index = _SIDE_INDEX[side]
     if axis == 0:
-        params[index, :, column] = lo + values * (hi - lo)
+        params[index] = uv
     else:
-        params[:, index, column] = lo + values * (hi - lo)
+        params[:, index] = uv
 
 
 def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], started: float,
              rounds: int) -> NetworkGrid:
-    """Copy the first block's side nodes onto the second's; measure the moves and kinks."""
+    """Give every set of matched nodes (across all interfaces: a corner where several
+    blocks meet is one set) the coordinates of its first block's node; measure the
+    moves and the kinks."""
     from ..measure import normals
     points = [b.points.copy() for b in blocks]
-    snap = kink = 0.0
+    parent: dict = {}
+
+    def find(key):
+        parent.setdefault(key, key)
+        while parent[key] != key:
+            parent[key] = parent[parent[key]]
+            key = parent[key]
+        return key
+
+    for f in interfaces:
+        a = _side_keys(f.block, f.side, blocks[f.block].dims)
+        b = _side_keys(f.other, f.other_side, blocks[f.other].dims)
+        if f.reversed:
+            b = b[::-1]
+        for ka, kb in zip(a, b, strict=True):
+            ra, rb = find(ka), find(kb)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)         # the first block's node leads
+    snap = 0.0
+    for key in list(parent):
+        root = find(key)
+        if root != key:
+            target = points[root[0]][root[1], root[2]]
+            snap = max(snap, float(np.linalg.norm(points[key[0]][key[1], key[2]] - target)))
+            points[key[0]][key[1], key[2]] = target
+    kink = 0.0
     figures: list[tuple[float, float]] = []
     for f in interfaces:
         a, b = points[f.block], points[f.other]
-        nodes_a = side_nodes(a, f.side)
-        nodes_b = side_nodes(b, f.other_side)
-        if f.reversed:
-            nodes_a = nodes_a[::-1]
-        snap = max(snap, float(np.max(np.linalg.norm(nodes_a - nodes_b, axis=1))))
-        _set_side(b, f.other_side, nodes_a)
         uv = side_nodes(blocks[f.block].parameters, f.side)
-        k = _kink(a, f.side, b, f.other_side, f.reversed, normals(surfaces[f.block], uv[:, 0], uv[:, 1]))
+        k = _kink(a, f.side, b, f.other_side, f.reversed,
+                  blocks[f.block].orientation * normals(surfaces[f.block].surface, uv[:, 0], uv[:, 1]))
         c = _crease(surfaces, blocks, f)
         figures.append((k, c))
         if c <= SMOOTH_INTERFACE:
@@ -457,6 +475,13 @@ def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], s
     out = tuple(replace(g, points=p) for p, g in zip(points, blocks, strict=True))
     return NetworkGrid(out, tuple(interfaces), snap, kink, rounds, tuple(figures),
                        time.perf_counter() - started)
+
+
+def _side_keys(block: int, side: str, dims: tuple[int, int]) -> list[tuple[int, int, int]]:
+    """``(block, i, j)`` of a side's nodes in the order of the index running along it."""
+    ni, nj = dims
+    return {"i0": [(block, 0, j) for j in range(nj)], "i1": [(block, ni - 1, j) for j in range(nj)],
+            "j0": [(block, i, 0) for i in range(ni)], "j1": [(block, i, nj - 1) for i in range(ni)]}[side]
 
 
 _SIDE_INDEX = {"i0": (0, 0), "i1": (0, -1), "j0": (1, 0), "j1": (1, -1)}
@@ -495,7 +520,7 @@ def _crease(surfaces, blocks: list[SurfaceGrid], f: Interface) -> float:
     ends = []
     for block, side in ((f.block, f.side), (f.other, f.other_side)):
         uv = side_nodes(blocks[block].parameters, side)
-        ends.append(normals(surfaces[block], uv[:, 0], uv[:, 1]))
+        ends.append(blocks[block].orientation * normals(surfaces[block].surface, uv[:, 0], uv[:, 1]))
     na, nb = ends
     if f.reversed:
         nb = nb[::-1]

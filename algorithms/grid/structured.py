@@ -32,12 +32,13 @@ from ..measure import normals as surface_normals
 from ..surface import NurbsSurface
 from ..tensor import Direction
 from . import distribution
-from .elliptic import EllipticResult, refine
+from .elliptic import EllipticResult, corner_jacobians, refine
 from .held import HeldLine, held_line, split_along
 from .quality import GridQuality, grid_quality
-from .tfi import distribution_mesh
+from .region import SIDE_NAMES, Region
+from .tfi import distribution_mesh, transfinite
 
-__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_surface", "side_curves"]
+__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_region", "grid_surface", "side_curves"]
 
 #: cells along the longest side when neither ``dims`` nor ``size`` is given
 DEFAULT_CELLS = 40
@@ -87,12 +88,16 @@ class Spacing:
         if law == "geometric" and (self.growth is None) == (self.first is None):
             raise InvalidGeometryError("the geometric law needs a growth ratio or a first spacing")
 
-    def fractions(self, n: int, curve: NurbsCurve, length: float) -> NDArray:
-        """``(n,)`` fractions of the arc length of ``curve`` (of ``length``) for this law."""
+    def fractions(self, n: int, curve: NurbsCurve | None, length: float,
+                  points: NDArray | None = None) -> NDArray:
+        """``(n,)`` fractions of the arc length of a side (of ``length``) for this law;
+        the curvature law reads the side's 3D ``curve``, or its dense ``points``."""
         if self.law == "uniform":
             return distribution.uniform(n)
         if self.law == "curvature":
-            return distribution.by_curvature(curve, n, strength=self.strength)
+            if curve is not None:
+                return distribution.by_curvature(curve, n, strength=self.strength)
+            return distribution.by_curvature_points(points, n, strength=self.strength)
         if self.law == "geometric":
             if self.growth is not None:
                 return distribution.geometric(n, growth=self.growth)
@@ -123,6 +128,9 @@ class SurfaceGrid:
         grid folded a cell or, not converged, was more skewed (never returned worse).
     held : tuple of (str, int)
         The grid lines that are held curves: ``("i", 14)`` is the i-line 14.
+    orientation : int
+        +1 when ``x_i x x_j`` follows the surface's normal ``S_u x S_v``, -1 when it
+        runs against it (the block's normal is then the surface's reversed).
     collapsed_sides : tuple of str
         Sides of zero length (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``).
     spacing_error : float
@@ -131,6 +139,8 @@ class SurfaceGrid:
     time_s : float
     start_points, start_parameters : (ni, nj, 3), (ni, nj, 2) float or None
         The algebraic start grid (to show what the refinement changed).
+    side_params : dict of str to (n,) float
+        The normalized side parameters (:class:`Side`) of each side's nodes.
     """
 
     points: NDArray
@@ -140,11 +150,13 @@ class SurfaceGrid:
     elliptic: EllipticResult | None
     kept_start: str | None = None
     held: tuple[tuple[str, int], ...] = ()
+    orientation: int = 1
     collapsed_sides: tuple[str, ...] = ()
     spacing_error: float = 0.0
     time_s: float = field(default=0.0, compare=False)
     start_points: NDArray | None = field(default=None, repr=False, compare=False)
     start_parameters: NDArray | None = field(default=None, repr=False, compare=False)
+    side_params: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def dims(self) -> tuple[int, int]:
@@ -152,7 +164,8 @@ class SurfaceGrid:
 
     def report(self) -> dict:
         """Plain-JSON figures of the block."""
-        out = {"dims": list(self.dims), "collapsed_sides": list(self.collapsed_sides),
+        out = {"dims": list(self.dims), "corner_angles": corner_angles(self.points),
+               "collapsed_sides": list(self.collapsed_sides),
                "held_lines": [f"{family}={index}" for family, index in self.held],
                "quality": self.quality.report(), "start_quality": self.start_quality.report(),
                "spacing_error": self.spacing_error, "time_s": self.time_s}
@@ -162,6 +175,20 @@ class SurfaceGrid:
                                "residuals": list(self.elliptic.residuals),
                                "kept_start": self.kept_start}
         return out
+
+
+def corner_angles(points: NDArray) -> list[float]:
+    """The angles (degrees) of a block's four corners, at (0, 0), (ni-1, 0), (ni-1, nj-1),
+    (0, nj-1): the face's own corners, which bound the orthogonality any grid can reach
+    (nan at a collapsed corner)."""
+    out = []
+    for i, j, di, dj in ((0, 0, 1, 1), (-1, 0, -1, 1), (-1, -1, -1, -1), (0, -1, 1, -1)):
+        a = points[i + di, j] - points[i, j]
+        b = points[i, j + dj] - points[i, j]
+        n = float(np.linalg.norm(a) * np.linalg.norm(b))
+        out.append(float(np.degrees(np.arccos(np.clip(np.dot(a, b) / n, -1.0, 1.0)))) if n > 0 else
+                   float("nan"))
+    return out
 
 
 def side_curves(surface: NurbsSurface) -> dict[str, NurbsCurve]:
@@ -196,19 +223,26 @@ def _dims(lengths: dict[str, float], dims, size) -> tuple[int, int]:
     return max(2, math.ceil(long_i / size - 1e-9) + 1), max(2, math.ceil(long_j / size - 1e-9) + 1)
 
 
-def _side_fractions(sides: dict[str, NurbsCurve], lengths: dict[str, float], collapsed: set[str],
+def _side_fractions(region: Region, lengths: dict[str, float], collapsed: set[str],
                     ni: int, nj: int, spacing: tuple[Spacing, Spacing]) -> dict[str, NDArray]:
-    """Normalized parameters of the side nodes, by the spacing laws in arc length."""
+    """Normalized side parameters ``x`` of the side nodes, by the spacing laws in arc length."""
     out = {}
+    curves = side_curves(region.surface) if region.is_rectangle else {}
     for name, other, n, law in (("j0", "j1", ni, spacing[0]), ("j1", "j0", ni, spacing[0]),
                                 ("i0", "i1", nj, spacing[1]), ("i1", "i0", nj, spacing[1])):
         if name in collapsed:
             if other in collapsed:
                 raise DegenerateGeometryError(f"sides {name} and {other} are both collapsed")
             continue
-        curve = sides[name]
-        lo, hi = curve.domain
-        out[name] = (distribution.points_along(curve, law.fractions(n, curve, lengths[name])) - lo) / (hi - lo)
+        side = region.sides[name]
+        dense = side.points(np.linspace(0.0, 1.0, 257)) if law.law == "curvature" else None
+        fractions = law.fractions(n, curves.get(name), lengths[name], dense)
+        if name in curves:                  # an iso-line: exact arc length on the 3D curve
+            curve = curves[name]
+            lo, hi = curve.domain
+            out[name] = (distribution.points_along(curve, fractions) - lo) / (hi - lo)
+        else:
+            out[name] = side.at_fractions(fractions)
     for name, other in (("j0", "j1"), ("j1", "j0"), ("i0", "i1"), ("i1", "i0")):
         if name in collapsed:
             out[name] = out[other]          # the pole's nodes coincide; keep the lines straight in (u, v)
@@ -227,6 +261,18 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
                 if asked is not None and law.law in ("tanh", "geometric"):
                     worst = max(worst, abs(got - asked) / asked)
     return worst
+
+
+def _region_start(region: Region, x: dict[str, NDArray]) -> NDArray:
+    """TFI in ``(u, v)`` of the four sides' nodes, blended by their arc-length fractions;
+    each corner the mean of its two sides' ends (a loop's pcurves meet to its tolerance)."""
+    sides = {name: region.sides[name].uv(x[name]) for name in SIDE_NAMES}
+    for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1),
+                         ("j1", -1, "i1", -1)):
+        corner = 0.5 * (sides[a][ia] + sides[b][ib])
+        sides[a][ia] = sides[b][ib] = corner
+    weights = distribution_mesh(*(region.sides[name].fractions_of(x[name]) for name in SIDE_NAMES))
+    return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
 
 
 def _transposed(surface: NurbsSurface) -> NurbsSurface:
@@ -276,11 +322,39 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
                  control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
                  sides: dict[str, NDArray] | None = None, hold: Sequence = (),
                  hold_tol: float | None = None) -> SurfaceGrid:
-    """A structured grid on a four-sided surface (003: redistribution, TFI, elliptic).
+    """A structured grid on a surface's whole parameter rectangle (003: redistribution, TFI, elliptic).
+
+    :func:`grid_region` on :meth:`Region.rectangle`; the parameters and their meaning
+    are :func:`grid_region`'s.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from surfprep import NurbsSurface
+    >>> k = [0, 0, 1, 1]
+    >>> plane = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[2, 0, 0], [2, 1, 0]]], float), k, k, 1, 1)
+    >>> grid = grid_surface(plane, dims=(5, 3))
+    >>> grid.points.shape, round(grid.quality.max_skewness, 12)
+    ((5, 3, 3), 0.0)
+    """
+    if not isinstance(surface, NurbsSurface) or surface.dimension != 3:
+        raise InvalidGeometryError("grid_surface needs a 3D NurbsSurface")
+    return grid_region(Region.rectangle(surface), dims=dims, size=size, spacing=spacing, smooth=smooth,
+                       control=control, tol=tol, max_sweeps=max_sweeps, sides=sides, hold=hold,
+                       hold_tol=hold_tol)
+
+
+def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: float | None = None,
+                spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
+                control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
+                sides: dict[str, NDArray] | None = None, hold: Sequence = (),
+                hold_tol: float | None = None) -> SurfaceGrid:
+    """A structured grid on a four-sided region of a surface (003: redistribution, TFI, elliptic).
 
     Parameters
     ----------
-    surface : NurbsSurface (3D)
+    region : Region
+        The surface and its four sides (:meth:`Region.rectangle`, :meth:`Region.from_loop`).
     dims : (int, int), optional
         Nodes along i (the u direction) and j (v). Default from ``size``.
     size : float, optional
@@ -295,14 +369,14 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         Passed to :func:`.elliptic.refine`.
     sides : dict, optional
         Nodes of some sides given, instead of by the law: side name (``"j0"``,
-        ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side curve's
-        parameters normalized to [0, 1], increasing from 0 to 1 (a network uses it
-        to give two faces the same nodes along their shared edge).
+        ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side's normalized
+        parameters (:class:`Side`), increasing from 0 to 1 (a network uses it to give
+        two faces the same nodes along their shared edge).
     hold : sequence of NurbsCurve (3D) or (m, 3) points
         Curves on the surface to hold as grid lines (:mod:`.held`): each runs from a
         side to the opposite one and becomes a line of the grid (from ``j0`` to
         ``j1``: an i-line); the pieces between are gridded and refined with the held
-        lines fixed. All held curves must run the same way.
+        lines fixed. All held curves must run the same way. Rectangles only.
     hold_tol : float, optional
         How far a held curve may lie from the surface; default 1e-4 of its box diagonal.
 
@@ -316,20 +390,11 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         Bad dims/size/spacing, a spacing no law of that many nodes can reach.
     DegenerateGeometryError
         Two opposite sides collapsed, or a surface of zero size.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from surfprep import NurbsSurface
-    >>> k = [0, 0, 1, 1]
-    >>> plane = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[2, 0, 0], [2, 1, 0]]], float), k, k, 1, 1)
-    >>> grid = grid_surface(plane, dims=(5, 3))
-    >>> grid.points.shape, round(grid.quality.max_skewness, 12)
-    ((5, 3, 3), 0.0)
     """
     started = time.perf_counter()
+    surface = region.surface
     if not isinstance(surface, NurbsSurface) or surface.dimension != 3:
-        raise InvalidGeometryError("grid_surface needs a 3D NurbsSurface")
+        raise InvalidGeometryError("a grid needs a 3D NurbsSurface")
     if smooth not in ("elliptic", "none"):
         raise InvalidGeometryError(f"smooth must be 'elliptic' or 'none', got {smooth!r}")
     if isinstance(spacing, Spacing):
@@ -337,14 +402,13 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     elif not (isinstance(spacing, tuple) and len(spacing) == 2
               and all(isinstance(s, Spacing) for s in spacing)):
         raise InvalidGeometryError("spacing must be a Spacing or a pair of them (along i, along j)")
-    curves = side_curves(surface)
-    lengths = {name: curve.arc_length() for name, curve in curves.items()}
+    lengths = {name: side.length for name, side in region.sides.items()}
     diag = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
     if not diag > 0.0:
         raise DegenerateGeometryError("the surface has zero size")
     collapsed = {name for name, length in lengths.items() if length <= COLLAPSED * diag}
     ni, nj = _dims(lengths, dims, size)
-    fractions = _side_fractions(curves, lengths, collapsed, ni, nj, spacing)
+    fractions = _side_fractions(region, lengths, collapsed, ni, nj, spacing)
     for name, given in (sides or {}).items():
         if name not in SIDES:
             raise InvalidGeometryError(f"unknown side {name!r}; expected one of {', '.join(SIDES)}")
@@ -357,19 +421,29 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
         fractions[name] = given
     u0, u1, v0, v1 = surface.domain
     pieces, axis = [(0, ni - 1)], 0
-    if hold:
-        xy, pieces, axis = _held_start(surface, hold, fractions,
-                                       1e-4 * diag if hold_tol is None else float(hold_tol))
-        s, t = xy[..., 0], xy[..., 1]
+    if hold and not region.is_rectangle:
+        raise InvalidGeometryError("held curves are supported on a surface's whole rectangle only")
+    if not region.is_rectangle:
+        st = _region_start(region, fractions)
     else:
-        s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
-    st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
+        if hold:
+            xy, pieces, axis = _held_start(surface, hold, fractions,
+                                           1e-4 * diag if hold_tol is None else float(hold_tol))
+            s, t = xy[..., 0], xy[..., 1]
+        else:
+            s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
+        st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
     st[..., 0] = np.clip(st[..., 0], u0, u1)
     st[..., 1] = np.clip(st[..., 1], v0, v1)
 
+    # the block's normal: the surface's, or its opposite where i x j runs the other way
+    # in (u, v) (a loop taken clockwise for a face used reversed)
+    orientation = 1 if float(np.sum(corner_jacobians(st[..., 0], st[..., 1]))) >= 0.0 else -1
+
     def measured(params: NDArray) -> tuple[NDArray, GridQuality]:
         points = surface.evaluate(params[..., 0], params[..., 1])
-        return points, grid_quality(points, surface_normals(surface, params[..., 0], params[..., 1]))
+        normals = orientation * surface_normals(surface, params[..., 0], params[..., 1])
+        return points, grid_quality(points, normals)
 
     start_points, start_quality = measured(st)
     start_params = st
@@ -392,8 +466,8 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
             st, points, quality = result.parameters, refined_points, refined
     held = tuple(("i" if axis == 0 else "j", q) for _, q in pieces[:-1]) if hold else ()
     return SurfaceGrid(points=points, parameters=st, quality=quality, start_quality=start_quality,
-                       elliptic=result, kept_start=kept_start, held=held,
+                       elliptic=result, kept_start=kept_start, held=held, orientation=orientation,
                        collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started, start_points=start_points,
-                       start_parameters=start_params)
+                       start_parameters=start_params, side_params=dict(fractions))

@@ -53,7 +53,7 @@ def test_blocks_follow_the_faces_outward_normals(fuselage):
 
 
 def test_a_trimmed_face_is_refused_with_its_reason_or_gridded_whole():
-    with pytest.raises(InvalidGeometryError, match="trimmed inside its surface"):
+    with pytest.raises(InvalidGeometryError, match="it has 47 edges, not four"):
         surfprep.grid(CATIA_FACE)
     result = surfprep.grid(CATIA_FACE, whole_surfaces=True, dims=(61, 41))
     block = result.network.blocks[0]
@@ -111,3 +111,26 @@ def test_report_is_plain_json(fuselage):
     json.dumps(report, allow_nan=False)
     assert {b["face"] for b in report["blocks"]} == set(fuselage.faces)
     assert all("residuals" in b["elliptic"] for b in report["blocks"])
+
+
+def test_trimmed_four_sided_faces_of_a_real_model(data_dir):
+    """occt_k1_catia_debis.stp: every face is trimmed inside its surface; those bounded by
+    one loop of four edges are gridded on that loop, point-matched, without a fold."""
+    model = surfprep.read(data_dir / "occt_k1_catia_debis.stp")
+    result = surfprep.grid(model)
+    four = [k for k, f in enumerate(model.faces)
+            if len((t := surfprep.to_nurbs(f)).loops) == 1 and len(t.loops[0].edges) == 4]
+    assert set(result.faces) == set(four) and len(four) >= 40
+    assert all("not four" in reason or "hole" in reason for _, reason in result.skipped)
+    report = result.report()
+    assert report["worst"]["folded_cells"] == 0 and report["worst"]["max_skewness"] < 0.5
+    assert len(result.network.interfaces) >= 40
+    for f in result.network.interfaces:
+        a = side_nodes(result.blocks[f.block], f.side)
+        b = side_nodes(result.blocks[f.other], f.other_side)
+        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    # the blocks lie on their faces: every node within the model's tolerance of the face's surface
+    from surfprep.algorithms.projection import distance_to_surface
+    for k, block in zip(result.faces, result.blocks, strict=True):
+        surface = surfprep.to_nurbs(model.faces[k]).surface
+        assert distance_to_surface(surface, block.reshape(-1, 3)).max() < 1e-2
