@@ -177,17 +177,16 @@ class SurfaceGrid:
         return out
 
 
-def corner_angles(points: NDArray) -> list[float]:
+def corner_angles(points: NDArray) -> list[float | None]:
     """The angles (degrees) of a block's four corners, at (0, 0), (ni-1, 0), (ni-1, nj-1),
     (0, nj-1): the face's own corners, which bound the orthogonality any grid can reach
-    (nan at a collapsed corner)."""
+    (None at a collapsed corner)."""
     out = []
     for i, j, di, dj in ((0, 0, 1, 1), (-1, 0, -1, 1), (-1, -1, -1, -1), (0, -1, 1, -1)):
         a = points[i + di, j] - points[i, j]
         b = points[i, j + dj] - points[i, j]
         n = float(np.linalg.norm(a) * np.linalg.norm(b))
-        out.append(float(np.degrees(np.arccos(np.clip(np.dot(a, b) / n, -1.0, 1.0)))) if n > 0 else
-                   float("nan"))
+        out.append(float(np.degrees(np.arccos(np.clip(np.dot(a, b) / n, -1.0, 1.0)))) if n > 0 else None)
     return out
 
 
