@@ -44,6 +44,7 @@ from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
+from ..algorithms.io.atomic import new_file_mode
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike
@@ -519,22 +520,6 @@ def _check_output_file(target: Path, obj: Any, overwrite: bool) -> None:
     if not overwrite:
         raise OutputFileError(
             f"output file {target} already exists (pass overwrite=True to replace it)")
-
-
-def new_file_mode() -> int:
-    """Permission bits of a newly created file under the process umask (0o644 for 022).
-
-    ``tempfile.mkstemp`` creates files readable by the owner only; outputs get
-    the mode ``open()`` would have given them.
-    """
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith("Umask:"):
-                    return 0o666 & ~int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    return 0o644
 
 
 # ========================================================== object -> shape

@@ -46,6 +46,7 @@ from .inputs import ShapeLike
 if TYPE_CHECKING:
     from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
     from .algorithms.reparam import ReparametrizationResult
+    from .algorithms.volume import NurbsVolume
     from .plugin.convert import to_nurbs, to_occ
     from .plugin.grid import GridResult, grid
     from .plugin.heal import HealResult, heal
@@ -88,6 +89,8 @@ __all__ = [
     "HealResult",
     "grid",
     "GridResult",
+    # trivariate solids (numpy only)
+    "NurbsVolume",
     # structured grids (numpy only)
     "grid_surface",
     "SurfaceGrid",
@@ -127,6 +130,7 @@ _LAZY_EXPORTS = {
     "HealResult": "surfprep.plugin.heal",
     "grid": "surfprep.plugin.grid",
     "GridResult": "surfprep.plugin.grid",
+    "NurbsVolume": "surfprep.algorithms.volume",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",
     "Spacing": "surfprep.algorithms.grid",
