@@ -1,0 +1,113 @@
+"""Splitting a trimmed face along curves in its domain: regions, areas, closed loops."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from surfprep import NurbsCurve, NurbsSurface, TrimEdge, TrimLoop, TrimmedFace
+from surfprep.algorithms.face_split import Cut, split_face
+from surfprep.errors import InvalidGeometryError
+
+
+def _plane() -> NurbsSurface:
+    """z = 0 over [0, 1]^2, (u, v) = (x, y)."""
+    g = np.array([0.0, 1.0])
+    cp = np.zeros((2, 2, 3))
+    cp[..., 0], cp[..., 1] = np.meshgrid(g, g, indexing="ij")
+    return NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+
+def _line(a, b) -> Cut:
+    pcurve = NurbsCurve(np.array([a, b], float), [0, 0, 1, 1], 1)
+    curve3d = NurbsCurve(np.array([[*a, 0.0], [*b, 0.0]]), [0, 0, 1, 1], 1)
+    return Cut(pcurve, curve3d)
+
+
+def _circle(centre, radius) -> Cut:
+    """A closed rational quadratic circle, counter-clockwise."""
+    s = np.sqrt(0.5)
+    unit = np.array([[1, 0], [1, 1], [0, 1], [-1, 1], [-1, 0], [-1, -1], [0, -1], [1, -1], [1, 0]], float)
+    weights = np.array([1, s, 1, s, 1, s, 1, s, 1])
+    knots = [0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1]
+    return Cut(NurbsCurve(np.asarray(centre) + radius * unit, knots, 2, weights))
+
+
+def _area(face: TrimmedFace) -> float:
+    """Parameter area: the outer loop's minus the holes' (shoelace on 2000 samples an edge)."""
+    total = 0.0
+    for loop in face.loops:
+        parts = []
+        for e in loop.edges:
+            t = np.linspace(e.t0, e.t1, 2001)
+            parts.append(e.pcurve.evaluate(t[::-1] if e.reversed else t)[:-1])
+        uv = np.concatenate(parts)
+        total += 0.5 * float(np.sum(uv[:, 0] * np.roll(uv[:, 1], -1) - np.roll(uv[:, 0], -1) * uv[:, 1]))
+    return total
+
+
+def _closed(face: TrimmedFace) -> None:
+    for loop in face.loops:
+        for a, b in zip(loop.edges, loop.edges[1:] + loop.edges[:1], strict=True):
+            np.testing.assert_allclose(a.uv_ends()[1], b.uv_ends()[0], atol=1e-9)
+
+
+def test_a_line_across_the_face_makes_two_regions():
+    face = TrimmedFace(_plane())                              # the whole square, no loop
+    parts = split_face(face, [_line((0.3, 0.0), (0.6, 1.0))])
+    assert len(parts) == 2
+    areas = sorted(_area(p) for p in parts)
+    np.testing.assert_allclose(areas, [0.45, 0.55], atol=1e-12)
+    for p in parts:
+        _closed(p)
+        assert len(p.loops) == 1 and _area(p) > 0               # counter-clockwise outer loops
+
+
+def test_two_lines_make_three_regions_and_each_cut_bounds_two():
+    cuts = [_line((0.2, 0.0), (0.3, 1.0)), _line((0.7, 0.0), (0.6, 1.0))]
+    parts = split_face(TrimmedFace(_plane()), cuts)
+    assert len(parts) == 3
+    np.testing.assert_allclose(sum(_area(p) for p in parts), 1.0, atol=1e-12)
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), sorted([0.25, 0.4, 0.35]), atol=1e-12)
+    for cut in cuts:
+        uses = [e for p in parts for e in p.edges if e.pcurve is cut.pcurve]
+        assert sorted(e.reversed for e in uses) == [False, True]
+
+
+def test_a_closed_cut_makes_an_island_and_a_hole():
+    parts = split_face(TrimmedFace(_plane()), [_circle((0.5, 0.5), 0.2)])
+    assert len(parts) == 2
+    island = min(parts, key=_area)
+    rest = max(parts, key=_area)
+    np.testing.assert_allclose(_area(island), np.pi * 0.04, rtol=1e-5)     # the samples' polygon
+    np.testing.assert_allclose(_area(rest) + _area(island), 1.0, atol=1e-12)
+    assert len(rest.loops) == 2 and len(island.loops) == 1
+
+
+def test_cuts_through_a_hole():
+    """A square plate with a square hole, cut by a line through the hole: two C shapes."""
+    outer = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    hole = [(0.4, 0.4), (0.4, 0.6), (0.6, 0.6), (0.6, 0.4)]                 # clockwise
+    loops = []
+    for corners in (outer, hole):
+        edges = []
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            edges.append(_line(a, b))
+        loops.append(TrimLoop(tuple(TrimEdge(c.curve3d, c.pcurve, 0.0, 1.0) for c in edges)))
+    face = TrimmedFace(_plane(), tuple(loops))
+    parts = split_face(face, [_line((0.5, 0.0), (0.5, 0.4)), _line((0.5, 0.6), (0.5, 1.0))])
+    assert len(parts) == 2
+    np.testing.assert_allclose([_area(p) for p in parts], [0.48, 0.48], atol=1e-12)
+    for p in parts:
+        _closed(p)
+        assert len(p.loops) == 1
+
+
+def test_cuts_that_cannot_be_used_are_refused():
+    face = TrimmedFace(_plane())
+    with pytest.raises(InvalidGeometryError, match="cross each other"):
+        split_face(face, [_line((0.2, 0.0), (0.8, 1.0)), _line((0.8, 0.0), (0.2, 1.0))])
+    with pytest.raises(InvalidGeometryError, match="not on the face's boundary"):
+        split_face(face, [_line((0.2, 0.3), (0.8, 1.0))])
+    with pytest.raises(InvalidGeometryError, match="same boundary point"):
+        split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
