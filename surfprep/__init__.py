@@ -55,6 +55,7 @@ if TYPE_CHECKING:
     from .plugin.occ.edges import make_edge
     from .plugin.occ.faces import make_face
     from .plugin.reparam import ReparametrizeResult, reparametrize
+    from .plugin.split import SplitResult, split
 
 __version__ = "0.1.0"
 
@@ -89,6 +90,8 @@ __all__ = [
     "HealResult",
     "grid",
     "GridResult",
+    "split",
+    "SplitResult",
     # trivariate solids (numpy only)
     "NurbsVolume",
     # structured grids (numpy only)
@@ -130,6 +133,8 @@ _LAZY_EXPORTS = {
     "HealResult": "surfprep.plugin.heal",
     "grid": "surfprep.plugin.grid",
     "GridResult": "surfprep.plugin.grid",
+    "split": "surfprep.plugin.split",
+    "SplitResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",

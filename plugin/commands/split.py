@@ -1,0 +1,77 @@
+"""``surfprep split A [B] -o OUT.step``: faces cut along their intersection curves."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..io import staged_write
+from .base import STDOUT, Command, Console, check_outputs, done_code, publish, read_model
+
+__all__ = ["COMMAND"]
+
+#: values of --method (plugin.intersect.Method; not imported to build the parser)
+METHODS = ("auto", "mesh", "characteristic")
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("a", type=Path, metavar="A", help="STEP or IGES file")
+    parser.add_argument("b", type=Path, nargs="?", metavar="B",
+                        help="second STEP or IGES file (default: A's faces cut where they meet each other)")
+    parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
+                        help="STEP/IGES file for the pieces and the uncut faces, sewn")
+    parser.add_argument("--tol", type=float, default=None, metavar="T",
+                        help="intersection tolerance in mm (default 1e-6 x the faces' box diagonal)")
+    parser.add_argument("--method", choices=METHODS, default="auto",
+                        help="intersection method (as surfprep intersect)")
+    parser.add_argument("--json", metavar="PATH", dest="json_path",
+                        help="write the report as JSON to PATH ('-' for stdout)")
+
+
+def _run(args: argparse.Namespace, console: Console) -> int:
+    from ..split import split
+    inputs = tuple(p for p in (args.a, args.b) if p is not None)
+    check_outputs(inputs, args.output, json_path=args.json_path)
+    model_a = read_model(args.a, console, strict=args.strict)
+    model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
+    result = split(model_a, model_b, tol=args.tol, method=args.method)
+    kept = [f for f in result.faces if f.kept is not None]
+    with staged_write(result.shape, args.output, overwrite=True) as staged:
+        report = {"a": str(args.a), "b": None if args.b is None else str(args.b),
+                  "output": str(staged.target), **result.report()}
+        report_path = publish(staged, report, args.json_path, console, protected=inputs)
+    if args.json_path != STDOUT:
+        for f in result.faces:
+            what = (f"kept whole: {f.kept}" if f.kept is not None
+                    else f"{len(f.pieces)} piece(s)")
+            console.print(f"face {f.operand}:{f.index}: {f.cuts} curve(s), {what}")
+        uses = ", ".join(f"{n} by {k} face(s)" for k, n in sorted(result.shared_edges.items()))
+        console.print(f"{len(result.curves)} curve(s), {sum(len(f.pieces) for f in result.faces)} "
+                      f"piece(s); edges: {uses}; {result.free_edges} free; "
+                      f"{'valid' if result.valid else 'INVALID'}; {result.time_s:.2f} s, "
+                      f"written to {staged.target}")
+        if report_path is not None:
+            console.note(f"report written to {report_path}")
+    return done_code(model_a, model_b, skipped=bool(kept))
+
+
+COMMAND = Command(
+    name="split",
+    summary="cut faces along their intersection curves; the pieces share the cut edges",
+    description=(
+        "Intersect A with B (or A's faces with one another, as surfprep intersect), cut every "
+        "face along its curves in its own parameters (open curves from boundary to boundary, "
+        "closed ones as islands) and write the pieces with the uncut faces, sewn: where two "
+        "surfaces cross, four pieces share one intersection edge (a non-manifold shell). A "
+        "face whose curves cross each other is kept whole and named (exit 1). The report gives "
+        "per face its curves and pieces, the edges by the number of faces using them, the free "
+        "edges and BRepCheck validity."),
+    epilog=(
+        "examples:\n"
+        "  surfprep split wing.step fuselage.step -o cut.step\n"
+        "  surfprep split model.step -o cut.step --json r.json\n"
+        "\n"
+        "Lengths and tolerances are in millimetres."),
+    add_arguments=_add_arguments,
+    run=_run,
+)

@@ -1,0 +1,49 @@
+"""``surfprep split``: the pieces written and read back, the report, exit codes."""
+
+from __future__ import annotations
+
+import json
+
+import cadquery as cq
+import pytest
+from helpers.cli import run
+
+import surfprep
+
+
+@pytest.fixture
+def sphere_and_plate(tmp_path):
+    a, b = tmp_path / "sphere.step", tmp_path / "plate.step"
+    cq.exporters.export(cq.Workplane().sphere(10), str(a))
+    cq.exporters.export(cq.Workplane().box(30, 30, 1).translate((0, 0, 5)), str(b))
+    return a, b
+
+
+def test_split_writes_the_pieces_and_a_report(tmp_path, capsys, sphere_and_plate):
+    a, b = sphere_and_plate
+    out, report = tmp_path / "cut.step", tmp_path / "cut.json"
+    code, stdout, err = run(capsys, "split", a, b, "-o", out, "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["pieces"] == 7 and data["free_edges"] == 0 and data["valid"]
+    assert data["edges_by_faces"]["4"] == 2
+    # the sphere's face and the plate's two big faces became 3 + 2 + 2 pieces; 4 side faces uncut
+    assert surfprep.read(out).n_faces == 7 + 4
+    assert "7 piece(s)" in stdout
+
+
+def test_a_face_kept_whole_is_exit_1(tmp_path, capsys):
+    a, b = tmp_path / "sheet.step", tmp_path / "cross.step"
+    cq.exporters.export(cq.Workplane("XY").rect(2, 2).extrude(0.001).faces(">Z"), str(a))
+    cross = (cq.Workplane("YZ").rect(2, 2).extrude(0.001).faces(">X").val(),
+             cq.Workplane("XZ").rect(2, 2).extrude(0.001).faces("<Y").val())
+    cq.exporters.export(cq.Workplane().add(list(cross)), str(b))
+    code, stdout, _ = run(capsys, "split", a, b, "-o", tmp_path / "cut.step")
+    assert code == 1 and "kept whole" in stdout and "cross each other" in stdout
+
+
+def test_the_output_is_checked_before_the_work(tmp_path, capsys, sphere_and_plate):
+    a, b = sphere_and_plate
+    code, _, err = run(capsys, "split", a, b, "-o", tmp_path / "cut.txt")
+    assert code == 2 and "unknown extension" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plate.step", "sphere.step"]

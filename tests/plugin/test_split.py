@@ -1,0 +1,49 @@
+"""surfprep.split: faces cut along their intersection curves, pieces sharing the cut edges."""
+
+from __future__ import annotations
+
+import math
+
+import cadquery as cq
+import numpy as np
+import pytest
+
+from surfprep.plugin.occ.shapes import face_area
+from surfprep.plugin.split import split
+
+
+def _sheet(plane: str, offset=(0, 0, 0)):
+    return cq.Workplane(plane).rect(2, 2).extrude(0.001).faces(">Z" if plane == "XY" else (
+        ">X" if plane == "YZ" else "<Y")).val().translate(cq.Vector(*offset))
+
+
+def test_two_crossing_sheets_become_four_pieces_around_one_edge():
+    out = split(_sheet("XY"), _sheet("YZ"))
+    report = out.report()
+    assert report["pieces"] == 4 and out.valid
+    assert out.shared_edges.get(4) == 1                   # the intersection edge: four faces
+    assert out.free_edges == 12                           # the sheets' outer borders, cut in two
+    for f in out.faces:
+        assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(4.0, rel=1e-9)
+
+
+def test_a_sphere_through_a_plate_is_cut_into_its_exact_zones():
+    radius, half = 10.0, 0.5
+    out = split(cq.Workplane().sphere(radius), cq.Workplane().box(30, 30, 2 * half).translate((0, 0, 5)))
+    assert out.valid and out.free_edges == 0
+    sphere = next(f for f in out.faces if f.operand == "a")
+    areas = sorted(face_area(p, 1e-9) for p in sphere.pieces)
+    assert len(areas) == 3
+    # the zone between the plate's faces: 2 pi R h (Archimedes), the caps likewise
+    np.testing.assert_allclose(areas, sorted([2 * math.pi * radius * 2 * half,
+                                              2 * math.pi * radius * (radius - 5.5),
+                                              2 * math.pi * radius * (radius + 4.5)]), rtol=1e-6)
+    assert out.shared_edges.get(4) == 2                   # both circles bound four faces
+
+
+def test_a_face_whose_curves_cross_is_kept_whole_with_the_reason():
+    out = split(_sheet("XY"), [_sheet("YZ"), _sheet("XZ")])
+    kept = [f for f in out.faces if f.kept is not None]
+    assert [(f.operand, f.index) for f in kept] == [("a", 0)]
+    assert "cross each other" in kept[0].kept and len(kept[0].pieces) == 1
+    assert out.report()["faces"][0]["kept_whole"] == kept[0].kept
