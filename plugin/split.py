@@ -15,6 +15,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ..algorithms.face_split import Cut, split_face
 from ..errors import OpenCascadeError, SurfprepError
 from .intersect import IntersectionResult, intersect
@@ -23,7 +25,7 @@ from .occ.faces import trimmed_face_to_occ
 from .occ.failures import describe, is_occ_failure
 from .occ.shapes import compound, count_free_edges, is_valid
 
-__all__ = ["SplitFace", "SplitResult", "split"]
+__all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split"]
 
 
 @dataclass(frozen=True)
@@ -55,6 +57,8 @@ class SplitResult:
         Number of edges by the number of faces using them (``{2: 31, 4: 1}``).
     valid : bool
         BRepCheck on every piece.
+    pieces_a, pieces_b : tuple of TopoDS_Face
+        Every face of ``a`` (of ``b``) after the cut: the pieces and the uncut faces.
     """
 
     shape: Any
@@ -64,6 +68,8 @@ class SplitResult:
     shared_edges: dict
     valid: bool
     time_s: float = field(default=0.0, compare=False)
+    pieces_a: tuple = field(default=(), repr=False, compare=False)
+    pieces_b: tuple = field(default=(), repr=False, compare=False)
 
     @property
     def geometry(self) -> Any:
@@ -150,7 +156,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
             cuts.setdefault(key, []).append(Cut(pcurve, c.curve3d))
             trimmed[key] = face.trimmed
     done: list[SplitFace] = []
-    faces = []
+    by_operand: dict[str, list] = {"a": [], "b": []}
     cut_faces = set(cuts)
     for operand, model in (("a", model_a), ("b", model_b)):
         if model is None:
@@ -158,20 +164,177 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
         for k, occ_face in enumerate(model.faces):
             key = (operand, k)
             if key not in cut_faces:
-                faces.append(occ_face)
+                by_operand[operand].append(occ_face)
                 continue
             try:
                 regions = split_face(trimmed[key], cuts[key])
                 pieces = tuple(trimmed_face_to_occ(region) for region in regions)
             except SurfprepError as exc:
                 done.append(SplitFace(operand, k, len(cuts[key]), (occ_face,), str(exc)))
-                faces.append(occ_face)
+                by_operand[operand].append(occ_face)
                 continue
             done.append(SplitFace(operand, k, len(cuts[key]), pieces))
-            faces.extend(pieces)
+            by_operand[operand].extend(pieces)
+    faces = by_operand["a"] + by_operand["b"]
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
     shape = _sew_non_manifold(faces, sew_tol) if len(faces) > 1 else compound(faces)
     valid = all(is_valid(p) for f in done for p in f.pieces)
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
-                       time.perf_counter() - started)
+                       time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]))
+
+
+#: the operations and, per operand, which pieces they keep: (of a, of b), each "in" or "out"
+#: of the other solid; "cut" also turns b's pieces over
+OPERATIONS = {"fuse": ("out", "out"), "common": ("in", "in"), "cut": ("out", "in")}
+
+
+@dataclass(frozen=True)
+class BooleanResult:
+    """A Boolean of two solids as a selection of split pieces (002 §1).
+
+    Attributes
+    ----------
+    shape : TopoDS_Shape
+        The kept pieces sewn (a solid when they close).
+    operation : str
+    split : SplitResult
+    kept : (int, int)
+        Pieces of ``a`` and of ``b`` kept.
+    volume : float
+        Of ``shape`` when it is a closed solid, else None.
+    """
+
+    shape: Any
+    operation: str
+    split: SplitResult
+    kept: tuple[int, int]
+    volume: float | None
+    valid: bool
+
+    @property
+    def geometry(self) -> Any:
+        return self.shape
+
+    def report(self) -> dict:
+        return {"operation": self.operation, "kept_pieces_a": self.kept[0], "kept_pieces_b": self.kept[1],
+                "volume": self.volume, "valid": self.valid, "split": self.split.report()}
+
+
+def _solid_of(model, tol: float):
+    """The model's solid: the one it holds, else its faces sewn (OpenCascadeError if open)."""
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+
+    from .occ.shapes import sew
+    explorer = TopExp_Explorer(model.shape, TopAbs_SOLID)
+    if explorer.More():
+        return explorer.Current()
+    shape, _ = sew(list(model.faces), tol)
+    if shape.ShapeType() != TopAbs_SOLID:
+        raise OpenCascadeError("a Boolean needs closed solids: the operand's faces do not sew closed")
+    return shape
+
+
+def _inside(piece, solid, tol: float) -> bool:
+    """Is a point inside the piece (away from its edges) inside the solid?"""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepClass import BRepClass_FaceClassifier
+    from OCP.BRepClass3d import BRepClass3d_SolidClassifier
+    from OCP.BRepTools import BRepTools
+    from OCP.gp import gp_Pnt2d
+    from OCP.TopAbs import TopAbs_IN
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(piece)
+    surface = BRep_Tool.Surface_s(piece)
+    best = None
+    for n in (5, 9, 17, 33):
+        for a in (np.arange(n) + 0.5) / n:
+            for b in (np.arange(n) + 0.5) / n:
+                uv = gp_Pnt2d(u0 + a * (u1 - u0), v0 + b * (v1 - v0))
+                if BRepClass_FaceClassifier(piece, uv, 1e-9).State() == TopAbs_IN:
+                    centred = abs(a - 0.5) + abs(b - 0.5)
+                    if best is None or centred < best[0]:
+                        best = (centred, uv)
+        if best is not None:
+            break
+    if best is None:
+        raise OpenCascadeError("no point found inside a piece to classify it")
+    point = surface.Value(best[1].X(), best[1].Y())
+    classifier = BRepClass3d_SolidClassifier(solid, point, tol)
+    return classifier.State() == TopAbs_IN
+
+
+def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method: str = "auto") -> BooleanResult:
+    """Fuse, cut (``a`` minus ``b``) or common of two solids, from their split pieces.
+
+    Every face of ``a`` and of ``b`` is cut along the intersection curves
+    (:func:`split`); each piece is classified by a point inside it against the
+    other solid, and the operation keeps (fuse) the pieces of each outside the
+    other, (common) those inside, (cut) ``a``'s outside ``b`` and ``b``'s inside
+    ``a`` turned over. The kept pieces are sewn into the result.
+
+    Raises
+    ------
+    InvalidGeometryError
+        An unknown operation.
+    OpenCascadeError
+        An operand that is not a closed solid.
+    """
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    from ..errors import InvalidGeometryError
+    from .occ.shapes import sew
+    if operation not in OPERATIONS:
+        raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
+    model_a, model_b = as_model(a), as_model(b)
+    cut = split(model_a, model_b, tol=tol, method=method)
+    size = max(model_a.size, model_b.size)
+    sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
+    solid_a, solid_b = _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)
+    keep_a, keep_b = OPERATIONS[operation]
+    chosen_a = [p for p in cut.pieces_a if _inside(p, solid_b, sew_tol) == (keep_a == "in")]
+    chosen_b = [p for p in cut.pieces_b if _inside(p, solid_a, sew_tol) == (keep_b == "in")]
+    if operation == "cut":
+        chosen_b = [p.Reversed() for p in chosen_b]
+    faces = chosen_a + chosen_b
+    if not faces:
+        return BooleanResult(compound([]), operation, cut, (0, 0), 0.0, True)
+    shape, _ = sew(faces, sew_tol)
+    solids = _solids(shape)
+    volume = None
+    if solids:
+        volume = 0.0
+        for solid in solids:
+            props = GProp_GProps()
+            BRepGProp.VolumeProperties_s(solid, props, 1e-9)          # GProp's default is 0.1 % off
+            volume += abs(float(props.Mass()))
+        shape = solids[0] if len(solids) == 1 else compound(solids)
+    return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), volume, is_valid(shape))
+
+
+def _solids(shape) -> list:
+    """The solids of a sewn result: itself, or each closed shell of a compound made solid;
+    empty when a shell stays open."""
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
+    from OCP.ShapeFix import ShapeFix_Solid
+    from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+    if shape.ShapeType() == TopAbs_SOLID:
+        return [shape]
+    out = []
+    explorer = TopExp_Explorer(shape, TopAbs_SHELL)
+    while explorer.More():
+        shell = TopoDS.Shell_s(explorer.Current())
+        explorer.Next()
+        if not BRep_Tool.IsClosed_s(shell):
+            return []
+        maker = BRepBuilderAPI_MakeSolid(shell)
+        if not maker.IsDone():
+            return []
+        fix = ShapeFix_Solid(maker.Solid())
+        fix.Perform()
+        out.append(fix.Solid())
+    return out

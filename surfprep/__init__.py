@@ -55,7 +55,7 @@ if TYPE_CHECKING:
     from .plugin.occ.edges import make_edge
     from .plugin.occ.faces import make_face
     from .plugin.reparam import ReparametrizeResult, reparametrize
-    from .plugin.split import SplitResult, split
+    from .plugin.split import BooleanResult, SplitResult, boolean, split
 
 __version__ = "0.1.0"
 
@@ -92,6 +92,8 @@ __all__ = [
     "GridResult",
     "split",
     "SplitResult",
+    "boolean",
+    "BooleanResult",
     # trivariate solids (numpy only)
     "NurbsVolume",
     # structured grids (numpy only)
@@ -135,6 +137,8 @@ _LAZY_EXPORTS = {
     "GridResult": "surfprep.plugin.grid",
     "split": "surfprep.plugin.split",
     "SplitResult": "surfprep.plugin.split",
+    "boolean": "surfprep.plugin.split",
+    "BooleanResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",

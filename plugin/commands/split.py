@@ -24,6 +24,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="intersection tolerance in mm (default 1e-6 x the faces' box diagonal)")
     parser.add_argument("--method", choices=METHODS, default="auto",
                         help="intersection method (as surfprep intersect)")
+    parser.add_argument("--boolean", choices=("fuse", "cut", "common"), default=None, metavar="OP",
+                        help="fuse, cut (A minus B) or common of two solids: write the pieces "
+                             "that operation keeps, sewn, instead of all of them")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
 
@@ -34,11 +37,23 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs(inputs, args.output, json_path=args.json_path)
     model_a = read_model(args.a, console, strict=args.strict)
     model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
-    result = split(model_a, model_b, tol=args.tol, method=args.method)
+    operation = None
+    if args.boolean is not None:
+        from ...errors import InvalidGeometryError
+        from ..split import boolean
+        if model_b is None:
+            raise InvalidGeometryError("--boolean needs two files, A and B")
+        operation = boolean(model_a, model_b, args.boolean, tol=args.tol, method=args.method)
+        result = operation.split
+    else:
+        result = split(model_a, model_b, tol=args.tol, method=args.method)
     kept = [f for f in result.faces if f.kept is not None]
-    with staged_write(result.shape, args.output, overwrite=True) as staged:
+    written_shape = result.shape if operation is None else operation.shape
+    with staged_write(written_shape, args.output, overwrite=True) as staged:
         report = {"a": str(args.a), "b": None if args.b is None else str(args.b),
                   "output": str(staged.target), **result.report()}
+        if operation is not None:
+            report["boolean"] = {k: v for k, v in operation.report().items() if k != "split"}
         report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path != STDOUT:
         for f in result.faces:
@@ -50,6 +65,10 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                       f"piece(s); edges: {uses}; {result.free_edges} free; "
                       f"{'valid' if result.valid else 'INVALID'}; {result.time_s:.2f} s, "
                       f"written to {staged.target}")
+        if operation is not None:
+            volume = "open" if operation.volume is None else f"volume {operation.volume:.10g}"
+            console.print(f"{args.boolean}: {operation.kept[0]} piece(s) of A and {operation.kept[1]} "
+                          f"of B kept, {volume}, {'valid' if operation.valid else 'INVALID'}")
         if report_path is not None:
             console.note(f"report written to {report_path}")
     return done_code(model_a, model_b, skipped=bool(kept))
@@ -65,10 +84,12 @@ COMMAND = Command(
         "surfaces cross, four pieces share one intersection edge (a non-manifold shell). A "
         "face whose curves cross each other is kept whole and named (exit 1). The report gives "
         "per face its curves and pieces, the edges by the number of faces using them, the free "
-        "edges and BRepCheck validity."),
+        "edges and BRepCheck validity. With --boolean, two solids are fused, cut or intersected "
+        "by keeping the pieces of each that lie outside (inside) the other, sewn into the result."),
     epilog=(
         "examples:\n"
         "  surfprep split wing.step fuselage.step -o cut.step\n"
+        "  surfprep split a.step b.step -o common.step --boolean common\n"
         "  surfprep split model.step -o cut.step --json r.json\n"
         "\n"
         "Lengths and tolerances are in millimetres."),

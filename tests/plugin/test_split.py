@@ -47,3 +47,29 @@ def test_a_face_whose_curves_cross_is_kept_whole_with_the_reason():
     assert [(f.operand, f.index) for f in kept] == [("a", 0)]
     assert "cross each other" in kept[0].kept and len(kept[0].pieces) == 1
     assert out.report()["faces"][0]["kept_whole"] == kept[0].kept
+
+
+@pytest.mark.parametrize("operation", ["common", "fuse", "cut"])
+def test_booleans_are_selections_of_pieces_with_the_exact_volumes(operation):
+    """A sphere (r = 10) and a 1 mm slab through it at z = 5: the common part is the
+    spherical slab pi (r^2 h - (z1^3 - z0^3) / 3); fuse and cut follow."""
+    from surfprep.plugin.split import boolean
+    r = 10.0
+    common = math.pi * (r * r * 1.0 - (5.5 ** 3 - 4.5 ** 3) / 3)
+    exact = {"common": common, "fuse": 4 / 3 * math.pi * r ** 3 + 900 - common,
+             "cut": 4 / 3 * math.pi * r ** 3 - common}[operation]
+    out = boolean(cq.Workplane().sphere(r), cq.Workplane().box(30, 30, 1).translate((0, 0, 5)), operation)
+    assert out.valid
+    # the curves are computed to 1e-6 x the model's size: the volume follows to that order
+    assert out.volume == pytest.approx(exact, rel=1e-6)
+    assert out.kept == {"common": (1, 2), "fuse": (2, 6), "cut": (2, 2)}[operation]
+    assert out.report()["operation"] == operation
+
+
+def test_a_boolean_needs_solids_and_a_known_operation():
+    from surfprep.errors import InvalidGeometryError, OpenCascadeError
+    from surfprep.plugin.split import boolean
+    with pytest.raises(InvalidGeometryError, match="unknown operation"):
+        boolean(cq.Workplane().sphere(1), cq.Workplane().box(1, 1, 1), "xor")
+    with pytest.raises(OpenCascadeError, match="closed solids"):
+        boolean(_sheet("XY"), _sheet("YZ"), "fuse")

@@ -47,3 +47,14 @@ def test_the_output_is_checked_before_the_work(tmp_path, capsys, sphere_and_plat
     code, _, err = run(capsys, "split", a, b, "-o", tmp_path / "cut.txt")
     assert code == 2 and "unknown extension" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plate.step", "sphere.step"]
+
+
+def test_boolean_common_writes_the_slab(tmp_path, capsys, sphere_and_plate):
+    a, b = sphere_and_plate
+    out, report = tmp_path / "common.step", tmp_path / "common.json"
+    code, _, err = run(capsys, "split", a, b, "-o", out, "--boolean", "common", "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())["boolean"]
+    assert data["operation"] == "common" and data["valid"]
+    assert abs(data["volume"] - 235.3576496) < 1e-3
+    assert surfprep.read(out).n_faces == 3                # the zone and the two discs
