@@ -226,30 +226,49 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None) 
             if _crossing(polylines[i], polylines[j], skip_ends=True):
                 raise InvalidGeometryError(f"cuts {i} and {j} cross each other: split them at the "
                                            "crossing first")
-    marks: list[_Mark] = []
-    closed: list[int] = []
-    for c, (cut, line) in enumerate(zip(cuts, polylines, strict=True)):
+    # each cut end: on the boundary (where), or joined to another cut's end inside the face
+    ends: dict[tuple[int, int], tuple[int, int, float] | None] = {}
+    closed_cuts = []
+    for c, line in enumerate(polylines):
         if np.linalg.norm(line[0] - line[-1]) <= eps:
-            closed.append(c)
+            closed_cuts.append(c)
             continue
         for end, point in ((0, line[0]), (1, line[-1])):
-            where = _locate(loops, point, eps)
-            if where is None:
-                raise InvalidGeometryError(f"cut {c} {'starts' if end == 0 else 'ends'} at "
-                                           f"{point.tolist()}, not on the face's boundary")
-            li, ei, t = where
+            ends[c, end] = _locate(loops, point, eps)
+    link: dict[tuple[int, int], tuple[int, int]] = {}
+    free = [key for key, where in ends.items() if where is None]
+    for key in free:
+        if key in link:
+            continue
+        point = polylines[key[0]][0 if key[1] == 0 else -1]
+        partner = next((other for other in free if other != key and other not in link
+                        and np.linalg.norm(polylines[other[0]][0 if other[1] == 0 else -1] - point) <= eps),
+                       None)
+        if partner is None:
+            raise InvalidGeometryError(f"cut {key[0]} {'starts' if key[1] == 0 else 'ends'} at "
+                                       f"{point.tolist()}, not on the face's boundary")
+        link[key], link[partner] = partner, key
+    chains = _chains(cuts, ends, link, closed_cuts)
+    marks: list[_Mark] = []
+    for k, (chain, is_closed) in enumerate(chains):
+        if is_closed:
+            continue
+        for end in (0, 1):
+            c, forward = chain[0] if end == 0 else chain[-1]
+            cut_end = (0 if forward else 1) if end == 0 else (1 if forward else 0)
+            li, ei, t = ends[c, cut_end]
             e = loops[li].edges[ei]
             frac = (t - e.t0) / (e.t1 - e.t0)
             gap = float(np.linalg.norm(curve3d_points(e, face.surface, np.array([t]))[0]
-                                       - _cut_point(cut, face, end)))
-            marks.append(_Mark(li, ei, t, c, end, ei + (1.0 - frac if e.reversed else frac), gap))
+                                       - _cut_point(cuts[c], face, cut_end)))
+            marks.append(_Mark(li, ei, t, k, end, ei + (1.0 - frac if e.reversed else frac), gap))
     seen = {}
     for m in marks:
         key = (m.loop, round(m.along / max(eps, 1e-15)))
         if key in seen:
             raise InvalidGeometryError(f"cuts {seen[key]} and {m.cut} end at the same boundary point")
         seen[key] = m.cut
-    # the cycles: traced from the runs, plus untouched loops and closed cuts
+    # the cycles: traced from the runs, plus untouched loops and closed chains
     by_loop: dict[int, list[_Mark]] = {}
     for m in marks:
         by_loop.setdefault(m.loop, []).append(m)
@@ -273,17 +292,78 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None) 
             used.add(current)
             pieces, start, stop = runs[current]
             cycle.extend(_loosened(piece, max(start.gap, stop.gap)) for piece in pieces)
-            cycle.append(_cut_edge(cuts[stop.cut], face, stop, other_end[id(stop)], stop.end == 1))
-            current = id(other_end[id(stop)])
+            far = other_end[id(stop)]
+            cycle.extend(_chain_edges(cuts, chains[stop.cut][0], face, stop.gap, far.gap,
+                                      backwards=stop.end == 1))
+            current = id(far)
         cycles.append(cycle)
     for li, loop in enumerate(loops):
         if li not in by_loop:
             cycles.append(list(loop.edges))
-    for c in closed:
-        ring = _Mark(-1, -1, 0.0, c, 0)
-        cycles.append([_cut_edge(cuts[c], face, ring, _Mark(-1, -1, 0.0, c, 1), False)])
-        cycles.append([_cut_edge(cuts[c], face, ring, _Mark(-1, -1, 0.0, c, 1), True)])
+    for chain, is_closed in chains:
+        if is_closed:
+            cycles.append(_chain_edges(cuts, chain, face, 0.0, 0.0, backwards=False))
+            cycles.append(_chain_edges(cuts, chain, face, 0.0, 0.0, backwards=True))
     return _regions(face, cycles)
+
+
+def _chains(cuts: list[Cut], ends: dict, link: dict, closed_cuts: list[int]
+            ) -> list[tuple[list[tuple[int, bool]], bool]]:
+    """Cuts joined end to end inside the face: ``([(cut, forward), ...], closed)`` each, open
+    chains running from a boundary end to a boundary end."""
+    chains: list[tuple[list[tuple[int, bool]], bool]] = [([(c, True)], True) for c in closed_cuts]
+    visited: set[int] = set(closed_cuts)
+
+    def follow(c: int, forward: bool) -> tuple[list[tuple[int, bool]], bool]:
+        chain = []
+        first = c
+        while True:
+            chain.append((c, forward))
+            visited.add(c)
+            far = (c, 1 if forward else 0)
+            if far not in link:
+                return chain, False                       # reached the boundary
+            c, end = link[far]
+            forward = end == 0
+            if c == first:
+                return chain, True                        # round a closed chain
+    for (c, end), where in ends.items():
+        if where is not None and c not in visited:
+            chains.append(follow(c, end == 0))
+    for c in range(len(cuts)):
+        if c not in visited:
+            chains.append(follow(c, True))
+    return chains
+
+
+def _chain_edges(cuts: list[Cut], chain: list[tuple[int, bool]], face: TrimmedFace, gap_start: float,
+                 gap_end: float, *, backwards: bool) -> list[TrimEdge]:
+    """The edges of a chain of cuts in order, run backwards when asked; the chain's ends
+    tolerate the gaps to the boundary, its joints the gaps between the pieces."""
+    order = list(reversed(chain)) if backwards else list(chain)
+    gap_first, gap_last = (gap_end, gap_start) if backwards else (gap_start, gap_end)
+    out = []
+    for k, (c, forward) in enumerate(order):
+        if backwards:
+            forward = not forward
+        cut = cuts[c]
+        t0, t1 = cut.range
+        probe = TrimEdge(cut.curve3d, cut.pcurve, t0, t1)
+        tolerance = max(DEFAULT_TOLERANCE, 1.01 * edge_deviation(probe, face.surface))
+        start_gap = gap_first if k == 0 else _joint_gap(cuts, order[k - 1], (c, forward), face)
+        end_gap = gap_last if k == len(order) - 1 else _joint_gap(cuts, (c, forward), order[k + 1], face)
+        at_t0, at_t1 = (start_gap, end_gap) if forward else (end_gap, start_gap)
+        out.append(TrimEdge(cut.curve3d, cut.pcurve, t0, t1, not forward, tolerance,
+                            vertex_tolerances=(max(DEFAULT_TOLERANCE, 1.01 * at_t0),
+                                               max(DEFAULT_TOLERANCE, 1.01 * at_t1))))
+    return out
+
+
+def _joint_gap(cuts: list[Cut], before: tuple[int, bool], after: tuple[int, bool], face: TrimmedFace) -> float:
+    """Distance in space between where one piece of a chain ends and the next begins."""
+    a = _cut_point(cuts[before[0]], face, 1 if before[1] else 0)
+    b = _cut_point(cuts[after[0]], face, 0 if after[1] else 1)
+    return float(np.linalg.norm(a - b))
 
 
 def _cut_point(cut: Cut, face: TrimmedFace, end: int) -> NDArray:
@@ -293,18 +373,6 @@ def _cut_point(cut: Cut, face: TrimmedFace, end: int) -> NDArray:
         return cut.curve3d.evaluate(t)[0]
     uv = cut.pcurve.evaluate(t)
     return face.surface.evaluate(uv[:, 0], uv[:, 1])[0]
-
-
-def _cut_edge(cut: Cut, face: TrimmedFace, a: _Mark, b: _Mark, backwards: bool) -> TrimEdge:
-    """The cut as an edge of a region: its tolerance the largest distance between its 3D
-    curve and its pcurve on the surface, its ends' the gaps to the boundary there."""
-    t0, t1 = cut.range
-    probe = TrimEdge(cut.curve3d, cut.pcurve, t0, t1)
-    tolerance = max(DEFAULT_TOLERANCE, 1.01 * edge_deviation(probe, face.surface))
-    at_start, at_end = (a, b) if a.end == 0 else (b, a)
-    return TrimEdge(cut.curve3d, cut.pcurve, t0, t1, backwards, tolerance,
-                    vertex_tolerances=(max(DEFAULT_TOLERANCE, 1.01 * at_start.gap),
-                                       max(DEFAULT_TOLERANCE, 1.01 * at_end.gap)))
 
 
 def _loosened(edge: TrimEdge, gap: float) -> TrimEdge:
@@ -334,9 +402,24 @@ def _regions(face: TrimmedFace, cycles: list[list[TrimEdge]]) -> list[TrimmedFac
         members[min(containing, key=lambda k: areas[k])].append(h)
     out = []
     for k in outer:
-        loops = [TrimLoop(tuple(cycles[k]))] + [TrimLoop(tuple(cycles[h])) for h in members[k]]
+        region = [cycles[k]] + [cycles[h] for h in members[k]]
+        edges = [e for cycle in region for e in cycle]
+        loops = [TrimLoop(tuple(_unpaired_seam(e, edges) for e in cycle)) for cycle in region]
         out.append(TrimmedFace(face.surface, tuple(loops), 0, face.reversed, face.name))
     return out
+
+
+def _unpaired_seam(edge: TrimEdge, edges: list[TrimEdge]) -> TrimEdge:
+    """A seam piece whose other occurrence is not in the region is a plain edge there (a
+    cut across a closed surface's seam leaves one side of it in each piece)."""
+    if edge.seam_pcurve is None:
+        return edge
+    paired = any(f is not edge and f.curve3d is edge.curve3d and f.reversed != edge.reversed
+                 and np.isclose(f.t0, edge.t0) and np.isclose(f.t1, edge.t1) for f in edges)
+    if paired:
+        return edge
+    return TrimEdge(edge.curve3d, edge.pcurve, edge.t0, edge.t1, edge.reversed, edge.tolerance, None,
+                    edge.degenerated, edge.vertex_tolerances)
 
 
 def _loop_samples(cycle: list[TrimEdge]) -> NDArray:

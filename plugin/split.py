@@ -284,7 +284,6 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     from OCP.GProp import GProp_GProps
 
     from ..errors import InvalidGeometryError
-    from .occ.shapes import sew
     if operation not in OPERATIONS:
         raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
     model_a, model_b = as_model(a), as_model(b)
@@ -300,7 +299,9 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     faces = chosen_a + chosen_b
     if not faces:
         return BooleanResult(compound([]), operation, cut, (0, 0), 0.0, True)
-    shape, _ = sew(faces, sew_tol)
+    # sewn as split() sews (OpenCascade's manifold sewing loses the seam halves of a cap
+    # cut across a sphere's seam: every edge came out degenerated)
+    shape = _sew_non_manifold(faces, sew_tol)
     solids = _solids(shape)
     volume = None
     if solids:

@@ -111,3 +111,17 @@ def test_cuts_that_cannot_be_used_are_refused():
         split_face(face, [_line((0.2, 0.3), (0.8, 1.0))])
     with pytest.raises(InvalidGeometryError, match="same boundary point"):
         split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
+
+
+def test_cuts_joined_end_to_end_inside_the_face_make_one_closed_chain():
+    """Two half circles meeting inside the face (an intersection curve cut at the other
+    surface's seam) bound one island, as the whole circle does."""
+    circle = _circle((0.5, 0.5), 0.2).pcurve
+    upper = Cut(circle.restrict(0.0, 0.5))
+    lower = Cut(circle.restrict(0.5, 1.0))
+    parts = split_face(TrimmedFace(_plane()), [upper, lower])
+    assert len(parts) == 2
+    island = min(parts, key=_area)
+    assert len(island.loops) == 1 and len(island.loops[0].edges) == 2
+    np.testing.assert_allclose(_area(island), np.pi * 0.04, rtol=1e-5)
+    _closed(island)

@@ -73,3 +73,14 @@ def test_a_boolean_needs_solids_and_a_known_operation():
         boolean(cq.Workplane().sphere(1), cq.Workplane().box(1, 1, 1), "xor")
     with pytest.raises(OpenCascadeError, match="closed solids"):
         boolean(_sheet("XY"), _sheet("YZ"), "fuse")
+
+
+def test_two_spheres_cut_across_a_seam_give_the_lens():
+    """The circle where two spheres meet crosses one sphere's seam (two curves that end on
+    it) and lies inside the other's face (the same two curves joined end to end there)."""
+    from surfprep.plugin.split import boolean
+    r, d = 5.0, 6.0
+    lens = math.pi * (4 * r + d) * (2 * r - d) ** 2 / 12
+    out = boolean(cq.Workplane().sphere(r), cq.Workplane().sphere(r).translate((d, 0, 0)), "common")
+    assert out.valid and out.volume == pytest.approx(lens, rel=1e-6)
+    assert [len(f.pieces) for f in out.split.faces] == [3, 2]      # the cap in two halves across the seam
