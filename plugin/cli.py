@@ -42,8 +42,9 @@ PROG = "surfprep"
 
 DESCRIPTION = """\
 Prepare B-spline CAD geometry for grid generation: read STEP/IGES files through
-OpenCascade, inspect how their surfaces are parametrized, convert faces to
-surfprep's NURBS types and back, cross-checked against OpenCascade."""
+OpenCascade, inspect how their surfaces are parametrized, reparametrize, heal,
+intersect and cut faces, and grid them (structured surface grids to Plot3D, CGNS
+or VTK), cross-checked against OpenCascade and Gmsh."""
 
 EPILOG = """\
 examples:
@@ -51,6 +52,8 @@ examples:
                                        parametrization quality
   surfprep info part.igs --json -      the same as JSON on stdout
   surfprep demo -o out/                the whole pipeline on a bundled sample
+  surfprep grid part.step -o part.cgns  structured grids on the four-sided faces
+  surfprep split a.step b.step -o c.step   faces cut along their intersection curves
   surfprep COMMAND --help              options of one command
 
 exit codes: 0 done; 1 done with faces skipped (entities the reader did not
