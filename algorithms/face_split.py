@@ -108,8 +108,10 @@ class _Mark:
     gap: float = 0.0               # distance in space between the boundary's point and the cut's end
 
 
-def _locate(loops: list[TrimLoop], point: NDArray, eps: float) -> tuple[int, int, float] | None:
-    """The loop, edge and edge parameter nearest to a point of the domain, within ``eps``."""
+def _locate(loops: list[TrimLoop], point: NDArray, eps: float,
+            near=lambda best: False) -> tuple[int, int, float] | None:
+    """The loop, edge and edge parameter nearest to a point of the domain: within ``eps``
+    in the parameters, or where ``near(best)`` accepts it (a test in space)."""
     best = None
     for li, loop in enumerate(loops):
         for ei, e in enumerate(loop.edges):
@@ -127,7 +129,7 @@ def _locate(loops: list[TrimLoop], point: NDArray, eps: float) -> tuple[int, int
             dist = float(np.linalg.norm(e.pcurve.evaluate(np.array([tt]))[0] - point))
             if best is None or dist < best[3]:
                 best = (li, ei, tt, dist)
-    if best is None or best[3] > eps:
+    if best is None or best[3] > eps and not near(best):
         return None
     return best[0], best[1], best[2]
 
@@ -192,7 +194,21 @@ def _runs(loop: TrimLoop, marks: list[_Mark]) -> list[tuple[list[TrimEdge], _Mar
     return runs
 
 
-def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None) -> list[TrimmedFace]:
+def _near_in_space(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, end: int, tol3d: float | None):
+    """A test that a boundary point found for a cut's end lies within ``tol3d`` of it in space."""
+    if tol3d is None:
+        return lambda best: False
+    point = _cut_point(cut, face, end)
+
+    def near(best) -> bool:
+        edge = loops[best[0]].edges[best[1]]
+        return float(np.linalg.norm(curve3d_points(edge, face.surface, np.array([best[2]]))[0] - point)) <= tol3d
+
+    return near
+
+
+def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
+               tol3d: float | None = None) -> list[TrimmedFace]:
     """The regions of a face cut along curves in its domain (see the module doc).
 
     Parameters
@@ -203,6 +219,10 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None) 
     tol : float, optional
         How close (in the parameters) a cut's end must be to the boundary, and a closed
         cut's ends to each other; default 1e-7 of the domain's span.
+    tol3d : float, optional
+        A cut's end is also on the boundary when the nearest boundary point lies within
+        this distance of it in space (model units: an intersection curve clipped to a
+        trimmed face ends on the trim to the intersection's tolerance).
 
     Returns
     -------
@@ -234,7 +254,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None) 
             closed_cuts.append(c)
             continue
         for end, point in ((0, line[0]), (1, line[-1])):
-            ends[c, end] = _locate(loops, point, eps)
+            ends[c, end] = _locate(loops, point, eps, _near_in_space(face, loops, cuts[c], end, tol3d))
     link: dict[tuple[int, int], tuple[int, int]] = {}
     free = [key for key, where in ends.items() if where is None]
     for key in free:

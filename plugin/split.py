@@ -115,7 +115,8 @@ def _sew_non_manifold(faces: list, tol: float):
     return shape
 
 
-def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "auto") -> SplitResult:
+def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "auto",
+          tool: bool = False) -> SplitResult:
     """The faces of ``a`` and ``b`` (or of ``a`` alone) cut along their intersection curves.
 
     Parameters
@@ -128,6 +129,9 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
         The intersection's tolerance (model units; its default).
     method : str
         The intersection method.
+    tool : bool
+        ``b`` only cuts: ``a``'s faces are split and returned, ``b``'s are not (a hull
+        split at a waterline by a plane larger than it).
 
     Returns
     -------
@@ -158,7 +162,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     done: list[SplitFace] = []
     by_operand: dict[str, list] = {"a": [], "b": []}
     cut_faces = set(cuts)
-    for operand, model in (("a", model_a), ("b", model_b)):
+    for operand, model in (("a", model_a), ("b", None if tool else model_b)):
         if model is None:
             continue
         for k, occ_face in enumerate(model.faces):
@@ -167,7 +171,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
                 by_operand[operand].append(occ_face)
                 continue
             try:
-                regions = split_face(trimmed[key], cuts[key])
+                regions = split_face(trimmed[key], cuts[key], tol3d=10.0 * (curves.tol or 0.0))
                 pieces = tuple(trimmed_face_to_occ(region) for region in regions)
             except SurfprepError as exc:
                 done.append(SplitFace(operand, k, len(cuts[key]), (occ_face,), str(exc)))

@@ -24,6 +24,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="intersection tolerance in mm (default 1e-6 x the faces' box diagonal)")
     parser.add_argument("--method", choices=METHODS, default="auto",
                         help="intersection method (as surfprep intersect)")
+    parser.add_argument("--tool", action="store_true",
+                        help="B only cuts: write A's faces split, not B's (a hull cut at a waterline)")
     parser.add_argument("--boolean", choices=("fuse", "cut", "common"), default=None, metavar="OP",
                         help="fuse, cut (A minus B) or common of two solids: write the pieces "
                              "that operation keeps, sewn, instead of all of them")
@@ -46,7 +48,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         operation = boolean(model_a, model_b, args.boolean, tol=args.tol, method=args.method)
         result = operation.split
     else:
-        result = split(model_a, model_b, tol=args.tol, method=args.method)
+        result = split(model_a, model_b, tol=args.tol, method=args.method, tool=args.tool)
     kept = [f for f in result.faces if f.kept is not None]
     written_shape = result.shape if operation is None else operation.shape
     with staged_write(written_shape, args.output, overwrite=True) as staged:

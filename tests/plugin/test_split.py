@@ -84,3 +84,29 @@ def test_two_spheres_cut_across_a_seam_give_the_lens():
     out = boolean(cq.Workplane().sphere(r), cq.Workplane().sphere(r).translate((d, 0, 0)), "common")
     assert out.valid and out.volume == pytest.approx(lens, rel=1e-6)
     assert [len(f.pieces) for f in out.split.faces] == [3, 2]      # the cap in two halves across the seam
+
+
+def test_a_real_hull_cut_at_a_waterline(data_dir):
+    """overture_kcs_hull_ideas.igs cut by a plane at 37 % of its depth (the plane only
+    cuts): every hull face it crosses comes out in two valid pieces of the same area."""
+    import surfprep
+    model = surfprep.read(data_dir / "overture_kcs_hull_ideas.igs")
+    xmin, ymin, zmin, xmax, ymax, zmax = model.bounding_box
+    z = zmin + 0.37 * (zmax - zmin)
+    plane = cq.Workplane("XY").rect(3 * (xmax - xmin), 3 * (ymax - ymin)).extrude(0.001).faces(">Z").val()
+    plane = plane.translate(cq.Vector((xmin + xmax) / 2, (ymin + ymax) / 2, z - 0.001))
+    out = split(model, plane, tool=True)
+    assert len(out.faces) == 6 and all(f.kept is None and len(f.pieces) == 2 for f in out.faces)
+    assert out.valid and out.shared_edges.get(4) is None          # the plane itself is not written
+    for f in out.faces:
+        whole = face_area(model.faces[f.index], 1e-9)
+        assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(whole, rel=1e-6)
+        # the pieces lie on either side of the waterline
+        from OCP.Bnd import Bnd_Box
+        from OCP.BRepBndLib import BRepBndLib
+        tops = []
+        for piece in f.pieces:
+            box = Bnd_Box()
+            BRepBndLib.AddOptimal_s(piece, box, False, False)
+            tops.append(box.CornerMax().Z())
+        assert min(tops) == pytest.approx(z, abs=1e-3 * (zmax - zmin))
