@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_readme_python_examples_run(tmp_path, monkeypatch):
-    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.DOTALL)
     assert len(blocks) >= 2
     (tmp_path / "step_samples").symlink_to(ROOT / "step_samples")
     monkeypatch.chdir(tmp_path)
@@ -25,6 +25,8 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert abs(namespace["contact"][1] - 10) < 1e-6
     assert namespace["network"].joins_before[0].max_gap > 1e-3 > 1e3 * namespace["join"].max_gap
     assert len(namespace["blocks"]) == 8 and namespace["worst"]["folded_cells"] == 0
+    assert namespace["pieces"].report()["pieces"] == 7 and namespace["pieces"].valid
+    assert abs(namespace["lens"].volume - 108.908545) < 1e-4
     assert (tmp_path / "fuselage.cgns").stat().st_size > 0
     first = namespace["wall"].points[1, 0] - namespace["wall"].points[0, 0]
     assert abs(float(np.linalg.norm(first)) - 5.0) < 5e-3

@@ -58,3 +58,12 @@ def test_boolean_common_writes_the_slab(tmp_path, capsys, sphere_and_plate):
     assert data["operation"] == "common" and data["valid"]
     assert abs(data["volume"] - 235.3576496) < 1e-3
     assert surfprep.read(out).n_faces == 3                # the zone and the two discs
+
+
+def test_tool_writes_only_the_first_models_faces(tmp_path, capsys, sphere_and_plate):
+    a, b = sphere_and_plate
+    out = tmp_path / "cut.step"
+    code, stdout, err = run(capsys, "split", a, b, "-o", out, "--tool")
+    assert code == 0, err
+    assert surfprep.read(out).n_faces == 3                # the sphere's three zones only
+    assert "face b:" not in stdout
