@@ -8,18 +8,22 @@ into, each a :class:`~surfprep.algorithms.trimmed.TrimmedFace` on the same surfa
 whose loops are made of pieces of the old loops (the same edges over shorter
 ranges) and of the cuts (each cut bounds two regions, run once each way).
 
-The arrangement is traced as a planar graph: the cuts' ends split the loops into
-runs; leaving a run at a cut's end the trace turns onto the cut (the region on the
-left of the loop stays on the left of the cut), and leaving a cut it goes on along
-the loop. Every cycle traced counter-clockwise bounds a region; clockwise cycles
-(a hole of the face, the outside of a closed cut) are holes of the smallest region
-that contains them. Cuts may not cross each other or touch the boundary elsewhere
-than at their ends (a cut with a crossing must be split there first: refused with
-the reason), and two cuts may not end at the same boundary point.
+The arrangement is traced as a planar graph: the cuts are split where they cross
+one another (crossings found on their polylines, then by Newton on the pcurves),
+their ends on the loops split the loops into runs, and cut ends that meet inside
+the face are one vertex. At each vertex the half-edges leave in the order of
+their angles; a face is traced by taking, at each vertex, the first half-edge
+clockwise from the way back, so the region stays on the left. Every cycle traced
+counter-clockwise bounds a region; clockwise cycles (a hole of the face, the
+outside of a closed cut) are holes of the smallest region that contains them. A
+cut end that is neither on the boundary nor on another cut is refused (a curve
+that stops inside a face cannot divide it), as are two cuts ending at one
+boundary point.
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,6 +110,7 @@ class _Mark:
     end: int                       # 0 the cut's start, 1 its end
     along: float = 0.0             # position along the loop (edge index + fraction in loop order)
     gap: float = 0.0               # distance in space between the boundary's point and the cut's end
+    vertex: int = -1               # its vertex in the arrangement
 
 
 def _locate(loops: list[TrimLoop], point: NDArray, eps: float,
@@ -132,23 +137,6 @@ def _locate(loops: list[TrimLoop], point: NDArray, eps: float,
     if best is None or best[3] > eps and not near(best):
         return None
     return best[0], best[1], best[2]
-
-
-def _crossing(a: NDArray, b: NDArray, skip_ends: bool) -> bool:
-    """Do two polylines cross (their end segments left out when ``skip_ends``)?"""
-    p, r = a[:-1], np.diff(a, axis=0)
-    q, s = b[:-1], np.diff(b, axis=0)
-    if skip_ends:
-        p, r, q, s = p[1:-1], r[1:-1], q[1:-1], s[1:-1]
-    if p.size == 0 or q.size == 0:
-        return False
-    rxs = r[:, None, 0] * s[None, :, 1] - r[:, None, 1] * s[None, :, 0]
-    qp = q[None, :, :] - p[:, None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (qp[..., 0] * s[None, :, 1] - qp[..., 1] * s[None, :, 0]) / rxs
-        u = (qp[..., 0] * r[:, None, 1] - qp[..., 1] * r[:, None, 0]) / rxs
-    hit = (rxs != 0) & (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
-    return bool(np.any(hit))
 
 
 def _signed_area(uv: NDArray) -> float:
@@ -215,10 +203,11 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     ----------
     face : TrimmedFace
     cuts : list of Cut
-        Open cuts from the boundary to the boundary, closed cuts inside the face.
+        Open cuts from the boundary to the boundary (or to other cuts' ends inside the
+        face), closed cuts; cuts may cross each other (they are split where they do).
     tol : float, optional
-        How close (in the parameters) a cut's end must be to the boundary, and a closed
-        cut's ends to each other; default 1e-7 of the domain's span.
+        How close (in the parameters) a cut's end must be to the boundary, and two ends
+        or crossings to be one vertex; default 1e-7 of the domain's span.
     tol3d : float, optional
         A cut's end is also on the boundary when the nearest boundary point lies within
         this distance of it in space (model units: an intersection curve clipped to a
@@ -233,157 +222,231 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     Raises
     ------
     InvalidGeometryError
-        A cut's end off the boundary, cuts crossing each other, two cuts ending at one
-        boundary point.
+        A cut's end neither on the boundary nor on another cut, two cuts ending at one
+        boundary point, cuts that overlap.
     """
     u0, u1, v0, v1 = face.surface.domain
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [_rectangle_loop(face)]
-    polylines = [cut.samples() for cut in cuts]
+    graph = _Graph(face, eps)
+    # where each cut is split: its ends and its crossings with the other cuts
+    params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]
     for i in range(len(cuts)):
         for j in range(i + 1, len(cuts)):
-            if _crossing(polylines[i], polylines[j], skip_ends=True):
-                raise InvalidGeometryError(f"cuts {i} and {j} cross each other: split them at the "
-                                           "crossing first")
-    # each cut end: on the boundary (where), or joined to another cut's end inside the face
-    ends: dict[tuple[int, int], tuple[int, int, float] | None] = {}
-    closed_cuts = []
-    for c, line in enumerate(polylines):
-        if np.linalg.norm(line[0] - line[-1]) <= eps:
-            closed_cuts.append(c)
-            continue
-        for end, point in ((0, line[0]), (1, line[-1])):
-            ends[c, end] = _locate(loops, point, eps, _near_in_space(face, loops, cuts[c], end, tol3d))
-    link: dict[tuple[int, int], tuple[int, int]] = {}
-    free = [key for key, where in ends.items() if where is None]
-    for key in free:
-        if key in link:
-            continue
-        point = polylines[key[0]][0 if key[1] == 0 else -1]
-        partner = next((other for other in free if other != key and other not in link
-                        and np.linalg.norm(polylines[other[0]][0 if other[1] == 0 else -1] - point) <= eps),
-                       None)
-        if partner is None:
-            raise InvalidGeometryError(f"cut {key[0]} {'starts' if key[1] == 0 else 'ends'} at "
-                                       f"{point.tolist()}, not on the face's boundary")
-        link[key], link[partner] = partner, key
-    chains = _chains(cuts, ends, link, closed_cuts)
+            for s, t in _crossings(cuts[i], cuts[j], eps):
+                point = cuts[i].pcurve.evaluate(np.array([s]))[0]
+                graph.vertex(point, _cut_point_at(cuts[i], face, s), _cut_point_at(cuts[j], face, t))
+                params[i].append(s)
+                params[j].append(t)
     marks: list[_Mark] = []
-    for k, (chain, is_closed) in enumerate(chains):
-        if is_closed:
-            continue
-        for end in (0, 1):
-            c, forward = chain[0] if end == 0 else chain[-1]
-            cut_end = (0 if forward else 1) if end == 0 else (1 if forward else 0)
-            li, ei, t = ends[c, cut_end]
+    for c, cut in enumerate(cuts):
+        line = cut.samples()
+        if np.linalg.norm(line[0] - line[-1]) <= eps:
+            continue                                             # closed: its ends are one vertex
+        for end, point in ((0, line[0]), (1, line[-1])):
+            where = _locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d))
+            if where is None:
+                continue                                         # an inner end: joined below
+            li, ei, t = where
             e = loops[li].edges[ei]
             frac = (t - e.t0) / (e.t1 - e.t0)
             gap = float(np.linalg.norm(curve3d_points(e, face.surface, np.array([t]))[0]
-                                       - _cut_point(cuts[c], face, cut_end)))
-            marks.append(_Mark(li, ei, t, k, end, ei + (1.0 - frac if e.reversed else frac), gap))
+                                       - _cut_point(cut, face, end)))
+            mark = _Mark(li, ei, t, c, end, ei + (1.0 - frac if e.reversed else frac), gap)
+            marks.append(mark)
+            mark.vertex = graph.vertex(point, curve3d_points(e, face.surface, np.array([t]))[0],
+                                       _cut_point(cut, face, end), boundary=True)
     seen = {}
     for m in marks:
         key = (m.loop, round(m.along / max(eps, 1e-15)))
         if key in seen:
             raise InvalidGeometryError(f"cuts {seen[key]} and {m.cut} end at the same boundary point")
         seen[key] = m.cut
-    # the cycles: traced from the runs, plus untouched loops and closed chains
+    # the cut segments between consecutive split parameters, both ways
+    for c, cut in enumerate(cuts):
+        ts = np.sort(np.clip(np.asarray(params[c], dtype=float), *cut.range))
+        width = 1e-12 * max(abs(cut.range[1] - cut.range[0]), 1.0)
+        kept = [ts[0]] + [t for t in ts[1:-1] if t - ts[0] > width and ts[-1] - t > width]
+        kept = [t for k, t in enumerate(kept) if k == 0 or t - kept[k - 1] > width] + [ts[-1]]
+        for a, b in itertools.pairwise(kept):
+            graph.cut_segment(c, cut, a, b)
+    # the boundary runs between marks, one way (the face's side)
     by_loop: dict[int, list[_Mark]] = {}
     for m in marks:
         by_loop.setdefault(m.loop, []).append(m)
-    runs = {}                                              # start mark id -> (pieces, start, stop)
     for li, ms in by_loop.items():
         for pieces, start, stop in _runs(loops[li], ms):
-            runs[id(start)] = (pieces, start, stop)
-    other_end = {}
-    for m in marks:
-        for n in marks:
-            if n is not m and n.cut == m.cut:
-                other_end[id(m)] = n
-    cycles: list[list[TrimEdge]] = []
-    used: set[int] = set()
-    for key in runs:
-        if key in used:
-            continue
-        cycle: list[TrimEdge] = []
-        current = key
-        while current not in used:
-            used.add(current)
-            pieces, start, stop = runs[current]
-            cycle.extend(_loosened(piece, max(start.gap, stop.gap)) for piece in pieces)
-            far = other_end[id(stop)]
-            cycle.extend(_chain_edges(cuts, chains[stop.cut][0], face, stop.gap, far.gap,
-                                      backwards=stop.end == 1))
-            current = id(far)
-        cycles.append(cycle)
+            graph.run(pieces, start, stop)
+    graph.check_ends()
+    cycles = graph.cycles()
     for li, loop in enumerate(loops):
         if li not in by_loop:
             cycles.append(list(loop.edges))
-    for chain, is_closed in chains:
-        if is_closed:
-            cycles.append(_chain_edges(cuts, chain, face, 0.0, 0.0, backwards=False))
-            cycles.append(_chain_edges(cuts, chain, face, 0.0, 0.0, backwards=True))
     return _regions(face, cycles)
 
 
-def _chains(cuts: list[Cut], ends: dict, link: dict, closed_cuts: list[int]
-            ) -> list[tuple[list[tuple[int, bool]], bool]]:
-    """Cuts joined end to end inside the face: ``([(cut, forward), ...], closed)`` each, open
-    chains running from a boundary end to a boundary end."""
-    chains: list[tuple[list[tuple[int, bool]], bool]] = [([(c, True)], True) for c in closed_cuts]
-    visited: set[int] = set(closed_cuts)
-
-    def follow(c: int, forward: bool) -> tuple[list[tuple[int, bool]], bool]:
-        chain = []
-        first = c
-        while True:
-            chain.append((c, forward))
-            visited.add(c)
-            far = (c, 1 if forward else 0)
-            if far not in link:
-                return chain, False                       # reached the boundary
-            c, end = link[far]
-            forward = end == 0
-            if c == first:
-                return chain, True                        # round a closed chain
-    for (c, end), where in ends.items():
-        if where is not None and c not in visited:
-            chains.append(follow(c, end == 0))
-    for c in range(len(cuts)):
-        if c not in visited:
-            chains.append(follow(c, True))
-    return chains
+def _cut_point_at(cut: Cut, face: TrimmedFace, t: float) -> NDArray:
+    """The cut's point in space at its parameter ``t``."""
+    if cut.curve3d is not None:
+        return cut.curve3d.evaluate(np.array([t]))[0]
+    uv = cut.pcurve.evaluate(np.array([t]))
+    return face.surface.evaluate(uv[:, 0], uv[:, 1])[0]
 
 
-def _chain_edges(cuts: list[Cut], chain: list[tuple[int, bool]], face: TrimmedFace, gap_start: float,
-                 gap_end: float, *, backwards: bool) -> list[TrimEdge]:
-    """The edges of a chain of cuts in order, run backwards when asked; the chain's ends
-    tolerate the gaps to the boundary, its joints the gaps between the pieces."""
-    order = list(reversed(chain)) if backwards else list(chain)
-    gap_first, gap_last = (gap_end, gap_start) if backwards else (gap_start, gap_end)
-    out = []
-    for k, (c, forward) in enumerate(order):
-        if backwards:
-            forward = not forward
-        cut = cuts[c]
-        t0, t1 = cut.range
-        probe = TrimEdge(cut.curve3d, cut.pcurve, t0, t1)
-        tolerance = max(DEFAULT_TOLERANCE, 1.01 * edge_deviation(probe, face.surface))
-        start_gap = gap_first if k == 0 else _joint_gap(cuts, order[k - 1], (c, forward), face)
-        end_gap = gap_last if k == len(order) - 1 else _joint_gap(cuts, (c, forward), order[k + 1], face)
-        at_t0, at_t1 = (start_gap, end_gap) if forward else (end_gap, start_gap)
-        out.append(TrimEdge(cut.curve3d, cut.pcurve, t0, t1, not forward, tolerance,
-                            vertex_tolerances=(max(DEFAULT_TOLERANCE, 1.01 * at_t0),
-                                               max(DEFAULT_TOLERANCE, 1.01 * at_t1))))
+def _crossings(a: Cut, b: Cut, eps: float) -> list[tuple[float, float]]:
+    """Parameters ``(s, t)`` where two cuts cross (ends that merely meet left out),
+    from their polylines then Newton on ``a(s) = b(t)``."""
+    sa, sb = np.linspace(*a.range, CUT_SAMPLES), np.linspace(*b.range, CUT_SAMPLES)
+    pa, pb = a.pcurve.evaluate(sa), b.pcurve.evaluate(sb)
+    p, r = pa[:-1], np.diff(pa, axis=0)
+    q, s = pb[:-1], np.diff(pb, axis=0)
+    rxs = r[:, None, 0] * s[None, :, 1] - r[:, None, 1] * s[None, :, 0]
+    qp = q[None, :, :] - p[:, None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (qp[..., 0] * s[None, :, 1] - qp[..., 1] * s[None, :, 0]) / rxs
+        u = (qp[..., 0] * r[:, None, 1] - qp[..., 1] * r[:, None, 0]) / rxs
+    hit = (rxs != 0) & (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
+    out: list[tuple[float, float]] = []
+    for i, j in zip(*np.nonzero(hit), strict=True):
+        x = sa[i] + t[i, j] * (sa[i + 1] - sa[i])
+        y = sb[j] + u[i, j] * (sb[j + 1] - sb[j])
+        for _ in range(20):                                  # Newton on a(x) - b(y) = 0
+            da, db = a.pcurve.derivatives(np.array([x]), 1)[0], b.pcurve.derivatives(np.array([y]), 1)[0]
+            f = da[0] - db[0]
+            jac = np.column_stack([da[1], -db[1]])
+            if abs(np.linalg.det(jac)) < 1e-300:
+                break
+            dx, dy = np.linalg.solve(jac, -f)
+            x = float(np.clip(x + dx, *a.range))
+            y = float(np.clip(y + dy, *b.range))
+            if abs(dx) + abs(dy) < 1e-15 * (1 + abs(x) + abs(y)):
+                break
+        at_end = min(abs(x - a.range[0]), abs(x - a.range[1])) * _speed(a, x) <= eps and \
+            min(abs(y - b.range[0]), abs(y - b.range[1])) * _speed(b, y) <= eps
+        if at_end:
+            continue                                         # two ends that meet: a joint, not a crossing
+        if all(abs(x - x0) > 1e-12 * (1 + abs(x)) for x0, _ in out):
+            out.append((x, y))
     return out
 
 
-def _joint_gap(cuts: list[Cut], before: tuple[int, bool], after: tuple[int, bool], face: TrimmedFace) -> float:
-    """Distance in space between where one piece of a chain ends and the next begins."""
-    a = _cut_point(cuts[before[0]], face, 1 if before[1] else 0)
-    b = _cut_point(cuts[after[0]], face, 0 if after[1] else 1)
-    return float(np.linalg.norm(a - b))
+def _speed(cut: Cut, t: float) -> float:
+    return float(np.linalg.norm(cut.pcurve.derivatives(np.array([t]), 1)[0, 1]))
+
+
+def _direction(pcurve: NurbsCurve, t: float, sign: float) -> NDArray:
+    """Unit direction of a pcurve at ``t`` run forwards (``sign`` 1) or backwards (-1); a
+    short chord where the derivative vanishes."""
+    d = sign * pcurve.derivatives(np.array([t]), 1)[0, 1]
+    n = float(np.linalg.norm(d))
+    if n > 0:
+        return d / n
+    lo, hi = pcurve.domain
+    step = 1e-6 * (hi - lo)
+    other = float(np.clip(t + sign * step, lo, hi))
+    d = pcurve.evaluate(np.array([other]))[0] - pcurve.evaluate(np.array([t]))[0]
+    return d / max(float(np.linalg.norm(d)), 1e-300)
+
+
+class _Graph:
+    """The arrangement as half-edges round vertices, traced face by face."""
+
+    def __init__(self, face: TrimmedFace, eps: float) -> None:
+        self.face = face
+        self.eps = eps
+        self.points: list[NDArray] = []          # vertex positions in (u, v)
+        self.space: list[list[NDArray]] = []     # the 3D points that meet there
+        self.boundary: list[bool] = []
+        self.half: list[dict] = []               # origin, target, edges, angle out, direction in
+
+    def vertex(self, point: NDArray, *space: NDArray, boundary: bool = False) -> int:
+        for k, q in enumerate(self.points):
+            if np.linalg.norm(q - point) <= self.eps:
+                self.space[k].extend(space)
+                self.boundary[k] = self.boundary[k] or boundary
+                return k
+        self.points.append(np.asarray(point, dtype=float))
+        self.space.append(list(space))
+        self.boundary.append(boundary)
+        return len(self.points) - 1
+
+    def _add(self, origin: int, target: int, edges: list[TrimEdge], out: NDArray, into: NDArray) -> None:
+        self.half.append({"origin": origin, "target": target, "edges": edges,
+                          "angle": float(np.arctan2(out[1], out[0])), "into": into})
+
+    def cut_segment(self, c: int, cut: Cut, a: float, b: float) -> None:
+        pa, pb = cut.pcurve.evaluate(np.array([a, b]))
+        va = self.vertex(pa, _cut_point_at(cut, self.face, a))
+        vb = self.vertex(pb, _cut_point_at(cut, self.face, b))
+        for origin, target, forward in ((va, vb, True), (vb, va, False)):
+            start, stop = (a, b) if forward else (b, a)
+            sign = 1.0 if forward else -1.0
+            edge = TrimEdge(cut.curve3d, cut.pcurve, a, b, not forward, 0.0)
+            self._add(origin, target, [("cut", c, edge)],
+                      _direction(cut.pcurve, start, sign), _direction(cut.pcurve, stop, sign))
+
+    def run(self, pieces: list[TrimEdge], start: _Mark, stop: _Mark) -> None:
+        first, last = pieces[0], pieces[-1]
+        t_first = first.t1 if first.reversed else first.t0
+        t_last = last.t0 if last.reversed else last.t1
+        self._add(start.vertex, stop.vertex, [("run", max(start.gap, stop.gap), p) for p in pieces],
+                  _direction(first.pcurve, t_first, -1.0 if first.reversed else 1.0),
+                  _direction(last.pcurve, t_last, -1.0 if last.reversed else 1.0))
+
+    def check_ends(self) -> None:
+        """Every vertex inside the face must join at least two cut segments."""
+        degree = np.zeros(len(self.points), int)
+        for h in self.half:
+            degree[h["origin"]] += 1
+        for k, d in enumerate(degree):
+            if not self.boundary[k] and d < 2:
+                raise InvalidGeometryError(f"a cut ends at {self.points[k].tolist()}, neither on the "
+                                           "face's boundary nor on another cut")
+
+    def cycles(self) -> list[list[TrimEdge]]:
+        outgoing: dict[int, list[int]] = {}
+        for k, h in enumerate(self.half):
+            outgoing.setdefault(h["origin"], []).append(k)
+        used: set[int] = set()
+        cycles = []
+        for k0 in range(len(self.half)):
+            if k0 in used:
+                continue
+            cycle: list[TrimEdge] = []
+            k = k0
+            while k not in used:
+                used.add(k)
+                h = self.half[k]
+                cycle.extend(self._edges(h))
+                back = float(np.arctan2(-h["into"][1], -h["into"][0]))
+                candidates = outgoing.get(h["target"], [])
+                # the first outgoing half-edge clockwise from the way back: the face stays on the left
+                k = min(candidates, key=lambda j: ((back - self.half[j]["angle"]) % (2 * np.pi)) or 2 * np.pi)
+            cycles.append(cycle)
+        return cycles
+
+    def _edges(self, h: dict) -> list[TrimEdge]:
+        out = []
+        gap_origin = self._gap(h["origin"])
+        gap_target = self._gap(h["target"])
+        for kind, info, edge in h["edges"]:
+            if kind == "run":
+                out.append(_loosened(edge, info))
+                continue
+            t0_end, t1_end = (gap_target, gap_origin) if edge.reversed else (gap_origin, gap_target)
+            probe = TrimEdge(edge.curve3d, edge.pcurve, edge.t0, edge.t1)
+            tolerance = max(DEFAULT_TOLERANCE, 1.01 * edge_deviation(probe, self.face.surface))
+            out.append(TrimEdge(edge.curve3d, edge.pcurve, edge.t0, edge.t1, edge.reversed, tolerance,
+                                vertex_tolerances=(max(DEFAULT_TOLERANCE, 1.01 * t0_end),
+                                                   max(DEFAULT_TOLERANCE, 1.01 * t1_end))))
+        return out
+
+    def _gap(self, k: int) -> float:
+        pts = np.array(self.space[k])
+        if len(pts) < 2:
+            return 0.0
+        return float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1)) * 2.0)
 
 
 def _cut_point(cut: Cut, face: TrimmedFace, end: int) -> NDArray:

@@ -5,8 +5,9 @@
 parameters (each curve has a pcurve on both faces) to
 :func:`~surfprep.algorithms.face_split.split_face`, rebuilds the pieces as
 OpenCascade faces and sews them (non-manifold: where two surfaces cross, four
-pieces share one intersection edge). A face whose curves cross each other, or that
-the builder refuses, is kept whole and named with the reason; nothing is dropped.
+pieces share one intersection edge). A face a curve stops inside (it cannot divide
+it), or that the builder refuses, is kept whole and named with the reason; nothing
+is dropped.
 """
 
 from __future__ import annotations

@@ -84,7 +84,7 @@ COMMAND = Command(
         "face along its curves in its own parameters (open curves from boundary to boundary, "
         "closed ones as islands) and write the pieces with the uncut faces, sewn: where two "
         "surfaces cross, four pieces share one intersection edge (a non-manifold shell). A "
-        "face whose curves cross each other is kept whole and named (exit 1). The report gives "
+        "face a curve stops inside is kept whole and named (exit 1). The report gives "
         "per face its curves and pieces, the edges by the number of faces using them, the free "
         "edges and BRepCheck validity. With --boolean, two solids are fused, cut or intersected "
         "by keeping the pieces of each that lie outside (inside) the other, sewn into the result."),

@@ -103,11 +103,31 @@ def test_cuts_through_a_hole():
         assert len(p.loops) == 1
 
 
+def test_crossing_cuts_make_four_regions():
+    parts = split_face(TrimmedFace(_plane()), [_line((0.2, 0.0), (0.8, 1.0)), _line((0.8, 0.0), (0.2, 1.0))])
+    assert len(parts) == 4
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.15, 0.15, 0.35, 0.35], atol=1e-12)
+    for p in parts:
+        _closed(p)
+
+
+def test_a_triangle_of_three_crossing_cuts_and_a_circle_across_one():
+    """Three lines pairwise crossing inside the square (7 regions) and a circle crossing one
+    line (it adds two: a lens on either side of the line)."""
+    cuts = [_line((0.1, 0.0), (0.6, 1.0)), _line((0.9, 0.0), (0.4, 1.0)), _line((0.0, 0.3), (1.0, 0.35))]
+    parts = split_face(TrimmedFace(_plane()), cuts)
+    assert len(parts) == 7
+    np.testing.assert_allclose(sum(_area(p) for p in parts), 1.0, atol=1e-12)
+    more = split_face(TrimmedFace(_plane()), [_line((0.5, 0.0), (0.5, 1.0)), _circle((0.55, 0.5), 0.2)])
+    assert len(more) == 4
+    np.testing.assert_allclose(sum(_area(p) for p in more), 1.0, atol=1e-9)
+    circle = sorted(_area(p) for p in more)[:2]
+    np.testing.assert_allclose(sum(circle), np.pi * 0.04, rtol=1e-5)
+
+
 def test_cuts_that_cannot_be_used_are_refused():
     face = TrimmedFace(_plane())
-    with pytest.raises(InvalidGeometryError, match="cross each other"):
-        split_face(face, [_line((0.2, 0.0), (0.8, 1.0)), _line((0.8, 0.0), (0.2, 1.0))])
-    with pytest.raises(InvalidGeometryError, match="not on the face's boundary"):
+    with pytest.raises(InvalidGeometryError, match="neither on the face's boundary nor on another cut"):
         split_face(face, [_line((0.2, 0.3), (0.8, 1.0))])
     with pytest.raises(InvalidGeometryError, match="same boundary point"):
         split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])

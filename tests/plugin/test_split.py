@@ -41,11 +41,22 @@ def test_a_sphere_through_a_plate_is_cut_into_its_exact_zones():
     assert out.shared_edges.get(4) == 2                   # both circles bound four faces
 
 
-def test_a_face_whose_curves_cross_is_kept_whole_with_the_reason():
+def test_a_face_whose_curves_cross_is_cut_into_four():
     out = split(_sheet("XY"), [_sheet("YZ"), _sheet("XZ")])
+    sheet = next(f for f in out.faces if f.operand == "a")
+    assert sheet.kept is None and len(sheet.pieces) == 4 and out.valid
+    assert sum(face_area(p, 1e-9) for p in sheet.pieces) == pytest.approx(4.0, rel=1e-9)
+
+
+def test_a_face_a_curve_ends_inside_is_kept_whole_with_the_reason():
+    """A fin half as wide as the plate: their curve ends inside the plate (on the fin's
+    edge): the fin is cut, the plate kept whole and named."""
+    fin = cq.Workplane("YZ").rect(1, 2).extrude(0.001).faces(">X").val()
+    out = split(_sheet("XY"), fin)
     kept = [f for f in out.faces if f.kept is not None]
     assert [(f.operand, f.index) for f in kept] == [("a", 0)]
-    assert "cross each other" in kept[0].kept and len(kept[0].pieces) == 1
+    assert "neither on the face's boundary nor on another cut" in kept[0].kept
+    assert [len(f.pieces) for f in out.faces if f.operand == "b"] == [2]
     assert out.report()["faces"][0]["kept_whole"] == kept[0].kept
 
 
