@@ -1,0 +1,53 @@
+"""Composing two trivariate solids: the curves where their boundaries meet, classification."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms.compose import compose
+from surfprep.algorithms.volume_builders import block, solid_sphere
+from surfprep.errors import InvalidGeometryError
+
+
+def test_two_balls_meet_in_one_circle_and_points_are_classified_exactly():
+    r, d = 5.0, 6.0
+    c = compose(solid_sphere(r, (0, 0, 0)), solid_sphere(r, (d, 0, 0)))
+    assert len(c.curves) >= 1
+    points = np.vstack([curve.points for _, _, curve in c.curves])
+    # the circle x = d / 2, radius sqrt(r^2 - (d/2)^2), to the tolerance
+    np.testing.assert_allclose(points[:, 0], d / 2, atol=10 * c.tol)
+    np.testing.assert_allclose(np.hypot(points[:, 1], points[:, 2]), math.sqrt(r * r - d * d / 4),
+                               atol=10 * c.tol)
+    # the whole circle, once: its points cover every angle
+    angles = np.sort(np.arctan2(points[:, 2], points[:, 1]))
+    assert np.max(np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))) < 0.5
+    rng = np.random.default_rng(7)
+    samples = rng.uniform([-6, -6, -6], [12, 6, 6], (3000, 3))
+    exact = (np.linalg.norm(samples, axis=1) <= r).astype(int) \
+        + 2 * (np.linalg.norm(samples - [d, 0, 0], axis=1) <= r).astype(int)
+    labels = c.classify(samples)
+    near = np.minimum(np.abs(np.linalg.norm(samples, axis=1) - r),
+                      np.abs(np.linalg.norm(samples - [d, 0, 0], axis=1) - r)) < 1e-6
+    assert np.array_equal(labels[~near], exact[~near])
+    assert {0, 1, 2, 3} <= set(labels.tolist())
+
+
+def test_a_ball_inside_a_block_meets_nothing():
+    c = compose(block(10.0, origin=(-5, -5, -5)), solid_sphere(2.0, (1, 1, 1)))
+    assert c.curves == ()
+    labels = c.classify([[1, 1, 1], [4, 4, 4], [20, 0, 0]])
+    assert labels.tolist() == [3, 1, 0]
+    where = c.locate([[1, 1, 1]])
+    assert where["in_a"][0] and where["in_b"][0]
+    np.testing.assert_allclose(block(10.0, origin=(-5, -5, -5)).evaluate(*where["uvw_a"][0]), [1, 1, 1],
+                               atol=1e-9)
+
+
+def test_compose_refuses_what_is_not_a_solid():
+    with pytest.raises(InvalidGeometryError, match="NurbsVolume"):
+        compose(solid_sphere(1.0), "ball")
+    with pytest.raises(InvalidGeometryError, match="tol"):
+        compose(solid_sphere(1.0), solid_sphere(1.0, (1, 0, 0)), tol=-1.0)
