@@ -44,6 +44,7 @@ from .errors import (
 from .inputs import ShapeLike
 
 if TYPE_CHECKING:
+    from .algorithms.compose import Composition, compose
     from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
     from .algorithms.reparam import ReparametrizationResult
     from .algorithms.volume import NurbsVolume
@@ -96,6 +97,8 @@ __all__ = [
     "BooleanResult",
     # trivariate solids (numpy only)
     "NurbsVolume",
+    "compose",
+    "Composition",
     # structured grids (numpy only)
     "grid_surface",
     "SurfaceGrid",
@@ -140,6 +143,8 @@ _LAZY_EXPORTS = {
     "boolean": "surfprep.plugin.split",
     "BooleanResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",
+    "compose": "surfprep.algorithms.compose",
+    "Composition": "surfprep.algorithms.compose",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",
     "Spacing": "surfprep.algorithms.grid",
