@@ -23,8 +23,7 @@ from ..errors import OpenCascadeError, SurfprepError
 from .intersect import IntersectionResult, intersect
 from .io import as_model
 from .occ.faces import trimmed_face_to_occ
-from .occ.failures import describe, is_occ_failure
-from .occ.shapes import compound, count_free_edges, is_valid
+from .occ.shapes import compound, count_free_edges, is_valid, sew
 
 __all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split"]
 
@@ -98,24 +97,6 @@ def _edge_uses(shape) -> dict:
     return out
 
 
-def _sew_non_manifold(faces: list, tol: float):
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
-    sewing = BRepBuilderAPI_Sewing(tol)
-    sewing.SetNonManifoldMode(True)
-    for f in faces:
-        sewing.Add(f)
-    try:
-        sewing.Perform()
-    except Exception as exc:
-        if not is_occ_failure(exc):
-            raise
-        raise OpenCascadeError(f"BRepBuilderAPI_Sewing failed: {describe(exc)}") from exc
-    shape = sewing.SewedShape()
-    if shape.IsNull():
-        raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")
-    return shape
-
-
 def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "auto",
           tool: bool = False) -> SplitResult:
     """The faces of ``a`` and ``b`` (or of ``a`` alone) cut along their intersection curves.
@@ -183,7 +164,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     faces = by_operand["a"] + by_operand["b"]
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
-    shape = _sew_non_manifold(faces, sew_tol) if len(faces) > 1 else compound(faces)
+    shape = sew(faces, sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
     valid = all(is_valid(p) for f in done for p in f.pieces)
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
                        time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]))
@@ -230,8 +211,6 @@ def _solid_of(model, tol: float):
     """The model's solid: the one it holds, else its faces sewn (OpenCascadeError if open)."""
     from OCP.TopAbs import TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
-
-    from .occ.shapes import sew
     explorer = TopExp_Explorer(model.shape, TopAbs_SOLID)
     if explorer.More():
         return explorer.Current()
@@ -306,7 +285,7 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
         return BooleanResult(compound([]), operation, cut, (0, 0), 0.0, True)
     # sewn as split() sews (OpenCascade's manifold sewing loses the seam halves of a cap
     # cut across a sphere's seam: every edge came out degenerated)
-    shape = _sew_non_manifold(faces, sew_tol)
+    shape = sew(faces, sew_tol, non_manifold=True)[0]
     solids = _solids(shape)
     volume = None
     if solids:

@@ -487,14 +487,6 @@ def _side_keys(block: int, side: str, dims: tuple[int, int]) -> list[tuple[int, 
 _SIDE_INDEX = {"i0": (0, 0), "i1": (0, -1), "j0": (1, 0), "j1": (1, -1)}
 
 
-def _set_side(block: NDArray, side: str, nodes: NDArray) -> None:
-    axis, index = _SIDE_INDEX[side]
-    if axis == 0:
-        block[index] = nodes
-    else:
-        block[:, index] = nodes
-
-
 def _inner_line(block: NDArray, side: str, depth: int = 1) -> NDArray:
     """The line of nodes ``depth`` steps inside a side."""
     axis, index = _SIDE_INDEX[side]

@@ -145,9 +145,15 @@ def face_area(shape: TopoDS_Shape, rel_tol: float | None = None) -> float:
     return float(props.Mass())
 
 
-def sew(faces: list[TopoDS_Shape], tol: float) -> tuple[TopoDS_Shape, BRepBuilderAPI_Sewing]:
-    """Faces sewn at ``tol`` into a shell (a solid when closed), orientations fixed."""
+def sew(faces: list[TopoDS_Shape], tol: float, *,
+        non_manifold: bool = False) -> tuple[TopoDS_Shape, BRepBuilderAPI_Sewing]:
+    """Faces sewn at ``tol`` into a shell (a solid when closed), orientations fixed.
+
+    ``non_manifold``: an edge may join more than two faces (four pieces round the edge
+    where two surfaces cross); the sewn shape is returned as the sewing makes it.
+    """
     sewing = BRepBuilderAPI_Sewing(tol)
+    sewing.SetNonManifoldMode(non_manifold)
     for f in faces:
         sewing.Add(f)
     try:
@@ -159,7 +165,7 @@ def sew(faces: list[TopoDS_Shape], tol: float) -> tuple[TopoDS_Shape, BRepBuilde
     shape = sewing.SewedShape()
     if shape.IsNull():
         raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")
-    return _shell_or_solid(shape), sewing
+    return (shape if non_manifold else _shell_or_solid(shape)), sewing
 
 
 def _shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
