@@ -29,7 +29,6 @@ from collections.abc import Sequence
 
 from ..errors import SurfprepError
 from .commands import COMMANDS, Console
-from .occ.failures import describe, is_occ_failure
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAILURE", "EXIT_ERROR"]
 
@@ -184,6 +183,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 - the CLI's last line of defence
         if args.debug:
             traceback.print_exc(file=err)
+        from .occ.failures import describe, is_occ_failure  # OCP is loaded by now if it ran
         if is_occ_failure(exc):   # an OpenCascade exception no command turned into ours
             return finish(EXIT_ERROR, f"{PROG}: error: OpenCascade failed: {describe(exc)}")
         hint = "" if args.debug else " (run with --debug for the traceback)"

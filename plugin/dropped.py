@@ -29,7 +29,7 @@ import re
 from collections import Counter
 from dataclasses import dataclass
 
-__all__ = ["DroppedEntity", "TranslationChecks", "translation_checks"]
+__all__ = ["DroppedEntity", "TranslationChecks", "dropped_report", "translation_checks"]
 
 #: entity types whose loss loses a face (OCCT type names contain one of these)
 FACE_LEVEL = ("Surface", "Face", "Shell", "Solid", "Plane", "Representation", "Brep", "Manifold",
@@ -165,3 +165,10 @@ def _labels(data: bytes, file_format: str, numbers: list[int]
             faces.setdefault(surface, []).append(f"#{int(m.group(1))} {name!r}" if name
                                                  else f"#{int(m.group(1))}")
     return labels, faces
+
+
+def dropped_report(*models) -> list[dict]:
+    """The dropped entities of ``models`` (:class:`~surfprep.plugin.io.CadModel` or None)
+    for a JSON report, each with its file's name."""
+    return [{"file": m.path.name if m.path is not None else None, **d.as_dict()}
+            for m in models if m is not None for d in m.dropped]

@@ -49,13 +49,13 @@ from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike
 from . import isolation
-from .content_checks import content_problems
 from .dropped import DroppedEntity
+from .file_format import FileFormat, check_input_file, known_suffixes, sniff_format
 from .occ.edges import make_edge
 from .occ.faces import make_face, trimmed_face_to_occ
 from .occ.failures import describe, is_occ_failure
 from .occ.shapes import FaceNames, all_faces, compound
-from .step_iges import FileFormat, Rgb, TranslatedModel, TranslationError, read_file, write_file
+from .step_iges import Rgb, TranslatedModel, TranslationError, read_file, write_file
 
 __all__ = [
     "CadModel",
@@ -74,10 +74,6 @@ __all__ = [
 #: Unit of ``CadModel.shape`` coordinates (OCCT's default working unit).
 MODEL_UNIT = "mm"
 
-_HEAD_BYTES = 4096
-_TAIL_BYTES = 2048
-_STEP_MAGIC = b"ISO-10303-21"
-_STEP_TRAILER = b"END-ISO-10303-21"
 #: seconds an isolated translation may take (the largest file of the test data, 4 MB,
 #: reads in about 1 s)
 DEFAULT_READ_TIMEOUT = 120.0
@@ -207,7 +203,7 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
         The file was read but holds no face (with ``require_faces``).
     """
     file = Path(path)
-    fmt = _check_input_file(file)
+    fmt = check_input_file(file)
     if isolate and isolation.AVAILABLE:
         translated = _translate_isolated(file, fmt, timeout)
     else:
@@ -277,87 +273,6 @@ def _translate_isolated(file: Path, fmt: FileFormat, timeout: float) -> Translat
                                f"{len(faces)} came back from the reading process")
     return TranslatedModel(shape, faces, tuple(data["face_names"]), tuple(data["face_colors"]),
                            data["length_unit"], data["used_xde"], data["checks"])
-
-
-def _check_input_file(file: Path) -> FileFormat:
-    if not file.exists():
-        raise InputFileError(f"input file {file} does not exist")
-    if file.is_dir():
-        raise InputFileError(f"input {file} is a directory, not a STEP/IGES file")
-    if not file.is_file():
-        raise InputFileError(f"input {file} is not a regular file")
-    fmt = FileFormat.from_suffix(file)
-    if fmt is None:
-        raise InputFileError(
-            f"input file {file} has unknown extension {file.suffix!r}; "
-            f"expected one of {_known_suffixes()}")
-    try:
-        size = file.stat().st_size
-        with file.open("rb") as stream:
-            head = stream.read(_HEAD_BYTES)
-            stream.seek(max(0, size - _TAIL_BYTES))
-            tail = stream.read()
-    except OSError as exc:
-        raise InputFileError(f"cannot open input file {file}: {exc.strerror or exc}") from None
-    if size == 0:
-        raise InputFileError(f"input file {file} is empty (0 bytes)")
-    content = sniff_format(head)
-    if content is None:
-        raise InputFileError(
-            f"input file {file} is not a {fmt.value} file (no {_format_signature(fmt)} "
-            "at its start): corrupt or of another type")
-    if content is not fmt:
-        raise InputFileError(
-            f"input file {file} holds {content.value} data but is named {file.suffix}; "
-            f"rename it to {content.suffixes[0]}")
-    if not _has_trailer(content, tail):
-        raise InputFileError(
-            f"{fmt.value} file {file} is truncated (no {_format_trailer(fmt)} at its end)")
-    try:
-        problems = content_problems(file.read_bytes(), fmt.value)
-    except OSError as exc:
-        raise InputFileError(f"cannot read input file {file}: {exc.strerror or exc}") from None
-    if problems:
-        raise InputFileError(f"{fmt.value} file {file} is corrupt: " + "; ".join(problems))
-    return fmt
-
-
-def _known_suffixes() -> str:
-    return ", ".join(s for fmt in FileFormat for s in fmt.suffixes)
-
-
-def _format_signature(fmt: FileFormat) -> str:
-    return ("'ISO-10303-21;' header" if fmt is FileFormat.STEP
-            else "80-column start/global section record")
-
-
-def _format_trailer(fmt: FileFormat) -> str:
-    return "'END-ISO-10303-21;' line" if fmt is FileFormat.STEP else "terminate (T) record"
-
-
-def sniff_format(head: bytes) -> FileFormat | None:
-    """The format the first bytes of a file are written in, or None if neither.
-
-    STEP (ISO 10303-21) files start with ``ISO-10303-21``; IGES files are
-    80-column records whose column 73 holds the section letter (``S`` start,
-    ``G`` global) and columns 74-80 a sequence number.
-    """
-    text = head.removeprefix(b"\xef\xbb\xbf")
-    if text.lstrip(b" \t\r\n").startswith(_STEP_MAGIC):
-        return FileFormat.STEP
-    if b"\x00" in head:
-        return None
-    first = text.lstrip(b"\r\n").split(b"\n", 1)[0].rstrip(b"\r")
-    if len(first) >= 73 and first[72:73] in (b"S", b"G") and first[73:80].strip().isdigit():
-        return FileFormat.IGES
-    return None
-
-
-def _has_trailer(fmt: FileFormat, tail: bytes) -> bool:
-    if fmt is FileFormat.STEP:
-        return _STEP_TRAILER in tail
-    lines = [ln.rstrip(b"\r") for ln in tail.split(b"\n") if ln.strip()]
-    return bool(lines) and len(lines[-1]) >= 73 and lines[-1][72:73] == b"T"
 
 
 def _healed(model: CadModel) -> CadModel:
@@ -470,7 +385,7 @@ def staged_write(obj: ShapeLike, path: str | os.PathLike, *,
     if fmt is None:
         raise OutputFileError(
             f"output file {target} has unknown extension {target.suffix!r}; "
-            f"expected one of {_known_suffixes()}")
+            f"expected one of {known_suffixes()}")
     _check_output_file(target, obj, overwrite)
     model = obj if isinstance(obj, CadModel) else CadModel.from_shape(to_shape(obj))
     if model.shape.IsNull():

@@ -16,11 +16,10 @@ afterwards.
 
 from __future__ import annotations
 
-import enum
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator, Sequence
 
 from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.IGESCAFControl import IGESCAFControl_Reader, IGESCAFControl_Writer
@@ -40,6 +39,7 @@ from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 from OCP.XCAFDoc import XCAFDoc_ColorType, XCAFDoc_DocumentTool, XCAFDoc_ShapeTool
 
 from .dropped import TranslationChecks, translation_checks
+from .file_format import FileFormat
 from .occ.shapes import FaceNames, all_faces, compound, distinct_faces
 
 __all__ = [
@@ -56,30 +56,6 @@ Rgb = tuple[float, float, float]
 _DONE = IFSelect_ReturnStatus.IFSelect_RetDone
 _SUBSHAPE_NAMES_READ = "read.stepcaf.subshapes.name"
 _SUBSHAPE_NAMES_WRITE = "write.stepcaf.subshapes.name"
-
-
-class FileFormat(enum.Enum):
-    """A CAD exchange format surfprep reads and writes."""
-
-    STEP = "STEP"
-    IGES = "IGES"
-
-    @property
-    def suffixes(self) -> tuple[str, ...]:
-        """File name extensions of the format (lower case, with the dot)."""
-        return _SUFFIXES[self]
-
-    @classmethod
-    def from_suffix(cls, path: str | Path) -> FileFormat | None:
-        """The format a file name's extension stands for (case-insensitive), or None."""
-        suffix = Path(path).suffix.lower()
-        for fmt, suffixes in _SUFFIXES.items():
-            if suffix in suffixes:
-                return fmt
-        return None
-
-
-_SUFFIXES = {FileFormat.STEP: (".step", ".stp"), FileFormat.IGES: (".igs", ".iges")}
 
 
 class TranslationError(Exception):

@@ -1,9 +1,11 @@
 """surfprep: prepare B-spline CAD geometry for grid generation and downstream CAD.
 
-The NURBS types, the trimmed-face types and the exceptions load at once; the
-OpenCascade side (``read``, ``write``, ``to_nurbs``, ``to_occ``, ``make_face``,
-the verbs ``intersect``, ``reparametrize``, ``heal`` and their result types)
-loads on first use, so numpy-only code does not pay for importing OCP.
+The exceptions load at once; everything else on first use (PEP 562): the NURBS
+and trimmed-face types with numpy and the compiled kernels, the OpenCascade side
+(``read``, ``write``, ``to_nurbs``, ``to_occ``, ``make_face``, the verbs
+``intersect``, ``reparametrize``, ``heal``... and their result types) with OCP.
+So numpy-only code does not pay for importing OCP, and ``surfprep --help`` or a
+one-line usage error pays for neither.
 
 Every verb returns a result object with the geometry (``.geometry``) and its
 plain-JSON report (``.report()``): :class:`IntersectionResult` (also the list
@@ -25,9 +27,6 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING
 
-from .algorithms import Direction, NurbsCurve, NurbsSurface
-from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
-from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
 from .errors import (
     ConversionError,
     DegenerateGeometryError,
@@ -44,6 +43,9 @@ from .errors import (
 from .inputs import ShapeLike
 
 if TYPE_CHECKING:
+    from .algorithms import Direction, NurbsCurve, NurbsSurface
+    from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
+    from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
     from .algorithms.compose import Composition, compose
     from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
     from .algorithms.reparam import ReparametrizationResult
@@ -117,9 +119,16 @@ __all__ = [
     "InvalidShapeWarning",
 ]
 
-#: Public names loaded on first use (the OpenCascade side, and what needs scipy beyond the
-#: NURBS core), and the module each comes from.
+#: Public names loaded on first use, and the module each comes from.
 _LAZY_EXPORTS = {
+    "NurbsCurve": "surfprep.algorithms",
+    "NurbsSurface": "surfprep.algorithms",
+    "Direction": "surfprep.algorithms",
+    "TrimmedFace": "surfprep.algorithms.trimmed",
+    "TrimLoop": "surfprep.algorithms.trimmed",
+    "TrimEdge": "surfprep.algorithms.trimmed",
+    "parametrization_quality": "surfprep.algorithms.parametrization",
+    "ParametrizationQuality": "surfprep.algorithms.parametrization",
     "ReparametrizationResult": "surfprep.algorithms.reparam",
     "read": "surfprep.plugin.io",
     "write": "surfprep.plugin.io",

@@ -19,15 +19,20 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from ...errors import InputFileError, OutputFileError
-from ..io import StagedFile, new_file_mode, read
+from ..dropped import dropped_report
+
+if TYPE_CHECKING:
+    from ..io import StagedFile
 
 __all__ = [
     "STDOUT",
     "Command",
     "Console",
+    "check_inputs",
+    "check_outputs",
     "done_code",
     "dropped_report",
     "publish",
@@ -140,6 +145,7 @@ def write_json_report(report: dict, destination: str | os.PathLike, console: Con
     parent = target.resolve().parent
     if not parent.is_dir():
         raise OutputFileError(f"report directory {parent} does not exist")
+    from ...algorithms.io.atomic import new_file_mode
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as stream:
@@ -189,13 +195,22 @@ def refuse_overwriting_inputs(target: Path, inputs: tuple[Path, ...]) -> None:
             raise OutputFileError(f"refusing to overwrite the input file {target}")
 
 
+def check_inputs(*paths: Path | str) -> None:
+    """Refuse a missing, empty, truncated or wrong-type STEP/IGES input now, in a fraction of
+    a second and before OpenCascade is loaded (:class:`~surfprep.errors.InputFileError`);
+    the full content check runs when the file is read."""
+    from ..file_format import check_input_file
+    for path in paths:
+        check_input_file(Path(path), content=False)
+
+
 def check_outputs(inputs: tuple[Path, ...], output: Path | None, *, plot: Path | None = None,
                   json_path: str | None = None, model: bool = True) -> None:
     """Fail before the work, not after (:class:`OutputFileError`): every output goes to an
     existing, writable folder, is not a folder itself and not one of the ``inputs``; the
     model ``output`` has a STEP/IGES extension (``model=False``: any output the caller
     checks itself, a grid file); ``--plot`` needs matplotlib."""
-    from ..step_iges import FileFormat
+    from ..file_format import FileFormat
     from .plotting import require_matplotlib
     report = None if json_path in (None, STDOUT) else Path(json_path)
     for target, what in ((output, "output"), (plot, "--plot"), (report, "--json")):
@@ -227,6 +242,8 @@ LISTED_DROPS = 3
 def read_model(path, console: Console, *, strict: bool = False, **options):
     """:func:`surfprep.read` for a command: what the translation left out is a warning
     line on stderr (an error with ``strict``), never silent."""
+    check_inputs(path)          # a bad file is refused before OpenCascade is loaded
+    from ..io import read
     model = read(path, **options)
     if model.dropped:
         listed = "; ".join(str(d) for d in model.dropped[:LISTED_DROPS])
@@ -238,12 +255,6 @@ def read_model(path, console: Console, *, strict: bool = False, **options):
             raise InputFileError(message + " (--strict)")
         console.note(f"surfprep: warning: {message}")
     return model
-
-
-def dropped_report(*models) -> list[dict]:
-    """The dropped entities of ``models`` for a JSON report, each with its file's name."""
-    return [{"file": m.path.name if m.path is not None else None, **d.as_dict()}
-            for m in models if m is not None for d in m.dropped]
 
 
 def done_code(*models, skipped: bool = False) -> int:

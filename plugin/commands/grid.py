@@ -9,7 +9,16 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import OutputFileError
-from .base import STDOUT, Command, Console, check_outputs, done_code, read_model, write_json_report
+from .base import (
+    STDOUT,
+    Command,
+    Console,
+    check_inputs,
+    check_outputs,
+    done_code,
+    read_model,
+    write_json_report,
+)
 from .plotting import pyplot, save_figure
 
 __all__ = ["COMMAND", "plot_grids"]
@@ -87,9 +96,10 @@ def _held_curves(path: Path, console: Console) -> list:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..grid import grid, grid_format
     inputs = (args.file,) + ((args.hold,) if args.hold is not None else ())
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path, model=False)
+    check_inputs(args.file)
+    from ..grid import grid, grid_format
     fmt = grid_format(args.output, args.format)
     if args.binary and fmt != "plot3d":
         raise OutputFileError("--binary is for Plot3D output only")

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
     Console,
+    check_inputs,
     check_outputs,
     done_code,
     dropped_report,
@@ -127,9 +127,11 @@ def _summary(report: dict) -> list[str]:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..heal import heal
     inputs = tuple(p for p in (args.input, args.patches) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
+    check_inputs(args.input)
+    from ..heal import heal
+    from ..io import staged_write
     model = read_model(args.input, console, strict=args.strict)
     with step_time_limit(args.job_time_limit, "an approximant") as restart:
         def progress(done: int, total: int) -> None:

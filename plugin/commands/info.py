@@ -1,246 +1,25 @@
-"""``surfprep info FILE``: what a STEP/IGES file holds, face by face."""
+"""``surfprep info FILE``: what a STEP/IGES file holds, face by face (:mod:`..describe`)."""
 
 from __future__ import annotations
 
 import argparse
-import enum
-import math
-from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from OCP.BRep import BRep_Tool
-from OCP.BRepAdaptor import BRepAdaptor_Curve
-from OCP.BRepGProp import BRepGProp
-from OCP.BRepTools import BRepTools
-from OCP.GeomAbs import GeomAbs_SurfaceType
-from OCP.GeomAdaptor import GeomAdaptor_Surface
-from OCP.GProp import GProp_GProps
-from OCP.TopoDS import TopoDS_Face
-
-from ...algorithms.parametrization import parametrization_quality
-from ...errors import NoFacesError, OpenCascadeError
-from ..io import CadModel, bounding_box
-from ..occ.failures import describe, is_occ_failure
-from ..occ.geom import surface_from_occ
-from ..occ.shapes import face_area, free_edges_of
+from ...errors import NoFacesError
 from .base import (
     STDOUT,
     Command,
     Console,
+    check_inputs,
     check_outputs,
     done_code,
-    dropped_report,
     read_model,
     write_json_report,
 )
 
-__all__ = ["COMMAND", "SurfaceKind", "FaceInfo", "describe_face", "model_report",
-           "format_table", "surface_kind", "SPLINE_KINDS"]
+__all__ = ["COMMAND"]
 
 
-class SurfaceKind(enum.Enum):
-    """Type of a face's surface, from ``GeomAdaptor_Surface.GetType``."""
-
-    PLANE = "Plane"
-    CYLINDER = "Cylinder"
-    CONE = "Cone"
-    SPHERE = "Sphere"
-    TORUS = "Torus"
-    BEZIER = "Bezier"
-    BSPLINE = "BSpline"
-    REVOLUTION = "Revolution"
-    EXTRUSION = "Extrusion"
-    OFFSET = "Offset"
-    OTHER = "Other"
-
-
-_KIND_OF = {
-    GeomAbs_SurfaceType.GeomAbs_Plane: SurfaceKind.PLANE,
-    GeomAbs_SurfaceType.GeomAbs_Cylinder: SurfaceKind.CYLINDER,
-    GeomAbs_SurfaceType.GeomAbs_Cone: SurfaceKind.CONE,
-    GeomAbs_SurfaceType.GeomAbs_Sphere: SurfaceKind.SPHERE,
-    GeomAbs_SurfaceType.GeomAbs_Torus: SurfaceKind.TORUS,
-    GeomAbs_SurfaceType.GeomAbs_BezierSurface: SurfaceKind.BEZIER,
-    GeomAbs_SurfaceType.GeomAbs_BSplineSurface: SurfaceKind.BSPLINE,
-    GeomAbs_SurfaceType.GeomAbs_SurfaceOfRevolution: SurfaceKind.REVOLUTION,
-    GeomAbs_SurfaceType.GeomAbs_SurfaceOfExtrusion: SurfaceKind.EXTRUSION,
-    GeomAbs_SurfaceType.GeomAbs_OffsetSurface: SurfaceKind.OFFSET,
-    GeomAbs_SurfaceType.GeomAbs_OtherSurface: SurfaceKind.OTHER,
-}
-#: Kinds whose own parametrization is a NURBS one, so the chord-length figure applies.
-SPLINE_KINDS = (SurfaceKind.BSPLINE, SurfaceKind.BEZIER)
-
-
-@dataclass(frozen=True)
-class FaceInfo:
-    """One row of ``surfprep info``. B-spline fields are None for other surface kinds.
-
-    ``param_quality*`` is the worst chord-length mismatch of eqs. 29.1/29.2
-    (:mod:`surfprep.algorithms.parametrization`; 1.0 = chord-length), computed on
-    the face's whole B-spline/Bezier surface; None for analytic faces, whose
-    native parametrization is not the NURBS one a conversion would produce.
-    """
-
-    index: int
-    name: str | None
-    surface_type: SurfaceKind
-    degree: tuple[int, int] | None
-    poles: tuple[int, int] | None
-    knot_spans: tuple[int, int] | None
-    rational: bool | None
-    uv_bounds: tuple[float, float, float, float]
-    area: float
-    bounding_box: tuple[float, float, float, float, float, float]
-    param_quality: float | None
-    param_quality_u: float | None
-    param_quality_v: float | None
-
-    def as_dict(self) -> dict:
-        out = asdict(self)
-        out["surface_type"] = self.surface_type.value
-        return out
-
-
-def surface_kind(adaptor: GeomAdaptor_Surface) -> SurfaceKind:
-    """The :class:`SurfaceKind` of an adapted surface."""
-    return _KIND_OF.get(adaptor.GetType(), SurfaceKind.OTHER)
-
-
-def describe_face(face: TopoDS_Face, index: int, name: str | None = None) -> FaceInfo:
-    """Surface type, B-spline data, UV bounds, area, box and parametrization figure."""
-    try:
-        geom_surface = BRep_Tool.Surface_s(face)
-        adaptor = GeomAdaptor_Surface(geom_surface)
-        kind = surface_kind(adaptor)
-        uv = tuple(float(x) for x in BRepTools.UVBounds_s(face))
-        area = face_area(face)
-        degree = poles = spans = rational = None
-        quality = None
-        if kind is SurfaceKind.BSPLINE:
-            bspline = adaptor.BSpline()
-            degree = (bspline.UDegree(), bspline.VDegree())
-            poles = (bspline.NbUPoles(), bspline.NbVPoles())
-            spans = (bspline.NbUKnots() - 1, bspline.NbVKnots() - 1)
-            rational = bool(bspline.IsURational() or bspline.IsVRational())
-            quality = parametrization_quality(surface_from_occ(bspline))
-        elif kind is SurfaceKind.BEZIER:
-            bezier = adaptor.Bezier()
-            degree = (bezier.UDegree(), bezier.VDegree())
-            poles = (bezier.NbUPoles(), bezier.NbVPoles())
-            spans = (1, 1)
-            rational = bool(bezier.IsURational() or bezier.IsVRational())
-            quality = parametrization_quality(surface_from_occ(bezier))
-    except Exception as exc:
-        if not is_occ_failure(exc):
-            raise
-        raise OpenCascadeError(f"cannot describe face {index}: {describe(exc)}") from exc
-    return FaceInfo(
-        index=index, name=name, surface_type=kind, degree=degree, poles=poles,
-        knot_spans=spans, rational=rational, uv_bounds=uv, area=area,
-        bounding_box=bounding_box(face),
-        param_quality=None if quality is None else _finite(quality.worst),
-        param_quality_u=None if quality is None else _finite(quality.worst_u),
-        param_quality_v=None if quality is None else _finite(quality.worst_v),
-    )
-
-
-def _finite(x: float) -> float | None:
-    return x if math.isfinite(x) else None
-
-
-def describe_edge(edge, index: int) -> dict:
-    """An edge that bounds no face: its curve type, length and whether it is closed."""
-    curve = BRepAdaptor_Curve(edge)
-    props = GProp_GProps()
-    BRepGProp.LinearProperties_s(edge, props)
-    kind = curve.GetType().name.removeprefix("GeomAbs_")
-    return {"index": index, "curve_type": kind, "length": float(props.Mass()),
-            "closed": bool(BRep_Tool.IsClosed_s(edge))}
-
-
-def model_report(model: CadModel, console: Console) -> dict:
-    """The ``info`` report of a model: file data and one :class:`FaceInfo` dict per face."""
-    faces = []
-    for i, (face, name) in enumerate(zip(model.faces, model.face_names)):
-        console.progress(i + 1, model.n_faces, "face")
-        faces.append(describe_face(face, i, name).as_dict())
-    x0, y0, z0, x1, y1, z1 = model.bounding_box
-    return {
-        "file": str(model.path) if model.path else None,
-        "format": model.file_format.value if model.file_format else None,
-        "declared_length_unit": model.length_unit,
-        "model_unit": model.model_unit,
-        "n_faces": model.n_faces,
-        "bounding_box": {"min": [x0, y0, z0], "max": [x1, y1, z1]},
-        "size": model.size,
-        "faces": faces,
-        "edges": [describe_edge(e, k) for k, e in enumerate(free_edges_of(model.shape))],
-        "dropped": dropped_report(model),
-        "translation_notes": [{"type": kind, "message": message, "count": count}
-                              for kind, message, count in model.translation_notes],
-    }
-
-
-# ------------------------------------------------------------------ text
-def _pair(p) -> str:
-    return "-" if p is None else f"{p[0]}x{p[1]}"
-
-
-def _quality(face: dict) -> str:
-    q = face["param_quality"]
-    if q is None:
-        return "-"
-    worse = "u" if (face["param_quality_u"] or 0) >= (face["param_quality_v"] or 0) else "v"
-    return f"{q:.3g} ({worse})"
-
-
-def _table(rows: list[tuple[str, ...]], right: set[int]) -> list[str]:
-    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
-    return ["  ".join(r[c].rjust(widths[c]) if c in right else r[c].ljust(widths[c])
-                      for c in range(len(rows[0]))).rstrip() for r in rows]
-
-
-def format_table(report: dict) -> str:
-    """The human-readable form of :func:`model_report`."""
-    faces = report["faces"]
-    n_spline = sum(f["surface_type"] in {k.value for k in SPLINE_KINDS} for f in faces)
-    lo, hi = report["bounding_box"]["min"], report["bounding_box"]["max"]
-    lines = [
-        f"file: {report['file']}",
-        f"format: {report['format']}   declared unit: {report['declared_length_unit']}   "
-        f"coordinates in: {report['model_unit']}",
-        f"faces: {report['n_faces']} ({n_spline} B-spline/Bezier)   size (bbox diagonal): "
-        f"{report['size']:.6g}",
-        "bbox: (" + ", ".join(f"{x:.6g}" for x in lo) + ") .. ("
-        + ", ".join(f"{x:.6g}" for x in hi) + ")",
-        "",
-    ]
-    header = ("#", "name", "type", "degree", "poles", "spans", "rat", "area", "param")
-    rows = [header]
-    for f in faces:
-        name = f["name"] or ""
-        rows.append((
-            str(f["index"]), name if len(name) <= 18 else name[:17] + "~", f["surface_type"],
-            _pair(f["degree"]), _pair(f["poles"]), _pair(f["knot_spans"]),
-            "-" if f["rational"] is None else ("yes" if f["rational"] else "no"),
-            f"{f['area']:.6g}", _quality(f)))
-    if faces:
-        lines += _table(rows, right={0, 7})
-    edges = report.get("edges", [])
-    if edges:
-        lines.append(f"edges bounding no face: {len(edges)}")
-        lines.append("")
-        rows = [("#", "curve", "length", "closed")]
-        rows += [(str(e["index"]), e["curve_type"], f"{e['length']:.6g}",
-                  "yes" if e["closed"] else "no") for e in edges]
-        lines += _table(rows, right={0, 2})
-    lines.append("")
-    lines.append("param: worst chord-length mismatch of eqs. 29.1/29.2 (1 = chord-length "
-                 "parametrized), worse direction in brackets; '-' for analytic faces")
-    return "\n".join(lines)
-
-
-# --------------------------------------------------------------- command
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE",
                         help="STEP (.step/.stp) or IGES (.igs/.iges) file")
@@ -253,9 +32,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs((Path(args.file),), None, json_path=args.json_path)  # before the work
+    check_inputs(args.file)
+    from ..describe import format_table, model_report
     model = read_model(args.file, console, strict=args.strict, heal=args.heal,
                        require_faces=False)
-    report = model_report(model, console)
+    report = model_report(model, progress=console.progress)
     if not report["faces"] and not report["edges"]:
         raise NoFacesError(f"{args.file} holds neither faces nor curves to list")
     if args.json_path == STDOUT:

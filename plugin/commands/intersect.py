@@ -9,11 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
     Console,
+    check_inputs,
     check_outputs,
     done_code,
     dropped_report,
@@ -204,9 +204,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..intersect import intersect
     inputs = tuple(p for p in (args.file_a, args.file_b) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
+    check_inputs(*inputs)
+    from ..intersect import intersect
+    from ..io import staged_write
     model_a = read_model(args.file_a, console, strict=args.strict)
     model_b = read_model(args.file_b, console, strict=args.strict) if args.file_b is not None \
         else None

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io import staged_write
 from .base import (
     STDOUT,
     Command,
     Console,
+    check_inputs,
     check_outputs,
     done_code,
     dropped_report,
@@ -102,10 +102,12 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..occ.geom import surface_from_occ
-    from ..reparam import reparametrize_model
     inputs = (args.file,)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
+    check_inputs(args.file)
+    from ..io import staged_write
+    from ..occ.geom import surface_from_occ
+    from ..reparam import reparametrize_model
     model = read_model(args.file, console, strict=args.strict)
     start = time.perf_counter()
     with step_time_limit(args.face_time_limit, "a face") as restart:

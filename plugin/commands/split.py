@@ -5,8 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..io import staged_write
-from .base import STDOUT, Command, Console, check_outputs, done_code, publish, read_model
+from .base import STDOUT, Command, Console, check_inputs, check_outputs, done_code, publish, read_model
 
 __all__ = ["COMMAND"]
 
@@ -34,9 +33,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ..split import split
     inputs = tuple(p for p in (args.a, args.b) if p is not None)
     check_outputs(inputs, args.output, json_path=args.json_path)
+    check_inputs(*inputs)
+    from ..io import staged_write
+    from ..split import split
     model_a = read_model(args.a, console, strict=args.strict)
     model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
     operation = None

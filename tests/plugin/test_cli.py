@@ -321,7 +321,7 @@ def test_parametrization_figure_of_occ_converted_cylinder_and_sphere():
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakeSphere
 
-    from surfprep.plugin.commands.info import SurfaceKind, describe_face
+    from surfprep.plugin.describe import SurfaceKind, describe_face
     from surfprep.plugin.io import CadModel
 
     cylinder = CadModel.from_shape(
