@@ -24,7 +24,7 @@ from OCP.TopoDS import TopoDS_Face
 
 from ..algorithms.parametrization import parametrization_quality
 from ..errors import OpenCascadeError
-from .dropped import dropped_report
+from .dropped import dropped_report, repaired_report
 from .io import CadModel, bounding_box
 from .occ.failures import describe, is_occ_failure
 from .occ.geom import surface_from_occ
@@ -177,6 +177,7 @@ def model_report(model: CadModel, *, progress: Callable[[int, int, str], None] |
         "faces": faces,
         "edges": [describe_edge(e, k) for k, e in enumerate(free_edges_of(model.shape))],
         "dropped": dropped_report(model),
+        "repaired": repaired_report(model),
         "translation_notes": [{"type": kind, "message": message, "count": count}
                               for kind, message, count in model.translation_notes],
     }

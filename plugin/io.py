@@ -49,7 +49,7 @@ from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike
 from . import isolation
-from .dropped import DroppedEntity
+from .dropped import DroppedEntity, RepairedEntity
 from .file_format import FileFormat, check_input_file, known_suffixes, sniff_format
 from .occ.edges import make_edge
 from .occ.faces import make_face, trimmed_face_to_occ
@@ -108,6 +108,8 @@ class CadModel:
         :mod:`.dropped`); empty for a model built in memory.
     translation_notes : tuple of (str, str, int)
         OCCT's other messages while reading, ``(entity type, message, count)``.
+    repaired : tuple of RepairedEntity
+        Entities whose shape OCCT changed while reading (:mod:`.dropped`).
     """
 
     shape: TopoDS_Shape
@@ -120,6 +122,7 @@ class CadModel:
     model_unit: str = field(default=MODEL_UNIT)
     dropped: tuple[DroppedEntity, ...] = ()
     translation_notes: tuple[tuple[str, str, int], ...] = ()
+    repaired: tuple[RepairedEntity, ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.faces)
@@ -215,7 +218,8 @@ def read(path: str | os.PathLike, *, heal: bool = False, isolate: bool = True,
     model = CadModel(translated.shape, translated.faces, translated.face_names,
                      translated.face_colors, translated.length_unit, file.resolve(), fmt,
                      dropped=translated.checks.dropped,
-                     translation_notes=translated.checks.notes)
+                     translation_notes=translated.checks.notes,
+                     repaired=translated.checks.repaired)
     return _healed(model) if heal else model
 
 
@@ -300,7 +304,7 @@ def _healed(model: CadModel) -> CadModel:
     return CadModel(shape, faces, tuple(names.get(f) for f in faces),
                     tuple(colors.get(f) for f in faces), model.length_unit, model.path,
                     model.file_format, dropped=model.dropped,
-                    translation_notes=model.translation_notes)
+                    translation_notes=model.translation_notes, repaired=model.repaired)
 
 
 # ==================================================================== write

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ...errors import InputFileError, OutputFileError
-from ..dropped import dropped_report
+from ..dropped import dropped_report, repaired_report
 
 if TYPE_CHECKING:
     from ..io import StagedFile
@@ -37,6 +37,7 @@ __all__ = [
     "dropped_report",
     "publish",
     "read_model",
+    "repaired_report",
     "to_jsonable",
     "write_json_report",
 ]
@@ -254,7 +255,24 @@ def read_model(path, console: Console, *, strict: bool = False, **options):
         if strict:
             raise InputFileError(message + " (--strict)")
         console.note(f"surfprep: warning: {message}")
+    if model.repaired:
+        console.note(f"surfprep: warning: {repairs_line(model)}")
     return model
+
+
+def repairs_line(model) -> str:
+    """One line saying which entities OpenCascade changed while reading ``model``: per
+    message, how many and the first labels."""
+    by_message: dict[str, list[str]] = {}
+    for r in model.repaired:
+        by_message.setdefault(r.repair, []).append(r.label)
+    parts = []
+    for message, labels in by_message.items():
+        shown = ", ".join(labels[:LISTED_DROPS]) + (", ..." if len(labels) > LISTED_DROPS else "")
+        parts.append(f"{message} ({len(labels)}: {shown})")
+    n = len(model.repaired)
+    return (f"{Path(model.path).name if model.path else 'model'}: OpenCascade changed {n} "
+            f"entit{'y' if n == 1 else 'ies'} of the file while reading it: " + "; ".join(parts))
 
 
 def done_code(*models, skipped: bool = False) -> int:

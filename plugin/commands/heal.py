@@ -18,6 +18,7 @@ from .base import (
     dropped_report,
     publish,
     read_model,
+    repaired_report,
 )
 from .plotting import pyplot, save_figure
 from .time_limit import seconds_argument, step_time_limit
@@ -140,7 +141,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                       patches=args.patches, overlap=args.overlap,
                       split_faces=args.split_faces, replace=args.replace, progress=progress)
-    report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model)}
+    report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
+              "repaired": repaired_report(model)}
     with staged_write(result.model, args.output, overwrite=True) as staged:
         report["output"] = str(staged.target)
         if args.plot is not None:

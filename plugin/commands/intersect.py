@@ -19,6 +19,7 @@ from .base import (
     dropped_report,
     publish,
     read_model,
+    repaired_report,
 )
 from .plotting import pyplot, save_figure
 from .time_limit import seconds_argument, step_time_limit
@@ -223,6 +224,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     tol = results[0].tol if results else args.tol
     report = intersection_report(results, elapsed, tol, inputs)
     report["dropped"] = dropped_report(model_a, model_b)
+    report["repaired"] = repaired_report(model_a, model_b)
     with ExitStack() as stack:
         staged = None
         if results:

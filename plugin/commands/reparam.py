@@ -18,6 +18,7 @@ from .base import (
     dropped_report,
     publish,
     read_model,
+    repaired_report,
 )
 from .plotting import pyplot, save_figure
 from .time_limit import seconds_argument, step_time_limit
@@ -122,7 +123,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         written = staged.target
         report = {"file": str(args.file), "output": str(written), "time_s": elapsed,
                   "tol": ok[0].done.result.tol if ok else args.tol,
-                  "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model)}
+                  "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model),
+                  "repaired": repaired_report(model)}
         if args.plot is not None:
             from OCP.BRep import BRep_Tool
             pairs = [(f"face {e.index}",
