@@ -6,7 +6,7 @@ To add a subcommand: write ``plugin/commands/<name>.py`` defining
 
 from __future__ import annotations
 
-from . import compose, demo, grid, heal, info, intersect, reparam, split
+from . import batch, compose, demo, grid, heal, info, intersect, reparam, split
 from .base import Command, Console
 
 __all__ = ["COMMANDS", "Command", "Console"]
@@ -14,4 +14,4 @@ __all__ = ["COMMANDS", "Command", "Console"]
 #: Every subcommand, in the order ``surfprep --help`` lists them.
 COMMANDS: tuple[Command, ...] = (info.COMMAND, demo.COMMAND, intersect.COMMAND,
                                  heal.COMMAND, reparam.COMMAND, grid.COMMAND,
-                                 split.COMMAND, compose.COMMAND)
+                                 split.COMMAND, compose.COMMAND, batch.COMMAND)

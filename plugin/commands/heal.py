@@ -21,7 +21,7 @@ from .base import (
     repaired_report,
 )
 from .plotting import pyplot, save_figure
-from .time_limit import seconds_argument, step_time_limit
+from ..time_limit import seconds_argument, step_time_limit
 
 __all__ = ["COMMAND", "plot_deviation"]
 

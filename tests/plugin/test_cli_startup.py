@@ -42,6 +42,7 @@ def _probe(*argv: str) -> dict:
     ("heal", "--help"),
     ("intersect", "--help"),
     ("grid", "--help"),
+    ("batch", "--help"),
     ("--version",),
 ])
 def test_help_loads_nothing_heavy(argv):

@@ -18,7 +18,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from ...errors import TimeLimitExceeded
+from ..errors import TimeLimitExceeded
 
 __all__ = ["REPEAT_S", "seconds_argument", "step_time_limit"]
 

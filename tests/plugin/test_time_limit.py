@@ -9,7 +9,7 @@ import time
 import pytest
 
 from surfprep.errors import TimeLimitExceeded
-from surfprep.plugin.commands.time_limit import step_time_limit
+from surfprep.plugin.time_limit import step_time_limit
 
 
 def test_a_step_over_the_limit_is_interrupted_and_the_handler_put_back():
