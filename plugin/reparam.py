@@ -423,6 +423,15 @@ class ModelFace:
     error: str | None
     time_s: float
 
+    def report(self) -> dict:
+        """Plain-JSON entry: index, name, time, ``status`` ok/skipped, error, and the
+        figures of :meth:`FaceReparametrization.report` when done."""
+        out = {"index": self.index, "name": self.name, "time_s": self.time_s,
+               "status": "ok" if self.done is not None else "skipped", "error": self.error}
+        if self.done is not None:
+            out.update(self.done.report())
+        return out
+
 
 def reparametrize_model(model, *, tol: float | None = None, faces: list[int] | None = None,
                         progress=None, **options) -> tuple[Any, list[ModelFace]]:

@@ -57,6 +57,7 @@ if TYPE_CHECKING:
     from .plugin.io import CadModel, FileFormat, read, write
     from .plugin.occ.edges import make_edge
     from .plugin.occ.faces import make_face
+    from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
     from .plugin.split import BooleanResult, SplitResult, boolean, split
 
@@ -83,6 +84,8 @@ __all__ = [
     "make_face",
     "make_edge",
     # the verbs and their results
+    "prepare",
+    "PrepareResult",
     "intersect",
     "IntersectionResult",
     "FaceIntersection",
@@ -138,6 +141,8 @@ _LAZY_EXPORTS = {
     "to_occ": "surfprep.plugin.convert",
     "make_face": "surfprep.plugin.occ.faces",
     "make_edge": "surfprep.plugin.occ.edges",
+    "prepare": "surfprep.plugin.prepare",
+    "PrepareResult": "surfprep.plugin.prepare",
     "intersect": "surfprep.plugin.intersect",
     "IntersectionResult": "surfprep.plugin.intersect",
     "FaceIntersection": "surfprep.plugin.intersect",

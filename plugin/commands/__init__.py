@@ -6,12 +6,12 @@ To add a subcommand: write ``plugin/commands/<name>.py`` defining
 
 from __future__ import annotations
 
-from . import batch, compose, demo, grid, heal, info, intersect, reparam, split
+from . import batch, compose, demo, grid, heal, info, intersect, prepare, reparam, split
 from .base import Command, Console
 
 __all__ = ["COMMANDS", "Command", "Console"]
 
 #: Every subcommand, in the order ``surfprep --help`` lists them.
-COMMANDS: tuple[Command, ...] = (info.COMMAND, demo.COMMAND, intersect.COMMAND,
+COMMANDS: tuple[Command, ...] = (info.COMMAND, demo.COMMAND, prepare.COMMAND, intersect.COMMAND,
                                  heal.COMMAND, reparam.COMMAND, grid.COMMAND,
                                  split.COMMAND, compose.COMMAND, batch.COMMAND)

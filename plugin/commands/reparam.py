@@ -23,19 +23,10 @@ from .base import (
 from .plotting import pyplot, save_figure
 from ..time_limit import seconds_argument, step_time_limit
 
-__all__ = ["COMMAND", "face_entry", "plot_isolines"]
+__all__ = ["COMMAND", "plot_isolines"]
 
 #: Isoparametric lines per direction in the plot, and faces plotted at most.
 PLOT_LINES, PLOT_FACES = 16, 4
-
-
-def face_entry(entry) -> dict:
-    """One face of the JSON report."""
-    out = {"index": entry.index, "name": entry.name, "time_s": entry.time_s,
-           "status": "ok" if entry.done is not None else "skipped", "error": entry.error}
-    if entry.done is not None:
-        out.update(entry.done.report())
-    return out
 
 
 def _isolines(surface, n: int = PLOT_LINES, samples: int = 120) -> list[np.ndarray]:
@@ -123,7 +114,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         written = staged.target
         report = {"file": str(args.file), "output": str(written), "time_s": elapsed,
                   "tol": ok[0].done.result.tol if ok else args.tol,
-                  "faces": [face_entry(e) for e in entries], "dropped": dropped_report(model),
+                  "faces": [e.report() for e in entries], "dropped": dropped_report(model),
                   "repaired": repaired_report(model)}
         if args.plot is not None:
             from OCP.BRep import BRep_Tool

@@ -36,6 +36,7 @@ from .failures import describe, is_occ_failure
 __all__ = [
     "FaceNames",
     "all_faces",
+    "area_and_centroid",
     "boundary_edge_points",
     "check_valid",
     "compound",
@@ -143,6 +144,15 @@ def face_area(shape: TopoDS_Shape, rel_tol: float | None = None) -> float:
         props = GProp_GProps()
         BRepGProp.SurfaceProperties_s(shape, props)
     return float(props.Mass())
+
+
+def area_and_centroid(shape: TopoDS_Shape) -> tuple[float, tuple[float, float, float]]:
+    """Area and centre of area of a face or of all faces of a shape (OpenCascade's
+    fixed-order Gauss integration, as :func:`face_area` without ``rel_tol``)."""
+    props = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, props)
+    c = props.CentreOfMass()
+    return float(props.Mass()), (c.X(), c.Y(), c.Z())
 
 
 def sew(faces: list[TopoDS_Shape], tol: float, *,
