@@ -109,9 +109,11 @@ def _direction(side: str) -> int:
 def match_sides(regions: list[NurbsSurface | Region], *, gap: float) -> list[Interface]:
     """Sides of different blocks (or of one closed surface) that are one edge.
 
-    Two sides match when their samples at equal fractions of their parameters
-    (in the same or the opposite direction) are within ``gap`` of each other's
-    curve; collapsed sides never match. Each side matches at most once (the
+    Two sides match when their samples at equal fractions of their arc length (in
+    the same or the opposite direction) are within ``gap`` of each other: equal
+    fractions of the *parameters* would put the samples of one edge at different
+    places on two faces parametrized differently along it (a reparametrized face
+    beside one that is not). Collapsed sides never match. Each side matches at most once (the
     first one found, in block order).
 
     Parameters
@@ -126,7 +128,7 @@ def match_sides(regions: list[NurbsSurface | Region], *, gap: float) -> list[Int
     samples, lengths = {}, {}
     for b, region in enumerate(regions):
         for name, side in region.sides.items():
-            pts = side.points(np.linspace(0.0, 1.0, MATCH_SAMPLES))
+            pts = side.points(side.at_fractions(np.linspace(0.0, 1.0, MATCH_SAMPLES)))
             samples[b, name] = pts
             lengths[b, name] = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
     keys = [k for k in samples if lengths[k] > gap]

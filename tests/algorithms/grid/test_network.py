@@ -26,6 +26,28 @@ def _quarters(flip_last: bool = False) -> list[NurbsSurface]:
     return [a1, a2, b1, _flip_u(b2) if flip_last else b2]
 
 
+def _plane_strip(y0: float, y1: float, middle_x: float) -> NurbsSurface:
+    """The rectangle [0, 1] x [y0, y1] of the plane z = 0, quadratic in u with its middle
+    control column at x = ``middle_x``: the same sides as a bilinear patch, another speed
+    along them (0.5 in u is x = 0.5 only for middle_x = 0.5)."""
+    x = np.array([0.0, middle_x, 1.0])
+    pts = np.zeros((3, 2, 3))
+    pts[:, :, 0] = x[:, None]
+    pts[:, :, 1] = [y0, y1]
+    return NurbsSurface(pts, [0, 0, 0, 1, 1, 1], [0, 0, 1, 1], 2, 1)
+
+
+def test_a_side_parametrized_otherwise_still_matches():
+    """A shared edge runs at another speed on each face (one face reparametrized, its
+    neighbour not): the sides are one edge, matched at equal fractions of arc length."""
+    a, b = _plane_strip(0.0, 1.0, 0.5), _plane_strip(1.0, 2.0, 0.1)
+    mid_a, mid_b = a.evaluate(0.5, 1.0), b.evaluate(0.5, 1.0)
+    assert np.linalg.norm(mid_a - mid_b) > 0.1              # equal parameters, other places
+    interfaces = match_sides([a, b], gap=1e-9)
+    assert [(f.block, f.side, f.other, f.other_side, f.reversed) for f in interfaces] == [
+        (0, "j1", 1, "j0", False)]
+
+
 @pytest.mark.parametrize("flip_last", [False, True])
 def test_shared_sides_are_found_in_either_direction(flip_last):
     interfaces = match_sides(_quarters(flip_last), gap=1e-9)
