@@ -12,9 +12,12 @@ Steps (later features append theirs to :func:`run_demo`):
 3. rebuild each face on the converted surface (with its trimming loops through
    :mod:`surfprep.plugin.occ.faces`, or with natural boundaries if that fails),
    write them to ``OUTDIR/<sample>-rebuilt.step`` and read that file back;
-4. grid every four-sided face (:func:`surfprep.grid`: point-matched blocks, elliptic
-   refinement on the surface metric) and write ``OUTDIR/<sample>-grid.xyz`` (Plot3D);
-5. write ``OUTDIR/<sample>-report.json`` and print a summary.
+4. prepare the model (:func:`surfprep.prepare`: heal, intersect, reparametrize, and
+   grid every four-sided face with point-matched blocks refined on the surface
+   metric), write ``OUTDIR/<sample>-prepared.step`` (read back) and
+   ``OUTDIR/<sample>-grid.xyz`` (Plot3D);
+5. write ``OUTDIR/<sample>-report.json`` and ``OUTDIR/<sample>-report.html`` (the
+   model in a 3-D view, the tables) and print a summary.
 """
 
 from __future__ import annotations
@@ -40,9 +43,17 @@ from .occ.faces import face_to_nurbs, make_face, trimmed_face_to_occ
 from .occ.geom import surface_from_occ, surface_to_occ
 from .occ.shapes import compound, face_area
 from .occ_reference import evaluate_surface
+from .prepare import PrepareResult, prepare
+from .prepare_report import write_prepare_report
 
-__all__ = ["bundled_sample", "samples_dir", "run_demo", "FaceRoundTrip", "GRID_SIZE",
-           "DEVIATION_TOLERANCE"]
+__all__ = [
+    "DEVIATION_TOLERANCE",
+    "GRID_SIZE",
+    "FaceRoundTrip",
+    "bundled_sample",
+    "run_demo",
+    "samples_dir",
+]
 
 #: Points per direction of the deviation grid on each face.
 GRID_SIZE = 50
@@ -179,7 +190,9 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
         written = write(rebuilt_model, step_path, overwrite=True)
         reread_faces = read(written).n_faces
 
-    grid_report, grid_ok = _grid_step(model, outdir / f"{stem}-grid.xyz", inputs, console)
+    prepared, prepare_report = _prepare_step(model, outdir, stem, inputs, console)
+    grid_report = prepare_report["grid"]
+    grid_ok = grid_report.get("worst", {}).get("folded_cells", 0) == 0
 
     tolerance = DEVIATION_TOLERANCE * model.size
     worst_eval = max((t.max_dev_nurbs_vs_occ for t in trips), default=0.0)
@@ -189,6 +202,9 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
         "rebuilt_surface_matches_occ": worst_rebuilt <= tolerance,
         "rebuilt_file_face_count": reread_faces == len(rebuilt_faces),
         "grid_without_folds": grid_ok,
+        "no_stage_failed": all(st.status != "failed" for st in prepared.stages),
+        "prepared_file_face_count":
+            prepare_report["prepared_step_faces_read_back"] == prepared.model.n_faces,
     }
     quality = [(f["param_quality"], f["index"]) for f in info["faces"]
                if f["param_quality"] is not None]
@@ -202,9 +218,15 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
             "max_dev_rebuilt_vs_occ": worst_rebuilt,
             "faces": [asdict(t) for t in trips],
         },
+        "prepare": prepared.report(),
         "grid": grid_report,
         "outputs": {"rebuilt_step": str(written) if written else None,
                     "rebuilt_step_faces_read_back": reread_faces,
+                    "prepared_step": prepare_report["prepared_step"],
+                    "prepared_step_faces_read_back":
+                        prepare_report["prepared_step_faces_read_back"],
+                    "grid": grid_report.get("output"),
+                    "html_report": prepare_report["html_report"],
                     "report": str(report_path.resolve())},
         "checks": checks,
         "seconds": round(time.perf_counter() - started, 3),
@@ -225,6 +247,10 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
     if written:
         console.print(f"  rebuilt faces ({n_trimmed} trimmed, {len(trips) - n_trimmed} "
                       f"natural boundary): {written} ({reread_faces} faces read back)")
+    console.print("  surfprep prepare (heal, intersect, reparametrize, grid):")
+    for stage in prepared.stages:
+        console.print(f"    {stage.line()}")
+    console.print(f"  prepared model: {prepare_report['prepared_step']}")
     if grid_report.get("output"):
         worst = grid_report["worst"]
         console.print(f"  structured grid: {grid_report['blocks']} block(s), point-matched on "
@@ -234,26 +260,36 @@ def run_demo(source: Path, outdir: Path, console: Console) -> tuple[dict, bool]:
     else:
         console.print(f"  structured grid: none ({grid_report.get('reason')})")
     console.print(f"  report: {report_path.resolve()}")
+    console.print(f"  look at it: {prepare_report['html_report']} (open it in a browser)")
     failed = [name for name, ok in checks.items() if not ok]
     if failed:
         console.note(f"surfprep demo: check failed: {', '.join(failed)}")
     return report, not failed
 
 
-def _grid_step(model: CadModel, target: Path, inputs, console: Console) -> tuple[dict, bool]:
-    """Grid the four-sided faces (elliptic, default sizes) and write Plot3D to ``target``."""
-    from .grid import grid
-    refuse_overwriting_inputs(target, inputs)
-    console.progress(0, 1, "grid")
-    try:
-        result = grid(model)
-    except SurfprepError as exc:
-        return {"output": None, "reason": str(exc)}, True
-    written = result.write(target)
-    console.progress(1, 1, "grid")
-    report = result.report()
-    worst = report["worst"]
-    return ({"output": str(written), "blocks": len(result.blocks),
-             "interfaces": len(result.network.interfaces), "worst": worst,
-             "skipped": report["skipped"], "time_s": result.time_s},
-            worst["folded_cells"] == 0)
+def _prepare_step(model: CadModel, outdir: Path, stem: str, inputs, console: Console
+                  ) -> tuple[PrepareResult, dict]:
+    """:func:`surfprep.prepare` on the model with a grid (elliptic, default sizes): the
+    prepared model to ``<stem>-prepared.step`` (read back), the blocks to
+    ``<stem>-grid.xyz`` (Plot3D), the HTML report to ``<stem>-report.html``."""
+    step_path, grid_path = outdir / f"{stem}-prepared.step", outdir / f"{stem}-grid.xyz"
+    for target in (step_path, grid_path):
+        refuse_overwriting_inputs(target, inputs)
+    html_path = outdir / f"{stem}-report.html"
+    refuse_overwriting_inputs(html_path, inputs)
+    result = prepare(model, heal="G0", grid=True,
+                     progress=lambda stage, done, total: console.progress(done, total, stage))
+    written = write(result.model, step_path, overwrite=True)
+    out = {"prepared_step": str(written), "prepared_step_faces_read_back": read(written).n_faces,
+           "html_report": str(write_prepare_report(result, html_path,
+                                                   title=f"surfprep demo: {stem}"))}
+    grid_stage = result.stage("grid")
+    if result.grid is None:
+        out["grid"] = {"output": None, "reason": grid_stage.reason}
+        return result, out
+    grid_written = result.grid.write(grid_path)
+    report = grid_stage.report
+    out["grid"] = {"output": str(grid_written), "blocks": len(result.grid.blocks),
+                   "interfaces": len(result.grid.network.interfaces), "worst": report["worst"],
+                   "skipped": report["skipped"], "time_s": result.grid.time_s}
+    return result, out

@@ -55,6 +55,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              f"(default {DEFAULT_STEP_TIME_LIMIT:g})")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
+    parser.add_argument("--report", type=Path, metavar="HTML",
+                        help="write a self-contained HTML report: the model in a 3-D view "
+                             "(faces by what was done to them, curves, grids by skewness) "
+                             "and every stage's tables")
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
@@ -62,6 +66,11 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     check_outputs(inputs, args.output, json_path=args.json_path)
     if args.curves is not None:
         check_outputs(inputs, args.curves)
+    if args.report is not None:
+        check_outputs(inputs, args.report, model=False)
+        if args.report.suffix.lower() not in (".html", ".htm"):
+            raise OutputFileError(f"--report {args.report}: an HTML report is written to a "
+                                  ".html file")
     if args.grid is not None:
         check_outputs(inputs, args.grid, model=False)
     elif args.dims is not None or args.size is not None:
@@ -86,6 +95,9 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     if args.curves is not None and result.curves:
         edges = [e for c in result.curves for e in c.to_edges()]
         outputs["curves"] = str(write(edges, args.curves, overwrite=True))
+    if args.report is not None:
+        from ..prepare_report import write_prepare_report
+        outputs["report"] = str(write_prepare_report(result, args.report))
     with staged_write(result.model, args.output, overwrite=True) as staged:
         outputs["model"] = str(staged.target)
         report["outputs"] = outputs
@@ -123,6 +135,7 @@ COMMAND = Command(
         "  surfprep prepare part.step -o ready.step\n"
         "  surfprep prepare hull.igs -o ready.step --heal G1 --grid hull.cgns --size 50\n"
         "  surfprep prepare part.step -o ready.step --no-intersect --json report.json\n"
+        "  surfprep prepare part.step -o ready.step --grid part.xyz --report part.html\n"
         "\n"
         "Lengths and tolerances are in millimetres."),
     add_arguments=_add_arguments,

@@ -210,9 +210,14 @@ def test_demo_writes_step_and_report(capsys, tmp_path):
     report_path = outdir / "occt_fuselage-report.json"
     assert step.is_file() and report_path.is_file()
     grid = outdir / "occt_fuselage-grid.xyz"
-    assert sorted(p.name for p in outdir.iterdir()) == sorted([step.name, report_path.name, grid.name])
+    prepared = outdir / "occt_fuselage-prepared.step"
+    page = outdir / "occt_fuselage-report.html"
+    assert sorted(p.name for p in outdir.iterdir()) == sorted(
+        [step.name, report_path.name, grid.name, prepared.name, page.name])
     report = json.loads(report_path.read_text())
     assert all(report["checks"].values())
+    assert [s["status"] for s in report["prepare"]["stages"]] == ["done"] * 4
+    assert report["outputs"]["prepared_step_faces_read_back"] == 8
     assert report["grid"]["blocks"] == 8 and report["grid"]["interfaces"] == 14
     assert report["grid"]["worst"]["folded_cells"] == 0
     assert report["info"]["n_faces"] == 8
@@ -271,8 +276,7 @@ def test_console_script_error_exit_code(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["occt_k1_catia_debis.stp", "pyiges_impeller_solidworks.igs",
-                                  "occt_cornetta.stp"])
+@pytest.mark.parametrize("name", ["occt_k1_catia_debis.stp", "occt_deflettore_solidedge.igs"])
 def test_demo_on_real_files(capsys, tmp_path, name, data_dir):
     path = data_dir / name
     code, _, err = run(capsys, "demo", "--input", str(path), "-o", str(tmp_path))

@@ -117,12 +117,15 @@ def test_healed_faces_are_told_apart():
 
 def test_the_command_writes_model_grid_and_report(capsys, tmp_path):
     out, grid, report = tmp_path / "ready.step", tmp_path / "ready.xyz", tmp_path / "r.json"
+    page = tmp_path / "ready.html"
     code, stdout, err = run(capsys, "prepare", FUSELAGE, "-o", out, "--grid", grid,
-                            "--dims", 5, 6, "--no-intersect", "--json", report)
+                            "--dims", 5, 6, "--no-intersect", "--json", report, "--report", page)
     assert code == 0, err
     assert "reparam: done" in stdout and "intersect: skipped: not asked for" in stdout
     data = json.loads(report.read_text())
-    assert data["outputs"] == {"grid": str(grid.resolve()), "model": str(out.resolve())}
+    assert data["outputs"] == {"grid": str(grid.resolve()), "model": str(out.resolve()),
+                               "report": str(page.resolve())}
+    assert "surfprep prepare: occt_fuselage.stp" in page.read_text()
     assert surfprep.read(out).n_faces == 8
     assert grid.stat().st_size > 0
 
@@ -130,6 +133,7 @@ def test_the_command_writes_model_grid_and_report(capsys, tmp_path):
 @pytest.mark.parametrize("argv, words", [
     (("--dims", "5", "6"), "--dims and --size are for --grid"),
     (("--grid", "out.txt"), "extension"),
+    (("--report", "out.txt"), "HTML report"),
 ])
 def test_the_command_refuses_before_the_work(capsys, tmp_path, argv, words):
     code, _, err = run(capsys, "prepare", FUSELAGE, "-o", tmp_path / "x.step",
