@@ -28,5 +28,9 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert namespace["pieces"].report()["pieces"] == 7 and namespace["pieces"].valid
     assert abs(namespace["lens"].volume - 108.908545) < 1e-4
     assert (tmp_path / "fuselage.cgns").stat().st_size > 0
+    assert namespace["status"] == ("reparametrized",) * 8
+    assert [line.split(":")[0] for line in namespace["lines"]] == ["heal", "intersect", "reparam",
+                                                                   "grid"]
+    assert (tmp_path / "fuselage-ready.step").stat().st_size > 0
     first = namespace["wall"].points[1, 0] - namespace["wall"].points[0, 0]
     assert abs(float(np.linalg.norm(first)) - 5.0) < 5e-3

@@ -141,3 +141,15 @@ def test_the_command_refuses_before_the_work(capsys, tmp_path, argv, words):
     assert code == 2
     assert err.strip().startswith("surfprep: error:") and words in err
     assert not (tmp_path / "x.step").exists()
+
+
+def test_a_step_past_its_time_limit_is_stopped_and_reported(fuselage):
+    """Every face given 10 ms: each reparametrization is stopped, the face kept as it
+    was with the reason, and the chain finishes. (``fuselage`` first: an alarm that
+    falls inside numba's loading of a cached kernel is swallowed by its ctypes callback,
+    so the kernels are loaded before the timing starts.)"""
+    result = prepare(FUSELAGE, heal=None, intersect=False, step_time_limit_s=0.01)
+    reparam = result.stage("reparam")
+    assert reparam.status == "done" and reparam.summary["faces"] == "0 of 8"
+    assert all("longer than 0.01 s" in f["error"] for f in reparam.report["faces"])
+    assert result.face_status == ("untouched",) * 8
