@@ -59,7 +59,8 @@ exit codes: 0 done; 1 done with faces skipped (entities the reader did not
 translate, faces a command could not process; each said on stderr) or an internal
 error; 2 nothing done: bad usage or an input/output error (one line on stderr; add
 --debug for a traceback).
-Progress ("face 12/255") goes to stderr when it is a terminal or with --progress."""
+Progress ("face pair 12/255 (5 %, 3 s, about 60 s left)") goes to stderr when it is a
+terminal or with --progress; --quiet leaves out progress and notes."""
 
 
 def _version() -> str:
@@ -80,6 +81,8 @@ def _common_options(defaults: bool) -> argparse.ArgumentParser:
                        help="show the Python traceback of an error")
     group.add_argument("--progress", action="store_true", default=default(None),
                        help="report progress on stderr even when it is not a terminal")
+    group.add_argument("--quiet", action="store_true", default=default(False),
+                       help="no progress and no notes on stderr (warnings and errors stay)")
     group.add_argument("--strict", action="store_true", default=default(False),
                        help="an entity of an input file that OpenCascade does not translate "
                             "is an error (exit 2), not a warning")
@@ -154,7 +157,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_usage(err)
         print(f"{PROG}: error: no command given (try '{PROG} --help')", file=err)
         return EXIT_ERROR
-    console = Console.for_streams(progress=True if args.progress else None)
+    console = Console.for_streams(progress=True if args.progress else None, quiet=args.quiet)
     caught: list[warnings.WarningMessage] = []
 
     def finish(code: int, *lines: str) -> int:

@@ -16,8 +16,9 @@ import math
 import os
 import sys
 import tempfile
+import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
@@ -48,36 +49,64 @@ STDOUT = "-"
 
 @dataclass(frozen=True)
 class Console:
-    """Where a command writes: results to ``out``, progress and notes to ``err``."""
+    """Where a command writes: results to ``out``, progress and notes to ``err``.
+
+    ``quiet`` leaves out the progress and the notes (warnings and errors stay);
+    ``clock`` gives the seconds progress lines measure (``time.monotonic``).
+    """
 
     out: TextIO
     err: TextIO
     show_progress: bool = False
+    quiet: bool = False
+    clock: Callable[[], float] = time.monotonic
+    _runs: dict = field(default_factory=dict, repr=False, compare=False)
 
     @classmethod
     def for_streams(cls, out: TextIO | None = None, err: TextIO | None = None,
-                    progress: bool | None = None) -> Console:
+                    progress: bool | None = None, quiet: bool = False) -> Console:
         """Streams default to ``sys.stdout``/``sys.stderr``; progress to "stderr is a TTY"."""
         out = sys.stdout if out is None else out
         err = sys.stderr if err is None else err
         if progress is None:
             progress = bool(getattr(err, "isatty", lambda: False)())
-        return cls(out, err, progress)
+        return cls(out, err, progress and not quiet, quiet)
 
     def print(self, *parts: Any) -> None:
         print(*parts, file=self.out)
 
     def note(self, *parts: Any) -> None:
+        """A line on ``err``; with ``quiet`` only warnings (``surfprep: warning: ...``)."""
+        if self.quiet and not (parts and str(parts[0]).startswith("surfprep: warning")):
+            return
         print(*parts, file=self.err)
 
     def progress(self, done: int, total: int, what: str) -> None:
-        """``what done/total`` on one refreshed line (TTY) or one line per call."""
+        """``what done/total (share, elapsed, time left)`` on one refreshed line (TTY) or one
+        line per call. The time left is the mean time per step so far times the steps to
+        go, shown once a second has passed; a count back at 0 starts ``what`` anew."""
         if not self.show_progress:
             return
+        now = self.clock()
+        start, width = self._runs.get(what, (None, 0))
+        if start is None or done <= 0:
+            start = now
+        elapsed = now - start
+        text = f"{what} {done}/{total}"
+        if total > 0:
+            extra = [f"{100.0 * done / total:.0f} %"]
+            if elapsed >= 1.0:
+                extra.append(f"{elapsed:.0f} s")
+                if 0 < done < total:
+                    extra.append(f"about {elapsed / done * (total - done):.0f} s left")
+            text += f" ({', '.join(extra)})"
         tty = bool(getattr(self.err, "isatty", lambda: False)())
-        end = "\n" if (not tty or done >= total) else ""
-        prefix = "\r" if tty else ""
-        self.err.write(f"{prefix}{what} {done}/{total}{end}")
+        self._runs[what] = (start, len(text))
+        if tty:
+            end = "\n" if done >= total else ""
+            self.err.write("\r" + text.ljust(width) + end)
+        else:
+            self.err.write(text + "\n")
         self.err.flush()
 
 

@@ -310,14 +310,44 @@ def test_progress_is_shown_on_a_terminal_by_default():
     assert console.show_progress
     for i in range(1, 4):
         console.progress(i, 3, "face")
-    assert tty.text == "\rface 1/3\rface 2/3\rface 3/3\n"
+    assert tty.text == "\rface 1/3 (33 %)\rface 2/3 (67 %)\rface 3/3 (100 %)\n"
     pipe = _Stream(tty=False)
     quiet = Console.for_streams(_Stream(False), pipe)
     quiet.progress(1, 3, "face")
     assert not quiet.show_progress and pipe.text == ""
     forced = Console.for_streams(_Stream(False), pipe, progress=True)
     forced.progress(2, 3, "face")
-    assert pipe.text == "face 2/3\n"
+    assert pipe.text == "face 2/3 (67 %)\n"
+
+
+def test_progress_says_how_long_is_left():
+    """After a second the line gives the time spent and the time left (mean per step so far
+    times the steps to go); a shorter line clears what the longer one left on a terminal."""
+    from dataclasses import replace
+
+    from surfprep.plugin.commands.base import Console
+    now = [100.0]
+    tty = _Stream(tty=True)
+    console = replace(Console.for_streams(_Stream(False), tty), clock=lambda: now[0])
+    console.progress(0, 10, "pair")
+    now[0] = 104.0
+    console.progress(2, 10, "pair")                   # 2 s a step, 8 to go
+    assert tty.text.endswith("\rpair 2/10 (20 %, 4 s, about 16 s left)")
+    now[0] = 120.0
+    console.progress(10, 10, "pair")
+    last = tty.text.rsplit("\r", 1)[1]
+    assert last.startswith("pair 10/10 (100 %, 20 s)") and last.endswith("\n")
+    assert len(last) == len("pair 2/10 (20 %, 4 s, about 16 s left)") + 1   # padded over
+
+
+def test_quiet_leaves_out_progress_and_notes_but_not_warnings():
+    from surfprep.plugin.commands.base import Console
+    err = _Stream(tty=True)
+    console = Console.for_streams(_Stream(False), err, progress=True, quiet=True)
+    console.progress(1, 2, "face")
+    console.note("report written to x.json")
+    console.note("surfprep: warning: something")
+    assert err.text == "surfprep: warning: something\n"
 
 
 # ------------------------------------- parametrization figure on OCC surfaces
