@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..time_limit import seconds_argument, step_time_limit
 from .base import (
     STDOUT,
     Command,
@@ -22,14 +23,16 @@ from .base import (
     repaired_report,
 )
 from .plotting import pyplot, save_figure
-from ..time_limit import seconds_argument, step_time_limit
 
 __all__ = [
     "COMMAND",
+    "PLOT_FACE_PANELS",
     "compare_with_occ",
+    "equal_extent",
     "intersection_report",
     "plot_characteristic",
     "plot_curves",
+    "widen_flat_axis",
 ]
 
 #: values of --method (plugin.intersect_methods.Method; not imported to build the parser)
@@ -83,18 +86,90 @@ def compare_with_occ(results, model_a, model_b) -> dict:
     }
 
 
-def plot_curves(results, path: Path) -> Path:
-    """3D view and both parameter domains of every curve, written to ``path`` (Agg)."""
+#: at most this many faces get a (u, v) panel in --plot (the title says how many more)
+PLOT_FACE_PANELS = 8
+
+
+def equal_extent(points: np.ndarray, floor: float) -> tuple[np.ndarray, float]:
+    """Centre and half-width of a cube (or square) holding ``points (m, d)``, the half-width
+    at least ``floor``: equal axes that do not blow rounding noise up to the whole plot."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return 0.5 * (lo + hi), max(0.5 * float(np.max(hi - lo)) * 1.05, floor)
+
+
+def widen_flat_axis(ax) -> None:
+    """An axis whose data spans less than 1e-6 of the other's (a curve along an
+    iso-parameter line, drawn over rounding noise) gets the other's span, centred."""
+    ax.relim()
+    (x0, y0), (x1, y1) = ax.dataLim.get_points()
+    wx, wy = x1 - x0, y1 - y0
+    if not (np.isfinite(wx) and np.isfinite(wy)):
+        return
+    if wy < 1e-6 * wx:
+        ax.set_ylim(0.5 * (y0 + y1) - 0.5 * wx, 0.5 * (y0 + y1) + 0.5 * wx)
+    elif wx < 1e-6 * wy:
+        ax.set_xlim(0.5 * (x0 + x1) - 0.5 * wy, 0.5 * (x0 + x1) + 0.5 * wy)
+
+
+def plot_curves(results, path: Path, *, two_models: bool = True) -> Path:
+    """The curves in space (equal axes) and in each face's own (u, v) domain, one panel
+    per face, written to ``path`` (Agg); ``two_models`` False when a model was intersected
+    with itself (every face is then of the same model)."""
     plt = pyplot()
     pairs = _characteristic_pairs(results)
-    rows = 1 + len(pairs)
+    faces: dict[tuple[str, int], list] = {}
+    for k, r in enumerate(results):
+        for side, operand, uv in (("A", r.face_a, r.curve.uv_a), ("B", r.face_b, r.curve.uv_b)):
+            if uv is not None:
+                key = (side if two_models else "A", operand.index)
+                faces.setdefault(key, [operand.surface.domain]).append((k, uv, r.curve.closed))
+    shown = sorted(faces)[:PLOT_FACE_PANELS]
+    cols = 3
+    top = 1 + len(shown)
+    top_rows = -(-top // cols)
+    rows = top_rows + len(pairs)
     fig = plt.figure(figsize=(15, 5 * rows))
-    ax3 = fig.add_subplot(rows, 3, 1, projection="3d")
-    axa, axb = fig.add_subplot(rows, 3, 2), fig.add_subplot(rows, 3, 3)
-    for k, pair in enumerate(pairs, start=1):
-        ax_r, ax_q = fig.add_subplot(rows, 3, 3 * k + 1), fig.add_subplot(rows, 3, 3 * k + 2)
+    ax3 = fig.add_subplot(rows, cols, 1, projection="3d")
+    colors = plt.get_cmap("tab10")
+    if not results:
+        ax3.set_axis_off()
+        ax3.text2D(0.5, 0.5, "no intersection curve", ha="center", va="center",
+                   transform=ax3.transAxes, fontsize="large")
+    else:
+        everything = np.vstack([r.points for r in results])
+        size = float(np.linalg.norm(everything.max(axis=0) - everything.min(axis=0)))
+        scale = max(size, float(np.max(np.abs(everything))), 1.0)
+        centre, half = equal_extent(everything, 1e-6 * scale)
+        for k, r in enumerate(results):
+            p = r.points if not r.curve.closed else np.vstack([r.points, r.points[:1]])
+            ax3.plot(p[:, 0], p[:, 1], p[:, 2], color=colors(k % 10), lw=1)
+        for axis, c in zip("xyz", centre):
+            getattr(ax3, f"set_{axis}lim")(c - half, c + half)
+        ax3.set_box_aspect((1, 1, 1))
+        ax3.set_xlabel("x")
+        ax3.set_ylabel("y")
+        ax3.set_zlabel("z")
+    hidden = len(faces) - len(shown)
+    ax3.set_title(f"{len(results)} curve(s) in space (equal axes)"
+                  + (f"; {hidden} more face(s) not drawn in (u, v)" if hidden else ""))
+    for slot, key in enumerate(shown, start=2):
+        ax = fig.add_subplot(rows, cols, slot)
+        (u0, u1, v0, v1), *curves = faces[key]
+        for k, uv, closed in curves:
+            uv = np.vstack([uv, uv[:1]]) if closed else uv
+            ax.plot(uv[:, 0], uv[:, 1], color=colors(k % 10), lw=1, label=f"curve {k}")
+        ax.set_xlim(u0, u1)                                 # the face's own domain
+        ax.set_ylim(v0, v1)
+        ax.set_xlabel("u")
+        ax.set_ylabel("v")
+        ax.set_title(f"face {key[1]} of {key[0] if two_models else 'the model'}: (u, v) domain")
+        if len(curves) <= 8:
+            ax.legend(fontsize="small")
+    for k, pair in enumerate(pairs):
+        base = cols * (top_rows + k)
+        ax_r, ax_q = fig.add_subplot(rows, cols, base + 1), fig.add_subplot(rows, cols, base + 2)
         plot_characteristic(ax_r, ax_q, pair)
-        note = fig.add_subplot(rows, 3, 3 * k + 3)
+        note = fig.add_subplot(rows, cols, base + 3)
         note.axis("off")
         counts = pair.record.counts()
         text = "\n".join([f"{kind}: {n}" for kind, n in sorted(counts.items())]
@@ -105,22 +180,6 @@ def plot_curves(results, path: Path) -> Path:
                             "dashed: u- (blue), v- (green)",
                             "        characteristic curves"])
         note.text(0.0, 1.0, text, va="top", fontsize="small", family="monospace")
-    colors = plt.get_cmap("tab10")
-    for k, r in enumerate(results):
-        c = colors(k % 10)
-        p = r.points if not r.curve.closed else np.vstack([r.points, r.points[:1]])
-        ax3.plot(p[:, 0], p[:, 1], p[:, 2], color=c, lw=1)
-        for ax, uv in ((axa, r.curve.uv_a), (axb, r.curve.uv_b)):
-            if uv is not None:
-                ax.plot(uv[:, 0], uv[:, 1], color=c, lw=1, label=f"{k}: faces {r.faces}")
-    ax3.set_title("curves in space")
-    axa.set_title("(u, v) on the first face of each pair")
-    axb.set_title("(u, v) on the second face of each pair")
-    for ax in (axa, axb):
-        ax.set_xlabel("u")
-        ax.set_ylabel("v")
-    if results and len(results) <= 12:
-        axb.legend(fontsize="small")
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -162,6 +221,8 @@ def plot_characteristic(ax_r, ax_q, pair) -> None:
         ax_q.plot(*on_q, marker=marker, color=color, ls="", ms=6)
     faces = (pair.face_a.index, pair.face_b.index)
     names = ("b", "a") if swapped else ("a", "b")
+    for ax in (ax_r, ax_q):
+        widen_flat_axis(ax)
     ax_r.set_title(f"faces {faces}: phi on {names[0]} (u, v)", fontsize="small")
     ax_q.set_title(f"faces {faces}: feet on {names[1]} (s, t)", fontsize="small")
     if seen:
@@ -234,7 +295,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if args.compare_occ:
             report["occ"] = compare_with_occ(results, model_a, model_b)
         if args.plot is not None:
-            report["plot"] = str(plot_curves(results, args.plot))
+            report["plot"] = str(plot_curves(results, args.plot,
+                                             two_models=args.file_b is not None))
         report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path == STDOUT:
         return done_code(model_a, model_b, skipped=bool(results.stopped))

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..time_limit import seconds_argument, step_time_limit
 from .base import (
     STDOUT,
     Command,
@@ -21,7 +22,6 @@ from .base import (
     repaired_report,
 )
 from .plotting import pyplot, save_figure
-from ..time_limit import seconds_argument, step_time_limit
 
 __all__ = ["COMMAND", "plot_isolines"]
 
@@ -46,11 +46,12 @@ def _plane(points: np.ndarray) -> np.ndarray:
     return vt[:2].T
 
 
-def plot_isolines(pairs, path: Path) -> Path:
+def plot_isolines(pairs, path: Path, *, shown_of: int | None = None) -> Path:
     """Isoparametric lines at equal parameter steps, before and after (Fig. 29.5).
 
     ``pairs`` is a list of ``(label, old NurbsSurface, new NurbsSurface)``; each
-    face is drawn in the plane of its two principal directions.
+    face is drawn in the plane of its two principal directions. ``shown_of``: how many
+    faces were reparametrized, when ``pairs`` holds only some (the title says so).
     """
     plt = pyplot()
     rows = max(1, len(pairs))
@@ -66,6 +67,8 @@ def plot_isolines(pairs, path: Path) -> Path:
             ax.set_aspect("equal")
             ax.set_title(f"{label}: {title} (u blue, v red, equal parameter steps)",
                          fontsize="small")
+    if shown_of is not None:
+        fig.suptitle(f"{len(pairs)} of {shown_of} reparametrized faces shown", fontsize="medium")
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -121,7 +124,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             pairs = [(f"face {e.index}",
                       surface_from_occ(BRep_Tool.Surface_s(model.faces[e.index])),
                       e.done.result.surface) for e in ok[:PLOT_FACES]]
-            report["plot"] = str(plot_isolines(pairs, args.plot))
+            report["plot"] = str(plot_isolines(
+                pairs, args.plot, shown_of=len(ok) if len(ok) > len(pairs) else None))
         report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path != STDOUT:
         for e in entries:

@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -24,7 +25,7 @@ from ...algorithms.trimmed import TrimmedFace
 from ...errors import OpenCascadeError
 from ...inputs import ShapeLike
 from ..convert import to_nurbs, unwrap
-from ..io import CadModel
+from ..io import CadModel, read
 from ..occ.faces import make_face, needs_nurbs_convert, trimmed_face_to_occ
 from ..occ.shapes import all_faces
 
@@ -79,6 +80,8 @@ class FaceOperand:
 
 
 def _as_faces(x: Any) -> list[tuple[TrimmedFace, TopoDS_Face | None]]:
+    if isinstance(x, (str, os.PathLike)):            # a STEP/IGES file, read as a model
+        return _as_faces(read(x))
     if isinstance(x, NurbsSurface):
         return [(TrimmedFace(x), None)]
     if isinstance(x, TrimmedFace):

@@ -156,3 +156,50 @@ def test_a_bad_pair_time_limit_is_a_usage_error(value, files, tmp_path, capsys):
                        "--pair-time-limit", value)
     assert code == 2
     assert "--pair-time-limit" in err
+
+
+# ------------------------------------------------------------------ --plot
+def test_plot_axes_are_equal_and_not_blown_up_from_noise():
+    from surfprep.plugin.commands.intersect import equal_extent, widen_flat_axis
+    from surfprep.plugin.commands.plotting import pyplot
+    centre, half = equal_extent(np.array([[0.0, 0.0, 5.0], [10.0, 2.0, 5.0 + 1e-12]]), 1e-3)
+    assert np.allclose(centre, [5.0, 1.0, 5.0]) and half == pytest.approx(5.25)
+    _, half = equal_extent(np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 1.0 + 1e-13]]), 1e-3)
+    assert half == 1e-3                                 # a point's noise is not the extent
+    plt = pyplot()
+    fig, ax = plt.subplots()
+    ax.plot([0.0, 6.0], [0.48, 0.48 + 1e-9])            # a constant-v curve over rounding noise
+    widen_flat_axis(ax)
+    lo, hi = ax.get_ylim()
+    assert hi - lo == pytest.approx(6.0) and lo < 0.48 < hi
+    plt.close(fig)
+
+
+def test_plot_draws_each_face_in_its_own_domain(files, tmp_path, monkeypatch):
+    """Sphere x slab: the 3-D view and one (u, v) panel per face (the sphere's and the
+    slab faces the curves lie on), each spanning that face's own domain; with no curve the
+    figure says so instead of drawing empty axes."""
+    import surfprep.plugin.commands.intersect as command
+    from surfprep.plugin.commands import plotting
+    result = surfprep.intersect(files["sphere"], str(files["slab"]))   # files, as the README says
+    assert len(result) == 2
+    seen = []
+
+    def keep(fig, path):
+        seen.append({ax.get_title(): (ax.get_xlim(), ax.get_ylim(), ax) for ax in fig.axes})
+        return plotting.save_figure(fig, path)
+
+    monkeypatch.setattr(command, "save_figure", keep)
+    command.plot_curves(result, tmp_path / "a.png", two_models=True)
+    panels = {t: v for t, v in seen[0].items() if "(u, v) domain" in t}
+    faces = {("A", c.face_a.index): c.face_a for c in result}
+    faces.update({("B", c.face_b.index): c.face_b for c in result})
+    assert len(panels) == len(faces) == 3                # the sphere's face, two slab faces
+    for title, (xlim, ylim, _) in panels.items():
+        words = title.split()
+        u0, u1, v0, v1 = faces[(words[3].rstrip(":"), int(words[1]))].surface.domain
+        assert xlim == (u0, u1) and ylim == (v0, v1)
+    command.plot_curves([], tmp_path / "b.png")
+    (view,) = [ax for _, _, ax in seen[1].values()]
+    assert view.get_title().startswith("0 curve(s)")
+    assert any(t.get_text() == "no intersection curve" for t in view.texts)
