@@ -67,7 +67,9 @@ __all__ = [
     "expand_inputs",
     "is_failed",
     "load_previous_summary",
+    "measured_argv",
     "parse_memory_size",
+    "peak_file",
     "plan_jobs",
     "prepare_outdir",
     "run_batch",
@@ -578,18 +580,17 @@ class _RunningChild:
         error record when it cannot be started."""
         for stale in (*job.outputs, job.report):
             stale.unlink(missing_ok=True)
-        memory = limits.memory_bytes
-        preexec = None if memory is None else (lambda: _limit_address_space(memory))
+        peak = peak_file(job)
+        peak.unlink(missing_ok=True)
+        argv = measured_argv(job.argv(command), peak_file=peak, memory_bytes=limits.memory_bytes)
         try:
             log_stream = open(job.log, "wb")  # noqa: SIM115 - closed when the child is reaped
         except OSError as exc:
             return _not_started(job, f"cannot write {job.log}: {exc.strerror or exc}")
         started = time.monotonic()
         try:
-            process = subprocess.Popen(job.argv(command), stdin=subprocess.DEVNULL,
-                                       stdout=log_stream, stderr=subprocess.STDOUT,
-                                       start_new_session=True,
-                                       preexec_fn=preexec)  # noqa: PLW1509 - setrlimit only
+            process = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=log_stream,
+                                       stderr=subprocess.STDOUT, start_new_session=True)
         except OSError as exc:
             log_stream.close()
             return _not_started(job, f"cannot start the child: {exc.strerror or exc}")
@@ -626,13 +627,54 @@ class _RunningChild:
         seconds = time.monotonic() - self.started
         self.process.returncode = os.waitstatus_to_exitcode(wait_status)   # Popen must not wait
         self.log_stream.close()
+        peak = peak_file(self.job)
+        try:                     # the command's own peak, measured by the launcher
+            peak_mb = _peak_mb(int(peak.read_text()))
+        except (OSError, ValueError):                   # killed before it could say
+            peak_mb = _peak_mb(usage.ru_maxrss)
+        peak.unlink(missing_ok=True)
         return _record(self.job, exit_code=self.process.returncode, timed_out=timed_out,
-                       seconds=seconds, peak_memory_mb=_peak_mb(usage), limits=self.limits)
+                       seconds=seconds, peak_memory_mb=peak_mb, limits=self.limits)
 
 
-def _limit_address_space(memory_bytes: int) -> None:
-    """In the child, before ``exec``: at most ``memory_bytes`` of address space."""
-    resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+#: the launcher: a small interpreter that forks the command (with the address-space limit
+#: set in the fork), waits for it, writes its ``ru_maxrss`` and ends as it ended
+_LAUNCHER = """\
+import os, resource, signal, sys
+limit, peak, argv = int(sys.argv[1]), sys.argv[2], sys.argv[3:]
+pid = os.fork()
+if pid == 0:
+    if limit > 0:
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    os.execvp(argv[0], argv)
+_, status, usage = os.wait4(pid, 0)
+with open(peak, "w") as f:
+    f.write(str(usage.ru_maxrss))
+code = os.waitstatus_to_exitcode(status)
+if code < 0:
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    signal.signal(-code, signal.SIG_DFL)
+    os.kill(os.getpid(), -code)
+sys.exit(code)
+"""
+
+
+def peak_file(job: FileJob) -> Path:
+    """Where the launcher writes ``job``'s peak memory (beside its log; removed when read)."""
+    return job.log.with_name(job.log.name.removesuffix(".log") + ".peak")
+
+
+def measured_argv(argv: Sequence[str], *, peak_file: Path, memory_bytes: int | None) -> list[str]:
+    """``argv`` run by the launcher: at most ``memory_bytes`` of address space, and its peak
+    resident memory written to ``peak_file``.
+
+    The peak of a process forked from this one would start at this process's size
+    (``ru_maxrss`` spans the ``exec``, and a ``vfork`` or ``posix_spawn`` child borrows
+    this process's memory until it), so a batch run from a large process (a test
+    worker, a Dask worker) would report its own size for every small file; forked from
+    the launcher, the command's peak starts at a bare interpreter's.
+    """
+    return [sys.executable, "-c", _LAUNCHER, str(int(memory_bytes or 0)), str(peak_file), *argv]
 
 
 def _has_exited(pid: int) -> bool:
@@ -651,10 +693,10 @@ def _kill_group(pid: int) -> None:
         pass
 
 
-def _peak_mb(usage: resource.struct_rusage) -> float:
+def _peak_mb(maxrss: int) -> float:
     """``ru_maxrss`` in MiB (kilobytes on Linux, bytes on macOS)."""
     scale = 1 << 20 if sys.platform == "darwin" else 1 << 10
-    return round(usage.ru_maxrss / scale, 1)
+    return round(maxrss / scale, 1)
 
 
 def _not_started(job: FileJob, message: str) -> FileRecord:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..time_limit import seconds_argument, step_time_limit
 from .base import (
     STDOUT,
     Command,
@@ -21,7 +22,6 @@ from .base import (
     repaired_report,
 )
 from .plotting import pyplot, save_figure
-from ..time_limit import seconds_argument, step_time_limit
 
 __all__ = ["COMMAND", "plot_deviation"]
 

@@ -413,3 +413,19 @@ def test_the_batch_command_module_is_light_at_import():
             "print(' '.join(m for m in ('surfprep.plugin.batch', 'dask') if m in sys.modules))")
     shown = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert shown.stdout.strip() == ""
+
+
+def test_peak_memory_is_the_files_own_from_a_large_process(tmp_path):
+    """Run from a process holding 400 MB (a test worker, a Dask worker), each file still
+    reports its own peak: a fork of the batch process would start at the batch's size."""
+    import numpy as np
+    ballast = np.ones(50_000_000)                       # 400 MB, touched
+    _make_inputs(tmp_path / "in")
+    result = batch.run_batch([str(tmp_path / "in" / "good" / "*.step")], verb="info",
+                             outdir=tmp_path / "out", jobs=2, timeout=MIXED_TIMEOUT_S,
+                             command=_stand_in(tmp_path))
+    one, two = sorted(result.records, key=lambda r: r.label)
+    assert ballast.sum() == 50_000_000
+    assert one.peak_memory_mb < 100
+    assert 120 < two.peak_memory_mb - one.peak_memory_mb < 200
+    assert not list((tmp_path / "out").glob("*.peak"))  # the launcher's notes are cleared
