@@ -28,6 +28,17 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert namespace["pieces"].report()["pieces"] == 7 and namespace["pieces"].valid
     assert abs(namespace["lens"].volume - 108.908545) < 1e-4
     assert (tmp_path / "fuselage.cgns").stat().st_size > 0
+    import build123d as bd
+    import cadquery as cq
+    assert [type(e) for e in namespace["circles"]] == [cq.Edge, cq.Edge]
+    assert sorted(round(e.Center().z, 4) for e in namespace["circles"]) == [4.5, 5.5]
+    assert type(namespace["zones"]) is cq.Compound and len(namespace["zones"].Faces()) == 11
+    assert namespace["zones_result"].report()["pieces"] == 7
+    assert [type(e) for e in namespace["rims"].vals()] == [cq.Edge, cq.Edge]
+    assert not hasattr(cq.Workplane, "surface_intersections")
+    assert type(namespace["solid"]) is bd.Solid and namespace["solid"].label == "bracket"
+    assert abs(namespace["healed"].part.volume - 600.0) < 1e-6
+    assert type(namespace["skin"]) is bd.Face
     assert namespace["status"] == ("reparametrized",) * 8
     assert [line.split(":")[0] for line in namespace["lines"]] == ["heal", "intersect", "reparam",
                                                                    "grid"]
