@@ -36,12 +36,12 @@ from scipy.optimize import brentq, root
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..measure import cumulative_arc_length
+from .arc_length import parameters_at_lengths
 
 __all__ = ["by_curvature", "by_curvature_points", "geometric", "points_along", "stretched", "uniform"]
 
 #: parameter samples per knot span when a curve's arc length is tabulated
 _SAMPLES_PER_SPAN = 24
-_NEWTON_STEPS = 4
 
 
 def _check_count(n: int) -> int:
@@ -333,32 +333,9 @@ def points_along(curve: NurbsCurve, fractions: ArrayLike) -> NDArray:
             or np.any(np.diff(x) < 0):
         raise InvalidGeometryError("fractions must be a non-decreasing 1-D array in [0, 1]")
     t, s = _arc_table(curve)
-    length = s[-1]
-    target = x * length
-    out = np.interp(target, s, t)
+    out = parameters_at_lengths(lambda u: np.linalg.norm(curve.derivatives(u, 1)[:, 1, :], axis=1),
+                                t, s, x * s[-1], (x > 0) & (x < 1))
     lo, hi = curve.domain
-    inner = (x > 0) & (x < 1)
-    for _ in range(_NEWTON_STEPS):
-        if not np.any(inner):
-            break
-        ti = out[inner]
-        # arc length from the nearest tabulated parameter below (short exact integral)
-        k = np.clip(np.searchsorted(t, ti, side="right") - 1, 0, t.size - 2)
-        base = s[k] + _short_lengths(curve, t[k], ti)
-        speed = np.linalg.norm(curve.derivatives(ti, 1)[:, 1, :], axis=1)
-        step = np.where(speed > 0, (target[inner] - base) / np.maximum(speed, 1e-300), 0.0)
-        out[inner] = np.clip(ti + step, lo, hi)
     out[x == 0] = lo
     out[x == 1] = hi
     return out
-
-
-_G_NODES, _G_WEIGHTS = np.polynomial.legendre.leggauss(8)
-
-
-def _short_lengths(curve: NurbsCurve, a: NDArray, b: NDArray) -> NDArray:
-    """Arc lengths between ``a`` and ``b`` inside one tabulation cell (8-point Gauss)."""
-    mid, half = 0.5 * (a + b), 0.5 * (b - a)
-    nodes = mid[:, None] + half[:, None] * _G_NODES[None, :]
-    speed = np.linalg.norm(curve.derivatives(nodes.reshape(-1), 1)[:, 1, :], axis=1)
-    return half * (speed.reshape(nodes.shape) @ _G_WEIGHTS)

@@ -23,13 +23,13 @@ from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
+from .arc_length import lengths_between, parameters_at_lengths
 
 __all__ = ["SIDE_NAMES", "Region", "Side"]
 
 SIDE_NAMES = ("j0", "j1", "i0", "i1")
 #: cells of the parameter partition a side's length is integrated on (plus the pcurve's knots)
 CELLS = 256
-_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(8)
 _NEWTON_STEPS = 4
 
 
@@ -79,10 +79,7 @@ class Side:
         knots = self.pcurve.knots[(self.pcurve.knots > lo) & (self.pcurve.knots < hi)]
         x = np.unique(np.concatenate([np.linspace(0.0, 1.0, CELLS + 1),
                                       (knots - self.t0) / (self.t1 - self.t0)]))
-        mid, half = 0.5 * (x[1:] + x[:-1]), 0.5 * np.diff(x)
-        nodes = mid[:, None] + half[:, None] * _NODES[None, :]
-        speed = self._speed(nodes.reshape(-1)).reshape(nodes.shape)
-        return x, np.concatenate([[0.0], np.cumsum(half * (speed @ _WEIGHTS))])
+        return x, np.concatenate([[0.0], np.cumsum(lengths_between(self._speed, x[:-1], x[1:]))])
 
     @property
     def length(self) -> float:
@@ -95,21 +92,7 @@ class Side:
         length = s[-1]
         if not length > 0.0:
             return f.copy()                              # a collapsed side: spread in x
-        target = f * length
-        out = np.interp(target, s, x)
-        inner = (f > 0) & (f < 1)
-        for _ in range(_NEWTON_STEPS):
-            if not np.any(inner):
-                break
-            xi = out[inner]
-            k = np.clip(np.searchsorted(x, xi, side="right") - 1, 0, x.size - 2)
-            a = x[k]
-            mid, half = 0.5 * (a + xi), 0.5 * (xi - a)
-            nodes = mid[:, None] + half[:, None] * _NODES[None, :]
-            base = s[k] + half * (self._speed(nodes.reshape(-1)).reshape(nodes.shape) @ _WEIGHTS)
-            speed = self._speed(xi)
-            step = np.where(speed > 0, (target[inner] - base) / np.maximum(speed, 1e-300), 0.0)
-            out[inner] = np.clip(xi + step, 0.0, 1.0)
+        out = parameters_at_lengths(self._speed, x, s, f * length, (f > 0) & (f < 1))
         out[f <= 0] = 0.0
         out[f >= 1] = 1.0
         return out
