@@ -105,8 +105,11 @@ def cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
         ids = chain.point_ids
         ca = None if uv_a is None else topology.uv_a[ids]
         cb = None if uv_b is None else topology.uv_b[ids]
-        jump_a = seam_jumps(ca, surface_a, chain.closed, closure_tol)
-        jump_b = seam_jumps(cb, surface_b, chain.closed, closure_tol)
+        steps = max(ids.size - (not chain.closed), 0)         # a mesh side has no seam
+        jump_a = (seam_jumps(ca, surface_a, chain.closed, closure_tol) if ca is not None
+                  else np.zeros(steps, dtype=bool))
+        jump_b = (seam_jumps(cb, surface_b, chain.closed, closure_tol) if cb is not None
+                  else np.zeros(steps, dtype=bool))
         jump = jump_a | jump_b
         if not jump.any():
             chains.append(chain)

@@ -236,10 +236,11 @@ def _characteristic_pairs(results, limit: int = 4) -> list:
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("file_a", type=Path, metavar="A", help="STEP or IGES file")
+    parser.add_argument("file_a", type=Path, metavar="A",
+                        help="STEP or IGES file, or an STL triangle mesh (then B is needed)")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
-                        help="second file; without it, the faces of A are intersected "
-                             "with each other (shared edges left out)")
+                        help="second file (STEP, IGES or STL); without it, the faces of A are "
+                             "intersected with each other (shared edges left out)")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
                         help="STEP/IGES file to write the curves to, as edges")
     parser.add_argument("--tol", type=float, default=None, metavar="T",
@@ -268,6 +269,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace, console: Console) -> int:
     inputs = tuple(p for p in (args.file_a, args.file_b) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
+    if any(Path(p).suffix.lower() == ".stl" for p in inputs):
+        return _run_with_mesh(args, console, inputs)
     check_inputs(*inputs)
     from ..intersect import intersect
     from ..io import staged_write
@@ -323,6 +326,53 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     if report_path is not None:
         console.note(f"report written to {report_path}")
     return done_code(model_a, model_b, skipped=bool(results.stopped))
+
+
+def _run_with_mesh(args: argparse.Namespace, console: Console, inputs) -> int:
+    """An STL mesh against the faces of a STEP/IGES file
+    (:func:`surfprep.plugin.intersect.mesh_operand.intersect_mesh`)."""
+    from ...errors import InputFileError
+    meshes = [p for p in inputs if Path(p).suffix.lower() == ".stl"]
+    if len(inputs) < 2 or len(meshes) == 2:
+        raise InputFileError("an STL mesh is intersected with the faces of a STEP or IGES file: "
+                             "give one of each")
+    if args.plot is not None or args.compare_occ:
+        raise InputFileError("--plot and --compare-occ are for two STEP/IGES files, not a mesh")
+    mesh_path = meshes[0]
+    cad_path = next(p for p in inputs if p is not mesh_path)
+    if not Path(mesh_path).is_file():
+        raise InputFileError(f"input file {mesh_path} does not exist")
+    check_inputs(cad_path)
+    from ...algorithms.io import read_stl
+    from ..intersect.mesh_operand import intersect_mesh
+    from ..io import staged_write
+    model = read_model(cad_path, console, strict=args.strict)
+    mesh = read_stl(mesh_path)
+    start = time.perf_counter()
+    with step_time_limit(args.pair_time_limit, "a face") as restart:
+        def progress(done: int, total: int) -> None:
+            restart(last=done >= total)
+            console.progress(done, total, "face")
+        results = intersect_mesh(mesh, model, tol=args.tol, progress=progress)
+    elapsed = time.perf_counter() - start
+    report = {"files": [str(f) for f in inputs], "mesh_file": str(mesh_path), **results.report(),
+              "time_s": elapsed, "dropped": dropped_report(model),
+              "repaired": repaired_report(model)}
+    with ExitStack() as stack:
+        staged = None
+        if results:
+            staged = stack.enter_context(staged_write(results.edges(), args.output,
+                                                      overwrite=True))
+        report["output"] = None if staged is None else str(staged.target)
+        report_path = publish(staged, report, args.json_path, console, protected=inputs)
+    if args.json_path != STDOUT:
+        console.print(f"{len(results)} intersection curve(s) of the mesh ({mesh.n_triangles} "
+                      f"triangles) with {results.pairs} face(s) in {elapsed:.3f} s"
+                      + (f", written to {report['output']}" if results else
+                         f"; nothing written to {args.output}"))
+        if report_path is not None:
+            console.note(f"report written to {report_path}")
+    return done_code(model)
 
 
 COMMAND = Command(

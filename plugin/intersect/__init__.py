@@ -47,6 +47,7 @@ plots).
 
 from __future__ import annotations
 
+import os
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -71,7 +72,7 @@ from .methods import (
     StoppedPair,
     pair_curves,
 )
-from .operands import FaceOperand, face_operands
+from .operands import DEFAULT_TOL_FACTOR, MIN_TOL_FACTOR, FaceOperand, face_operands
 
 __all__ = [
     "DEFAULT_TOL_FACTOR",
@@ -89,10 +90,6 @@ __all__ = [
     "intersect",
 ]
 
-#: default ``tol``: this times the diagonal of the box of all faces
-DEFAULT_TOL_FACTOR = 1e-6
-#: smallest accepted ``tol``: this times that diagonal
-MIN_TOL_FACTOR = 1e-9
 # ------------------------------------------------------------------ result
 @dataclass(frozen=True, eq=False)
 class FaceIntersection:
@@ -203,6 +200,27 @@ def _one_pair(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | No
     return pieces, _contacts(record, fa, fb, tol, within), coincident, (record, tuple(curves))
 
 
+def _mesh_operand(a, b):
+    """``(mesh, other)`` when one operand is a triangle mesh (a ``TriangleMesh`` or the path
+    of an ``.stl`` file), ``(None, None)`` when neither is."""
+    from ...algorithms.intersection import TriangleMesh
+
+    def as_mesh(x):
+        if isinstance(x, TriangleMesh):
+            return x
+        if isinstance(x, (str, os.PathLike)) and str(x).lower().endswith(".stl"):
+            from ...algorithms.io import read_stl
+            return read_stl(x)
+        return None
+    ma, mb = as_mesh(a), None if b is None else as_mesh(b)
+    if ma is None and mb is None:
+        return None, None
+    if b is None or (ma is not None and mb is not None):
+        raise InvalidGeometryError("a triangle mesh is intersected with exact faces: give one "
+                                   "mesh and one model, face or surface")
+    return (ma, b) if ma is not None else (mb, a)
+
+
 def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = None,
               mesh_tol: float | None = None, method: Method | str = Method.AUTO,
               progress: Callable[[int, int], None] | None = None) -> IntersectionResult:
@@ -234,6 +252,10 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     Returns
     -------
     IntersectionResult
+        (A :class:`~surfprep.plugin.intersect.mesh_operand.MeshIntersectionResult`
+        when one operand is a triangle mesh: a ``TriangleMesh`` or an ``.stl`` path;
+        its curves lie on the exact faces within ``tol`` and as near the surface the
+        mesh stands for as the mesh itself.)
         A list of FaceIntersection: pieces clipped to both faces, in face-pair
         order, each with ``found_by``. Curves that break ``tol`` (near-tangential
         or overlapping surfaces, where the refinement does not converge) are left
@@ -270,6 +292,10 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     >>> cut.report()["curves"][0]["found_by"]
     <FoundBy.MESH: 'mesh'>
     """
+    mesh, other = _mesh_operand(a, b)
+    if mesh is not None:                      # a triangle mesh against exact faces
+        from .mesh_operand import intersect_mesh
+        return intersect_mesh(mesh, other, tol=tol, mesh_tol=mesh_tol, progress=progress)
     start_time = time.perf_counter()
     method = Method(method)
     faces_a = face_operands(a)

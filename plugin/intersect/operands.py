@@ -29,7 +29,12 @@ from ..io import CadModel, read
 from ..occ.faces import make_face, needs_nurbs_convert, trimmed_face_to_occ
 from ..occ.shapes import all_faces
 
-__all__ = ["FaceOperand", "face_operands"]
+__all__ = ["DEFAULT_TOL_FACTOR", "MIN_TOL_FACTOR", "FaceOperand", "face_operands"]
+
+#: default ``tol`` of an intersection: this times the diagonal of the box of all faces
+DEFAULT_TOL_FACTOR = 1e-6
+#: smallest accepted ``tol``: this times that diagonal
+MIN_TOL_FACTOR = 1e-9
 
 
 # ------------------------------------------------------------------ operands
