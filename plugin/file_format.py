@@ -15,7 +15,11 @@ from pathlib import Path
 from ..errors import InputFileError
 from .content_checks import content_problems
 
-__all__ = ["FileFormat", "check_input_file", "known_suffixes", "sniff_format"]
+__all__ = ["MESH_SUFFIXES", "FileFormat", "check_input_file", "is_mesh_file", "known_suffixes",
+           "sniff_format"]
+
+#: extensions of discrete geometry read as a mesh operand: STL, and Plot3D surface grids
+MESH_SUFFIXES = (".stl", ".xyz", ".p3d", ".x", ".g", ".grd")
 
 _HEAD_BYTES = 4096
 _TAIL_BYTES = 2048
@@ -139,3 +143,8 @@ def _has_trailer(fmt: FileFormat, tail: bytes) -> bool:
         return _STEP_TRAILER in tail
     lines = [ln.rstrip(b"\r") for ln in tail.split(b"\n") if ln.strip()]
     return bool(lines) and len(lines[-1]) >= 73 and lines[-1][72:73] == b"T"
+
+
+def is_mesh_file(path: str | Path) -> bool:
+    """True for a path whose extension is one of :data:`MESH_SUFFIXES`."""
+    return Path(path).suffix.lower() in MESH_SUFFIXES

@@ -206,6 +206,40 @@ class TriangleMesh:
         return cls(mesh.vertices[used], remap[mesh.triangles],
                    None if mesh.uv is None else mesh.uv[used], mesh.patch)
 
+    @classmethod
+    def from_grids(cls, blocks) -> TriangleMesh:
+        """Structured surface grids (Plot3D blocks, ``(ni, nj, 3)`` float each) as one mesh.
+
+        Every cell becomes two triangles (split along its shorter diagonal, the better
+        chord of a curved cell); ``patch`` numbers the block each comes from; cells
+        collapsed to a line or a point (a pole, a degenerate side) give no triangle.
+        Blocks keep their own vertices (a shared edge is not merged).
+        """
+        points, triangles, patch, offset = [], [], [], 0
+        for k, block in enumerate(blocks):
+            x = np.asarray(block, dtype=float)
+            if x.ndim != 3 or x.shape[2] != 3 or x.shape[0] < 2 or x.shape[1] < 2:
+                raise InvalidGeometryError(f"grid block {k} must have shape (ni >= 2, nj >= 2, "
+                                           f"3), got {x.shape}")
+            ni, nj = x.shape[:2]
+            idx = offset + np.arange(ni * nj).reshape(ni, nj)
+            a, b, c, d = idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]
+            flat = x.reshape(-1, 3)
+            short = (np.linalg.norm(flat[a - offset] - flat[c - offset], axis=-1)
+                     <= np.linalg.norm(flat[b - offset] - flat[d - offset], axis=-1))
+            first = np.where(short[..., None], np.stack([a, b, c], -1), np.stack([a, b, d], -1))
+            second = np.where(short[..., None], np.stack([a, c, d], -1), np.stack([b, c, d], -1))
+            tri = np.concatenate([first.reshape(-1, 3), second.reshape(-1, 3)])
+            points.append(flat)
+            triangles.append(tri)
+            patch.append(np.full(tri.shape[0], k))
+            offset += ni * nj
+        if not points:
+            raise InvalidGeometryError("no grid block to make a mesh of")
+        vertices, tri = np.concatenate(points), np.concatenate(triangles)
+        keep = ~collinear_mask(vertices[tri])
+        return cls.from_arrays(vertices, tri[keep], patch=np.concatenate(patch)[keep])
+
     # ------------------------------------------------------------------ sizes
     @property
     def n_vertices(self) -> int:

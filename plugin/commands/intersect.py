@@ -237,10 +237,11 @@ def _characteristic_pairs(results, limit: int = 4) -> list:
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file_a", type=Path, metavar="A",
-                        help="STEP or IGES file, or an STL triangle mesh (then B is needed)")
+                        help="STEP or IGES file, or a mesh: STL or a Plot3D surface grid "
+                             "(.xyz .p3d .x .g .grd; then B is needed)")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
-                        help="second file (STEP, IGES or STL); without it, the faces of A are "
-                             "intersected with each other (shared edges left out)")
+                        help="second file (STEP, IGES, STL or Plot3D); without it, the faces of "
+                             "A are intersected with each other (shared edges left out)")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
                         help="STEP/IGES file to write the curves to, as edges")
     parser.add_argument("--tol", type=float, default=None, metavar="T",
@@ -269,7 +270,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 def _run(args: argparse.Namespace, console: Console) -> int:
     inputs = tuple(p for p in (args.file_a, args.file_b) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
-    if any(Path(p).suffix.lower() == ".stl" for p in inputs):
+    from ..file_format import is_mesh_file
+    if any(is_mesh_file(p) for p in inputs):
         return _run_with_mesh(args, console, inputs)
     check_inputs(*inputs)
     from ..intersect import intersect
@@ -329,13 +331,15 @@ def _run(args: argparse.Namespace, console: Console) -> int:
 
 
 def _run_with_mesh(args: argparse.Namespace, console: Console, inputs) -> int:
-    """An STL mesh against the faces of a STEP/IGES file
+    """An STL mesh or a Plot3D surface grid against the faces of a STEP/IGES file
     (:func:`surfprep.plugin.intersect.mesh_operand.intersect_mesh`)."""
     from ...errors import InputFileError
-    meshes = [p for p in inputs if Path(p).suffix.lower() == ".stl"]
+    from ..file_format import is_mesh_file
+    from ..intersect.mesh_operand import intersect_mesh, read_mesh
+    meshes = [p for p in inputs if is_mesh_file(p)]
     if len(inputs) < 2 or len(meshes) == 2:
-        raise InputFileError("an STL mesh is intersected with the faces of a STEP or IGES file: "
-                             "give one of each")
+        raise InputFileError("a mesh (STL or Plot3D) is intersected with the faces of a STEP or "
+                             "IGES file: give one of each")
     if args.plot is not None or args.compare_occ:
         raise InputFileError("--plot and --compare-occ are for two STEP/IGES files, not a mesh")
     mesh_path = meshes[0]
@@ -343,11 +347,9 @@ def _run_with_mesh(args: argparse.Namespace, console: Console, inputs) -> int:
     if not Path(mesh_path).is_file():
         raise InputFileError(f"input file {mesh_path} does not exist")
     check_inputs(cad_path)
-    from ...algorithms.io import read_stl
-    from ..intersect.mesh_operand import intersect_mesh
     from ..io import staged_write
     model = read_model(cad_path, console, strict=args.strict)
-    mesh = read_stl(mesh_path)
+    mesh = read_mesh(mesh_path)
     start = time.perf_counter()
     with step_time_limit(args.pair_time_limit, "a face") as restart:
         def progress(done: int, total: int) -> None:

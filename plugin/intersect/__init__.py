@@ -201,16 +201,17 @@ def _one_pair(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | No
 
 
 def _mesh_operand(a, b):
-    """``(mesh, other)`` when one operand is a triangle mesh (a ``TriangleMesh`` or the path
-    of an ``.stl`` file), ``(None, None)`` when neither is."""
+    """``(mesh, other)`` when one operand is a triangle mesh (a ``TriangleMesh``, or the path
+    of an STL file or a Plot3D surface grid), ``(None, None)`` when neither is."""
     from ...algorithms.intersection import TriangleMesh
+    from ..file_format import is_mesh_file
+    from .mesh_operand import read_mesh
 
     def as_mesh(x):
         if isinstance(x, TriangleMesh):
             return x
-        if isinstance(x, (str, os.PathLike)) and str(x).lower().endswith(".stl"):
-            from ...algorithms.io import read_stl
-            return read_stl(x)
+        if isinstance(x, (str, os.PathLike)) and is_mesh_file(x):
+            return read_mesh(x)
         return None
     ma, mb = as_mesh(a), None if b is None else as_mesh(b)
     if ma is None and mb is None:
@@ -253,7 +254,8 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     -------
     IntersectionResult
         (A :class:`~surfprep.plugin.intersect.mesh_operand.MeshIntersectionResult`
-        when one operand is a triangle mesh: a ``TriangleMesh`` or an ``.stl`` path;
+        when one operand is a triangle mesh: a ``TriangleMesh``, an ``.stl`` path or a
+        Plot3D surface grid's;
         its curves lie on the exact faces within ``tol`` and as near the surface the
         mesh stands for as the mesh itself.)
         A list of FaceIntersection: pieces clipped to both faces, in face-pair

@@ -19,6 +19,7 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,11 +33,40 @@ from ...algorithms.intersection import (
     intersect_surfaces,
 )
 from ...algorithms.tolerance import check_tolerance
-from ...errors import InvalidGeometryError, InvalidToleranceError
+from ...errors import (
+    DegenerateGeometryError,
+    InputFileError,
+    InvalidGeometryError,
+    InvalidToleranceError,
+)
 from ..occ.edges import make_edge
 from .operands import DEFAULT_TOL_FACTOR, MIN_TOL_FACTOR, FaceOperand, face_operands
 
-__all__ = ["MeshCurve", "MeshIntersectionResult", "intersect_mesh"]
+__all__ = ["MeshCurve", "MeshIntersectionResult", "intersect_mesh", "read_mesh"]
+
+def read_mesh(path) -> TriangleMesh:
+    """An STL file, or a multi-block Plot3D surface grid (every cell two triangles), as a
+    :class:`~surfprep.algorithms.intersection.TriangleMesh`.
+
+    Raises
+    ------
+    InputFileError
+        Missing, empty, not of its extension's format, truncated or holding no triangle.
+    """
+    from ...algorithms.grid.io.plot3d import read_plot3d
+    from ...algorithms.io import read_stl
+    if Path(path).suffix.lower() == ".stl":
+        return read_stl(path)
+    try:
+        blocks = read_plot3d(path)
+    except FileNotFoundError:
+        raise InputFileError(f"input file {path} does not exist") from None
+    except ValueError as exc:
+        raise InputFileError(f"{path} is not a Plot3D surface grid: {exc}") from None
+    try:
+        return TriangleMesh.from_grids(blocks)
+    except (InvalidGeometryError, DegenerateGeometryError) as exc:
+        raise InputFileError(f"the grid of {path} makes no mesh: {exc}") from None
 
 
 @dataclass(frozen=True, eq=False)

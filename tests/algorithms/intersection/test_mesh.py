@@ -133,3 +133,22 @@ def test_from_checked_mesh_is_the_validated_one():
         np.testing.assert_array_equal(mine, full)
         assert mine.dtype == full.dtype and not mine.flags.writeable
     assert not mesh.degenerate_triangles().any()
+
+
+def test_structured_grids_become_one_mesh():
+    """A flat 3 x 4 grid (6 cells) and a fan collapsed at one side: two triangles a cell,
+    the area exact, the collapsed cells' flat triangles left out, the block in ``patch``."""
+    x, y = np.meshgrid([0.0, 1.0, 3.0], [0.0, 1.0, 2.0, 4.0], indexing="ij")
+    flat = np.stack([x, y, np.zeros_like(x)], axis=-1)
+    fan = flat.copy()
+    fan[0] = 0.0                                          # the first row collapsed to a point
+    mesh = TriangleMesh.from_grids([flat, fan])
+    corners = mesh.triangle_points()
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
+                                         corners[:, 2] - corners[:, 0]), axis=1)
+    first = mesh.patch == 0
+    assert first.sum() == 12 and area[first].sum() == pytest.approx(12.0)
+    assert (~first).sum() == 12 - 3 and area[~first].sum() == pytest.approx(
+        12.0 - 1.0 * 4.0 + 0.5 * 1.0 * 4.0)               # the first column of cells a triangle
+    with pytest.raises(InvalidGeometryError, match="shape"):
+        TriangleMesh.from_grids([np.zeros((1, 4, 3))])

@@ -81,3 +81,30 @@ def test_the_command_line_takes_an_stl_file(sphere_stl, slab, tmp_path, capsys):
     assert surfprep.read(out, require_faces=False).shape is not None
     code, _, err = run(capsys, "intersect", sphere_stl, "-o", tmp_path / "x.step")
     assert code == 2 and "give one of each" in err
+
+
+def test_a_plot3d_surface_grid_is_a_mesh_operand(slab, tmp_path, capsys):
+    """A structured grid of the sphere (two blocks: the upper and lower halves, 61 x 121
+    nodes, collapsed at the poles) written as Plot3D, against the slab: the same two circles,
+    within the grid's own chordal deviation."""
+    from surfprep.algorithms.grid.io import write_plot3d
+    theta = np.linspace(0.0, 2.0 * np.pi, 121)
+    blocks = []
+    for lat in (np.linspace(0.0, np.pi / 2, 61), np.linspace(-np.pi / 2, 0.0, 61)):
+        la, th = np.meshgrid(lat, theta, indexing="ij")
+        blocks.append(RADIUS * np.stack([np.cos(la) * np.cos(th), np.cos(la) * np.sin(th),
+                                         np.sin(la)], axis=-1))
+    path = write_plot3d(tmp_path / "sphere.xyz", blocks)
+    result = surfprep.intersect(path, slab)
+    assert len(result) == 2 and set(result.mesh.patch.tolist()) == {0, 1}
+    sag = RADIUS * (1 - np.cos(np.pi / 120))               # a cell's chord below the arc
+    for curve in result:
+        z = curve.points[0, 2]
+        assert np.max(np.abs(curve.points[:, 2] - z)) <= result.tol
+        radius = np.linalg.norm(curve.points[:, :2], axis=1)
+        exact = np.sqrt(RADIUS ** 2 - z ** 2)
+        assert np.all(radius <= exact + 1e-6) and np.all(radius >= exact - 2 * sag)
+    step = tmp_path / "slab.step"
+    surfprep.write(slab, step)
+    code, stdout, err = run(capsys, "intersect", path, step, "-o", tmp_path / "c.step")
+    assert code == 0 and "2 intersection curve(s) of the mesh" in stdout, err
