@@ -18,8 +18,9 @@ from .content_checks import content_problems
 __all__ = ["MESH_SUFFIXES", "FileFormat", "check_input_file", "is_mesh_file", "known_suffixes",
            "sniff_format"]
 
-#: extensions of discrete geometry read as a mesh operand: STL, and Plot3D surface grids
-MESH_SUFFIXES = (".stl", ".xyz", ".p3d", ".x", ".g", ".grd")
+#: extensions of discrete geometry read as a mesh operand: STL, Wavefront OBJ, and Plot3D
+#: surface grids
+MESH_SUFFIXES = (".stl", ".obj", ".xyz", ".p3d", ".x", ".g", ".grd")
 
 _HEAD_BYTES = 4096
 _TAIL_BYTES = 2048

@@ -237,10 +237,10 @@ def _characteristic_pairs(results, limit: int = 4) -> list:
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file_a", type=Path, metavar="A",
-                        help="STEP or IGES file, or a mesh: STL or a Plot3D surface grid "
+                        help="STEP or IGES file, or a mesh: STL, OBJ or a Plot3D surface grid "
                              "(.xyz .p3d .x .g .grd; then B is needed)")
     parser.add_argument("file_b", type=Path, metavar="B", nargs="?",
-                        help="second file (STEP, IGES, STL or Plot3D); without it, the faces of "
+                        help="second file (STEP, IGES, STL, OBJ or Plot3D); without it, the faces of "
                              "A are intersected with each other (shared edges left out)")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
                         help="STEP/IGES file to write the curves to, as edges")

@@ -45,8 +45,8 @@ from .operands import DEFAULT_TOL_FACTOR, MIN_TOL_FACTOR, FaceOperand, face_oper
 __all__ = ["MeshCurve", "MeshIntersectionResult", "intersect_mesh", "read_mesh"]
 
 def read_mesh(path) -> TriangleMesh:
-    """An STL file, or a multi-block Plot3D surface grid (every cell two triangles), as a
-    :class:`~surfprep.algorithms.intersection.TriangleMesh`.
+    """An STL or Wavefront OBJ file, or a multi-block Plot3D surface grid (every cell two
+    triangles), as a :class:`~surfprep.algorithms.intersection.TriangleMesh`.
 
     Raises
     ------
@@ -54,9 +54,12 @@ def read_mesh(path) -> TriangleMesh:
         Missing, empty, not of its extension's format, truncated or holding no triangle.
     """
     from ...algorithms.grid.io.plot3d import read_plot3d
-    from ...algorithms.io import read_stl
-    if Path(path).suffix.lower() == ".stl":
+    from ...algorithms.io import read_obj, read_stl
+    suffix = Path(path).suffix.lower()
+    if suffix == ".stl":
         return read_stl(path)
+    if suffix == ".obj":
+        return read_obj(path)
     try:
         blocks = read_plot3d(path)
     except FileNotFoundError:

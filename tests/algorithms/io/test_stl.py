@@ -70,3 +70,4 @@ def test_bad_files_are_refused(tmp_path, content, words):
 def test_a_missing_file_is_refused(tmp_path):
     with pytest.raises(InputFileError, match="cannot read"):
         read_stl(tmp_path / "missing.stl")
+

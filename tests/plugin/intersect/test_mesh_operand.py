@@ -108,3 +108,16 @@ def test_a_plot3d_surface_grid_is_a_mesh_operand(slab, tmp_path, capsys):
     surfprep.write(slab, step)
     code, stdout, err = run(capsys, "intersect", path, step, "-o", tmp_path / "c.step")
     assert code == 0 and "2 intersection curve(s) of the mesh" in stdout, err
+
+
+def test_an_obj_file_is_the_same_mesh(sphere_stl, slab, tmp_path):
+    """The sphere's mesh written as Wavefront OBJ (full precision) gives the STL's curves."""
+    from surfprep.algorithms.io import read_stl
+    mesh = read_stl(sphere_stl)
+    path = tmp_path / "sphere.obj"
+    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in mesh.vertices)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in mesh.triangles))
+    from_obj, from_stl = surfprep.intersect(path, slab), surfprep.intersect(sphere_stl, slab)
+    assert len(from_obj) == len(from_stl) == 2
+    assert sorted(round(c.length, 9) for c in from_obj) == \
+        sorted(round(c.length, 9) for c in from_stl)
