@@ -115,7 +115,7 @@ def test_an_obj_file_is_the_same_mesh(sphere_stl, slab, tmp_path):
     from surfprep.algorithms.io import read_stl
     mesh = read_stl(sphere_stl)
     path = tmp_path / "sphere.obj"
-    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in mesh.vertices)
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in mesh.vertices)
                     + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in mesh.triangles))
     from_obj, from_stl = surfprep.intersect(path, slab), surfprep.intersect(sphere_stl, slab)
     assert len(from_obj) == len(from_stl) == 2
