@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import InputFileError
 from ..time_limit import seconds_argument, step_time_limit
 from .base import (
     STDOUT,
@@ -73,6 +74,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                              "min(1e-3 x size, 0.01 x median edge length))")
     parser.add_argument("--patches", type=Path, default=None, metavar="SPEC.json",
                         help="directed patches: four corners or four curves each")
+    parser.add_argument("--mesh", type=Path, action="append", default=[], metavar="MESH",
+                        dest="meshes",
+                        help="discrete geometry the approximants may also be projected onto "
+                             "(STL, OBJ or a Plot3D surface grid; repeatable): a scan over a "
+                             "hole gives the patch its shape")
     parser.add_argument("--overlap", choices=("trim", "union"), default="trim",
                         help="a strip overlap of two four-sided faces: trim the later face "
                              "back (default) or replace both by one approximant over their "
@@ -128,9 +134,12 @@ def _summary(report: dict) -> list[str]:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    inputs = tuple(p for p in (args.input, args.patches) if p is not None)
+    inputs = tuple(p for p in (args.input, args.patches, *args.meshes) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     check_inputs(args.input)
+    for mesh in args.meshes:
+        if not mesh.is_file():
+            raise InputFileError(f"--mesh {mesh} does not exist or is not a file")
     from ..heal import heal
     from ..io import staged_write
     model = read_model(args.input, console, strict=args.strict)
@@ -140,7 +149,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             console.progress(done, total, "approximant")
         result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                       patches=args.patches, overlap=args.overlap,
-                      split_faces=args.split_faces, replace=args.replace, progress=progress)
+                      split_faces=args.split_faces, replace=args.replace,
+                      meshes=args.meshes, progress=progress)
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
               "repaired": repaired_report(model)}
     with staged_write(result.model, args.output, overwrite=True) as staged:

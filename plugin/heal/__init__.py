@@ -85,7 +85,7 @@ from ...algorithms.healing.strip_overlap import OverlapRepair, find_overlaps, ov
 from ...algorithms.projection import project_to_surface
 from ...algorithms.tolerance import check_tolerance
 from ...algorithms.trimmed import TrimmedFace
-from ...errors import InvalidGeometryError, SurfprepError
+from ...errors import ConversionError, InvalidGeometryError, SurfprepError
 from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs, make_face
@@ -303,10 +303,26 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 
 
 # ---------------------------------------------------------------------- heal
+def _mesh_sources(meshes) -> list:
+    """The ``meshes`` argument of :func:`heal` as triangle meshes (paths read)."""
+    from ...algorithms.intersection import TriangleMesh
+    out = []
+    for item in (meshes,) if isinstance(meshes, (str, os.PathLike, TriangleMesh)) else meshes:
+        if isinstance(item, TriangleMesh):
+            out.append(item)
+        elif isinstance(item, (str, os.PathLike)):
+            from ..intersect.mesh_operand import read_mesh
+            out.append(read_mesh(item))
+        else:
+            raise ConversionError(f"a healing mesh must be a TriangleMesh or the path of an STL, "
+                                  f"OBJ or Plot3D file, got {type(item).__name__}")
+    return out
+
+
 def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True,
-         replace: str = "defects", progress=None) -> HealResult:
+         replace: str = "defects", meshes: Any = (), progress=None) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -345,6 +361,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         corner at such an edge's end); the others keep their exact geometry (an
         approximant in their place could only open gaps that were closed). "all": every face, as 001's network of approximants (also what
         "defects" does when directed patches or trimmed-back overlaps cut faces).
+    meshes : sequence of TriangleMesh or paths, optional
+        Discrete geometry the approximants may also be projected onto (001 takes
+        triangles as input): a scan or an STL / OBJ / Plot3D grid covering a hole
+        makes the patch over it follow the data instead of the multiquadric fill of
+        the neighbours' shape. The faces stay each face's preferred source.
 
     Returns
     -------
@@ -402,7 +423,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     overlaps = find_overlaps(faces, four, gap_tol)
     trimmed, unions = overlap_boundaries(faces, overlaps, OverlapRepair.parse(overlap),
                                           gap_tol)
-    sources = [face_source(faces[i]) for i in kept]
+    sources = [face_source(faces[i]) for i in kept] + _mesh_sources(meshes)
     if not sources and not directed:
         raise InvalidGeometryError("heal: no face of the input could be read")
     if replace not in ("defects", "all"):
