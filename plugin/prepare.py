@@ -218,6 +218,7 @@ def prepare(source: Any, *, heal: str | None = "G0", reparam: bool = True,
         stages.append(report)
         if out is not None:
             model, healed = out
+            reparametrized = np.zeros(model.n_faces, bool)   # over the healed model's faces
     # intersect
     if not intersect:
         stages.append(StageReport("intersect", "skipped", "not asked for"))

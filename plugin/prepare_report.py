@@ -3,7 +3,7 @@
 :func:`write_prepare_report` puts a :class:`~surfprep.plugin.prepare.PrepareResult`
 into one self-contained page (:func:`surfprep.plugin.report_html.write_html_report`):
 the faces in a 3-D view coloured by what the preparation did to them (healed,
-reparametrized, untouched), the intersection curves found, the grid blocks
+reparametrized, untouched; a healed face by its distance from the input faces), the intersection curves found, the grid blocks
 coloured by their cells' equiangle skewness, and the tables of every stage with
 the figures of the JSON report.
 """
@@ -20,10 +20,15 @@ from .occ.mesh import face_triangles
 from .prepare import PrepareResult
 from .report_html import ReportTable, SceneGrid, SceneMesh, ScenePolyline, write_html_report
 
-__all__ = ["DEFLECTION", "scene_of", "tables_of", "write_prepare_report"]
+__all__ = ["DEFLECTION", "DEVIATION_LABEL", "DISTANCE_TOL", "scene_of", "tables_of",
+           "write_prepare_report"]
 
 #: triangulation deflection of the view, as a share of the model's size
 DEFLECTION = 2e-3
+#: convergence of the closest points behind the healed faces' colours, share of the size
+DISTANCE_TOL = 1e-7
+#: the scale bar of the healed faces' colours
+DEVIATION_LABEL = "healed faces: distance from the input faces (mm)"
 
 
 def write_prepare_report(result: PrepareResult, path: str | os.PathLike, *,
@@ -50,15 +55,22 @@ def write_prepare_report(result: PrepareResult, path: str | os.PathLike, *,
 
 
 def scene_of(result: PrepareResult) -> tuple[list[SceneMesh], list[ScenePolyline], list[SceneGrid]]:
-    """The 3-D scene: one mesh per face of the prepared model (group: its status), one
-    polyline per intersection curve, one grid per block with its cells' skewness."""
+    """The 3-D scene: one mesh per face of the prepared model (group: its status; a healed
+    face coloured by each vertex's distance from the input faces), one polyline per
+    intersection curve, one grid per block with its cells' skewness."""
     model = result.model
     deflection = DEFLECTION * model.size if model.size > 0 else 1.0
+    inputs = _input_faces(result) if "healed" in result.face_status else None
     meshes = []
     for k, (vertices, triangles) in enumerate(face_triangles(model.faces, deflection=deflection)):
         if len(triangles):
             name = model.face_names[k] or f"face {k}"
-            meshes.append(SceneMesh(name, vertices, triangles, result.face_status[k]))
+            values = None
+            if result.face_status[k] == "healed" and inputs is not None:
+                values = inputs.distance(vertices, tol=DISTANCE_TOL * model.size)
+                values = np.where(np.isfinite(values), values, np.nan)
+            meshes.append(SceneMesh(name, vertices, triangles, result.face_status[k], values,
+                                    None if values is None else DEVIATION_LABEL))
     polylines = [ScenePolyline(f"curve {k} (faces {c.face_a.index}, {c.face_b.index})",
                                np.asarray(c.points, dtype=float), "intersection curves")
                  for k, c in enumerate(result.curves or ())]
@@ -109,6 +121,21 @@ def tables_of(result: PrepareResult) -> list[ReportTable]:
                    b["quality"]["min_angle"], b["quality"]["folded_cells"])
                   for k, b in enumerate(grid.report["blocks"]))))
     return tables
+
+
+def _input_faces(result: PrepareResult):
+    """The input model's faces, prepared for distance queries (those that cannot be read
+    as NURBS left out); None when none can."""
+    from ..algorithms.healing.fidelity import InputFaces
+    from ..errors import SurfprepError
+    from .occ.faces import face_to_nurbs
+    faces = []
+    for face in result.source.faces:
+        try:
+            faces.append(face_to_nurbs(face))
+        except SurfprepError:
+            continue
+    return InputFaces.of(faces) if faces else None
 
 
 def _counts(result: PrepareResult) -> str:

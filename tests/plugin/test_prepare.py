@@ -153,3 +153,12 @@ def test_a_step_past_its_time_limit_is_stopped_and_reported(fuselage):
     assert reparam.status == "done" and reparam.summary["faces"] == "0 of 8"
     assert all("longer than 0.01 s" in f["error"] for f in reparam.report["faces"])
     assert result.face_status == ("untouched",) * 8
+
+
+@pytest.mark.slow
+def test_healing_that_drops_faces_without_reparametrizing():
+    """The capsule holds its faces twice; healed with the reparametrization off, the status
+    is given for each face of the healed model (36 in, 18 out)."""
+    result = prepare(CAPSULE, intersect=False, reparam=False)
+    assert result.model.n_faces == 18 and len(result.face_status) == 18
+    assert result.face_status.count("reparametrized") == 0

@@ -80,3 +80,26 @@ def test_the_demo_report_draws_in_a_browser(capsys, tmp_path):
     assert len(np.unique(pixels, axis=0)) > 100       # shaded faces and grid lines, not blank
     assert stage_cells == [s["status"] for s in report["prepare"]["stages"]]
     assert "reparam: done" in text and "grid: done" in text
+
+
+@pytest.mark.slow
+def test_healed_faces_are_coloured_by_their_distance_from_the_input():
+    """The Mars capsule: each healed face's vertices carry their distance from the input
+    faces, most of them within the heal stage's tolerance; the others carry none.
+
+    Found by this picture and not fixed yet: the two approximants' largest vertex
+    distance is 0.022, twice their tolerance (0.011), where the heal report says 0.0036
+    (its 25 x 25 sample); the far vertices lie on the patches' boundary by the overlaps
+    trimmed back. The bound below keeps that on record rather than within tol."""
+    result = prepare(SAMPLES / "overture_marscapsule_proe.igs", intersect=False, reparam=False)
+    meshes, _, _ = scene_of(result)
+    healed = [m for m in meshes if m.group == "healed"]
+    assert len(healed) == result.face_status.count("healed") > 0
+    worst = max(p["deviation_from_input"] for p in result.stage("heal").report["patches"])
+    tol = max(p["tol"] for p in result.stage("heal").report["patches"])
+    assert worst <= tol
+    for m in healed:
+        assert m.values is not None and m.values.shape == (m.vertices.shape[0],)
+        assert np.nanmedian(m.values) <= tol
+        assert 1.5 * tol < np.nanmax(m.values) < 3 * tol       # the finding, on record
+    assert all(m.values is None for m in meshes if m.group != "healed")
