@@ -297,8 +297,10 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             edges = [e for r in results for e in r.to_edges()]
             staged = stack.enter_context(staged_write(edges, args.output, overwrite=True))
         report["output"] = None if staged is None else str(staged.target)
-        if args.compare_occ:
+        if args.compare_occ:                 # one OpenCascade call: say what runs, and for how long
+            console.progress(0, 1, "OpenCascade section (BRepAlgoAPI_Section)")
             report["occ"] = compare_with_occ(results, model_a, model_b)
+            console.progress(1, 1, "OpenCascade section (BRepAlgoAPI_Section)")
         if args.plot is not None:
             report["plot"] = str(plot_curves(results, args.plot,
                                              two_models=args.file_b is not None))
