@@ -81,6 +81,14 @@ class Console:
             return
         print(*parts, file=self.err)
 
+    def stage(self, what: str) -> None:
+        """``what`` on a line of its own when progress is shown: a stage beginning that has
+        no count of its own (reading, sewing)."""
+        if self.show_progress:
+            tty = bool(getattr(self.err, "isatty", lambda: False)())
+            self.err.write(("\r" if tty else "") + what + "\n")
+            self.err.flush()
+
     def progress(self, done: int, total: int, what: str) -> None:
         """``what done/total (share, elapsed, time left)`` on one refreshed line (TTY) or one
         line per call. The time left is the mean time per step so far times the steps to

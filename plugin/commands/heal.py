@@ -150,7 +150,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                       patches=args.patches, overlap=args.overlap,
                       split_faces=args.split_faces, replace=args.replace,
-                      meshes=args.meshes, progress=progress)
+                      meshes=args.meshes, progress=progress,
+                      stage=lambda what: console.stage(f"heal: {what}"))
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
               "repaired": repaired_report(model)}
     with staged_write(result.model, args.output, overwrite=True) as staged:

@@ -60,6 +60,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -322,7 +323,8 @@ def _mesh_sources(meshes) -> list:
 def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True,
-         replace: str = "defects", meshes: Any = (), progress=None) -> HealResult:
+         replace: str = "defects", meshes: Any = (), progress=None,
+         stage: Callable[[str], None] | None = None) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
     Parameters
@@ -366,6 +368,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         triangles as input): a scan or an STL / OBJ / Plot3D grid covering a hole
         makes the patch over it follow the data instead of the multiquadric fill of
         the neighbours' shape. The faces stay each face's preferred source.
+    progress : callable(done, total), optional
+        Called before each approximant and after the last.
+    stage : callable(str), optional
+        Called as each stage begins ("reading the faces", "finding gaps, holes and
+        overlaps", "approximants", "joining, sewing and checking").
 
     Returns
     -------
@@ -392,7 +399,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     (True, True)
     """
     start = time.perf_counter()
+    say = stage if stage is not None else (lambda what: None)
     continuity = Continuity.parse(continuity)
+    say("reading the faces")
     model = _as_model(shape)
     faces, skipped = _read_faces(model)
     edges = face_edges(faces)
@@ -401,6 +410,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
                else check_tolerance(gap_tol, "gap_tol", low=low, high=high))
     if tol is not None:
         tol = check_tolerance(tol, "tol", low=low, high=high)
+    say("finding gaps, holes and overlaps")
     directed = read_patch_spec(patches, faces) if patches is not None else []
     cut = cut_under_patches(model, faces, directed, [face_source(f) for f in faces if f],
                             tol=tol, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,
@@ -440,9 +450,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
                      gap_tol=gap_tol, skipped=skipped)
     inputs = InputFaces.of(faces)
+    say("approximants")
     done = approximate(jobs, sources, {i: k for k, i in enumerate(kept)}, tol, gap_tol,
                        skipped, inputs, progress)
     done += directed_jobs(directed, cut)
+    say("joining, sewing and checking")
     before = _Before.of(model, gap_tol)
     result, done, snapped = _no_worse_than_before(
         done, dropped, skipped, before, every_edge=every_edge, model=model, work=work,

@@ -528,3 +528,14 @@ def test_warnings_of_one_kind_are_counted_and_numerical_ones_say_so(capsys, monk
         "surfprep: warning: 1 of 7 intersection curves left out (and 4 more like it)",
         "surfprep: warning: numerical: invalid value encountered in multiply (in a step whose "
         "result is checked against the tolerance)"]
+
+
+def test_heal_says_its_stages(capsys, tmp_path):
+    """--progress: the stages without a count of their own are said as they begin."""
+    code, _, err = run(capsys, "heal", SAMPLES / "occt_fuselage.stp", "-o", tmp_path / "h.step",
+                       "--progress")
+    assert code == 0
+    lines = [ln.strip("\r") for ln in err.splitlines()]
+    stages = [ln for ln in lines if ln.startswith("heal: ")]
+    assert stages == ["heal: reading the faces", "heal: finding gaps, holes and overlaps",
+                      "heal: approximants", "heal: joining, sewing and checking"]
