@@ -11,13 +11,13 @@ left aside.
 from __future__ import annotations
 
 import os
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ...errors import InputFileError
-from ..intersection.mesh import TriangleMesh, collinear_mask
+from ..intersection.mesh import TriangleMesh
+from .stl import triangles_with_area
 
 __all__ = ["read_obj"]
 
@@ -79,10 +79,4 @@ def read_obj(path: str | os.PathLike) -> TriangleMesh:
         raise InputFileError(f"OBJ file {file} holds a coordinate that is not a finite number")
     if tri.min() < 0 or tri.max() >= len(points):
         raise InputFileError(f"OBJ file {file} has a face index out of range 1..{len(points)}")
-    flat = collinear_mask(points[tri])
-    if flat.all():
-        raise InputFileError(f"OBJ file {file} holds only faces of zero area")
-    if flat.any():
-        warnings.warn(f"{file.name}: {int(flat.sum())} of {flat.size} triangles have zero area "
-                      "and are left out", stacklevel=2)
-    return TriangleMesh.from_arrays(points, tri[~flat])
+    return TriangleMesh.from_arrays(points, tri[triangles_with_area(points[tri], file, "OBJ")])

@@ -19,12 +19,13 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ...errors import InputFileError
 from ..intersection.mesh import TriangleMesh, collinear_mask
 from .atomic import atomic_output
 
-__all__ = ["read_stl", "write_stl"]
+__all__ = ["read_stl", "triangles_with_area", "write_stl"]
 
 _RECORD = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
 _VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
@@ -78,13 +79,20 @@ def read_stl(path: str | os.PathLike) -> TriangleMesh:
     corners = np.asarray(corners, dtype=float)
     if not np.all(np.isfinite(corners)):
         raise InputFileError(f"STL file {file} holds a coordinate that is not a finite number")
+    return TriangleMesh.from_arrays(corners[triangles_with_area(corners, file, "STL")])
+
+
+def triangles_with_area(corners: NDArray, file: Path, kind: str) -> NDArray:
+    """Mask ``(m,)`` of the triangles ``corners (m, 3, 3)`` of a ``kind`` file that have an
+    area; the others are counted in a warning (they are left out), and a file without any
+    is refused (:class:`InputFileError`)."""
     flat = collinear_mask(corners)
     if flat.all():
-        raise InputFileError(f"STL file {file} holds only triangles of zero area")
+        raise InputFileError(f"{kind} file {file} holds only triangles of zero area")
     if flat.any():
         warnings.warn(f"{file.name}: {int(flat.sum())} of {flat.size} triangles have zero area "
-                      "(coincident or collinear corners) and are left out", stacklevel=2)
-    return TriangleMesh.from_arrays(corners[~flat])
+                      "(coincident or collinear corners) and are left out", stacklevel=3)
+    return ~flat
 
 
 def write_stl(mesh: TriangleMesh, path: str | os.PathLike) -> Path:
