@@ -179,7 +179,9 @@ def _box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
 
 def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float
                ) -> list[list[FaceEdge]]:
-    """Loops of four free edges from at least two faces, in loop order."""
+    """Loops of free edges from at least two faces (any number of edges up to 64), in
+    loop order: where every end on the loop meets exactly one other free edge's end
+    within ``gap_tol``."""
     if not free:
         return []
     ends = np.concatenate([edges[k].ends for k in free])          # (2 f, 3)
@@ -204,7 +206,7 @@ def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float
             continue
         loop = _walk(start, vertex, incident)
         seen.update(loop or [start])
-        if loop and len(loop) == 4 and len({edges[free[n]].face for n in loop}) >= 2:
+        if loop and len({edges[free[n]].face for n in loop}) >= 2:
             loops.append([edges[free[n]] for n in loop])
     return loops
 

@@ -238,6 +238,21 @@ def _project(off, coons, ring_rows: int, sources, mesh_tol, size, cache, preferr
     return ring, y, t, found, src
 
 
+def _fill_hits(off, missing: NDArray, fill_source, mesh_tol, size, cache
+               ) -> tuple[NDArray, NDArray]:
+    """Positions ``t`` and hit flags of the grid segments ``missing`` (flat indices) on
+    the fill source (the surface a hole's surroundings continue into)."""
+    a, b = off.upper.reshape(-1, 3)[missing], off.lower.reshape(-1, 3)[missing]
+    box = off.box
+    if cache.get("fill") is None or not cache["fill"].covers(box):
+        pad = _BOX_PAD * np.ptp(box, axis=0).max()
+        cache["fill"] = clip_sources(
+            as_sources(fill_source), box + np.array([[-pad], [pad]]),
+            mesh_tol=mesh_tol if mesh_tol else MESH_FRACTION * off.distance)
+    _, t, hit, _ = project_grid(a, b, cache["fill"].restrict(box), tol=_NEWTON_FRACTION * size)
+    return t, hit
+
+
 def _fill(coons, ring, t, known, t_ring, found_ring, fill, neighbours) -> NDArray:
     """Positions everywhere on the grid (:mod:`.fill`, with the ring's data if any)."""
     if ring is None or np.all(known):
@@ -255,7 +270,7 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
               interpolant: Interpolant, fill: FillMethod, neighbours: int,
               mesh_tol: float | None, keep_boundary: bool, tol: float, size: float,
               ring_rows: int, preferred: int | None, cache: dict,
-              side_error: bool = False) -> _Pass:
+              side_error: bool = False, fill_source=None) -> _Pass:
     coons = discrete_coons(boundary, m, n)
     off = offsets(coons, offset)
     ring, y, t, found, src = _project(off, coons, ring_rows, sources, mesh_tol, size, cache,
@@ -272,7 +287,14 @@ def _one_pass(boundary: Boundary, sources: tuple, m: int, n: int, *, offset: flo
             f"lie over them (or the offset distance {off.distance:.3g} is too small)")
     y = y.reshape(shape + (3,))
     rim, found, t = _sides(found, t, y, coons.points, keep_boundary, tol)
-    t_all = _fill(coons, ring, t, found | rim, t_ring, found_ring, fill, neighbours)
+    known = found | rim
+    if fill_source is not None and not np.all(known):
+        # artificial positions where the segments cross the fill source
+        missing = np.flatnonzero(~known)
+        t_fill, hit = _fill_hits(off, missing, fill_source, mesh_tol, size, cache)
+        t, known = t.copy(), known.copy()
+        t.flat[missing[hit]], known.flat[missing[hit]] = t_fill[hit], True
+    t_all = _fill(coons, ring, t, known, t_ring, found_ring, fill, neighbours)
     z = (1 - t_all[..., None]) * off.upper + t_all[..., None] * off.lower
     grid = np.where(found[..., None], y, z)
     grid[rim] = coons.points[rim]
@@ -294,6 +316,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       keep_boundary: bool = True, ring_rows: int | None = None,
                       fill_resolution: tuple[int, int] = FILL_RESOLUTION,
                       preferred_source: int | None = None, side_error: bool = False,
+                      fill_source: Source | None = None,
                       strict: bool = False) -> LocalApproximant:
     """A bicubic B-spline surface over four boundary curves that follows the sources.
 
@@ -358,6 +381,12 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
         (e.g. a side made of several edges of a face) then raises the
         resolution like an interior miss. Off by default (001's error is the
         interior's only).
+    fill_source : NurbsSurface, TriangleMesh or SurfaceSource, optional
+        Where a segment meets no source, its artificial projection is its crossing
+        with this surface (a hole's cap,
+        :func:`.hole_cap.cap_hole`) instead of the fill's interpolated position;
+        those points stay artificial (not in the error, counted in
+        ``artificial_share``). The sources always win where they are hit.
     strict : bool
         Raise :class:`InvalidToleranceError` instead of returning an
         unconverged approximant.
@@ -408,7 +437,7 @@ def local_approximant(boundary: Boundary | Sequence[BoundaryCurve],
                       fill=fill, neighbours=neighbours, mesh_tol=mesh_tol,
                       keep_boundary=keep_boundary, tol=tol, size=size,
                       ring_rows=ring_rows, preferred=preferred_source, cache=cache,
-                      side_error=side_error)
+                      side_error=side_error, fill_source=fill_source)
         share = float(p.artificial.mean())
         history.append(ResolutionStep(current, p.error.max_error, p.error.rms_error, share))
         passes.append(p)

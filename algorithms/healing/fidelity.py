@@ -161,22 +161,27 @@ class InputFaces:
         return best
 
 
-def _samples(surface: NurbsSurface, n: int, rim_only: bool) -> NDArray:
+def _samples(surface: NurbsSurface, n: int, rim_only: bool | Sequence[int]) -> NDArray:
     u0, u1, v0, v1 = surface.domain
     u, v = np.linspace(u0, u1, n), np.linspace(v0, v1, n)
-    if not rim_only:
+    if rim_only is False:
         return surface.evaluate_grid(u, v).reshape(-1, 3)
-    uv = np.concatenate([np.stack([u, np.full(n, v0)], 1), np.stack([u, np.full(n, v1)], 1),
-                         np.stack([np.full(n, u0), v], 1), np.stack([np.full(n, u1), v], 1)])
+    sides = (0, 1, 2, 3) if rim_only is True else tuple(rim_only)
+    # bottom (v0), right (u1), top (v1), left (u0): the boundary's loop order
+    uv = [np.stack([u, np.full(n, v0)], 1), np.stack([np.full(n, u1), v], 1),
+          np.stack([u, np.full(n, v1)], 1), np.stack([np.full(n, u0), v], 1)]
+    uv = np.concatenate([uv[k] for k in sides])
     return surface.evaluate(uv[:, 0], uv[:, 1])
 
 
 def surface_deviation(surface: NurbsSurface, faces: InputFaces, *, tol: float,
-                      samples: int = DEFAULT_SAMPLES, rim_only: bool = False
+                      samples: int = DEFAULT_SAMPLES, rim_only: bool | Sequence[int] = False
                       ) -> SurfaceDeviation:
     """How far ``surface`` lies from the faces: ``samples x samples`` points uniform in
     its parameter rectangle, or ``samples`` along each of its four sides with
-    ``rim_only`` (a patch over a hole), measured by :meth:`InputFaces.distance`.
+    ``rim_only`` (a patch over a hole), or along the sides listed (0 bottom ``v0``,
+    1 right ``u1``, 2 top ``v1``, 3 left ``u0``: a sub-patch of a hole, whose other
+    sides cross the hole), measured by :meth:`InputFaces.distance`.
 
     Examples
     --------

@@ -322,3 +322,41 @@ def boxes_sharing_a_wall():
     a = cq.Workplane().box(1.0, 1.0, 1.0).val()
     b = cq.Workplane().box(1.0, 1.0, 1.0).translate((1.0, 0.0, 0.0)).val()
     return cq.Compound.makeCompound([a, b]).wrapped
+
+
+# ------------------------------------------------------ n-sided holes (hole_cap.py)
+def gentle_height(x, y):
+    """The graph of the n-sided hole cases (benchmarks/heal.py's too)."""
+    return 0.3 * np.sin(1.3 * x) * np.cos(0.9 * y) + 0.1 * x * y
+
+
+def fan_around_hole(n: int, *, r: float = 0.15, outer: float = 0.5, centre=(0.5, 0.5),
+                    height=gentle_height, samples: int = 7) -> list[NurbsSurface]:
+    """``n`` four-sided patches of ``z = height(x, y)`` around a regular ``n``-gon hole of
+    circumradius ``r`` (patch ``k`` spans the hole's edge ``k`` at ``v = 0`` and the outer
+    ``n``-gon's at ``v = 1``); neighbours share their ``u = 1`` / ``u = 0`` sides exactly
+    (interpolants of the same points with the same parameters)."""
+    angle = np.linspace(0.0, 2 * np.pi, n + 1)[:-1] + 0.3
+    inner = np.column_stack([centre[0] + r * np.cos(angle), centre[1] + r * np.sin(angle)])
+    rim = np.column_stack([centre[0] + outer * np.cos(angle), centre[1] + outer * np.sin(angle)])
+    s = np.linspace(0.0, 1.0, samples)
+    ss, tt = np.meshgrid(s, s, indexing="ij")
+    out = []
+    for k in range(n):
+        j = (k + 1) % n
+        a = (1 - ss)[..., None] * inner[k] + ss[..., None] * inner[j]
+        b = (1 - ss)[..., None] * rim[k] + ss[..., None] * rim[j]
+        xy = (1 - tt)[..., None] * a + tt[..., None] * b
+        z = height(xy[..., 0], xy[..., 1])[..., None]
+        out.append(interpolate_surface(np.concatenate([xy, z], axis=-1), params_u=s, params_v=s))
+    return out
+
+
+def inside_regular_polygon(n: int, *, r: float = 0.15, centre=(0.5, 0.5), rings: int = 15,
+                           spokes: int = 60) -> np.ndarray:
+    """(k, 2) points of the disc inscribed in the hole of :func:`fan_around_hole` (98 %)."""
+    radius = np.linspace(0.0, 0.98 * r * np.cos(np.pi / n), rings)
+    angle = np.linspace(0.0, 2 * np.pi, spokes, endpoint=False)
+    rr, aa = np.meshgrid(radius, angle)
+    return np.column_stack([centre[0] + (rr * np.cos(aa)).ravel(),
+                            centre[1] + (rr * np.sin(aa)).ravel()])
