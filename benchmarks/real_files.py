@@ -104,9 +104,13 @@ def outcome(command: str, result: Run, timeout: float) -> str:
     if command == "heal":
         free = r["free_edges"]
         skipped = len(r.get("skipped", []))
+        loops = r.get("free_loops", [])
+        holes = sum(lp["kind"] == "hole" for lp in loops)
+        filled = len({p["index"] for p in r["patches"] if p["kind"] == "hole"})
         return (f"exit {result.code}: free edges {free['before']} -> {free['after']}, "
                 f"{len(r['patches'])} patches" + (f", {skipped} skipped" if skipped else "")
-                + tail)
+                + (f", loops {len(loops)}: {holes} holes ({filled} filled), "
+                   f"{len(loops) - holes} other" if loops else "") + tail)
     done = sum(1 for f in r["faces"] if f.get("error") is None)
     return f"exit {result.code}: {done}/{len(r['faces'])} faces{tail}"
 

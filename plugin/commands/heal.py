@@ -4,6 +4,7 @@ bicubic approximants (:func:`surfprep.plugin.heal.heal`)."""
 from __future__ import annotations
 
 import argparse
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +93,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="re-approximate only the faces with a gap, a hole or an "
                              "overlap at their edges (default; the others keep their exact "
                              "geometry) or every face")
+    parser.add_argument("--fill", choices=("holes", "all", "none"), default="holes",
+                        help="which loops of free edges to fill: holes, whose surroundings "
+                             "continue across them (default), also open boundaries such as "
+                             "a sheet's edge or a pipe's end (all), or none")
     parser.add_argument("--job-time-limit", type=seconds_argument,
                         default=DEFAULT_JOB_TIME_LIMIT, metavar="S", dest="job_time_limit",
                         help="stop an approximant that takes longer than S seconds to build, "
@@ -126,6 +131,13 @@ def _summary(report: dict) -> list[str]:
                      f"{max(j['max_gap'] for j in joins):.3g} mm, max normal angle "
                      f"{max(j['max_angle_deg'] for j in joins):.3g} deg "
                      f"({report['continuity']})")
+    loops = report.get("free_loops", [])
+    if loops:
+        kinds = Counter(lp["kind"] for lp in loops)
+        lines.append(f"{len(loops)} loop(s) of free edges: "
+                     + ", ".join(f"{n} {kind}{'s' if n > 1 else ''}"
+                                 for kind, n in sorted(kinds.items()))
+                     + f"; fill tried on {sum(lp['fill'] for lp in loops)}")
     lines.append(f"free edges {free['before']} -> {free['after']} (at gap_tol "
                  f"{report['gap_tol']:.3g} mm), {free['tight_before']} -> "
                  f"{free['tight_after']} (geometric); valid {valid['before']} -> "
@@ -150,7 +162,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                       patches=args.patches, overlap=args.overlap,
                       split_faces=args.split_faces, replace=args.replace,
-                      meshes=args.meshes, progress=progress,
+                      meshes=args.meshes, fill=args.fill, progress=progress,
                       stage=lambda what: console.stage(f"heal: {what}"))
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
               "repaired": repaired_report(model)}
@@ -179,9 +191,11 @@ COMMAND = Command(
         "geometry, an edge on a hole, an overlap; every face with --replace all) gets a "
         "bicubic B-spline approximant over its own four edges, projected onto all "
         "original faces (Hamann & Jean 1996), and is kept as it was where the "
-        "approximant lies farther than tol from the input faces; four-sided holes "
-        "bounded by free edges of neighbouring faces are filled the same way (Hardy's "
-        "multiquadric over the hole); faces lying on other faces are dropped, a face "
+        "approximant lies farther than tol from the input faces; loops of free edges "
+        "of neighbouring faces are classified by their surroundings: holes (the "
+        "surroundings continue across them) are filled, four-sided ones by one "
+        "approximant, others by four-sided patches around a centre on a thin-plate "
+        "cap continuing the surroundings; open boundaries stay open unless --fill all; faces lying on other faces are dropped, a face "
         "lying partly on another is trimmed back to the other's boundary; directed "
         "patches come from --patches and replace what they cover (the faces under "
         "them are cut away). The approximants are joined G0 (shared control "

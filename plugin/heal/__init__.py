@@ -14,7 +14,9 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    or both replaced by one approximant over the union (``overlap="union"``,
    :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; free
-   edges chained into loops of four from two or more faces are holes;
+   edges chained into loops from two or more faces are classified by their
+   surroundings (:mod:`.loops`): holes (the surroundings continue across them) are
+   filled, open boundaries (a sheet's edge) are not, unless ``fill`` says otherwise;
 3. every four-sided face with a defect (``replace="defects"``, the default: an
    edge paired with another face's but not closed in the geometry, an edge on a
    hole, an overlap; every face with ``replace="all"``) gets a
@@ -25,8 +27,9 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    approximant misses ``tol`` at the largest resolution is kept as it is, and
    the report says so); a face that is not four-sided is split into four-sided
    sub-patches (``split_faces``, default) and replaced when all of them fit;
-   every hole one over its four free edges (a loop whose patch lands on faces,
-   e.g. the mouth of a slot, is no hole and stays open);
+   every hole one over its four free edges, or, with another number of edges,
+   four-sided sub-patches of its cap (a loop whose patch lands on faces off
+   ``tol``, e.g. the mouth of a slot, stays open);
 4. the approximants are joined by :func:`~surfprep.algorithms.healing.connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
    as it was (not re-approximated) is fitted to that face's edge or edges, or
@@ -48,7 +51,8 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    the input, a free border cut into the sides of sub-patches with ``replace="all"``,
    or directed patches;
    untouched faces keep their names (a replaced face passes its name to its
-   approximant; holes are named ``heal_hole_<k>``).
+   approximant; holes are named ``heal_hole_<k>``, their sub-patches
+   ``heal_hole_<k>_<n>``).
 
 The building blocks are :mod:`surfprep.algorithms.healing`
 (``local_approximant``, ``connect``, ``Continuity``, ``Side``); the approximants
@@ -108,6 +112,7 @@ from .jobs import (
     plan_jobs,
     replaced_faces,
 )
+from .loops import plan_loops
 from .spec import read_patch_spec
 from .trim_back import trim_overlaps_of
 
@@ -249,6 +254,7 @@ class HealResult:
             "valid": {"before": self.valid_before, "after": self.valid_after},
             "max_edge_tolerance": self.max_edge_tolerance,
             "replace": self.extra.get("replace"),
+            "free_loops": self.extra.get("free_loops", []),
         }
 
 
@@ -323,7 +329,7 @@ def _mesh_sources(meshes) -> list:
 def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity | str = "G0",
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True,
-         replace: str = "defects", meshes: Any = (), progress=None,
+         replace: str = "defects", meshes: Any = (), fill: str = "holes", progress=None,
          stage: Callable[[str], None] | None = None) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
@@ -368,6 +374,13 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         triangles as input): a scan or an STL / OBJ / Plot3D grid covering a hole
         makes the patch over it follow the data instead of the multiquadric fill of
         the neighbours' shape. The faces stay each face's preferred source.
+    fill : "holes", "all" or "none"
+        Which loops of free edges (from two or more faces) are filled
+        (:mod:`.loops`): "holes" (default) those whose surroundings continue across
+        them; "all" also open boundaries (a sheet's edge, a pipe's end: capped by
+        the smoothest surface through the rim); "none" none. Loops of any number of
+        edges: four corners give one patch, others quads around a centre. The
+        report's ``free_loops`` says what each loop is and what was done.
     progress : callable(done, total), optional
         Called before each approximant and after the last.
     stage : callable(str), optional
@@ -428,7 +441,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     edges, pairs = _without_faces(edges, pairs, gone)
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
-    holes = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
+    rims = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
+    loops = plan_loops(rims, faces, fill=fill)
+    holes = [loop for loop in loops if loop.fill]
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)
     trimmed, unions = overlap_boundaries(faces, overlaps, OverlapRepair.parse(overlap),
@@ -444,7 +459,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
                        "is re-approximated (replace='all')")
         replace = "all"
     defective = kept if replace == "all" else _defective(
-        kept, edges, pairs, holes, {o.kept for o in overlaps} | set(trimmed) | set(unions)
+        kept, edges, pairs, [rims[h.index] for h in holes if h.edges == 4], {o.kept for o in overlaps} | set(trimmed) | set(unions)
         | {j for j, _ in unions.values()}, TIGHT_FACTOR * model.size, gap_tol, continuity,
         skipped)
     jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
@@ -461,6 +476,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         inputs=inputs, gap_tol=gap_tol, tol=tol, continuity=continuity, start=start,
         keep_split=replace == "all")
     result.extra["replace"] = replace
+    result.extra["free_loops"] = [loop.as_dict() for loop in loops]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["snapped_sides"] = snapped
@@ -665,7 +681,8 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
     out, moved, off = [], [], []
     for (job, la), surface in zip(done, network.patches if network else ()):
         deviation = surface_deviation(surface, inputs, tol=INPUT_CHECK_TOL * la.tol,
-                                      rim_only=job.origin.kind == "hole").max_distance
+                                      rim_only=job.origin.kind == "hole" and job.rim_sides
+                                      ).max_distance
         if job.origin.kind != "directed" and deviation > la.tol:
             (moved if deviation <= la.tol + gap_tol else off).append((job, deviation, la.tol))
         out.append(deviation)

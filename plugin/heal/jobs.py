@@ -32,6 +32,10 @@ __all__ = ["INPUT_CHECK_TOL", "RETRY_MARGIN", "Job", "PatchOrigin", "approximate
 
 #: the dense check against the input projects to this times the patch's tol
 INPUT_CHECK_TOL = 1e-3
+#: first resolution of a patch over a hole's cap: the cap is smooth and fully hit, so
+#: the first (8, 8) already meets tol, but the tangent planes at the rim follow the
+#: cap's to 0.02 degrees only; at (16, 16) to 0.004-0.012 (an n-sided hole in a fan)
+CAP_RESOLUTION = (16, 16)
 #: a patch off the input is rebuilt once to its own error times tol / deviation, times this
 RETRY_MARGIN = 0.8
 
@@ -57,7 +61,9 @@ class Job:
     boundary: Any
     name: str | None
     reference: TrimmedFace | None     # face whose orientation the approximant takes
-    split: bool = False               # one of the sub-patches of a face that is not four-sided
+    split: bool = False               # one of several sub-patches of a face or a hole
+    rim_sides: tuple[int, ...] = (0, 1, 2, 3)   # a hole's sides on its rim (the others cross it)
+    cap: Any = None                   # a hole's cap (its artificial projections lie on it)
 
 
 def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: float,
@@ -83,7 +89,7 @@ def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: b
               gap_tol: float = 0.0, skipped: list[str] | None = None) -> list[Job]:
     """The approximants to build: one per union of overlapping faces, per kept face
     (its own four edges, a strip-trimmed boundary, or its four-sided sub-patches) and
-    per hole."""
+    per sub-patch of a hole to fill (``holes``: :class:`.loops.FreeLoop`)."""
     jobs = []
     for i, (j, outline) in unions.items():
         jobs.append(Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
@@ -98,9 +104,12 @@ def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: b
             name = faces[i].name if len(boundaries) == 1 or not faces[i].name \
                 else f"{faces[i].name}_{n}"
             jobs.append(Job(PatchOrigin("face", (i,), i), curves, name, faces[i], split))
-    for k, loop in enumerate(holes):
-        jobs.append(Job(PatchOrigin("hole", tuple(sorted({e.face for e in loop})), k),
-                         [e.curve for e in loop], f"heal_hole_{k}", None))
+    for loop in holes:
+        many = len(loop.boundaries) > 1
+        for n, (curves, rim) in enumerate(loop.boundaries):
+            name = f"heal_hole_{loop.index}_{n}" if many else f"heal_hole_{loop.index}"
+            jobs.append(Job(PatchOrigin("hole", loop.faces, loop.index), curves, name, None,
+                            many, tuple(rim), loop.cap))
     return jobs
 
 
@@ -139,8 +148,8 @@ def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_to
     for n, job in enumerate(jobs):
         if progress is not None:
             progress(n, len(jobs))
-        if job.split and job.origin.index in failed:
-            continue              # the face is kept whole: its other sub-patches are moot
+        if job.split and (job.origin.kind, job.origin.index) in failed:
+            continue              # kept whole / left open: its other sub-patches are moot
         try:
             la = _one_job(job, sources, source_of, tol, gap_tol, skipped, inputs)
         except TimeLimitExceeded as exc:
@@ -148,7 +157,7 @@ def approximate(jobs: list[Job], sources, source_of: dict[int, int], tol, gap_to
             skipped.append(f"{job.origin.kind} {job.origin.index}: stopped ({exc}); left as "
                            "it was")
         if la is None:
-            failed |= {job.origin.index} if job.split else set()
+            failed |= {(job.origin.kind, job.origin.index)} if job.split else set()
             continue
         out.append((job, la))
     if progress is not None:
@@ -160,10 +169,12 @@ def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped
              inputs: InputFaces | None) -> LocalApproximant | None:
     """The approximant of one job (:func:`approximate`), or None with a note."""
     own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
+    extra = {} if job.cap is None else {"resolution": CAP_RESOLUTION,
+                                        "fill_source": job.cap.source(job.name or "")}
 
     def build(target):
         return local_approximant(job.boundary, sources, tol=target, gap_tol=gap_tol,
-                                 preferred_source=own, side_error=job.split)
+                                 preferred_source=own, side_error=job.split, **extra)
     try:
         la = build(tol)
     except TimeLimitExceeded:
@@ -224,15 +235,20 @@ def _held_to_input(job: Job, la: LocalApproximant, build, inputs: InputFaces,
 
 
 def _whole_faces_only(jobs: list[Job], out: list, skipped: list[str],
-                      failed: set[int] = frozenset()) -> list:
-    """A face split into sub-patches is replaced only when every sub-patch fits (the
-    sub-patches after the first that does not fit, of a face in ``failed``, are not
-    built)."""
-    want = Counter(j.origin.index for j in jobs if j.origin.kind == "face")
-    got = Counter(j.origin.index for j, _ in out if j.origin.kind == "face")
-    partial = {i for i, k in want.items() if got[i] not in (0, k)} | \
-        {i for i in failed if got[i]}
-    skipped += [f"face {i}: {got[i]} of {want[i]} sub-patches fit"
-                f"{' (the rest not tried after one failed)' if i in failed else ''}; "
-                "kept as it was" for i in sorted(partial)]
-    return [(j, la) for j, la in out if not (j.origin.kind == "face" and j.origin.index in partial)]
+                      failed: set[tuple[str, int]] = frozenset()) -> list:
+    """A face split into sub-patches is replaced, a hole filled by several, only when
+    every sub-patch fits (the sub-patches after the first that does not fit, of a face
+    or hole in ``failed`` (``(kind, index)``), are not built)."""
+    def key(job):
+        return job.origin.kind, job.origin.index
+
+    split = [j for j in jobs if j.origin.kind in ("face", "hole")]
+    want = Counter(key(j) for j in split)
+    got = Counter(key(j) for j, _ in out if j.origin.kind in ("face", "hole"))
+    partial = {k for k, n in want.items() if got[k] not in (0, n)} | \
+        {k for k in failed if got[k]}
+    skipped += [f"{kind} {i}: {got[kind, i]} of {want[kind, i]} sub-patches fit"
+                f"{' (the rest not tried after one failed)' if (kind, i) in failed else ''}; "
+                + ("kept as it was" if kind == "face" else "left open")
+                for kind, i in sorted(partial)]
+    return [(j, la) for j, la in out if key(j) not in partial]

@@ -197,8 +197,10 @@ def _quad(p00, p10, p01, p11):
 @pytest.mark.slow
 def test_mouth_of_a_shallow_pocket_is_not_a_hole():
     # floor and four walls 0.1 high: the walls' top edges chain into a loop of four free
-    # edges, but a patch over it lands on the floor (segments of length 2 d = 1 > 0.1):
-    # no hole, left open; the walls and floor stay closed to each other
+    # edges, but the walls turn away from it by 90 degrees: an open boundary (issue 21
+    # item 4), left open; the walls and floor stay closed to each other. With
+    # fill="all" a patch is tried and lands on the floor (segments of length 2 d = 1 >
+    # 0.1) off tol: no hole, left open all the same.
     z0, z1 = 0.0, 0.1
     c = [(0, 0), (1, 0), (1, 1), (0, 1)]
     walls = [_quad((*c[k], z0), (*c[(k + 1) % 4], z0), (*c[k], z1), (*c[(k + 1) % 4], z1))
@@ -206,8 +208,12 @@ def test_mouth_of_a_shallow_pocket_is_not_a_hole():
     floor = _quad((0, 0, z0), (1, 0, z0), (0, 1, z0), (1, 1, z0))
     r = heal(compound([make_face(s) for s in walls + [floor]]))
     assert not any(p.origin.kind == "hole" for p in r.patches)
-    assert any("not a hole" in s for s in r.skipped)
+    (loop,) = r.report()["free_loops"]
+    assert loop["kind"] == "open boundary" and loop["slope_deg"] > 80 and not loop["fill"]
     assert r.free_edges_after == 4 and r.valid_after
+    forced = heal(compound([make_face(s) for s in walls + [floor]]), fill="all")
+    assert not any(p.origin.kind == "hole" for p in forced.patches)
+    assert any("not a hole" in s for s in forced.skipped)
 
 
 def test_only_faces_with_a_defect_are_replaced_by_default():
@@ -283,10 +289,30 @@ def test_free_edges_the_pairing_misses_are_taken_back(monkeypatch):
 
     monkeypatch.setattr(heal_module, "face_edges",
                         lambda faces: [e for e in face_edges(faces) if e.k >= 0])
-    r = heal(slotted_plate())
+    # the mouths' walls turn away from them: open boundaries, filled only with fill="all"
+    r = heal(slotted_plate(), fill="all")
     assert r.free_edges_after <= r.free_edges_before == 0
     assert r.patches == () and r.valid_after
     (note,) = [s for s in r.skipped if "taken back" in s]
     assert "free edges 0 -> 12" in note
     assert all(f"face {i}" in note for i in (6, 7, 8, 9)) and "hole 0" in note
 
+
+
+def test_a_slots_mouth_is_an_open_boundary_by_geometry(monkeypatch):
+    """Issue 21 item 4: with the pairing blind to inner loops (as above) the slot's
+    mouths are loops of free edges; their walls turn away from them by 90 degrees, so
+    they are open boundaries and nothing is built over them (before, an approximant
+    was built and taken back only because it left more free edges)."""
+    from helpers.heal_cases import slotted_plate
+
+    import surfprep.plugin.heal as heal_module
+    from surfprep.algorithms.healing.adjacency import face_edges
+
+    monkeypatch.setattr(heal_module, "face_edges",
+                        lambda faces: [e for e in face_edges(faces) if e.k >= 0])
+    r = heal(slotted_plate())
+    loops = r.report()["free_loops"]
+    assert loops and all(lp["kind"] == "open boundary" and not lp["fill"] for lp in loops)
+    assert all(lp["slope_deg"] > 80 for lp in loops)
+    assert r.patches == () and r.free_edges_after == r.free_edges_before == 0
