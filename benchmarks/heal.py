@@ -19,6 +19,20 @@
    alone for OpenCascade; the whole ``heal`` call for surfprep (which also
    rebuilds the eight neighbours and sews).
 
+1b. **Holes of 3, 5 and 6 sides** (``nsided_table``): a fan of ``n`` bicubic patches
+   of the same graph around a regular ``n``-gon hole of circumradius 0.15
+   (``tests/helpers/heal_cases.fan_around_hole``). surfprep ``heal`` G0 / G1 (the
+   hole classed by its surroundings, capped by the thin-plate spline of the rim
+   and the faces near it, ``n`` four-sided patches around a centre; neighbours
+   untouched) vs ``BRepOffsetAPI_MakeFilling`` (the front end of
+   ``BRepFill_Filling``) with the ``n`` edges as C0, and as G1 constraints on their
+   faces. Deviation from the true graph over the hole's inscribed disc (900
+   points, closest points to the union of the fill's patches); the largest normal
+   angle along the rim against the input faces (41 points per rim side); the
+   largest distance of the fill's rim from the input faces (the gap left); for
+   surfprep also the angle across its own spokes; time as above (surfprep: the
+   whole ``heal`` call, reading, classing, sewing and checks included).
+
 2. **Gap**: two patches of the graph with a 1e-3 gap and mismatched
    parametrization along the shared side. surfprep ``heal`` vs
    ``BRepBuilderAPI_Sewing(2e-3)`` + ``ShapeFix_Shape``: the geometric gap left
@@ -207,6 +221,109 @@ def hole_table() -> list[str]:
             "max normal angle to the neighbours in the output (deg) | max distance of the "
             "original hole edges to the fill | time (s) | "
             "note |"), "|---|---|---|---|---|---|"]
+    return head + rows
+
+
+# ------------------------------------------------------------ n-sided holes
+def _normal_angle(n1, n2):
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1),
+                                 np.abs(np.sum(n1 * n2, axis=1))))
+
+
+def _along(surface, uv, others):
+    """(largest normal angle, largest distance) along ``uv`` on ``surface`` against the
+    nearest of ``others``."""
+    pts = surface.evaluate(uv[:, 0], uv[:, 1])
+    best = None
+    for other in others:
+        foot = project_to_surface(other, pts)
+        if best is None or foot.distance.max() < best[1]:
+            angle = _normal_angle(surface.normals(uv[:, 0], uv[:, 1]),
+                                  other.normals(foot.uv[:, 0], foot.uv[:, 1])).max()
+            best = (float(angle), float(foot.distance.max()))
+    return best
+
+
+def _nsided_truth(heal_cases, n):
+    xy = heal_cases.inside_regular_polygon(n)
+    return np.column_stack([xy, heal_cases.gentle_height(xy[:, 0], xy[:, 1])])
+
+
+def _nsided_ours(heal_cases, n, continuity):
+    fan = heal_cases.fan_around_hole(n)
+    shape = compound([make_face(s) for s in fan])
+    start = time.perf_counter()
+    result = surfprep.heal(shape, continuity=continuity)
+    elapsed = time.perf_counter() - start
+    holes = [s for p, s in zip(result.patches, result.network.patches)
+             if p.origin.kind == "hole"]
+    truth = _nsided_truth(heal_cases, n)
+    dev = float(np.min([project_to_surface(h, truth).distance for h in holes], axis=0).max())
+    t = np.linspace(0.02, 0.98, 41)
+    rim = [_along(h, uv, fan) for h in holes
+           for uv in (np.column_stack([t, 0 * t]), np.column_stack([0 * t, t]))]
+    spokes = [_along(h, uv, [o for o in holes if o is not h])[0] for h in holes
+              for uv in (np.column_stack([1 + 0 * t, t]), np.column_stack([t, 1 + 0 * t]))]
+    note = (f"{len(holes)} patches, spokes {max(spokes):.2g} deg, free edges "
+            f"{result.free_edges_before} -> {result.free_edges_after} (the fan's outer "
+            f"edge stays open), valid {result.valid_after}")
+    return dev, max(a for a, _ in rim), max(d for _, d in rim), elapsed, note
+
+
+def _nsided_occ(heal_cases, n, order):
+    fan = heal_cases.fan_around_hole(n)
+    faces = [make_face(s) for s in fan]
+    sides = []
+    for face, surface in zip(faces, fan):
+        target = surface.evaluate(0.5, 0.0)          # the hole's edge is the fan face's v = 0
+        sides.append((min(edges_of(face), key=lambda e: _edge_mid_distance(e, target)), face))
+    start = time.perf_counter()
+    filling = BRepOffsetAPI_MakeFilling()
+    for edge, face in sides:
+        if order is GeomAbs_C0:
+            filling.Add(edge, GeomAbs_C0)
+        else:
+            filling.Add(edge, face, order)
+    filling.Build()
+    elapsed = time.perf_counter() - start
+    if not filling.IsDone():
+        return None, None, None, elapsed, "IsDone() False"
+    surface = to_nurbs(TopoDS.Face_s(TopExp_Explorer(filling.Shape(), TopAbs_FACE).Current())
+                       ).surface
+    dev = float(project_to_surface(surface, _nsided_truth(heal_cases, n)).distance.max())
+    worst_angle, worst_gap = 0.0, 0.0
+    for (edge, _), neighbour in zip(sides, fan):
+        c = edge_to_nurbs(edge)
+        pts = c.evaluate(np.linspace(*c.domain, 43)[1:-1])
+        fa, fb = project_to_surface(surface, pts), project_to_surface(neighbour, pts)
+        angle = _normal_angle(surface.normals(fa.uv[:, 0], fa.uv[:, 1]),
+                              neighbour.normals(fb.uv[:, 0], fb.uv[:, 1]))
+        worst_angle = max(worst_angle, float(angle.max()))
+        worst_gap = max(worst_gap, float(fa.distance.max()))
+    return dev, worst_angle, worst_gap, elapsed, f"IsDone, G0 error {filling.G0Error():.2g}"
+
+
+def nsided_table() -> list[str]:
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from helpers import heal_cases
+    rows = []
+    for n in (3, 5, 6):
+        for label, run in (
+                ("surfprep heal G0", lambda: _nsided_ours(heal_cases, n, "G0")),
+                ("surfprep heal G1", lambda: _nsided_ours(heal_cases, n, "G1")),
+                ("MakeFilling C0", lambda: _nsided_occ(heal_cases, n, GeomAbs_C0)),
+                ("MakeFilling G1", lambda: _nsided_occ(heal_cases, n, GeomAbs_G1))):
+            dev, angle, gap, elapsed, note = run()
+            if dev is None:
+                rows.append(f"| {n} | {label} | - | - | - | {elapsed:.3f} | {note} |")
+                continue
+            rows.append(f"| {n} | {label} | {dev:.2g} | {angle:.2g} | {gap:.2g} | "
+                        f"{elapsed:.3f} | {note} |")
+    head = ["| sides | method | deviation from true surface | max normal angle to the input "
+            "faces along the rim (deg) | max distance of the fill's rim from the input faces "
+            "| time (s) | note |", "|---|---|---|---|---|---|---|"]
     return head + rows
 
 
@@ -402,7 +519,7 @@ def files_table() -> list[str]:
 
 def main() -> None:
     import sys
-    tables = (hole_table, gap_table, crossing_table, table1_rows, files_table)
+    tables = (hole_table, nsided_table, gap_table, crossing_table, table1_rows, files_table)
     if len(sys.argv) > 1:                  # e.g. python benchmarks/heal.py crossing_table
         tables = tuple(t for t in tables if t.__name__ in sys.argv[1:])
     for table in tables:

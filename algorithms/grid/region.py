@@ -23,7 +23,7 @@ from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
-from .arc_length import lengths_between, parameters_at_lengths
+from ..arc_length_inversion import lengths_between, parameters_at_lengths
 
 __all__ = ["SIDE_NAMES", "Region", "Side"]
 

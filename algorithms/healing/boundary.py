@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
+from ..arc_length_inversion import parameters_at_lengths
 from ..measure import cumulative_arc_length
 
 __all__ = ["SIDE_NAMES", "Boundary", "BoundaryCurve", "as_boundary", "corners_boundary"]
@@ -34,8 +35,7 @@ __all__ = ["SIDE_NAMES", "Boundary", "BoundaryCurve", "as_boundary", "corners_bo
 SIDE_NAMES = ("bottom", "right", "top", "left")
 #: default gap_tol: this fraction of the boundary's bounding-box diagonal
 DEFAULT_RELATIVE_GAP = 1e-4
-_ARC_SAMPLES = 64            # parameter samples per knot span for the arc-length table
-_ARC_NEWTON = 3              # Newton steps polishing the table's inverse
+_ARC_SAMPLES = 8             # table entries per knot span (Newton from the table polishes)
 
 BoundaryCurve = NurbsCurve | NDArray
 
@@ -224,12 +224,14 @@ def _uniform_points(c: BoundaryCurve, m: int, start: NDArray, end: NDArray) -> N
         length = cumulative_arc_length(c, t)
         if not length[-1] > 0:
             raise DegenerateGeometryError("a boundary curve has zero length")
-        target = s * length[-1]
-        u = np.interp(target, length, t)
-        for _ in range(_ARC_NEWTON):              # arc length(u) = target, speed |C'|
-            speed = np.linalg.norm(c.derivatives(u, 1)[:, 1], axis=1)
-            step = (cumulative_arc_length(c, u) - target) / np.maximum(speed, 1e-300)
-            u = np.clip(u - step, t[0], t[-1])
+
+        def speed(x):
+            return np.linalg.norm(c.derivatives(x, 1)[:, 1], axis=1)
+
+        # arc length(u) = target: Newton from the table, each length measured from the
+        # table's entry below (not from the start: that was 3 whole-curve integrations)
+        u = parameters_at_lengths(speed, t, length, s * length[-1],
+                                  np.ones(s.size, bool))
         pts = c.evaluate(u)
     else:
         chord = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])

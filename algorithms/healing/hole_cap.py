@@ -51,7 +51,7 @@ from scipy.spatial import cKDTree
 
 from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
-from ..face_region import FaceRegion
+from ..face_region import FaceRegion, inside_loops
 from ..fitting import interpolate_surface
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
@@ -250,12 +250,7 @@ def _segments_cross(poly: NDArray) -> bool:
 
 def _inside(points: NDArray, poly: NDArray) -> NDArray:
     """(k,) bool: even-odd test of planar points against the closed polygon."""
-    x, y = points[:, 0:1], points[:, 1:2]
-    x0, y0 = poly[:, 0], poly[:, 1]
-    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        hit = ((y0 > y) != (y1 > y)) & (x < x0 + (y - y0) * (x1 - x0) / (y1 - y0))
-    return np.count_nonzero(hit, axis=1) % 2 == 1
+    return inside_loops(points, [poly])
 
 
 def surroundings(faces: Sequence[TrimmedFace], rim: ArrayLike, *, reach: float,

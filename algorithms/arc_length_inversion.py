@@ -1,9 +1,10 @@
 """Arc length of a path known by its speed: short lengths by Gauss quadrature, and the
 parameters at given lengths (the inverse of a tabulated arc length).
 
-A grid side is a 3D curve (:func:`.distribution.points_along`) or a pcurve seen
-through its surface (:class:`.region.Side`); both know their speed ``|dP/dt|`` and
-a fine table of ``(t, s(t))``. :func:`parameters_at_lengths` turns target lengths
+A grid side is a 3D curve (:func:`.grid.distribution.points_along`) or a pcurve seen
+through its surface (:class:`.grid.region.Side`), an approximant's boundary curve is
+sampled uniformly in arc length (:mod:`.healing.boundary`); all know their speed
+``|dP/dt|`` and a fine table of ``(t, s(t))``. :func:`parameters_at_lengths` turns target lengths
 into parameters the same way for both: monotone interpolation in the table, then
 Newton on ``s(t) - target`` with the speed, each ``s(t)`` measured from the table's
 nearest entry below by 8-point Gauss--Legendre (exact for polynomial speed of
