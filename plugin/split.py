@@ -23,7 +23,7 @@ from ..errors import OpenCascadeError, SurfprepError
 from .intersect import IntersectionResult, intersect
 from .io import as_model
 from .occ.faces import trimmed_face_to_occ
-from .occ.shapes import compound, count_free_edges, is_valid, sew
+from .occ.shapes import compound, count_free_edges, is_valid, sew, shell_or_solid
 
 __all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split"]
 
@@ -301,9 +301,6 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
 def _solids(shape) -> list:
     """The solids of a sewn result: itself, or each closed shell of a compound made solid;
     empty when a shell stays open."""
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid
-    from OCP.ShapeFix import ShapeFix_Solid
     from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
@@ -312,14 +309,9 @@ def _solids(shape) -> list:
     out = []
     explorer = TopExp_Explorer(shape, TopAbs_SHELL)
     while explorer.More():
-        shell = TopoDS.Shell_s(explorer.Current())
+        solid = shell_or_solid(TopoDS.Shell_s(explorer.Current()))
         explorer.Next()
-        if not BRep_Tool.IsClosed_s(shell):
+        if solid.ShapeType() != TopAbs_SOLID:
             return []
-        maker = BRepBuilderAPI_MakeSolid(shell)
-        if not maker.IsDone():
-            return []
-        fix = ShapeFix_Solid(maker.Solid())
-        fix.Perform()
-        out.append(fix.Solid())
+        out.append(solid)
     return out

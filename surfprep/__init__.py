@@ -60,6 +60,7 @@ if TYPE_CHECKING:
     from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
     from .plugin.split import BooleanResult, SplitResult, boolean, split
+    from .plugin.volume_boundary import BoundarySolid, boundary_solid
 
 __version__ = "0.1.0"
 
@@ -104,6 +105,8 @@ __all__ = [
     "NurbsVolume",
     "compose",
     "Composition",
+    "boundary_solid",
+    "BoundarySolid",
     # structured grids (numpy only)
     "grid_surface",
     "SurfaceGrid",
@@ -159,6 +162,8 @@ _LAZY_EXPORTS = {
     "NurbsVolume": "surfprep.algorithms.volume",
     "compose": "surfprep.algorithms.compose",
     "Composition": "surfprep.algorithms.compose",
+    "boundary_solid": "surfprep.plugin.volume_boundary",
+    "BoundarySolid": "surfprep.plugin.volume_boundary",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",
     "Spacing": "surfprep.algorithms.grid",

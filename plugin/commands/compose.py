@@ -24,6 +24,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--labels", type=Path, metavar="LABELS",
                         help="write one label a line for --classify's points: 0 outside both, "
                              "1 in A only, 2 in B only, 3 in both")
+    parser.add_argument("--boundary", type=Path, metavar="OUT",
+                        help="write both solids' boundaries as OpenCascade solids to a STEP "
+                             "or IGES file (a shell where a boundary does not close)")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
 
@@ -58,6 +61,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         raise InputFileError("--classify and --labels go together")
     if args.labels is not None:
         check_outputs(inputs, args.labels, model=False)
+    if args.boundary is not None:
+        check_outputs(inputs, args.boundary)
     a, b = _solid(args.a), _solid(args.b)
     points = _points(args.classify) if args.classify is not None else None
     started = time.perf_counter()
@@ -73,6 +78,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         report["labels"] = {str(k): int(np.sum(labels == k)) for k in range(4)}
         with atomic_output(args.labels) as temporary:
             temporary.write_text("".join(f"{int(x)}\n" for x in labels))
+    if args.boundary is not None:
+        report["boundary"] = _write_boundary(a, b, args.boundary)
     if args.json_path is not None:
         write_json_report(report, args.json_path, console, protected=inputs)
     if args.json_path != STDOUT:
@@ -81,7 +88,27 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if labels is not None:
             console.print("labels: " + ", ".join(f"{k}: {v}" for k, v in report["labels"].items())
                           + f", written to {args.labels}")
+        if args.boundary is not None:
+            console.print("boundaries: " + "; ".join(
+                f"{k} {'solid' if b['closed'] else 'open shell'} of {len(b['faces'])} face(s), "
+                f"OpenCascade volume {b['volume']:.10g}" for k, b in report["boundary"].items()
+                if k in ("A", "B")) + f", written to {report['boundary']['output']}")
     return 0
+
+
+def _write_boundary(a, b, path: Path) -> dict:
+    """Both solids' boundaries as OpenCascade solids written to ``path``; their figures."""
+    from ..io import write
+    from ..occ.shapes import compound
+    from ..volume_boundary import boundary_solid
+    out, shapes = {}, []
+    for key, solid in (("A", a), ("B", b)):
+        result = boundary_solid(solid)
+        shapes.append(result.shape)
+        out[key] = {"faces": list(result.faces), "closed": result.closed,
+                    "free_edges": result.free_edges, "volume": result.volume}
+    out["output"] = str(write(compound(shapes), path, overwrite=True))
+    return out
 
 
 COMMAND = Command(
@@ -91,10 +118,13 @@ COMMAND = Command(
         "Read two solids from GoTools .g2 files, intersect their exterior boundary surfaces "
         "(collapsed faces and seams left out) and report the curves; with --classify, label "
         "each point 0 outside both, 1 in A only, 2 in B only, 3 in both (Newton inversion into "
-        "each solid). Volumes of the composed regions are not computed yet."),
+        "each solid); with --boundary, write both solids' boundaries (their non-degenerate "
+        "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES. "
+        "Volumes of the composed regions are not computed yet."),
     epilog=("examples:\n"
             "  surfprep compose a.g2 b.g2 --json r.json\n"
-            "  surfprep compose a.g2 b.g2 --classify points.csv --labels labels.csv"),
+            "  surfprep compose a.g2 b.g2 --classify points.csv --labels labels.csv\n"
+            "  surfprep compose a.g2 b.g2 --boundary both.step"),
     add_arguments=_add_arguments,
     run=_run,
 )

@@ -47,6 +47,7 @@ __all__ = [
     "is_valid",
     "max_edge_tolerance",
     "sew",
+    "shell_or_solid",
 ]
 
 
@@ -175,10 +176,13 @@ def sew(faces: list[TopoDS_Shape], tol: float, *,
     shape = sewing.SewedShape()
     if shape.IsNull():
         raise OpenCascadeError("BRepBuilderAPI_Sewing returned a null shape")
-    return (shape if non_manifold else _shell_or_solid(shape)), sewing
+    return (shape if non_manifold else shell_or_solid(shape)), sewing
 
 
-def _shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
+def shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
+    """A shell with its orientations fixed (``ShapeFix_Shell``), made a solid when it
+    closes (``BRepBuilderAPI_MakeSolid``, ``ShapeFix_Solid``); other shapes as they
+    are."""
     if shape.ShapeType() != TopAbs_SHELL:
         return shape
     fixer = ShapeFix_Shell(TopoDS.Shell_s(shape))
