@@ -301,11 +301,14 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
 def _solids(shape) -> list:
     """The solids of a sewn result: itself, or each closed shell of a compound made solid;
     empty when a shell stays open."""
-    from OCP.TopAbs import TopAbs_SHELL, TopAbs_SOLID
+    from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
     if shape.ShapeType() == TopAbs_SOLID:
         return [shape]
+    if shape.ShapeType() == TopAbs_FACE:          # one closed face kept: a ball inside
+        solid = shell_or_solid(shape)
+        return [solid] if solid.ShapeType() == TopAbs_SOLID else []
     out = []
     explorer = TopExp_Explorer(shape, TopAbs_SHELL)
     while explorer.More():

@@ -1,5 +1,6 @@
 """The boundary of a trivariate NURBS solid as an OpenCascade solid (issue 24): what a
-CAD tool sees of a :class:`~surfprep.algorithms.volume.NurbsVolume`.
+CAD tool sees of a :class:`~surfprep.algorithms.volume.NurbsVolume`; and, through it,
+the volumes of the regions of two composed solids (:func:`composed_volumes`).
 
 The non-degenerate exterior faces (004 §3: collapsed faces such as a ball's centre
 and poles left out, the two faces of a closed direction glued, :meth:`exterior_faces`)
@@ -12,21 +13,21 @@ sewing one face returns the face. Every result is checked by ``BRepCheck_Analyze
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
-from OCP.BRep import BRep_Builder
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
-from OCP.TopoDS import TopoDS_Shape, TopoDS_Shell
+from OCP.TopoDS import TopoDS_Shape
 
 from ..algorithms.volume import NurbsVolume
 from ..errors import InvalidGeometryError, OpenCascadeError
 from .occ.faces import make_face
 from .occ.shapes import count_free_edges, is_valid, sew, shell_or_solid
 
-__all__ = ["BoundarySolid", "boundary_solid"]
+__all__ = ["BoundarySolid", "ComposedVolumes", "boundary_solid", "composed_volumes"]
 
 #: faces pointing out of a right-handed solid (``det J > 0``)
 OUTWARD = {"u1", "v0", "w1"}
@@ -100,15 +101,9 @@ def boundary_solid(volume: NurbsVolume, *, tol: float | None = None) -> Boundary
     if not faces:
         raise InvalidGeometryError("the solid has no exterior face (every face collapsed)")
     occ_faces = [make_face(s, reversed=(name in OUTWARD) != right) for name, s in faces.items()]
-    if len(occ_faces) > 1:
-        shape, _ = sew(occ_faces, tol)
-    else:
-        builder, shell = BRep_Builder(), TopoDS_Shell()
-        builder.MakeShell(shell)
-        builder.Add(shell, occ_faces[0])
-        shape = shell_or_solid(shell)
+    shape = sew(occ_faces, tol)[0] if len(occ_faces) > 1 else shell_or_solid(occ_faces[0])
     if shape.ShapeType() == TopAbs_FACE:
-        shape = shell_or_solid(_shell_of(shape))
+        shape = shell_or_solid(shape)
     if not is_valid(shape):
         raise OpenCascadeError("the boundary of the solid is not valid for BRepCheck_Analyzer")
     closed = shape.ShapeType() == TopAbs_SOLID
@@ -120,8 +115,62 @@ def boundary_solid(volume: NurbsVolume, *, tol: float | None = None) -> Boundary
     return BoundarySolid(shape, tuple(faces), closed, count_free_edges(shape), measured)
 
 
-def _shell_of(face: TopoDS_Shape) -> TopoDS_Shell:
-    builder, shell = BRep_Builder(), TopoDS_Shell()
-    builder.MakeShell(shell)
-    builder.Add(shell, face)
-    return shell
+@dataclass(frozen=True)
+class ComposedVolumes:
+    """Volumes of the three regions of two composed solids (model units cubed).
+
+    Attributes
+    ----------
+    a_only, b_only, both : float
+    time_s : float
+    """
+
+    a_only: float
+    b_only: float
+    both: float
+    time_s: float
+
+    def as_dict(self) -> dict:
+        return {"A only": self.a_only, "B only": self.b_only, "both": self.both,
+                "time_s": self.time_s}
+
+
+def composed_volumes(a: NurbsVolume, b: NurbsVolume, *, tol: float | None = None
+                     ) -> ComposedVolumes:
+    """Volumes of the regions "A only", "B only" and "both" of two solids.
+
+    "Both" is the volume of the common solid of their boundaries
+    (:func:`boundary_solid`), cut along surfprep's intersection curves and classified
+    (:func:`surfprep.boolean`, ``"common"``), integrated by OpenCascade; the others
+    are each boundary solid's volume, integrated the same way, less "both". Accuracy: the curves' tolerance and OpenCascade's integration, about 1e-7
+    relative on the tests (two balls: the lens within 1.4e-7 of its exact volume).
+
+    Parameters
+    ----------
+    a, b : NurbsVolume
+        Solids in 3D whose boundaries close.
+    tol : float, optional
+        Intersection tolerance (model units), as :func:`surfprep.intersect`.
+
+    Raises
+    ------
+    InvalidGeometryError
+        A boundary that does not close.
+    OpenCascadeError
+        The common solid could not be built.
+    """
+    from .split import boolean
+    start = time.perf_counter()
+    sa, sb = boundary_solid(a), boundary_solid(b)
+    for name, s in (("A", sa), ("B", sb)):
+        if not s.closed:
+            raise InvalidGeometryError(f"solid {name}'s boundary does not close "
+                                       f"({s.free_edges} free edges): no volumes")
+    common = boolean(sa.shape, sb.shape, "common", tol=tol)
+    if common.volume is None:
+        raise OpenCascadeError("the common part of the two solids did not close into a solid")
+    both = float(common.volume)
+    # every figure from OpenCascade's integration, so that a solid inside the other
+    # leaves 0 outside it rather than the two integrations' difference
+    return ComposedVolumes(sa.volume - both, sb.volume - both, both,
+                           time.perf_counter() - start)

@@ -60,7 +60,12 @@ if TYPE_CHECKING:
     from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
     from .plugin.split import BooleanResult, SplitResult, boolean, split
-    from .plugin.volume_boundary import BoundarySolid, boundary_solid
+    from .plugin.volume_boundary import (
+        BoundarySolid,
+        ComposedVolumes,
+        boundary_solid,
+        composed_volumes,
+    )
 
 __version__ = "0.1.0"
 
@@ -107,6 +112,8 @@ __all__ = [
     "Composition",
     "boundary_solid",
     "BoundarySolid",
+    "composed_volumes",
+    "ComposedVolumes",
     # structured grids (numpy only)
     "grid_surface",
     "SurfaceGrid",
@@ -164,6 +171,8 @@ _LAZY_EXPORTS = {
     "Composition": "surfprep.algorithms.compose",
     "boundary_solid": "surfprep.plugin.volume_boundary",
     "BoundarySolid": "surfprep.plugin.volume_boundary",
+    "composed_volumes": "surfprep.plugin.volume_boundary",
+    "ComposedVolumes": "surfprep.plugin.volume_boundary",
     "grid_surface": "surfprep.algorithms.grid",
     "SurfaceGrid": "surfprep.algorithms.grid",
     "Spacing": "surfprep.algorithms.grid",

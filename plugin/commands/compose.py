@@ -24,6 +24,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--labels", type=Path, metavar="LABELS",
                         help="write one label a line for --classify's points: 0 outside both, "
                              "1 in A only, 2 in B only, 3 in both")
+    parser.add_argument("--volumes", action="store_true",
+                        help="also the volumes of A only, B only and both (the common solid of "
+                             "their boundaries cut along the curves, integrated by OpenCascade)")
     parser.add_argument("--boundary", type=Path, metavar="OUT",
                         help="write both solids' boundaries as OpenCascade solids to a STEP "
                              "or IGES file (a shell where a boundary does not close)")
@@ -78,6 +81,9 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         report["labels"] = {str(k): int(np.sum(labels == k)) for k in range(4)}
         with atomic_output(args.labels) as temporary:
             temporary.write_text("".join(f"{int(x)}\n" for x in labels))
+    if args.volumes:
+        from ..volume_boundary import composed_volumes
+        report["volumes"] = composed_volumes(a, b, tol=args.tol).as_dict()
     if args.boundary is not None:
         report["boundary"] = _write_boundary(a, b, args.boundary)
     if args.json_path is not None:
@@ -88,6 +94,10 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if labels is not None:
             console.print("labels: " + ", ".join(f"{k}: {v}" for k, v in report["labels"].items())
                           + f", written to {args.labels}")
+        if args.volumes:
+            v = report["volumes"]
+            console.print(f"volumes: A only {v['A only']:.10g}, B only {v['B only']:.10g}, "
+                          f"both {v['both']:.10g} ({v['time_s']:.2f} s)")
         if args.boundary is not None:
             console.print("boundaries: " + "; ".join(
                 f"{k} {'solid' if b['closed'] else 'open shell'} of {len(b['faces'])} face(s), "
@@ -119,12 +129,12 @@ COMMAND = Command(
         "(collapsed faces and seams left out) and report the curves; with --classify, label "
         "each point 0 outside both, 1 in A only, 2 in B only, 3 in both (Newton inversion into "
         "each solid); with --boundary, write both solids' boundaries (their non-degenerate "
-        "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES. "
-        "Volumes of the composed regions are not computed yet."),
+        "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES; "
+        "with --volumes, the volumes of A only, B only and both."),
     epilog=("examples:\n"
             "  surfprep compose a.g2 b.g2 --json r.json\n"
             "  surfprep compose a.g2 b.g2 --classify points.csv --labels labels.csv\n"
-            "  surfprep compose a.g2 b.g2 --boundary both.step"),
+            "  surfprep compose a.g2 b.g2 --boundary both.step --volumes"),
     add_arguments=_add_arguments,
     run=_run,
 )

@@ -27,7 +27,7 @@ from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
-from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Shell
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
 from ...errors import OpenCascadeError
@@ -181,8 +181,14 @@ def sew(faces: list[TopoDS_Shape], tol: float, *,
 
 def shell_or_solid(shape: TopoDS_Shape) -> TopoDS_Shape:
     """A shell with its orientations fixed (``ShapeFix_Shell``), made a solid when it
-    closes (``BRepBuilderAPI_MakeSolid``, ``ShapeFix_Solid``); other shapes as they
-    are."""
+    closes (``BRepBuilderAPI_MakeSolid``, ``ShapeFix_Solid``); a lone face is put in a
+    shell first (sewing one face returns the face: a ball's sphere, a torus); other
+    shapes as they are."""
+    if shape.ShapeType() == TopAbs_FACE:
+        builder, shell = BRep_Builder(), TopoDS_Shell()
+        builder.MakeShell(shell)
+        builder.Add(shell, shape)
+        shape = shell
     if shape.ShapeType() != TopAbs_SHELL:
         return shape
     fixer = ShapeFix_Shell(TopoDS.Shell_s(shape))

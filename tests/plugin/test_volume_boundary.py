@@ -16,7 +16,7 @@ from surfprep.algorithms.volume_builders import block, revolve, solid_sphere, so
 from surfprep.errors import InvalidGeometryError
 from surfprep.plugin.io import read
 from surfprep.plugin.occ.shapes import is_valid
-from surfprep.plugin.volume_boundary import boundary_solid
+from surfprep.plugin.volume_boundary import boundary_solid, composed_volumes
 
 
 @pytest.mark.parametrize(("solid", "exact", "faces"), [
@@ -75,3 +75,21 @@ def test_compose_writes_both_boundaries_to_step(tmp_path, capsys):
     # an input is never an output
     code, _, err = run(capsys, "compose", a, b, "--boundary", a)
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+def _lens(radius, distance):
+    """Volume of the intersection of two balls of equal radius ``distance`` apart."""
+    return np.pi * (4 * radius + distance) * (2 * radius - distance) ** 2 / 12
+
+
+@pytest.mark.parametrize(("a", "b", "both"), [
+    (solid_sphere(5.0), solid_sphere(5.0, (6.0, 0.0, 0.0)), _lens(5.0, 6.0)),
+    (block((10.0, 10.0, 10.0), origin=(-5.0, -5.0, -5.0)), solid_sphere(2.0),
+     4 / 3 * np.pi * 8),                                      # a ball inside a block
+    (solid_sphere(1.0), solid_sphere(1.0, (5.0, 0.0, 0.0)), 0.0),   # apart
+])
+def test_composed_volumes_against_exact_answers(a, b, both):
+    v = composed_volumes(a, b)
+    assert v.both == pytest.approx(both, rel=3e-7, abs=1e-12)
+    assert v.a_only == pytest.approx(a.volume() - both, rel=1e-6)
+    assert v.b_only == pytest.approx(b.volume() - both, rel=1e-6, abs=1e-9)
