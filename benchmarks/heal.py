@@ -309,21 +309,19 @@ def nsided_table() -> list[str]:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from helpers import heal_cases
     rows = []
+    runs = (("surfprep heal G0", _nsided_ours, "G0"), ("surfprep heal G1", _nsided_ours, "G1"),
+            ("MakeFilling C0", _nsided_occ, GeomAbs_C0), ("MakeFilling G1", _nsided_occ, GeomAbs_G1))
     for n in (3, 5, 6):
-        for label, run in (
-                ("surfprep heal G0", lambda: _nsided_ours(heal_cases, n, "G0")),
-                ("surfprep heal G1", lambda: _nsided_ours(heal_cases, n, "G1")),
-                ("MakeFilling C0", lambda: _nsided_occ(heal_cases, n, GeomAbs_C0)),
-                ("MakeFilling G1", lambda: _nsided_occ(heal_cases, n, GeomAbs_G1))):
-            dev, angle, gap, elapsed, note = run()
+        for label, run, how in runs:
+            dev, angle, gap, elapsed, note = run(heal_cases, n, how)
             if dev is None:
                 rows.append(f"| {n} | {label} | - | - | - | {elapsed:.3f} | {note} |")
                 continue
             rows.append(f"| {n} | {label} | {dev:.2g} | {angle:.2g} | {gap:.2g} | "
                         f"{elapsed:.3f} | {note} |")
-    head = ["| sides | method | deviation from true surface | max normal angle to the input "
-            "faces along the rim (deg) | max distance of the fill's rim from the input faces "
-            "| time (s) | note |", "|---|---|---|---|---|---|---|"]
+    head = [("| sides | method | deviation from true surface | max normal angle to the input "
+             "faces along the rim (deg) | max distance of the fill's rim from the input faces "
+             "| time (s) | note |"), "|---|---|---|---|---|---|---|"]
     return head + rows
 
 
