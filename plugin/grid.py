@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..algorithms import NurbsSurface
-from ..algorithms.grid.faces import face_region
+from ..algorithms.grid.faces import face_regions
 from ..algorithms.grid.io import write_cgns, write_plot3d, write_vtm, write_vts
 from ..algorithms.grid.network import NetworkGrid, grid_network
 from ..algorithms.grid.quality import cell_skewness
@@ -244,6 +244,9 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
     else:
         chosen = list(range(len(items)))
     unreadable = {k for k, _ in skipped}
+    gap = DEFAULT_RELATIVE_GAP * model_size if gap is None else float(gap)
+    if not np.isfinite(gap) or gap <= 0:
+        raise InvalidGeometryError(f"gap must be a positive length, got {gap!r}")
     surfaces, kept, kept_names, flips = [], [], [], []
     skipped = [s for s in skipped if s[0] in chosen]
     for k in chosen:
@@ -260,16 +263,22 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
             if item.surface.dimension != 3:
                 skipped.append((k, "not a 3D surface"))
                 continue
-            region = face_region(item)
-            if isinstance(region, str):
+            regions = face_regions(item, gap_tol=gap)
+            if isinstance(regions, str):
                 if not whole_surfaces:
-                    skipped.append((k, region))
+                    skipped.append((k, regions))
                     continue
-                region = Region.rectangle(item.surface)
-            if region.is_rectangle:
-                region = reversed_v(item.surface) if flip else item.surface
-            else:
-                flip = False                 # a loop's region is oriented by the loop's direction
+                regions = [Region.rectangle(item.surface)]
+            name = names[k] if k < len(names) else None
+            for n, region in enumerate(regions):
+                if region.is_rectangle:
+                    region = reversed_v(item.surface) if flip else item.surface
+                surfaces.append(region)
+                kept.append(k)
+                kept_names.append(name if len(regions) == 1 or name is None else f"{name}_{n}")
+                # a loop's region is oriented by the loop's direction
+                flips.append(flip and isinstance(region, NurbsSurface))
+            continue
         surfaces.append(region)
         kept.append(k)
         kept_names.append(names[k] if k < len(names) else None)
@@ -278,9 +287,6 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         why = "; ".join(f"face {k}: {r}" for k, r in skipped[:3])
         raise InvalidGeometryError(f"nothing to grid: no four-sided face ({why})" if why
                                    else "nothing to grid")
-    gap = DEFAULT_RELATIVE_GAP * model_size if gap is None else float(gap)
-    if not np.isfinite(gap) or gap <= 0:
-        raise InvalidGeometryError(f"gap must be a positive length, got {gap!r}")
     held = _assign_held(surfaces, list(hold), gap)
     network = grid_network(surfaces, gap=gap, dims=dims, size=size, spacing=spacing,
                            smooth=smooth, tol=tol, max_sweeps=max_sweeps, hold=held,

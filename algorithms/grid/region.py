@@ -180,22 +180,39 @@ class Region:
         """
         if len(face.loops) != 1 or len(face.loops[0].edges) != 4:
             raise InvalidGeometryError("the face is not bounded by one loop of four edges")
-        edges = list(face.loops[0].edges)
         runs = []
-        for e in edges:
+        for e in face.loops[0].edges:
             t0, t1 = (e.t1, e.t0) if e.reversed else (e.t0, e.t1)
             runs.append((e.pcurve, t0, t1))
+        return cls.from_runs(face.surface, runs, clockwise=clockwise)
+
+    @classmethod
+    def from_runs(cls, surface: NurbsSurface, runs, *, clockwise: bool = False) -> Region:
+        """The region inside four pcurves meeting end to end, as :meth:`from_loop` takes
+        a face's loop (a four-sided sub-patch of a face that is not four-sided).
+
+        Parameters
+        ----------
+        surface : NurbsSurface
+        runs : sequence of four (NurbsCurve (2D), float, float)
+            Each pcurve and the parameters it is run between, in loop order.
+        clockwise : bool
+        """
+        runs = list(runs)
+        if len(runs) != 4:
+            raise InvalidGeometryError(f"a region has four sides, got {len(runs)}")
+        face_domain = surface.domain
         ends = [pc.evaluate(np.array([a, b])) for pc, a, b in runs]
         area = sum(a[0, 0] * a[1, 1] - a[1, 0] * a[0, 1] for a in ends)    # shoelace over the chords
         if (area < 0) != clockwise:                                          # turn it the asked way
             runs = [(pc, b, a) for pc, a, b in reversed(runs)]
             ends = [e[::-1] for e in reversed(ends)]
         chords = [e[1] - e[0] for e in ends]
-        span = np.array([np.ptp(face.surface.domain[:2]), np.ptp(face.surface.domain[2:])])
+        span = np.array([np.ptp(face_domain[:2]), np.ptp(face_domain[2:])])
         along_u = [c[0] / span[0] / max(np.linalg.norm(c / span), 1e-300) for c in chords]
         k = int(np.argmax(along_u))
         order = [runs[(k + m) % 4] for m in range(4)]
         (p0, a0, b0), (p1, a1, b1), (p2, a2, b2), (p3, a3, b3) = order
-        s = face.surface
+        s = surface
         return cls(s, {"j0": Side(s, p0, a0, b0), "i1": Side(s, p1, a1, b1),
                        "j1": Side(s, p2, b2, a2), "i0": Side(s, p3, b3, a3)}, False)

@@ -125,6 +125,11 @@ class Decomposition:
         The centre of a split (None for one patch).
     turning : (m,) float
         Turning angle (radians) at the start of every real edge.
+    quads_pcurves : tuple of tuple of four NurbsCurve (2D)
+        Each sub-patch's sides in the face's ``(u, v)``, as ``quads`` (the loop's
+        pcurves over the same pieces, the spokes' straight segments), each run
+        over its whole domain along the loop: what a structured grid of the
+        sub-patch needs (:func:`surfprep.algorithms.grid.faces.face_regions`).
     """
 
     quads: tuple
@@ -132,6 +137,7 @@ class Decomposition:
     corners: NDArray
     centre_uv: NDArray | None
     turning: NDArray
+    quads_pcurves: tuple = ()
 
 
 # ------------------------------------------------------------------ curves
@@ -213,6 +219,7 @@ class _Side:
     uv: NDArray
     piece: NDArray
     t: NDArray
+    pcurve: NurbsCurve | None = None
 
     def locate(self, s: float) -> tuple[int, float]:
         """Loop position ``(edge, t)`` at arc length ``s`` along the side."""
@@ -258,8 +265,9 @@ def _side(real: Sequence[LoopEdge], pieces: list) -> _Side:
         ts.append(t)
     xyz = np.concatenate(xyz)
     length = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))]
+    pcurve = join_curves([_restricted(real[k].pcurve, a, b) for k, a, b in pieces])
     return _Side(tuple(pieces), curve, length, np.concatenate(uv), np.concatenate(piece),
-                 np.concatenate(ts))
+                 np.concatenate(ts), pcurve)
 
 
 def _uniform_uv(side_uv: NDArray, length: NDArray, n: int) -> NDArray:
@@ -328,7 +336,8 @@ def _spoke(surface, centre: NDArray, mid_uv: NDArray, mid_xyz: NDArray
 def _single(sides: Sequence[_Side], orientation: float) -> list:
     _check_quad([_uniform_uv(s.uv, s.length, CHECK_SAMPLES) for s in sides], orientation,
                 "the four-sided patch")
-    return [([s.curve for s in sides], np.concatenate([s.uv for s in sides]))]
+    return [([s.curve for s in sides], np.concatenate([s.uv for s in sides]),
+             [s.pcurve for s in sides])]
 
 
 def _star(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArray]:
@@ -352,6 +361,8 @@ def _star(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArr
         j = i - 1
         spoke_out, spoke_in = spokes[i], spokes[j]
         curves = [first[i].curve, reverse_curve(spoke_out[0]), spoke_in[0], second[j].curve]
+        pcurves = [first[i].pcurve, _uv_segment(mid_uv[i], centre),
+                   _uv_segment(centre, mid_uv[j]), second[j].pcurve]
         spoke_length = [np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
                         for uv in (spoke_out[1][::-1], spoke_in[1])]
         uv_sides = [_uniform_uv(first[i].uv, first[i].length, CHECK_SAMPLES),
@@ -359,8 +370,13 @@ def _star(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArr
                     _uniform_uv(spoke_in[1], spoke_length[1], CHECK_SAMPLES),
                     _uniform_uv(second[j].uv, second[j].length, CHECK_SAMPLES)]
         _check_quad(uv_sides, orientation, f"sub-patch {i} of {n}")
-        quads.append((curves, np.concatenate(uv_sides)))
+        quads.append((curves, np.concatenate(uv_sides), pcurves))
     return quads, centre
+
+
+def _uv_segment(a: NDArray, b: NDArray) -> NurbsCurve:
+    """The straight segment from ``a`` to ``b`` in ``(u, v)`` (a spoke's pcurve)."""
+    return NurbsCurve(np.array([a, b], dtype=float), np.array([0.0, 0.0, 1.0, 1.0]), 1)
 
 
 def decompose_loop(surface, edges: Sequence[LoopEdge], *,
@@ -412,8 +428,8 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         quads, centre = _single(sides, orientation), None
     else:
         quads, centre = _star(surface, real, cuts, sides, outline, orientation)
-    return Decomposition(tuple(tuple(q) for q, _ in quads), tuple(uv for _, uv in quads),
-                         corners, centre, turning)
+    return Decomposition(tuple(tuple(q) for q, _, _ in quads), tuple(uv for _, uv, _ in quads),
+                         corners, centre, turning, tuple(tuple(p) for _, _, p in quads))
 
 
 # ------------------------------------------------------------------ trimmed faces

@@ -42,7 +42,7 @@ def test_nothing_to_grid_is_one_line_and_exit_2(tmp_path, capsys):
     out = tmp_path / "c.xyz"
     code, _, err = run(capsys, "grid", CATIA_FACE, "-o", out)
     assert code == 2
-    assert "it has 47 edges, not four" in err and len(err.strip().splitlines()) == 1
+    assert "not split into four-sided blocks" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
 
 
