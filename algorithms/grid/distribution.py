@@ -34,9 +34,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, root
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
+from ..arc_length_inversion import parameters_at_lengths
 from ..curve import NurbsCurve
 from ..measure import cumulative_arc_length
-from ..arc_length_inversion import parameters_at_lengths
 
 __all__ = ["by_curvature", "by_curvature_points", "geometric", "points_along", "stretched", "uniform"]
 

@@ -20,10 +20,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
+from ..arc_length_inversion import lengths_between, parameters_at_lengths
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
-from ..arc_length_inversion import lengths_between, parameters_at_lengths
 
 __all__ = ["SIDE_NAMES", "Region", "Side"]
 

@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
-from ..curve import NurbsCurve
 from ..arc_length_inversion import parameters_at_lengths
+from ..curve import NurbsCurve
 from ..measure import cumulative_arc_length
 
 __all__ = ["SIDE_NAMES", "Boundary", "BoundaryCurve", "as_boundary", "corners_boundary"]
