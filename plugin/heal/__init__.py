@@ -62,6 +62,7 @@ to build are planned in :mod:`.jobs`.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 import time
 from collections.abc import Callable
@@ -471,10 +472,16 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     done += directed_jobs(directed, cut)
     say("joining, sewing and checking")
     before = _Before.of(model, gap_tol)
-    result, done, snapped = _no_worse_than_before(
-        done, dropped, skipped, before, every_edge=every_edge, model=model, work=work,
-        inputs=inputs, gap_tol=gap_tol, tol=tol, continuity=continuity, start=start,
-        keep_split=replace == "all")
+    again = functools.partial(
+        _no_worse_than_before, skipped=skipped, before=before, every_edge=every_edge,
+        model=model, work=work, inputs=inputs, gap_tol=gap_tol, tol=tol,
+        continuity=continuity, start=start, keep_split=replace == "all")
+    notes_so_far = list(skipped)
+    result, done, snapped = again(done, dropped)
+    if result.tight_free_edges_after > result.tight_free_edges_before:
+        result, done, snapped = _tight_round(
+            result, done, snapped, dropped, functools.partial(again, skipped=notes_so_far),
+            before, work=work, model=model, gap_tol=gap_tol)
     result.extra["replace"] = replace
     result.extra["free_loops"] = [loop.as_dict() for loop in loops]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
@@ -484,6 +491,30 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),
          "action": "union" if o.kept in unions else "trimmed back"} for o in overlaps]
     return result
+
+
+def _tight_round(result, done, snapped, dropped, again, before: _Before, *, work, model,
+                 gap_tol: float):
+    """With more free edges in the geometry (sewn at ``TIGHT_FACTOR`` x size) than the
+    input had, the approximants along the new ones (:func:`_opened_in_geometry`) taken
+    back and the rest joined again (``again``, :func:`_no_worse_than_before`, from the
+    same drops, so its notes say again what it takes back); kept when that leaves
+    fewer, with a note."""
+    network = result.network
+    kept_drops = [d for d in dropped if d in set(result.dropped)]
+    blame = _opened_in_geometry(work, done, network, kept_drops, before, model, gap_tol)
+    if not blame:
+        return result, done, snapped
+    retry, retry_done, retry_snapped = again(_without_jobs(done, blame), dropped)
+    if retry.tight_free_edges_after >= result.tight_free_edges_after:
+        return result, done, snapped
+    what = sorted({f"{done[k][0].origin.kind} {done[k][0].origin.index}" for k in blame})
+    note = (f"free edges in the geometry (sewn at {TIGHT_FACTOR:g} x size) "
+            f"{result.tight_free_edges_before} -> {result.tight_free_edges_after} with them, "
+            f"{retry.tight_free_edges_after} without: taken back (faces kept as they were): "
+            f"{', '.join(what)}")
+    return (dataclasses.replace(retry, skipped=retry.skipped + (note,)), retry_done,
+            retry_snapped)
 
 
 def _no_worse_than_before(done, dropped, skipped: list[str], before: _Before, *, every_edge,
@@ -665,10 +696,12 @@ def _rolled_back(done, opening: set[int], undropped: set, result: HealResult) ->
 
 
 def _without_jobs(done, opening: set[int]) -> list:
-    """``done`` without the jobs in ``opening``; a face split into sub-patches goes whole."""
-    faces = {done[k][0].origin.index for k in opening if done[k][0].origin.kind == "face"}
+    """``done`` without the jobs in ``opening``; a face or a hole split into sub-patches
+    goes whole."""
+    whole = {(done[k][0].origin.kind, done[k][0].origin.index) for k in opening
+             if done[k][0].origin.kind in ("face", "hole")}
     return [(job, la) for k, (job, la) in enumerate(done) if k not in opening
-            and not (job.origin.kind == "face" and job.origin.index in faces)]
+            and (job.origin.kind, job.origin.index) not in whole]
 
 
 def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list[str]
@@ -740,31 +773,21 @@ class _Before:
     tight_free_edges: int
     valid: bool
     free_lines: list = field(default_factory=list)   # the free edges at gap_tol, (129, 3) each
+    tight_lines: list = field(default_factory=list)  # ... at TIGHT_FACTOR x size
 
     @classmethod
     def of(cls, model: CadModel, gap_tol: float) -> _Before:
         sewn, _ = sew(list(model.faces), gap_tol)
         tight, _ = sew(list(model.faces), TIGHT_FACTOR * model.size)
         return cls(count_free_edges(sewn), count_free_edges(tight), is_valid(model.shape),
-                   boundary_edge_points(sewn, 129))
+                   boundary_edge_points(sewn, 129), boundary_edge_points(tight, 129))
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,
               deviations, before: _Before) -> HealResult:
     """The output from ``work`` (the input with faces under directed patches cut) and the
     approximants; ``before``: the figures of ``model`` (the input)."""
-    gone = replaced_faces(done) | {b for _, b in dropped}
-    untouched = [i for i in range(work.n_faces) if i not in gone]
-    new_faces, names = [], FaceNames()
-    for (job, _), surface in zip(done, network.patches if network else ()):
-        face = _oriented_face(surface, job.reference)
-        new_faces.append(face)
-        if job.name:
-            names.add(face, job.name)
-    originals = [work.faces[i] for i in untouched]
-    for i in untouched:
-        if work.face_names[i] is not None:
-            names.add(work.faces[i], work.face_names[i])
+    originals, new_faces, names = _output_faces(work, done, network, dropped)
     shape, sewing = sew(originals + new_faces, gap_tol)
     out_faces = all_faces(shape)
     out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
@@ -784,6 +807,47 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
         max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
         continuity=continuity, time_s=time.perf_counter() - start,
         extra={"faces_in": model.n_faces})
+
+
+def _output_faces(work, done, network, dropped) -> tuple[list, list, FaceNames]:
+    """The faces of the result before sewing: the untouched ones of ``work``, the
+    approximants (oriented as the faces they replace), and their names."""
+    gone = replaced_faces(done) | {b for _, b in dropped}
+    untouched = [i for i in range(work.n_faces) if i not in gone]
+    new_faces, names = [], FaceNames()
+    for (job, _), surface in zip(done, network.patches if network else ()):
+        face = _oriented_face(surface, job.reference)
+        new_faces.append(face)
+        if job.name:
+            names.add(face, job.name)
+    originals = [work.faces[i] for i in untouched]
+    for i in untouched:
+        if work.face_names[i] is not None:
+            names.add(work.faces[i], work.face_names[i])
+    return originals, new_faces, names
+
+
+def _opened_in_geometry(work, done, network, dropped, before: _Before, model, gap_tol: float
+                        ) -> set[int]:
+    """The approximants (indices of ``done``) along free edges that the result's faces
+    sewn at ``TIGHT_FACTOR`` x size have and the input's have not: gaps the approximants
+    opened in the geometry (a corner off a neighbour's short edge) where sewing at
+    ``gap_tol`` hides them."""
+    if network is None:
+        return set()
+    originals, new_faces, _ = _output_faces(work, done, network, dropped)
+    tight, _ = sew(originals + new_faces, TIGHT_FACTOR * model.size)
+    free = boundary_edge_points(tight, 9)
+    if not free:
+        return set()
+    known = (_polylines_along(before.tight_lines, free, gap_tol) if before.tight_lines
+             else [[] for _ in free])
+    opened = [f for f, along in zip(free, known) if not along]
+    if not opened:
+        return set()
+    rims = [_rim(surface) for surface in network.patches]
+    near = _polylines_along([np.concatenate(r) for r in rims], opened, gap_tol, pieces=rims)
+    return {k for ks in near for k in ks if done[k][0].origin.kind != "directed"}
 
 
 def _sewn_name(face: TopoDS_Face, sewing, names: FaceNames, inputs: list) -> str | None:
