@@ -242,13 +242,13 @@ def test_only_faces_with_a_defect_are_replaced_by_default():
 
 
 def test_taking_back_a_sub_patch_takes_back_its_whole_face():
-    from surfprep.plugin.heal import _without_jobs
     from surfprep.plugin.heal.jobs import Job, PatchOrigin
+    from surfprep.plugin.heal.rollback import without_jobs
 
     def job(kind, index):
         return (Job(PatchOrigin(kind, (index,), index), None, None, None), None)
     done = [job("face", 3), job("face", 3), job("hole", 0), job("face", 5), job("directed", 1)]
-    kept = _without_jobs(done, {1, 2})
+    kept = without_jobs(done, {1, 2})
     assert [(j.origin.kind, j.origin.index) for j, _ in kept] == [("face", 5), ("directed", 1)]
 
 
