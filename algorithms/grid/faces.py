@@ -1,6 +1,7 @@
 """Which trimmed faces a structured grid can cover: four-sided on their surface's rectangle,
 bounded by one loop of four edges, or (:func:`face_regions`) split into four-sided
-sub-patches around a centre when bounded by one loop of another number of sides.
+sub-patches around a centre (a butterfly for a disc) when bounded by one loop of
+another number of sides.
 
 A face is gridded as one block when its boundary is the whole parameter
 rectangle of its surface: one loop, every edge's pcurve on a side of the
@@ -99,10 +100,11 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     three, five or more corners is split as healing splits it (:func:`..healing.decompose.decompose_face`: the loop's
     corners, quads around a centre joined by straight spokes in ``(u, v)``), one
     region per sub-patch; blocks of neighbouring sub-patches share their spoke; a
-    loop of four corners made of more edges is one region over its four sides.
-    Faces with holes, loops of fewer than three corners (a disc, a lens: their one
-    block would have 180-degree corners), and loops the split refuses (a spoke
-    leaving a very non-convex outline, a cusp) get the reason.
+    loop of four corners made of more edges is one region over its four sides; a
+    loop of at most two corners (a disc, a lens) five, the butterfly: an inner quad
+    and four between it and the loop (its O-grid remapped to an H-grid). Faces with
+    holes and loops the split refuses (a spoke leaving a very non-convex outline, a
+    cusp) get the reason.
 
     Parameters
     ----------
@@ -122,16 +124,10 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     if len(face.loops) != 1:
         return region
     try:
-        split = decompose_face(face, gap_tol=gap_tol)
+        split = decompose_face(face, gap_tol=gap_tol, layout="butterfly")
     except NotDecomposableError as exc:
         return f"not split into four-sided blocks: {exc}"
     if split is None:
         return region
-    if split.centre_uv is None and split.corners.size < 4:
-        # a disc, a lens, a half disc: one block whose corners are split points of a
-        # smooth side, 180 degrees wide (cells there collapse to slivers); an O-grid
-        # remapped to an H-grid would serve, not built yet
-        return (f"its loop has {split.corners.size} corner(s): one block would have "
-                "corners of 180 degrees on a smooth side; not gridded")
     return [Region.from_runs(face.surface, [(pc, *pc.domain) for pc in quad],
                              clockwise=bool(face.reversed)) for quad in split.quads_pcurves]

@@ -379,8 +379,60 @@ def _uv_segment(a: NDArray, b: NDArray) -> NurbsCurve:
     return NurbsCurve(np.array([a, b], dtype=float), np.array([0.0, 0.0, 1.0, 1.0]), 1)
 
 
+#: inner corners of the butterfly layout: this fraction of the way from the centre to
+#: the loop's split points
+BUTTERFLY_INNER = 0.5
+
+
+def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArray]:
+    """Five quads for a loop of at most two corners (a disc, a lens): an inner quad
+    around the centre and four quads between it and the loop, joined by straight
+    spokes in ``(u, v)`` from the four split points to the inner corners (the O-grid
+    of a disc remapped to an H-grid; no corner lies on a smooth side at 180 degrees)."""
+    split_uv = np.array([real[k].pcurve.evaluate(t) for k, t in cuts]).reshape(4, 2)
+    split_xyz = np.array([real[k].curve.evaluate(t) for k, t in cuts]).reshape(4, 3)
+    centre = split_uv.mean(axis=0)
+    inner = centre + BUTTERFLY_INNER * (split_uv - centre)
+    if not np.all(inside_loops(inner, [outline])):
+        raise NotDecomposableError("an inner corner of the butterfly lies outside the face "
+                                   "(non-convex outline)")
+    spokes = [_spoke(surface, inner[i], split_uv[i], split_xyz[i]) for i in range(4)]
+    for _, uv in spokes:
+        if not np.all(inside_loops(uv[:-SPOKE_SAMPLES // 8], [outline])):
+            raise NotDecomposableError("a split curve leaves the face (non-convex outline)")
+    ring = []
+    for i in range(4):
+        a, b = inner[i], inner[(i + 1) % 4]
+        uv = a + np.linspace(0.0, 1.0, SPOKE_SAMPLES)[:, None] * (b - a)
+        ring.append((interpolate_curve(surface.evaluate(uv[:, 0], uv[:, 1])), uv))
+
+    def length(uv):
+        return np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
+
+    quads = []
+    for i in range(4):
+        j = (i + 1) % 4
+        spoke_in, spoke_out = spokes[j], spokes[i]          # P_j -> Q_j is spoke_in reversed
+        curves = [sides[i].curve, reverse_curve(spoke_in[0]), reverse_curve(ring[i][0]),
+                  spoke_out[0]]
+        pcurves = [sides[i].pcurve, _uv_segment(split_uv[j], inner[j]),
+                   _uv_segment(inner[j], inner[i]), _uv_segment(inner[i], split_uv[i])]
+        uv_sides = [_uniform_uv(sides[i].uv, sides[i].length, CHECK_SAMPLES),
+                    _uniform_uv(spoke_in[1][::-1], length(spoke_in[1][::-1]), CHECK_SAMPLES),
+                    _uniform_uv(ring[i][1][::-1], length(ring[i][1][::-1]), CHECK_SAMPLES),
+                    _uniform_uv(spoke_out[1], length(spoke_out[1]), CHECK_SAMPLES)]
+        _check_quad(uv_sides, orientation, f"outer sub-patch {i} of the butterfly")
+        quads.append((curves, np.concatenate(uv_sides), pcurves))
+    uv_sides = [_uniform_uv(r[1], length(r[1]), CHECK_SAMPLES) for r in ring]
+    _check_quad(uv_sides, orientation, "the butterfly's inner sub-patch")
+    quads.append(([r[0] for r in ring], np.concatenate(uv_sides),
+                  [_uv_segment(inner[i], inner[(i + 1) % 4]) for i in range(4)]))
+    return quads, centre
+
+
 def decompose_loop(surface, edges: Sequence[LoopEdge], *,
-                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition:
+                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE,
+                   layout: str = "auto") -> Decomposition:
     """Four-sided sub-patches covering a face bounded by one loop (module docstring).
 
     Parameters
@@ -391,6 +443,11 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         The outer loop, in loop order, each edge oriented along it.
     smooth_angle : float
         Radians; vertices turning less join their edges into one side.
+    layout : "auto" or "butterfly"
+        For a loop of at most two corners: one patch on four split points
+        ("auto", the module docstring; corners of 180 degrees where a split point
+        lies on a smooth side) or five, an inner quad and four around it
+        ("butterfly": :func:`_butterfly`, what a structured grid needs).
 
     Returns
     -------
@@ -402,6 +459,8 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         With the reason: no real edge, too many corners, a spoke leaving the
         face, a folding sub-patch.
     """
+    if layout not in ("auto", "butterfly"):
+        raise InvalidGeometryError(f"layout must be 'auto' or 'butterfly', got {layout!r}")
     real = [e for e in edges if e.curve is not None]
     if not real:
         raise NotDecomposableError("the loop has no edge with a 3D curve")
@@ -424,7 +483,9 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
     outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
                               for e in edges])
     orientation = np.sign(_signed_area(outline)) or 1.0
-    if n == 4:
+    if n == 4 and layout == "butterfly" and corners.size <= 2:
+        quads, centre = _butterfly(surface, real, cuts, sides, outline, orientation)
+    elif n == 4:
         quads, centre = _single(sides, orientation), None
     else:
         quads, centre = _star(surface, real, cuts, sides, outline, orientation)
@@ -468,14 +529,16 @@ def loop_edges(face: TrimmedFace, *, gap_tol: float) -> list[LoopEdge]:
 
 
 def decompose_face(face: TrimmedFace, *, gap_tol: float,
-                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition | None:
+                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE,
+                   layout: str = "auto") -> Decomposition | None:
     """The decomposition of a face that is neither four-sided nor untrimmed (None for
-    those: :func:`quad_boundaries` handles them); raises with the reason."""
+    those: :func:`quad_boundaries` handles them); raises with the reason. ``layout``
+    as :func:`decompose_loop`."""
     gap_tol = check_tolerance(gap_tol, "gap_tol")
     if four_sided_boundary(face) is not None or not face.loops:
         return None
     return decompose_loop(face.surface, loop_edges(face, gap_tol=gap_tol),
-                          smooth_angle=smooth_angle)
+                          smooth_angle=smooth_angle, layout=layout)
 
 
 def _surface_sides(face: TrimmedFace) -> list[NurbsCurve]:

@@ -192,10 +192,25 @@ def test_a_face_of_n_sides_is_gridded_as_n_blocks_around_a_centre(case, n, min_a
     assert sum(area(b) for b in result.blocks) == pytest.approx(exact, rel=2e-3)
 
 
-def test_a_disc_is_refused_rather_than_gridded_with_180_degree_corners():
+def test_a_disc_is_gridded_as_a_butterfly_not_with_180_degree_corners():
+    """A face bounded by one circle: an inner quad and four around it (its O-grid as an
+    H-grid), point-matched on all eight shared sides; one block on four split points
+    of the circle (what healing's single patch is) had corners of 180 degrees and
+    cells of 6.6 degrees (skewness 0.93)."""
     from helpers import heal_cases
-    with pytest.raises(InvalidGeometryError, match="0 corner.s.: one block would have corners"):
-        surfprep.grid(_loop_face(heal_cases.disc), size=0.04)
+
+    from surfprep.algorithms.projection import project_to_surface
+    face = _loop_face(heal_cases.disc)
+    result = surfprep.grid(face, size=0.04)
+    assert len(result.blocks) == 5 and len(result.network.interfaces) == 8
+    for f in result.network.interfaces:
+        a = side_nodes(result.blocks[f.block], f.side)
+        b = side_nodes(result.blocks[f.other], f.other_side)
+        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    worst = result.report()["worst"]
+    assert worst["folded_cells"] == 0 and worst["min_angle"] > 40 and worst["max_skewness"] < 0.6
+    nodes = np.concatenate([b.reshape(-1, 3) for b in result.blocks])
+    assert project_to_surface(face.surface, nodes).distance.max() < 1e-9
     # four corners made of six edges (two pairs continuing each other) stay one block
     result = surfprep.grid(_loop_face(heal_cases.six_edges_two_smooth), size=0.04)
     assert len(result.blocks) == 1 and result.report()["worst"]["folded_cells"] == 0
