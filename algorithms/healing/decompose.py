@@ -15,7 +15,10 @@ corner, the others join their edges into one side. With ``c`` corners:
   on the surface by a *spoke*, quad ``k`` is ``V_k, M_k, C, M_{k-1}``;
 * ``c <= 2`` (a disc, a lens, a half disc): the vertices (all of them when the
   loop has at most four edges) and split points at the middle (in arc length)
-  of the longest stretches between them, four in all, one patch.
+  of the longest stretches between them, four in all, one patch; or, with
+  ``layout="butterfly"`` (what a structured grid needs: no corner of 180 degrees
+  on a smooth side), five: an inner quad halfway to those four points and four
+  quads between it and the loop.
 
 Spokes are straight lines in the face's parameter plane from the centre (the
 mean ``(u, v)`` of the side midpoints) mapped onto the surface and interpolated
