@@ -172,10 +172,12 @@ def _face_index(faces, face):
     return next(n for n, f in enumerate(faces) if f.IsSame(face))
 
 
-def fill_occ_filling(sides, order):
+def make_filling(edges_faces, order):
+    """``BRepOffsetAPI_MakeFilling`` over ``(edge, face)`` pairs, the edges as C0
+    constraints or on their faces at ``order``: ``(surface or None, seconds, note)``."""
     start = time.perf_counter()
     filling = BRepOffsetAPI_MakeFilling()
-    for edge, face, _ in sides:
+    for edge, face in edges_faces:
         if order is GeomAbs_C0:
             filling.Add(edge, GeomAbs_C0)
         else:
@@ -183,12 +185,14 @@ def fill_occ_filling(sides, order):
     filling.Build()
     elapsed = time.perf_counter() - start
     if not filling.IsDone():
-        return None, elapsed, "IsDone() False", None
-    shape = filling.Shape()
-    ex = TopExp_Explorer(shape, TopAbs_FACE)
-    face = TopoDS.Face_s(ex.Current())
-    return (to_nurbs(face).surface, elapsed, f"IsDone, G0 error {filling.G0Error():.2g}",
-            None)
+        return None, elapsed, "IsDone() False"
+    face = TopoDS.Face_s(TopExp_Explorer(filling.Shape(), TopAbs_FACE).Current())
+    return to_nurbs(face).surface, elapsed, f"IsDone, G0 error {filling.G0Error():.2g}"
+
+
+def fill_occ_filling(sides, order):
+    surface, elapsed, note = make_filling([(edge, face) for edge, face, _ in sides], order)
+    return surface, elapsed, note, None
 
 
 def fill_occ_coons(sides):
@@ -277,19 +281,9 @@ def _nsided_occ(heal_cases, n, order):
     for face, surface in zip(faces, fan):
         target = surface.evaluate(0.5, 0.0)          # the hole's edge is the fan face's v = 0
         sides.append((min(edges_of(face), key=lambda e: _edge_mid_distance(e, target)), face))
-    start = time.perf_counter()
-    filling = BRepOffsetAPI_MakeFilling()
-    for edge, face in sides:
-        if order is GeomAbs_C0:
-            filling.Add(edge, GeomAbs_C0)
-        else:
-            filling.Add(edge, face, order)
-    filling.Build()
-    elapsed = time.perf_counter() - start
-    if not filling.IsDone():
-        return None, None, None, elapsed, "IsDone() False"
-    surface = to_nurbs(TopoDS.Face_s(TopExp_Explorer(filling.Shape(), TopAbs_FACE).Current())
-                       ).surface
+    surface, elapsed, note = make_filling(sides, order)
+    if surface is None:
+        return None, None, None, elapsed, note
     dev = float(project_to_surface(surface, _nsided_truth(heal_cases, n)).distance.max())
     worst_angle, worst_gap = 0.0, 0.0
     for (edge, _), neighbour in zip(sides, fan):
@@ -300,7 +294,7 @@ def _nsided_occ(heal_cases, n, order):
                               neighbour.normals(fb.uv[:, 0], fb.uv[:, 1]))
         worst_angle = max(worst_angle, float(angle.max()))
         worst_gap = max(worst_gap, float(fa.distance.max()))
-    return dev, worst_angle, worst_gap, elapsed, f"IsDone, G0 error {filling.G0Error():.2g}"
+    return dev, worst_angle, worst_gap, elapsed, note
 
 
 def nsided_table() -> list[str]:
