@@ -27,9 +27,13 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--volumes", action="store_true",
                         help="also the volumes of A only, B only and both (the common solid of "
                              "their boundaries cut along the curves, integrated by OpenCascade)")
-    parser.add_argument("--boundary", type=Path, metavar="OUT",
-                        help="write both solids' boundaries as OpenCascade solids to a STEP "
-                             "or IGES file (a shell where a boundary does not close)")
+    parser.add_argument("--shell", type=Path, metavar="OUT",
+                        help="write a boundary as OpenCascade solids to a STEP or IGES file "
+                             "(which one: --boundary)")
+    parser.add_argument("--boundary", choices=("both", "union", "common", "A-B"),
+                        default="both",
+                        help="with --shell: both solids' boundaries (default), or the boundary "
+                             "of their union, common part or A minus B (cut along the curves)")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
 
@@ -64,8 +68,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         raise InputFileError("--classify and --labels go together")
     if args.labels is not None:
         check_outputs(inputs, args.labels, model=False)
-    if args.boundary is not None:
-        check_outputs(inputs, args.boundary)
+    if args.shell is not None:
+        check_outputs(inputs, args.shell)
     a, b = _solid(args.a), _solid(args.b)
     points = _points(args.classify) if args.classify is not None else None
     started = time.perf_counter()
@@ -83,9 +87,12 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             temporary.write_text("".join(f"{int(x)}\n" for x in labels))
     if args.volumes:
         from ..volume_boundary import composed_volumes
-        report["volumes"] = composed_volumes(a, b, tol=args.tol).as_dict()
-    if args.boundary is not None:
-        report["boundary"] = _write_boundary(a, b, args.boundary)
+        volumes = composed_volumes(a, b, tol=args.tol)
+        report["volumes"] = volumes.as_dict()
+        report["volume_common"] = volumes.both
+        report["volume_union"] = volumes.a_only + volumes.b_only + volumes.both
+    if args.shell is not None:
+        report["boundary"] = _write_boundary(a, b, args.shell, args.boundary, args.tol)
     if args.json_path is not None:
         write_json_report(report, args.json_path, console, protected=inputs)
     if args.json_path != STDOUT:
@@ -98,27 +105,41 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             v = report["volumes"]
             console.print(f"volumes: A only {v['A only']:.10g}, B only {v['B only']:.10g}, "
                           f"both {v['both']:.10g} ({v['time_s']:.2f} s)")
-        if args.boundary is not None:
-            console.print("boundaries: " + "; ".join(
-                f"{k} {'solid' if b['closed'] else 'open shell'} of {len(b['faces'])} face(s), "
-                f"OpenCascade volume {b['volume']:.10g}" for k, b in report["boundary"].items()
-                if k in ("A", "B")) + f", written to {report['boundary']['output']}")
+        if args.shell is not None:
+            written = report["boundary"]
+            console.print(f"{written['which']}: " + "; ".join(
+                f"{k} {'solid' if w['closed'] else 'open shell'} of {len(w['faces'])} "
+                f"face(s), OpenCascade volume {w['volume']:.10g}"
+                for k, w in written["solids"].items()) + f", written to {written['output']}")
     return 0
 
 
-def _write_boundary(a, b, path: Path) -> dict:
-    """Both solids' boundaries as OpenCascade solids written to ``path``; their figures."""
+#: --boundary's Boolean operations (surfprep.boolean's names)
+_OPERATIONS = {"union": "fuse", "common": "common", "A-B": "cut"}
+
+
+def _write_boundary(a, b, path: Path, which: str, tol) -> dict:
+    """Both solids' boundaries, or the boundary of their union / common part / A minus B
+    (:func:`surfprep.boolean` of the boundary solids), written to ``path``."""
     from ..io import write
-    from ..occ.shapes import compound
+    from ..occ.shapes import compound, count_free_edges
+    from ..split import boolean
     from ..volume_boundary import boundary_solid
-    out, shapes = {}, []
-    for key, solid in (("A", a), ("B", b)):
-        result = boundary_solid(solid)
-        shapes.append(result.shape)
-        out[key] = {"faces": list(result.faces), "closed": result.closed,
-                    "free_edges": result.free_edges, "volume": result.volume}
-    out["output"] = str(write(compound(shapes), path, overwrite=True))
-    return out
+    solids = {"A": boundary_solid(a), "B": boundary_solid(b)}
+    if which == "both":
+        shape = compound([s.shape for s in solids.values()])
+        figures = {k: {"faces": list(s.faces), "closed": s.closed, "free_edges": s.free_edges,
+                       "volume": s.volume} for k, s in solids.items()}
+    else:
+        result = boolean(solids["A"].shape, solids["B"].shape, _OPERATIONS[which], tol=tol)
+        shape = result.shape
+        pieces = [f"A piece {k}" for k in range(result.kept[0])] + \
+            [f"B piece {k}" for k in range(result.kept[1])]
+        figures = {which: {"faces": pieces,
+                           "closed": result.volume is not None,
+                           "free_edges": count_free_edges(shape),
+                           "volume": float("nan") if result.volume is None else result.volume}}
+    return {"which": which, "solids": figures, "output": str(write(shape, path, overwrite=True))}
 
 
 COMMAND = Command(
@@ -128,13 +149,15 @@ COMMAND = Command(
         "Read two solids from GoTools .g2 files, intersect their exterior boundary surfaces "
         "(collapsed faces and seams left out) and report the curves; with --classify, label "
         "each point 0 outside both, 1 in A only, 2 in B only, 3 in both (Newton inversion into "
-        "each solid); with --boundary, write both solids' boundaries (their non-degenerate "
-        "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES; "
-        "with --volumes, the volumes of A only, B only and both."),
+        "each solid); with --shell, write both solids' boundaries (their non-degenerate "
+        "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES, or "
+        "with --boundary union|common|A-B the boundary of that region (the boundary solids "
+        "cut along the curves); with --volumes, the volumes of A only, B only and both."),
     epilog=("examples:\n"
             "  surfprep compose a.g2 b.g2 --json r.json\n"
             "  surfprep compose a.g2 b.g2 --classify points.csv --labels labels.csv\n"
-            "  surfprep compose a.g2 b.g2 --boundary both.step --volumes"),
+            "  surfprep compose a.g2 b.g2 --shell both.step --volumes\n"
+            "  surfprep compose a.g2 b.g2 --boundary common --shell lens.step"),
     add_arguments=_add_arguments,
     run=_run,
 )

@@ -63,9 +63,9 @@ def test_compose_writes_both_boundaries_to_step(tmp_path, capsys):
     write_g2(a, [solid_sphere(5.0, (0, 0, 0))])
     write_g2(b, [block((4.0, 4.0, 4.0), origin=(3.0, -2.0, -2.0))])
     out, report = tmp_path / "both.step", tmp_path / "r.json"
-    code, stdout, err = run(capsys, "compose", a, b, "--boundary", out, "--json", report)
+    code, stdout, err = run(capsys, "compose", a, b, "--shell", out, "--json", report)
     assert code == 0, err
-    data = json.loads(report.read_text())["boundary"]
+    data = json.loads(report.read_text())["boundary"]["solids"]
     assert data["A"]["closed"] and data["B"]["closed"]
     assert data["A"]["volume"] == pytest.approx(4 / 3 * np.pi * 125, rel=2e-7)
     assert data["B"]["volume"] == pytest.approx(64.0, rel=1e-12)
@@ -73,8 +73,26 @@ def test_compose_writes_both_boundaries_to_step(tmp_path, capsys):
     assert model.n_faces == 7 and is_valid(model.shape)
     assert "written to" in stdout and "solid of 6 face(s)" in stdout
     # an input is never an output
-    code, _, err = run(capsys, "compose", a, b, "--boundary", a)
+    code, _, err = run(capsys, "compose", a, b, "--shell", a)
     assert code == 2 and len(err.strip().splitlines()) == 1
+
+
+def test_compose_writes_the_common_part_and_the_volumes(tmp_path, capsys):
+    a, b = tmp_path / "a.g2", tmp_path / "b.g2"
+    write_g2(a, [solid_sphere(5.0, (0, 0, 0))])
+    write_g2(b, [solid_sphere(5.0, (6, 0, 0))])
+    out, report = tmp_path / "lens.step", tmp_path / "r.json"
+    code, stdout, err = run(capsys, "compose", a, b, "--boundary", "common", "--shell", out,
+                            "--volumes", "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    lens, ball = _lens(5.0, 6.0), 4 / 3 * np.pi * 125
+    assert data["boundary"]["solids"]["common"]["volume"] == pytest.approx(lens, rel=3e-7)
+    assert data["volume_common"] == pytest.approx(lens, rel=3e-7)
+    assert data["volume_union"] == pytest.approx(2 * ball - lens, rel=3e-7)
+    model = read(out)
+    assert model.n_faces >= 2 and is_valid(model.shape)     # a cap of each ball (one cut
+    assert "common: common solid of" in stdout              # at its seam as well)
 
 
 def _lens(radius, distance):
