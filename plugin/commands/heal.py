@@ -114,7 +114,8 @@ def _summary(report: dict) -> list[str]:
                     default=float("nan"))
     worst_dev = max((p["deviation_from_input"] for p in patches), default=float("nan"))
     lines = [(f"{len(patches)} approximant(s) "
-             f"({sum(p['kind'] == 'hole' for p in patches)} hole(s) filled), "
+             f"({len({p['index'] for p in patches if p['kind'] == 'hole'})} hole(s) "
+             "filled), "
              f"largest error {worst_err:.3g} mm (largest distance from the input faces, "
              f"dense: {worst_dev:.3g} mm), {len(report['dropped_overlaps'])} duplicate "
              f"face(s) dropped, {report['time_s']:.2f} s")]

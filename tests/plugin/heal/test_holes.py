@@ -112,3 +112,18 @@ def test_a_sliver_between_faces_is_a_gap_not_a_hole():
              enumerate((lower, upper))]
     (loop,) = plan_loops([edges], [None, None])
     assert loop.kind == "gap" and not loop.fill and "0.02 wide along 20" in loop.why
+
+
+def test_the_command_counts_holes_not_sub_patches(tmp_path, capsys):
+    from helpers.cli import run
+
+    from surfprep.plugin.io import write
+    source = tmp_path / "fan.step"
+    write(compound([make_face(s) for s in fan_around_hole(5)]), source)
+    code, out, err = run(capsys, "heal", source, "-o", tmp_path / "healed.step")
+    assert code == 0, err
+    assert "5 approximant(s) (1 hole(s) filled)" in out
+    assert "2 loop(s) of free edges: 1 hole, 1 open boundary; fill tried on 1" in out
+    code, out, err = run(capsys, "heal", source, "-o", tmp_path / "open.step", "--fill", "none")
+    assert code == 0, err
+    assert "0 approximant(s)" in out and "fill tried on 0" in out
