@@ -1,7 +1,7 @@
 """Which trimmed faces a structured grid can cover: four-sided on their surface's rectangle,
 bounded by one loop of four edges, or (:func:`face_regions`) split into four-sided
 sub-patches around a centre (a butterfly for a disc) when bounded by one loop of
-another number of sides.
+another number of sides, or four blocks round a single hole.
 
 A face is gridded as one block when its boundary is the whole parameter
 rectangle of its surface: one loop, every edge's pcurve on a side of the
@@ -102,7 +102,9 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     region per sub-patch; blocks of neighbouring sub-patches share their spoke; a
     loop of four corners made of more edges is one region over its four sides; a
     loop of at most two corners (a disc, a lens) five, the butterfly: an inner quad
-    and four between it and the loop (its O-grid remapped to an H-grid). Faces with
+    and four between it and the loop (its O-grid remapped to an H-grid). A face with
+    one hole: four blocks round it (:func:`..healing.decompose.decompose_ring`, spokes
+    from the outer loop's four corners or cut points to the hole). Faces with more
     holes and loops the split refuses (a spoke leaving a very non-convex outline, a
     cusp) get the reason.
 
@@ -116,11 +118,23 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     -------
     list of Region, or str
     """
-    from ..healing.decompose import NotDecomposableError, decompose_face
+    from ..healing.decompose import (
+        NotDecomposableError,
+        decompose_face,
+        decompose_ring,
+        ring_edges,
+    )
 
     region = face_region(face)
     if not isinstance(region, str):
         return [region]
+    if len(face.loops) == 2:
+        try:
+            ring = decompose_ring(face.surface, *ring_edges(face, gap_tol=gap_tol))
+        except NotDecomposableError as exc:
+            return f"it has 1 hole: not split into four blocks round it ({exc})"
+        return [Region.from_runs(face.surface, [(pc, *pc.domain) for pc in quad],
+                                 clockwise=bool(face.reversed)) for quad in ring.quads_pcurves]
     if len(face.loops) != 1:
         return region
     try:

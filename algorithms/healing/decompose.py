@@ -68,10 +68,12 @@ __all__ = [
     "NotDecomposableError",
     "decompose_face",
     "decompose_loop",
+    "decompose_ring",
     "join_curves",
     "loop_edges",
     "quad_boundaries",
     "reverse_curve",
+    "ring_edges",
     "turning_angles",
     "why_not_decomposable",
 ]
@@ -494,6 +496,125 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         quads, centre = _star(surface, real, cuts, sides, outline, orientation)
     return Decomposition(tuple(tuple(q) for q, _, _ in quads), tuple(uv for _, uv, _ in quads),
                          corners, centre, turning, tuple(tuple(p) for _, _, p in quads))
+
+
+def _inner_cut(real_inner, centre: NDArray, towards: NDArray) -> tuple[int, float]:
+    """Loop position on the inner loop seen from ``centre`` in the direction of
+    ``towards`` (both in ``(u, v)``): the dense sample whose polar angle is nearest."""
+    want = np.arctan2(*(towards - centre)[::-1])
+    best, where = np.inf, None
+    for k, e in enumerate(real_inner):
+        t = np.linspace(*e.pcurve.domain, _DENSE)
+        d = e.pcurve.evaluate(t) - centre
+        gap = np.abs(np.angle(np.exp(1j * (np.arctan2(d[:, 1], d[:, 0]) - want))))
+        j = int(np.argmin(gap))
+        if gap[j] < best:
+            best, where = gap[j], (k, float(t[j]))
+    return where
+
+
+def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge], *,
+                   smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition:
+    """Four quads covering a face with one hole (an annulus: the O-grid round a hole cut
+    into four blocks).
+
+    The outer loop is cut at its four corners (or, with at most two, at four points
+    spread in arc length as :func:`decompose_loop` spreads them); the hole's loop at
+    the points seen from its centre in the directions of those cuts; quad ``i`` runs
+    along the outer loop from cut ``i`` to ``i + 1``, in along a straight spoke in
+    ``(u, v)``, back along the hole and out along the next spoke.
+
+    Parameters
+    ----------
+    surface : NurbsSurface
+    outer, inner : sequence of LoopEdge
+        The outer loop counter-clockwise, the hole's loop counter-clockwise too (run
+        the other way from the face's orientation of it), each edge along its loop.
+
+    Raises
+    ------
+    NotDecomposableError
+        Three or more than four outer corners, a spoke crossing the hole or leaving
+        the face, a folding quad.
+    """
+    real = [e for e in outer if e.curve is not None]
+    hole = [e for e in inner if e.curve is not None]
+    if not real or not hole:
+        raise NotDecomposableError("a loop without an edge with a 3D curve")
+    turning = turning_angles(outer)
+    corners = np.flatnonzero(turning > smooth_angle)
+    if corners.size not in (0, 1, 2, 4):
+        raise NotDecomposableError(f"a face with a hole and {corners.size} outer corners: "
+                                   "four blocks round the hole need four or at most two")
+    cuts = [(int(k), real[k].curve.domain[0]) for k in corners]
+    if len(cuts) <= 2:
+        seeds = [(k, real[k].curve.domain[0]) for k in range(len(real))] if len(real) <= 4 \
+            else cuts
+        cuts = _extra_cuts(real, seeds, 4)
+    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+                              for e in outer])
+    hole_outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+                                   for e in inner])
+    orientation = np.sign(_signed_area(outline)) or 1.0
+    centre = hole_outline.mean(axis=0)
+    outer_uv = np.array([real[k].pcurve.evaluate(t) for k, t in cuts]).reshape(4, 2)
+    outer_xyz = np.array([real[k].curve.evaluate(t) for k, t in cuts]).reshape(4, 3)
+    hole_cuts = [_inner_cut(hole, centre, p) for p in outer_uv]
+    if len({c for c in hole_cuts}) != 4:
+        raise NotDecomposableError("the hole's cut points coincide (a hole far off centre)")
+    hole_uv = np.array([hole[k].pcurve.evaluate(t) for k, t in hole_cuts]).reshape(4, 2)
+    spokes = [_spoke(surface, hole_uv[i], outer_uv[i], outer_xyz[i]) for i in range(4)]
+    for _, uv in spokes:
+        inside = inside_loops(uv[1:-1], [outline, hole_outline])
+        if not np.all(inside):
+            raise NotDecomposableError("a spoke from the hole to the outer loop leaves the face")
+    outer_sides = [_side(real, _pieces(real, cuts[i], cuts[(i + 1) % 4])) for i in range(4)]
+    hole_sides = [_side(hole, _pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % 4]))
+                  for i in range(4)]
+
+    def length(uv):
+        return np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
+
+    quads = []
+    for i in range(4):
+        j = (i + 1) % 4
+        o, h, s_in, s_out = outer_sides[i], hole_sides[i], spokes[j], spokes[i]
+        curves = [o.curve, reverse_curve(s_in[0]), reverse_curve(h.curve), s_out[0]]
+        pcurves = [o.pcurve, _uv_segment(outer_uv[j], hole_uv[j]), reverse_curve(h.pcurve),
+                   _uv_segment(hole_uv[i], outer_uv[i])]
+        uv_sides = [_uniform_uv(o.uv, o.length, CHECK_SAMPLES),
+                    _uniform_uv(s_in[1][::-1], length(s_in[1][::-1]), CHECK_SAMPLES),
+                    _uniform_uv(h.uv[::-1], h.length[-1] - h.length[::-1], CHECK_SAMPLES),
+                    _uniform_uv(s_out[1], length(s_out[1]), CHECK_SAMPLES)]
+        _check_quad(uv_sides, orientation, f"block {i} round the hole")
+        quads.append((curves, np.concatenate(uv_sides), pcurves))
+    return Decomposition(tuple(tuple(q) for q, _, _ in quads), tuple(uv for _, uv, _ in quads),
+                         corners, centre, turning, tuple(tuple(p) for _, _, p in quads))
+
+
+def ring_edges(face: TrimmedFace, *, gap_tol: float) -> tuple[list[LoopEdge], list[LoopEdge]]:
+    """The outer loop and the one hole of a face, both counter-clockwise in ``(u, v)``
+    (:func:`decompose_ring`'s input).
+
+    Raises
+    ------
+    NotDecomposableError
+        Not exactly one hole, seam edges, edges without a 3D curve, loops that do not
+        close within ``gap_tol``.
+    """
+    if len(face.loops) != 2:
+        raise NotDecomposableError(f"{len(face.loops) - 1} holes: a ring needs one")
+    out = []
+    for n in (face.outer_loop_index, 1 - face.outer_loop_index):
+        alone = TrimmedFace(face.surface, (face.loops[n],))
+        edges = loop_edges(alone, gap_tol=gap_tol)
+        out.append(edges)
+    outer, inner = out
+    if _signed_area(np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, 9))[:-1]
+                                    for e in inner])) < 0:
+        inner = [LoopEdge(None if e.curve is None else reverse_curve(e.curve),
+                          reverse_curve(e.pcurve)) for e in reversed(inner)]
+    return outer, inner
 
 
 # ------------------------------------------------------------------ trimmed faces
