@@ -60,6 +60,25 @@ from ..fitting import interpolate_curve
 from ..tolerance import check_tolerance
 from ..trimmed import TrimEdge, TrimmedFace
 from .adjacency import four_sided_boundary
+from .loop_sides import (
+    CHECK_SAMPLES,
+    DENSE,
+    SPOKE_SAMPLES,
+    LoopEdge,
+    LoopSide,
+    NotDecomposableError,
+    check_quad,
+    extra_cuts,
+    join_curves,
+    loop_pieces,
+    loop_side,
+    reverse_curve,
+    signed_area,
+    spoke_curve,
+    turning_angles,
+    uniform_uv,
+    uv_segment,
+)
 
 __all__ = [
     "DEFAULT_SMOOTH_ANGLE",
@@ -84,34 +103,8 @@ DEFAULT_SMOOTH_ANGLE = np.radians(20.0)
 MAX_SIDES = 16
 #: a vertex turning by more than this (radians) is a cusp: no sub-patch fits in it
 CUSP_ANGLE = np.radians(179.0)
-#: tangents at a vertex: chord to the point this fraction of the edge's end-to-end distance away
-TANGENT_REACH = 0.01
-#: samples of a spoke in (u, v) interpolated in 3D
-SPOKE_SAMPLES = 33
-#: samples per side of the (u, v) Coons check of a sub-patch
-CHECK_SAMPLES = 16
-_DENSE = 65                  # parameter samples per edge for arc lengths
 
 
-
-class NotDecomposableError(InvalidGeometryError):
-    """The face cannot be split into four-sided sub-patches; ``str()`` is the reason."""
-
-
-@dataclass(frozen=True, eq=False)
-class LoopEdge:
-    """One edge of a face's outer loop, oriented along the loop.
-
-    Attributes
-    ----------
-    curve : NurbsCurve (3D) or None
-        None for a degenerated edge (a surface pole).
-    pcurve : NurbsCurve (2D)
-        Same parameter and direction as ``curve``.
-    """
-
-    curve: NurbsCurve | None
-    pcurve: NurbsCurve
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,202 +138,10 @@ class Decomposition:
     quads_pcurves: tuple = ()
 
 
-# ------------------------------------------------------------------ curves
-def reverse_curve(curve: NurbsCurve) -> NurbsCurve:
-    """The same curve run the other way, on the same domain."""
-    a, b = curve.domain
-    knots = a + b - curve.knots[::-1]
-    weights = None if curve.weights is None else curve.weights[::-1]
-    return NurbsCurve(curve.control_points[::-1], knots, curve.degree, weights)
-
-
-def join_curves(curves: Sequence[NurbsCurve]) -> NurbsCurve:
-    """Exact C0 join of curves meeting end to end: degrees raised to the largest,
-    domains laid end to end, each piece's weights scaled to match at the joint
-    (a homogeneous scaling leaves a rational curve unchanged), tiny gaps closed
-    at their midpoint."""
-    if len(curves) == 1:
-        return curves[0]
-    degree = max(c.degree for c in curves)
-    rational = any(c.is_rational for c in curves)
-    pws, knots, scale = [], [], 1.0
-    for n, c in enumerate(curves):
-        c = c.clamp()
-        c = c.elevate_degree(degree - c.degree) if c.degree < degree else c
-        pw = (c.homogeneous_points() if rational
-              else np.column_stack([c.control_points, np.ones(c.n_control)]))
-        k = np.asarray(c.knots, float)
-        if n:
-            pw *= scale / pw[0, -1]
-            pws[-1][-1] = 0.5 * (pws[-1][-1] + pw[0])
-            pw, k = pw[1:], k[degree + 1:] + (knots[-1][-1] - k[0])
-            knots[-1] = knots[-1][:-1]          # the joint stays ``degree`` times
-        scale = pw[-1, -1]
-        pws.append(pw)
-        knots.append(k)
-    pw, kv = np.concatenate(pws), np.concatenate(knots)
-    if rational:
-        return NurbsCurve.from_homogeneous(pw, kv, degree)
-    return NurbsCurve(pw[:, :-1], kv, degree)
-
-
-def turning_angles(edges: Sequence[LoopEdge]) -> NDArray:
-    """(m,) float: the angle (radians) between the end tangent of real edge ``k - 1``
-    and the start tangent of real edge ``k`` (cyclic; a degenerated edge between them,
-    a surface pole, is skipped: the 3D tangents meet there as at any vertex)."""
-    real = [e.curve for e in edges if e.curve is not None]
-    t_in = np.roll(np.array([_end_tangent(c, 1) for c in real]), 1, axis=0)
-    t_out = np.array([_end_tangent(c, 0) for c in real])
-    denom = np.linalg.norm(t_in, axis=1) * np.linalg.norm(t_out, axis=1)
-    cos = np.einsum("kc,kc->k", t_in, t_out) / np.where(denom > 0, denom, 1.0)
-    return np.where(denom > 0, np.arccos(np.clip(cos, -1.0, 1.0)), np.pi)
-
-
-def _end_tangent(curve: NurbsCurve, end: int) -> NDArray:
-    """(3,) float: the curve's direction at its start (``end = 0``) or end (1), along
-    the curve, as the chord to the first point :data:`TANGENT_REACH` of the edge's
-    length away: a vanishing or wild end derivative (repeated or nearly repeated
-    control points of high-degree edges, tiny hooks) does not fake a cusp."""
-    t0, t1 = curve.domain
-    steps = np.geomspace(1e-7, 1.0, 60) * (t1 - t0)
-    t = t1 - steps if end else t0 + steps
-    pts = curve.evaluate(np.r_[t1 if end else t0, t])
-    reach = np.linalg.norm(pts[1:] - pts[0], axis=1)
-    k = int(np.argmax(reach >= TANGENT_REACH * reach[-1])) if reach[-1] > 0 else 0
-    chord = pts[k + 1] - pts[0]
-    return -chord if end else chord
-
-
-# ------------------------------------------------------------ loop positions
-@dataclass(frozen=True, eq=False)
-class _Side:
-    """A chain of edge pieces ``(edge, t_start, t_end)`` between two loop positions,
-    its joined 3D curve and dense samples (3D arc length ``(k,)``, uv ``(k, 2)``,
-    piece index and parameter ``(k,)``)."""
-
-    pieces: tuple
-    curve: NurbsCurve
-    length: NDArray
-    uv: NDArray
-    piece: NDArray
-    t: NDArray
-    pcurve: NurbsCurve | None = None
-
-    def locate(self, s: float) -> tuple[int, float]:
-        """Loop position ``(edge, t)`` at arc length ``s`` along the side."""
-        j = int(np.clip(np.searchsorted(self.length, s) - 1, 0, self.length.size - 2))
-        if self.piece[j] != self.piece[j + 1]:
-            j += 1 if j + 2 < self.length.size else -1
-        span = self.length[j + 1] - self.length[j]
-        w = 0.0 if span <= 0 else float(np.clip((s - self.length[j]) / span, 0, 1))
-        k = self.pieces[int(self.piece[j])][0]
-        return k, float((1 - w) * self.t[j] + w * self.t[j + 1])
-
-
-def _restricted(curve: NurbsCurve, a: float, b: float) -> NurbsCurve:
-    t0, t1 = curve.domain
-    eps = 1e-12 * (t1 - t0)
-    if a <= t0 + eps and b >= t1 - eps:
-        return curve
-    return curve.restrict(max(a, t0), min(b, t1))
-
-
-def _pieces(real: Sequence[LoopEdge], a: tuple[int, float], b: tuple[int, float]) -> list:
-    """Edge pieces ``(edge, t0, t1)`` along the loop from position ``a`` to ``b``."""
-    (ka, ta), (kb, tb) = a, b
-    if ka == kb and tb > ta:
-        return [(ka, ta, tb)]
-    out = [(ka, ta, real[ka].curve.domain[1])]
-    k = (ka + 1) % len(real)
-    while k != kb:
-        out.append((k, *real[k].curve.domain))
-        k = (k + 1) % len(real)
-    out.append((kb, real[kb].curve.domain[0], tb))
-    return [p for p in out if p[2] - p[1] > 1e-12 * np.ptp(real[p[0]].curve.domain)]
-
-
-def _side(real: Sequence[LoopEdge], pieces: list) -> _Side:
-    curve = join_curves([_restricted(real[k].curve, a, b) for k, a, b in pieces])
-    xyz, uv, piece, ts = [], [], [], []
-    for n, (k, a, b) in enumerate(pieces):
-        t = np.linspace(a, b, _DENSE)
-        xyz.append(real[k].curve.evaluate(t))
-        uv.append(real[k].pcurve.evaluate(t))
-        piece.append(np.full(t.size, n))
-        ts.append(t)
-    xyz = np.concatenate(xyz)
-    length = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))]
-    pcurve = join_curves([_restricted(real[k].pcurve, a, b) for k, a, b in pieces])
-    return _Side(tuple(pieces), curve, length, np.concatenate(uv), np.concatenate(piece),
-                 np.concatenate(ts), pcurve)
-
-
-def _uniform_uv(side_uv: NDArray, length: NDArray, n: int) -> NDArray:
-    """(n + 1, 2) float: uv points at uniform arc length (eq. 4's sampling)."""
-    s = np.linspace(0.0, length[-1], n + 1)
-    return np.column_stack([np.interp(s, length, side_uv[:, 0]), np.interp(s, length, side_uv[:, 1])])
-
-
-def _extra_cuts(real: Sequence[LoopEdge], cuts: list, count: int) -> list:
-    """``cuts`` completed to ``count`` loop positions, each new one at the middle (in
-    arc length) of the longest stretch between positions."""
-    lengths = np.array([np.sum(np.linalg.norm(np.diff(real[k].curve.evaluate(
-        np.linspace(*real[k].curve.domain, _DENSE)), axis=0), axis=1)) for k in range(len(real))])
-    start = np.r_[0.0, np.cumsum(lengths)]
-    total = start[-1]
-    at = sorted(start[k] for k, _ in cuts) or [0.0]
-    while len(at) < count:
-        gaps = np.diff(np.r_[at, at[0] + total])
-        g = int(np.argmax(gaps))
-        at = sorted(at + [(at[g] + 0.5 * gaps[g]) % total])
-    whole = _side(real, [(k, *real[k].curve.domain) for k in range(len(real))])
-    return [whole.locate(s) for s in at]
-
-
-# ------------------------------------------------------------------ checks
-def _coons_cells(sides_uv: Sequence[NDArray]) -> NDArray:
-    """Signed areas ``(m, m)`` of the cells of the bilinearly blended Coons map (001
-    eq. 4) of four uv sides (bottom, right, top, left, in loop order, ``(m + 1, 2)``)."""
-    bottom, right, top, left = (np.asarray(s, float) for s in sides_uv)
-    top, left = top[::-1], left[::-1]
-    m = bottom.shape[0] - 1
-    u = np.linspace(0, 1, m + 1)[:, None, None]
-    v = np.linspace(0, 1, m + 1)[None, :, None]
-    p00, p10, p11, p01 = bottom[0], bottom[-1], top[-1], top[0]
-    x = ((1 - v) * bottom[:, None] + v * top[:, None] + (1 - u) * left[None] + u * right[None]
-         - ((1 - u) * (1 - v) * p00 + u * (1 - v) * p10 + u * v * p11 + (1 - u) * v * p01))
-    d1 = x[1:, 1:] - x[:-1, :-1]
-    d2 = x[:-1, 1:] - x[1:, :-1]
-    return 0.5 * (d1[..., 0] * d2[..., 1] - d1[..., 1] * d2[..., 0])
-
-
-def _signed_area(poly: NDArray) -> float:
-    x, y = poly[:, 0], poly[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-
-
-def _check_quad(sides_uv: Sequence[NDArray], orientation: float, what: str) -> None:
-    cells = _coons_cells(sides_uv) * orientation
-    if cells.min() < -1e-9 * np.abs(cells).sum():
-        raise NotDecomposableError(
-            f"{what}: its Coons map folds in (u, v) (a very non-convex outline)")
-
-
 # -------------------------------------------------------------- the layouts
-def _spoke(surface, centre: NDArray, mid_uv: NDArray, mid_xyz: NDArray
-           ) -> tuple[NurbsCurve, NDArray]:
-    """3D curve from the centre to a side midpoint along the uv line, and its uv
-    samples ``(SPOKE_SAMPLES, 2)``."""
-    s = np.linspace(0.0, 1.0, SPOKE_SAMPLES)[:, None]
-    uv = (1 - s) * centre + s * mid_uv
-    pts = surface.evaluate(uv[:, 0], uv[:, 1])
-    pts[-1] = mid_xyz                      # the edge's point (on the surface within its tolerance)
-    return interpolate_curve(pts), uv
-
-
-def _single(sides: Sequence[_Side], orientation: float) -> list:
-    _check_quad([_uniform_uv(s.uv, s.length, CHECK_SAMPLES) for s in sides], orientation,
-                "the four-sided patch")
+def _single(sides: Sequence[LoopSide], orientation: float) -> list:
+    check_quad([uniform_uv(s.uv, s.length, CHECK_SAMPLES) for s in sides], orientation,
+               "the four-sided patch")
     return [([s.curve for s in sides], np.concatenate([s.uv for s in sides]),
              [s.pcurve for s in sides])]
 
@@ -355,33 +156,30 @@ def _star(surface, real, cuts, sides, outline, orientation) -> tuple[list, NDArr
     if not inside_loops(centre[None], [outline])[0]:
         raise NotDecomposableError("the centre of the split lies outside the face (non-convex "
                                    "outline)")
-    spokes = [_spoke(surface, centre, mid_uv[i], mid_xyz[i]) for i in range(n)]
+    spokes = [spoke_curve(surface, centre, mid_uv[i], mid_xyz[i]) for i in range(n)]
     for curve, uv in spokes:
         if not np.all(inside_loops(uv[1:-SPOKE_SAMPLES // 8], [outline])):
             raise NotDecomposableError("a split curve leaves the face (non-convex outline)")
-    first = [_side(real, _pieces(real, cuts[i], mids[i])) for i in range(n)]
-    second = [_side(real, _pieces(real, mids[i], cuts[(i + 1) % n])) for i in range(n)]
+    first = [loop_side(real, loop_pieces(real, cuts[i], mids[i])) for i in range(n)]
+    second = [loop_side(real, loop_pieces(real, mids[i], cuts[(i + 1) % n])) for i in range(n)]
     quads = []
     for i in range(n):
         j = i - 1
         spoke_out, spoke_in = spokes[i], spokes[j]
         curves = [first[i].curve, reverse_curve(spoke_out[0]), spoke_in[0], second[j].curve]
-        pcurves = [first[i].pcurve, _uv_segment(mid_uv[i], centre),
-                   _uv_segment(centre, mid_uv[j]), second[j].pcurve]
+        pcurves = [first[i].pcurve, uv_segment(mid_uv[i], centre),
+                   uv_segment(centre, mid_uv[j]), second[j].pcurve]
         spoke_length = [np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
                         for uv in (spoke_out[1][::-1], spoke_in[1])]
-        uv_sides = [_uniform_uv(first[i].uv, first[i].length, CHECK_SAMPLES),
-                    _uniform_uv(spoke_out[1][::-1], spoke_length[0], CHECK_SAMPLES),
-                    _uniform_uv(spoke_in[1], spoke_length[1], CHECK_SAMPLES),
-                    _uniform_uv(second[j].uv, second[j].length, CHECK_SAMPLES)]
-        _check_quad(uv_sides, orientation, f"sub-patch {i} of {n}")
+        uv_sides = [uniform_uv(first[i].uv, first[i].length, CHECK_SAMPLES),
+                    uniform_uv(spoke_out[1][::-1], spoke_length[0], CHECK_SAMPLES),
+                    uniform_uv(spoke_in[1], spoke_length[1], CHECK_SAMPLES),
+                    uniform_uv(second[j].uv, second[j].length, CHECK_SAMPLES)]
+        check_quad(uv_sides, orientation, f"sub-patch {i} of {n}")
         quads.append((curves, np.concatenate(uv_sides), pcurves))
     return quads, centre
 
 
-def _uv_segment(a: NDArray, b: NDArray) -> NurbsCurve:
-    """The straight segment from ``a`` to ``b`` in ``(u, v)`` (a spoke's pcurve)."""
-    return NurbsCurve(np.array([a, b], dtype=float), np.array([0.0, 0.0, 1.0, 1.0]), 1)
 
 
 #: inner corners of the butterfly layout: this fraction of the way from the centre to
@@ -401,7 +199,7 @@ def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, 
     if not np.all(inside_loops(inner, [outline])):
         raise NotDecomposableError("an inner corner of the butterfly lies outside the face "
                                    "(non-convex outline)")
-    spokes = [_spoke(surface, inner[i], split_uv[i], split_xyz[i]) for i in range(4)]
+    spokes = [spoke_curve(surface, inner[i], split_uv[i], split_xyz[i]) for i in range(4)]
     for _, uv in spokes:
         if not np.all(inside_loops(uv[:-SPOKE_SAMPLES // 8], [outline])):
             raise NotDecomposableError("a split curve leaves the face (non-convex outline)")
@@ -420,18 +218,18 @@ def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, 
         spoke_in, spoke_out = spokes[j], spokes[i]          # P_j -> Q_j is spoke_in reversed
         curves = [sides[i].curve, reverse_curve(spoke_in[0]), reverse_curve(ring[i][0]),
                   spoke_out[0]]
-        pcurves = [sides[i].pcurve, _uv_segment(split_uv[j], inner[j]),
-                   _uv_segment(inner[j], inner[i]), _uv_segment(inner[i], split_uv[i])]
-        uv_sides = [_uniform_uv(sides[i].uv, sides[i].length, CHECK_SAMPLES),
-                    _uniform_uv(spoke_in[1][::-1], length(spoke_in[1][::-1]), CHECK_SAMPLES),
-                    _uniform_uv(ring[i][1][::-1], length(ring[i][1][::-1]), CHECK_SAMPLES),
-                    _uniform_uv(spoke_out[1], length(spoke_out[1]), CHECK_SAMPLES)]
-        _check_quad(uv_sides, orientation, f"outer sub-patch {i} of the butterfly")
+        pcurves = [sides[i].pcurve, uv_segment(split_uv[j], inner[j]),
+                   uv_segment(inner[j], inner[i]), uv_segment(inner[i], split_uv[i])]
+        uv_sides = [uniform_uv(sides[i].uv, sides[i].length, CHECK_SAMPLES),
+                    uniform_uv(spoke_in[1][::-1], length(spoke_in[1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(ring[i][1][::-1], length(ring[i][1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(spoke_out[1], length(spoke_out[1]), CHECK_SAMPLES)]
+        check_quad(uv_sides, orientation, f"outer sub-patch {i} of the butterfly")
         quads.append((curves, np.concatenate(uv_sides), pcurves))
-    uv_sides = [_uniform_uv(r[1], length(r[1]), CHECK_SAMPLES) for r in ring]
-    _check_quad(uv_sides, orientation, "the butterfly's inner sub-patch")
+    uv_sides = [uniform_uv(r[1], length(r[1]), CHECK_SAMPLES) for r in ring]
+    check_quad(uv_sides, orientation, "the butterfly's inner sub-patch")
     quads.append(([r[0] for r in ring], np.concatenate(uv_sides),
-                  [_uv_segment(inner[i], inner[(i + 1) % 4]) for i in range(4)]))
+                  [uv_segment(inner[i], inner[(i + 1) % 4]) for i in range(4)]))
     return quads, centre
 
 
@@ -482,12 +280,12 @@ def decompose_loop(surface, edges: Sequence[LoopEdge], *,
         # edges end there), split points fill the longest stretches up to four
         seeds = [(k, real[k].curve.domain[0]) for k in range(len(real))] if len(real) <= 4 \
             else cuts
-        cuts = _extra_cuts(real, seeds, 4)
+        cuts = extra_cuts(real, seeds, 4)
     n = len(cuts)
-    sides = [_side(real, _pieces(real, cuts[i], cuts[(i + 1) % n])) for i in range(n)]
-    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+    sides = [loop_side(real, loop_pieces(real, cuts[i], cuts[(i + 1) % n])) for i in range(n)]
+    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, DENSE))[:-1]
                               for e in edges])
-    orientation = np.sign(_signed_area(outline)) or 1.0
+    orientation = np.sign(signed_area(outline)) or 1.0
     if n == 4 and layout == "butterfly" and corners.size <= 2:
         quads, centre = _butterfly(surface, real, cuts, sides, outline, orientation)
     elif n == 4:
@@ -504,7 +302,7 @@ def _inner_cut(real_inner, centre: NDArray, towards: NDArray) -> tuple[int, floa
     want = np.arctan2(*(towards - centre)[::-1])
     best, where = np.inf, None
     for k, e in enumerate(real_inner):
-        t = np.linspace(*e.pcurve.domain, _DENSE)
+        t = np.linspace(*e.pcurve.domain, DENSE)
         d = e.pcurve.evaluate(t) - centre
         gap = np.abs(np.angle(np.exp(1j * (np.arctan2(d[:, 1], d[:, 0]) - want))))
         j = int(np.argmin(gap))
@@ -550,12 +348,12 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
     if len(cuts) <= 2:
         seeds = [(k, real[k].curve.domain[0]) for k in range(len(real))] if len(real) <= 4 \
             else cuts
-        cuts = _extra_cuts(real, seeds, 4)
-    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+        cuts = extra_cuts(real, seeds, 4)
+    outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, DENSE))[:-1]
                               for e in outer])
-    hole_outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, _DENSE))[:-1]
+    hole_outline = np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, DENSE))[:-1]
                                    for e in inner])
-    orientation = np.sign(_signed_area(outline)) or 1.0
+    orientation = np.sign(signed_area(outline)) or 1.0
     centre = hole_outline.mean(axis=0)
     outer_uv = np.array([real[k].pcurve.evaluate(t) for k, t in cuts]).reshape(4, 2)
     outer_xyz = np.array([real[k].curve.evaluate(t) for k, t in cuts]).reshape(4, 3)
@@ -563,13 +361,13 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
     if len({c for c in hole_cuts}) != 4:
         raise NotDecomposableError("the hole's cut points coincide (a hole far off centre)")
     hole_uv = np.array([hole[k].pcurve.evaluate(t) for k, t in hole_cuts]).reshape(4, 2)
-    spokes = [_spoke(surface, hole_uv[i], outer_uv[i], outer_xyz[i]) for i in range(4)]
+    spokes = [spoke_curve(surface, hole_uv[i], outer_uv[i], outer_xyz[i]) for i in range(4)]
     for _, uv in spokes:
         inside = inside_loops(uv[1:-1], [outline, hole_outline])
         if not np.all(inside):
             raise NotDecomposableError("a spoke from the hole to the outer loop leaves the face")
-    outer_sides = [_side(real, _pieces(real, cuts[i], cuts[(i + 1) % 4])) for i in range(4)]
-    hole_sides = [_side(hole, _pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % 4]))
+    outer_sides = [loop_side(real, loop_pieces(real, cuts[i], cuts[(i + 1) % 4])) for i in range(4)]
+    hole_sides = [loop_side(hole, loop_pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % 4]))
                   for i in range(4)]
 
     def length(uv):
@@ -580,13 +378,13 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
         j = (i + 1) % 4
         o, h, s_in, s_out = outer_sides[i], hole_sides[i], spokes[j], spokes[i]
         curves = [o.curve, reverse_curve(s_in[0]), reverse_curve(h.curve), s_out[0]]
-        pcurves = [o.pcurve, _uv_segment(outer_uv[j], hole_uv[j]), reverse_curve(h.pcurve),
-                   _uv_segment(hole_uv[i], outer_uv[i])]
-        uv_sides = [_uniform_uv(o.uv, o.length, CHECK_SAMPLES),
-                    _uniform_uv(s_in[1][::-1], length(s_in[1][::-1]), CHECK_SAMPLES),
-                    _uniform_uv(h.uv[::-1], h.length[-1] - h.length[::-1], CHECK_SAMPLES),
-                    _uniform_uv(s_out[1], length(s_out[1]), CHECK_SAMPLES)]
-        _check_quad(uv_sides, orientation, f"block {i} round the hole")
+        pcurves = [o.pcurve, uv_segment(outer_uv[j], hole_uv[j]), reverse_curve(h.pcurve),
+                   uv_segment(hole_uv[i], outer_uv[i])]
+        uv_sides = [uniform_uv(o.uv, o.length, CHECK_SAMPLES),
+                    uniform_uv(s_in[1][::-1], length(s_in[1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(h.uv[::-1], h.length[-1] - h.length[::-1], CHECK_SAMPLES),
+                    uniform_uv(s_out[1], length(s_out[1]), CHECK_SAMPLES)]
+        check_quad(uv_sides, orientation, f"block {i} round the hole")
         quads.append((curves, np.concatenate(uv_sides), pcurves))
     return Decomposition(tuple(tuple(q) for q, _, _ in quads), tuple(uv for _, uv, _ in quads),
                          corners, centre, turning, tuple(tuple(p) for _, _, p in quads))
@@ -610,7 +408,7 @@ def ring_edges(face: TrimmedFace, *, gap_tol: float) -> tuple[list[LoopEdge], li
         edges = loop_edges(alone, gap_tol=gap_tol)
         out.append(edges)
     outer, inner = out
-    if _signed_area(np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, 9))[:-1]
+    if signed_area(np.concatenate([e.pcurve.evaluate(np.linspace(*e.pcurve.domain, 9))[:-1]
                                     for e in inner])) < 0:
         inner = [LoopEdge(None if e.curve is None else reverse_curve(e.curve),
                           reverse_curve(e.pcurve)) for e in reversed(inner)]
