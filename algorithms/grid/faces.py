@@ -118,6 +118,7 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     -------
     list of Region, or str
     """
+    from ...errors import DegenerateGeometryError
     from ..healing.decompose import (
         NotDecomposableError,
         decompose_face,
@@ -131,7 +132,7 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     if len(face.loops) == 2:
         try:
             ring = decompose_ring(face.surface, *ring_edges(face, gap_tol=gap_tol))
-        except NotDecomposableError as exc:
+        except (NotDecomposableError, DegenerateGeometryError) as exc:
             return f"it has 1 hole: not split into four blocks round it ({exc})"
         return [Region.from_runs(face.surface, [(pc, *pc.domain) for pc in quad],
                                  clockwise=bool(face.reversed)) for quad in ring.quads_pcurves]
@@ -139,7 +140,7 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
         return region
     try:
         split = decompose_face(face, gap_tol=gap_tol, layout="butterfly")
-    except NotDecomposableError as exc:
+    except (NotDecomposableError, DegenerateGeometryError) as exc:
         return f"not split into four-sided blocks: {exc}"
     if split is None:
         return region

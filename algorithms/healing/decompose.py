@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError
+from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..face_region import inside_loops
 from ..fitting import interpolate_curve
@@ -207,7 +207,11 @@ def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, 
     for i in range(4):
         a, b = inner[i], inner[(i + 1) % 4]
         uv = a + np.linspace(0.0, 1.0, SPOKE_SAMPLES)[:, None] * (b - a)
-        ring.append((interpolate_curve(surface.evaluate(uv[:, 0], uv[:, 1])), uv))
+        try:
+            ring.append((interpolate_curve(surface.evaluate(uv[:, 0], uv[:, 1])), uv))
+        except DegenerateGeometryError:
+            raise NotDecomposableError("the butterfly's inner quad runs where the surface "
+                                       "collapses") from None
 
     def length(uv):
         return np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ...errors import InvalidGeometryError
+from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..fitting import interpolate_curve
 
@@ -269,7 +269,11 @@ def spoke_curve(surface, centre: NDArray, mid_uv: NDArray, mid_xyz: NDArray
     uv = (1 - s) * centre + s * mid_uv
     pts = surface.evaluate(uv[:, 0], uv[:, 1])
     pts[-1] = mid_xyz                      # the edge's point (on the surface within its tolerance)
-    return interpolate_curve(pts), uv
+    try:
+        return interpolate_curve(pts), uv
+    except DegenerateGeometryError:
+        raise NotDecomposableError("a spoke runs where the surface collapses (its points "
+                                   "coincide in space)") from None
 
 
 def uv_segment(a: NDArray, b: NDArray) -> NurbsCurve:
