@@ -72,6 +72,7 @@ from .loop_sides import (
     join_curves,
     loop_pieces,
     loop_side,
+    polyline_lengths,
     reverse_curve,
     signed_area,
     spoke_curve,
@@ -213,9 +214,6 @@ def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, 
             raise NotDecomposableError("the butterfly's inner quad runs where the surface "
                                        "collapses") from None
 
-    def length(uv):
-        return np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
-
     quads = []
     for i in range(4):
         j = (i + 1) % 4
@@ -225,12 +223,12 @@ def _butterfly(surface, real, cuts, sides, outline, orientation) -> tuple[list, 
         pcurves = [sides[i].pcurve, uv_segment(split_uv[j], inner[j]),
                    uv_segment(inner[j], inner[i]), uv_segment(inner[i], split_uv[i])]
         uv_sides = [uniform_uv(sides[i].uv, sides[i].length, CHECK_SAMPLES),
-                    uniform_uv(spoke_in[1][::-1], length(spoke_in[1][::-1]), CHECK_SAMPLES),
-                    uniform_uv(ring[i][1][::-1], length(ring[i][1][::-1]), CHECK_SAMPLES),
-                    uniform_uv(spoke_out[1], length(spoke_out[1]), CHECK_SAMPLES)]
+                    uniform_uv(spoke_in[1][::-1], polyline_lengths(spoke_in[1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(ring[i][1][::-1], polyline_lengths(ring[i][1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(spoke_out[1], polyline_lengths(spoke_out[1]), CHECK_SAMPLES)]
         check_quad(uv_sides, orientation, f"outer sub-patch {i} of the butterfly")
         quads.append((curves, np.concatenate(uv_sides), pcurves))
-    uv_sides = [uniform_uv(r[1], length(r[1]), CHECK_SAMPLES) for r in ring]
+    uv_sides = [uniform_uv(r[1], polyline_lengths(r[1]), CHECK_SAMPLES) for r in ring]
     check_quad(uv_sides, orientation, "the butterfly's inner sub-patch")
     quads.append(([r[0] for r in ring], np.concatenate(uv_sides),
                   [uv_segment(inner[i], inner[(i + 1) % 4]) for i in range(4)]))
@@ -374,9 +372,6 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
     hole_sides = [loop_side(hole, loop_pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % 4]))
                   for i in range(4)]
 
-    def length(uv):
-        return np.r_[0, np.cumsum(np.linalg.norm(np.diff(uv, axis=0), axis=1))]
-
     quads = []
     for i in range(4):
         j = (i + 1) % 4
@@ -385,9 +380,9 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
         pcurves = [o.pcurve, uv_segment(outer_uv[j], hole_uv[j]), reverse_curve(h.pcurve),
                    uv_segment(hole_uv[i], outer_uv[i])]
         uv_sides = [uniform_uv(o.uv, o.length, CHECK_SAMPLES),
-                    uniform_uv(s_in[1][::-1], length(s_in[1][::-1]), CHECK_SAMPLES),
+                    uniform_uv(s_in[1][::-1], polyline_lengths(s_in[1][::-1]), CHECK_SAMPLES),
                     uniform_uv(h.uv[::-1], h.length[-1] - h.length[::-1], CHECK_SAMPLES),
-                    uniform_uv(s_out[1], length(s_out[1]), CHECK_SAMPLES)]
+                    uniform_uv(s_out[1], polyline_lengths(s_out[1]), CHECK_SAMPLES)]
         check_quad(uv_sides, orientation, f"block {i} round the hole")
         quads.append((curves, np.concatenate(uv_sides), pcurves))
     return Decomposition(tuple(tuple(q) for q, _, _ in quads), tuple(uv for _, uv, _ in quads),

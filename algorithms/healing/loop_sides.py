@@ -37,6 +37,7 @@ __all__ = [
     "join_curves",
     "loop_pieces",
     "loop_side",
+    "polyline_lengths",
     "restricted_curve",
     "reverse_curve",
     "signed_area",
@@ -206,6 +207,11 @@ def loop_side(real: Sequence[LoopEdge], pieces: list) -> LoopSide:
     pcurve = join_curves([restricted_curve(real[k].pcurve, a, b) for k, a, b in pieces])
     return LoopSide(tuple(pieces), curve, length, np.concatenate(uv), np.concatenate(piece),
                  np.concatenate(ts), pcurve)
+
+
+def polyline_lengths(points: NDArray) -> NDArray:
+    """``(m,)`` float: the length along a polyline ``(m, k)`` from its first point."""
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
 
 
 def uniform_uv(side_uv: NDArray, length: NDArray, n: int) -> NDArray:

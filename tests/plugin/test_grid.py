@@ -17,6 +17,20 @@ FUSELAGE = SAMPLES / "occt_fuselage.stp"
 CATIA_FACE = SAMPLES / "occt_catia4_face_L1.igs"
 
 
+def _assert_point_matched(result):
+    """Every shared edge of the network: the two blocks' nodes along it are the same."""
+    for f in result.network.interfaces:
+        a = side_nodes(result.blocks[f.block], f.side)
+        b = side_nodes(result.blocks[f.other], f.other_side)
+        assert np.array_equal(a[::-1] if f.reversed else a, b)
+
+
+def _cells_area(block):
+    """Area of a block's cells (two triangles' worth each, by the diagonals)."""
+    d1, d2 = block[1:, 1:] - block[:-1, :-1], block[:-1, 1:] - block[1:, :-1]
+    return 0.5 * np.linalg.norm(np.cross(d1, d2), axis=-1).sum()
+
+
 @pytest.fixture(scope="module")
 def fuselage():
     return surfprep.grid(FUSELAGE, size=1500.0)
@@ -26,10 +40,7 @@ def test_every_face_of_the_fuselage_is_a_point_matched_block(fuselage):
     model = surfprep.read(FUSELAGE)
     assert fuselage.faces == tuple(range(model.n_faces)) and not fuselage.skipped
     assert len(fuselage.network.interfaces) == 14
-    for f in fuselage.network.interfaces:
-        a = side_nodes(fuselage.blocks[f.block], f.side)
-        b = side_nodes(fuselage.blocks[f.other], f.other_side)
-        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    _assert_point_matched(fuselage)
     # the faces are sewn: the nodes moved onto a neighbour's side by a rounding only
     assert fuselage.network.snap < 1e-6 * model.size
     worst = fuselage.report()["worst"]
@@ -137,10 +148,7 @@ def test_trimmed_four_sided_faces_of_a_real_model(data_dir):
     assert max(q for q, k in zip(skew, result.faces) if k in four) < 0.5
     assert max(q for q, k in zip(skew, result.faces) if k in others) < 0.95
     assert len(result.network.interfaces) >= 40
-    for f in result.network.interfaces:
-        a = side_nodes(result.blocks[f.block], f.side)
-        b = side_nodes(result.blocks[f.other], f.other_side)
-        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    _assert_point_matched(result)
     # the blocks lie on their faces: every node within the model's tolerance of the face's surface
     from surfprep.algorithms.projection import distance_to_surface
     for k, block in zip(result.faces, result.blocks, strict=True):
@@ -172,10 +180,7 @@ def test_a_face_of_n_sides_is_gridded_as_n_blocks_around_a_centre(case, n, min_a
     assert len(result.blocks) == n and result.faces == (0,) * n and not result.skipped
     # the blocks share their spokes node for node
     assert len(result.network.interfaces) == n
-    for f in result.network.interfaces:
-        a = side_nodes(result.blocks[f.block], f.side)
-        b = side_nodes(result.blocks[f.other], f.other_side)
-        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    _assert_point_matched(result)
     worst = result.report()["worst"]
     assert worst["folded_cells"] == 0 and worst["min_angle"] > min_angle
     # every node on the face: on its surface and inside its loop
@@ -184,13 +189,10 @@ def test_a_face_of_n_sides_is_gridded_as_n_blocks_around_a_centre(case, n, min_a
     assert foot.distance.max() < 1e-9
     assert FaceRegion(face).contains(foot.uv, 1e-9).all()
     # together they cover the face: area of the cells against the face's area
-    def area(block):
-        d1, d2 = block[1:, 1:] - block[:-1, :-1], block[:-1, 1:] - block[1:, :-1]
-        return 0.5 * np.linalg.norm(np.cross(d1, d2), axis=-1).sum()
     from surfprep.plugin.occ.faces import make_face
     from surfprep.plugin.occ.shapes import face_area
     exact = face_area(make_face(face.surface, face.loops))
-    assert sum(area(b) for b in result.blocks) == pytest.approx(exact, rel=2e-3)
+    assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(exact, rel=2e-3)
 
 
 def test_a_disc_is_gridded_as_a_butterfly_not_with_180_degree_corners():
@@ -204,10 +206,7 @@ def test_a_disc_is_gridded_as_a_butterfly_not_with_180_degree_corners():
     face = _loop_face(heal_cases.disc)
     result = surfprep.grid(face, size=0.04)
     assert len(result.blocks) == 5 and len(result.network.interfaces) == 8
-    for f in result.network.interfaces:
-        a = side_nodes(result.blocks[f.block], f.side)
-        b = side_nodes(result.blocks[f.other], f.other_side)
-        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    _assert_point_matched(result)
     worst = result.report()["worst"]
     assert worst["folded_cells"] == 0 and worst["min_angle"] > 40 and worst["max_skewness"] < 0.6
     nodes = np.concatenate([b.reshape(-1, 3) for b in result.blocks])
@@ -224,10 +223,7 @@ def test_a_face_with_a_hole_is_gridded_as_four_blocks_round_it():
     from helpers.heal_cases import HOLE_CENTRE, HOLE_RADIUS, plane_with_hole
     result = surfprep.grid(plane_with_hole(), size=0.04)
     assert len(result.blocks) == 4 and len(result.network.interfaces) == 4
-    for f in result.network.interfaces:
-        a = side_nodes(result.blocks[f.block], f.side)
-        b = side_nodes(result.blocks[f.other], f.other_side)
-        assert np.array_equal(a[::-1] if f.reversed else a, b)
+    _assert_point_matched(result)
     worst = result.report()["worst"]
     assert worst["folded_cells"] == 0 and worst["min_angle"] > 44.9 and worst["max_skewness"] < 0.51
     nodes = np.concatenate([b.reshape(-1, 3) for b in result.blocks])
@@ -236,10 +232,7 @@ def test_a_face_with_a_hole_is_gridded_as_four_blocks_round_it():
     assert r.min() > HOLE_RADIUS * (1 - 1e-9)
     assert np.all((nodes[:, :2] > 0.1 - 1e-9) & (nodes[:, :2] < 0.9 + 1e-9))
     # cells add up to the square less the disc
-    def area(block):
-        d1, d2 = block[1:, 1:] - block[:-1, :-1], block[:-1, 1:] - block[1:, :-1]
-        return 0.5 * np.linalg.norm(np.cross(d1, d2), axis=-1).sum()
-    assert sum(area(b) for b in result.blocks) == pytest.approx(0.64 - np.pi * 0.09, rel=2e-3)
+    assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(0.64 - np.pi * 0.09, rel=2e-3)
 
 
 def test_a_spoke_through_a_collapsed_point_is_a_reason_not_a_crash(data_dir):
