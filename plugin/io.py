@@ -44,7 +44,7 @@ from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
-from ..algorithms.io.atomic import new_file_mode
+from ..atomic_files import new_file_mode
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike

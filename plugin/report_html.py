@@ -384,7 +384,7 @@ def write_html_report(path: str | os.PathLike, *, title: str, summary: Sequence[
     FileNotFoundError
         The folder of ``path`` does not exist.
     """
-    from ..algorithms.io.atomic import atomic_output
+    from ..atomic_files import atomic_output
 
     if not isinstance(title, str):
         raise TypeError(f"write_html_report: title must be a string, got {title!r}")

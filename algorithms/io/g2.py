@@ -41,7 +41,7 @@ from ...errors import ConversionError, InputFileError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..volume import NurbsVolume
-from .atomic import atomic_output
+from ...atomic_files import atomic_output
 
 __all__ = ["CLASS_IDS", "format_g2", "read_g2", "write_g2"]
 

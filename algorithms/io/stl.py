@@ -21,9 +21,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from ...atomic_files import atomic_output
 from ...errors import InputFileError
 from ..intersection.mesh import TriangleMesh, collinear_mask
-from .atomic import atomic_output
 
 __all__ = ["read_stl", "triangles_with_area", "write_stl"]
 

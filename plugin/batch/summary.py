@@ -8,12 +8,11 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 
+from ...atomic_files import write_text
 from ...errors import OutputFileError
 from .child import is_number, read_json
 from .records import STATUS_DONE_BEFORE, SUMMARY_CSV, SUMMARY_JSON, FileJob, FileRecord
@@ -68,29 +67,10 @@ def write_summary(records: Sequence[FileRecord], outdir: Path) -> tuple[Path, Pa
 
 
 def _write_atomically(path: Path, text: str) -> None:
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as stream:
-            stream.write(text)
-        os.chmod(name, _new_file_mode())
-        os.replace(name, path)
+        write_text(path, text, newline="")
     except OSError as exc:
         raise OutputFileError(f"cannot write {path}: {exc.strerror or exc}") from None
-    finally:
-        Path(name).unlink(missing_ok=True)
-
-
-def _new_file_mode() -> int:
-    """The mode ``open()`` gives a new file under the umask (read from ``/proc``, as
-    :func:`surfprep.algorithms.io.atomic.new_file_mode` does; not imported: it loads numpy)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith("Umask:"):
-                    return 0o666 & ~int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    return 0o644
 
 
 def done_before(job: FileJob, previous: Mapping[str, FileRecord]) -> FileRecord | None:

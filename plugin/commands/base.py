@@ -15,13 +15,13 @@ import json
 import math
 import os
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
+from ...atomic_files import write_text
 from ...errors import InputFileError, OutputFileError
 from ..dropped import dropped_report, repaired_report
 
@@ -183,17 +183,10 @@ def write_json_report(report: dict, destination: str | os.PathLike, console: Con
     parent = target.resolve().parent
     if not parent.is_dir():
         raise OutputFileError(f"report directory {parent} does not exist")
-    from ...algorithms.io.atomic import new_file_mode
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as stream:
-            stream.write(text)
-        os.chmod(tmp, new_file_mode())
-        os.replace(tmp, target)
+        write_text(target, text)
     except OSError as exc:
         raise OutputFileError(f"cannot write report {target}: {exc.strerror or exc}") from None
-    finally:
-        Path(tmp).unlink(missing_ok=True)
     return target.resolve()
 
 

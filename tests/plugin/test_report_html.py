@@ -23,7 +23,7 @@ from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeSphere
 from OCP.gp import gp_Pnt
 from PIL import Image
 
-from surfprep.algorithms.io.atomic import new_file_mode
+from surfprep.atomic_files import new_file_mode
 from surfprep.plugin.occ.mesh import face_triangles
 from surfprep.plugin.occ.shapes import all_faces
 from surfprep.plugin.report_html import (

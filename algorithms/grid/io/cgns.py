@@ -51,7 +51,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...io.atomic import atomic_output
+from ....atomic_files import atomic_output
 from .blocks import Interface, as_blocks, check_interfaces
 
 if TYPE_CHECKING:                   # h5py loads when a CGNS file is written

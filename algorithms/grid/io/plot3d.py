@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...io.atomic import atomic_output
+from ....atomic_files import atomic_output
 from .blocks import as_blocks
 
 __all__ = ["MAX_RECORD_BYTES", "read_plot3d", "write_plot3d"]

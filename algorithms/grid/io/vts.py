@@ -23,7 +23,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ...io.atomic import atomic_output
+from ....atomic_files import atomic_output
 from .blocks import as_block, as_blocks
 
 __all__ = ["write_vtm", "write_vts"]

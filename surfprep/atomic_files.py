@@ -1,7 +1,10 @@
 """Atomic file output: write to a temporary file beside the target, then ``os.replace``.
 
 A reader of the target sees the old file or the whole new one, never a half-written
-file; on any failure the temporary is removed and the target is left as it was.
+file; on any failure the temporary is removed and the target is left as it was. Beside
+:mod:`surfprep.errors` (standard library only): the geometry's writers, the CLI's
+reports and the batch summaries all use it, and a batch parent or ``--help`` does not
+load numpy for it.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["atomic_output", "new_file_mode"]
+__all__ = ["atomic_output", "new_file_mode", "write_text"]
 
 
 @contextmanager
@@ -73,3 +76,15 @@ def new_file_mode() -> int:
     except (OSError, ValueError):
         pass
     return 0o644
+
+
+def write_text(path: str | os.PathLike, text: str, *, newline: str | None = None) -> Path:
+    """``text`` written to ``path`` atomically (:func:`atomic_output`), UTF-8.
+
+    ``newline`` as :func:`open` (``""`` for CSV). Returns ``path``; raises ``OSError``
+    (the callers say which output failed).
+    """
+    with atomic_output(path) as temporary, \
+            open(temporary, "w", encoding="utf-8", newline=newline) as stream:
+        stream.write(text)
+    return Path(path)
