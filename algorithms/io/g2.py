@@ -37,11 +37,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from ...atomic_files import atomic_output
 from ...errors import ConversionError, InputFileError, InvalidGeometryError
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..volume import NurbsVolume
-from ...atomic_files import atomic_output
 
 __all__ = ["CLASS_IDS", "format_g2", "read_g2", "write_g2"]
 
