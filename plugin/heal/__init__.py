@@ -100,6 +100,7 @@ from .jobs import (
 )
 from .loops import plan_loops
 from .result import HealResult, PatchReport
+from .retrim import retrim_to_neighbours
 from .rollback import TIGHT_FACTOR, Before, no_worse_than_before, tight_round
 from .spec import read_patch_spec
 from .trim_back import trim_overlaps_of
@@ -278,6 +279,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     if cut.cuts or partial:
         edges = face_edges(faces)
     pairs = pair_edges(edges, gap_tol)
+    work, faces, retrims = retrim_to_neighbours(work, faces, edges, pairs, tol=tol,
+                                                skipped=skipped)
+    if retrims:
+        edges = face_edges(faces)
+        pairs = pair_edges(edges, gap_tol)
     dropped = duplicate_faces(faces, edges, pairs, gap_tol)
     gone = {b for _, b in dropped}
     kept = [i for i, f in enumerate(faces) if f is not None and i not in gone]
@@ -329,6 +335,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     result.extra["free_loops"] = [loop.as_dict() for loop in loops]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
+    result.extra["retrimmed"] = [r.as_dict() for r in retrims]
     result.extra["snapped_sides"] = snapped
     result.extra["trimmed_overlaps"] = [
         {"kept": o.kept, "trimmed": o.trimmed, "replaced": o.trimmed in replaced_faces(done),

@@ -119,6 +119,7 @@ class HealResult:
             "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
             "cuts": self.extra.get("cuts", []),
             "partial_overlaps": self.extra.get("partial_overlaps", []),
+            "retrimmed": self.extra.get("retrimmed", []),
             "snapped_sides": self.extra.get("snapped_sides", 0),
             "skipped": list(self.skipped),
             "free_edges": {"before": self.free_edges_before, "after": self.free_edges_after,

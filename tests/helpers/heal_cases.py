@@ -360,3 +360,47 @@ def inside_regular_polygon(n: int, *, r: float = 0.15, centre=(0.5, 0.5), rings:
     rr, aa = np.meshgrid(radius, angle)
     return np.column_stack([centre[0] + (rr * np.cos(aa)).ravel(),
                             centre[1] + (rr * np.sin(aa)).ravel()])
+
+
+# ------------------------------------------- an open box whose lid is trimmed short
+LID_SHORT = 0.05      # the lid's loop stops this far short of its east wall
+
+
+def _face_on(surface: NurbsSurface, corners) -> TrimmedFace:
+    return TrimmedFace(surface, (_loop(polygon_loop(surface, corners)),))
+
+
+def _wall(top, depth: float = 0.5) -> NurbsSurface:
+    """A wall hanging ``depth`` below the curve ``top(t)``, t in [0, 1]; its side v = 0
+    runs along ``top``."""
+    t = np.linspace(0.0, 1.0, 9)
+    d = np.linspace(0.0, depth, 4)
+    pts = top(t)[:, None, :] - d[None, :, None] * np.array([0.0, 0.0, 1.0])
+    return interpolate_surface(pts, params_u=t, params_v=d / depth)
+
+
+def short_lid_box(short: float = LID_SHORT, lid_surface: NurbsSurface | None = None
+                  ) -> list[TrimmedFace]:
+    """A curved lid over ``[0.1, 0.9]^2`` (``(u, v) = (x, y)``) whose loop stops
+    ``short`` before its east side, and four walls hanging from the lid surface's
+    isocurves at ``x, y = 0.1, 0.9``: the lid's surface holds the walls' top edges,
+    its loop does not (faces: lid, west, east, south, north)."""
+    lid = lid_surface if lid_surface is not None else graph_surface(
+        lambda x, y: 0.2 * np.sin(2 * x) * np.cos(1.5 * y), samples=9)
+
+    def along(u=None, v=None):
+        def top(t):
+            s = 0.1 + 0.8 * t
+            uu = np.full_like(s, u) if u is not None else s
+            vv = np.full_like(s, v) if v is not None else s
+            return lid.evaluate(uu, vv)
+        return top
+
+    square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    walls = [_face_on(_wall(along(u=0.1)), square), _face_on(_wall(along(u=0.9)), square),
+             _face_on(_wall(along(v=0.1)), square), _face_on(_wall(along(v=0.9)), square)]
+    top = _face_on(lid, [(0.1, 0.1), (0.9 - short, 0.1), (0.9 - short, 0.9), (0.1, 0.9)])
+    return [top, *walls]
+
+
+__all__ += ["LID_SHORT", "short_lid_box"]

@@ -1,0 +1,85 @@
+"""Faces re-trimmed to their neighbours' edges (algorithms/healing/retrim.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms.healing.adjacency import face_edges, pair_edges
+from surfprep.algorithms.healing.loop_sides import signed_area
+from surfprep.algorithms.healing.retrim import retrim_faces, retrim_partners
+from surfprep.algorithms.projection import distance_to_surface
+from tests.helpers.heal_cases import LID_SHORT, graph_surface, short_lid_box
+
+GAP_TOL = 0.01
+
+
+def _free(faces):
+    edges = face_edges(faces)
+    pairs = pair_edges(edges, GAP_TOL)
+    paired = {k for p in pairs for k in p}
+    return edges, pairs, [k for k in range(len(edges)) if k not in paired]
+
+
+def _uv_outline(face):
+    pts = []
+    for e in face.loops[0].edges:
+        uv = e.pcurve.evaluate(np.linspace(e.t0, e.t1, 65))
+        pts.append((uv[::-1] if e.reversed else uv)[:-1])
+    return np.concatenate(pts)
+
+
+def test_the_short_lid_is_retrimmed_to_its_walls_and_nothing_else_moves():
+    faces = short_lid_box()
+    edges, pairs, free = _free(faces)
+    # the lid's south, east and north edges are free (its west edge pairs with its wall)
+    assert sorted(edges[k].k for k in free if edges[k].face == 0) == [0, 1, 2]
+    new, retrims, notes = retrim_faces(faces, edges, free, pairs=pairs)
+    assert notes == []
+    assert [r.face for r in retrims] == [0]
+    r = retrims[0]
+    assert sorted(face for face, _ in r.partners) == [2, 3, 4]      # east, south, north walls
+    assert r.width == pytest.approx(LID_SHORT, rel=0.05)            # the loop moved 0.05
+    assert r.deviation < 1e-4                                       # the walls' tops on the lid
+    for i in range(1, 5):
+        assert new[i] is faces[i]                                   # walls untouched
+    assert new[0].surface is faces[0].surface                       # the lid's surface too
+    # exact answer: the lid's loop is now the square [0.1, 0.9]^2 in (u, v)
+    outline = _uv_outline(new[0])
+    assert outline.min(axis=0) == pytest.approx([0.1, 0.1], abs=1e-5)
+    assert outline.max(axis=0) == pytest.approx([0.9, 0.9], abs=1e-5)
+    assert signed_area(outline) == pytest.approx(0.64, abs=1e-4)
+    # every new edge lies on the lid's surface, densely
+    for e in new[0].loops[0].edges:
+        pts = e.curve3d.evaluate(np.linspace(e.t0, e.t1, 101))
+        assert distance_to_surface(new[0].surface, pts).max() < 1e-4
+    # the lid now pairs with every wall: only the walls' bottoms stay free
+    _, _, still_free = _free(new)
+    assert len(still_free) == 4
+
+
+def test_a_partner_beyond_the_surface_is_not_taken():
+    """The lid's surface ends where its loop does: the east wall's top lies off it."""
+    lid = graph_surface(lambda x, y: 0.2 * np.sin(2 * x) * np.cos(1.5 * y), samples=9)
+    clipped = lid.restrict(None, 0.9 - LID_SHORT, None, None)
+    faces = short_lid_box(lid_surface=lid)
+    faces[0] = type(faces[0])(clipped, faces[0].loops)
+    edges, pairs, free = _free(faces)
+    partners = retrim_partners(faces, edges, free)
+    assert all(edges[a].face != 0 for a, _, _, _ in partners)
+    new, retrims, _ = retrim_faces(faces, edges, free, pairs=pairs)
+    assert retrims == [] and new[0] is faces[0]
+
+
+def test_tol_bounds_the_distance_of_the_partner_from_the_surface():
+    faces = short_lid_box()
+    edges, pairs, free = _free(faces)
+    deviation = retrim_faces(faces, edges, free, pairs=pairs)[1][0].deviation
+    new, retrims, _notes = retrim_faces(faces, edges, free, pairs=pairs, tol=0.5 * deviation)
+    assert retrims == [] and new[0] is faces[0]
+
+
+def test_a_gap_wider_than_the_retrim_width_is_left():
+    faces = short_lid_box(short=0.3)         # 0.3 of an edge of 0.8: no partners
+    edges, _pairs, free = _free(faces)
+    assert retrim_partners(faces, edges, free) == []
