@@ -13,7 +13,11 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    overlapping over a strip the later one is trimmed back to the other's side,
    or both replaced by one approximant over the union (``overlap="union"``,
    :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
-2. edges of different faces within ``gap_tol`` of each other are paired; free
+2. edges of different faces within ``gap_tol`` of each other are paired; a face
+   whose free edges run beside its neighbours' free edges (farther than ``gap_tol``,
+   within a fifth of their length) that lie on its surface within ``tol`` is
+   re-trimmed to them, its surface untouched (:mod:`.retrim`: a loop written off by
+   the exporter, not a gap in the geometry); free
    edges chained into loops from two or more faces are classified by their
    surroundings (:mod:`.loops`): holes (the surroundings continue across them) are
    filled, open boundaries (a sheet's edge) are not, unless ``fill`` says otherwise;

@@ -25,7 +25,8 @@ def test_marscapsule_duplicates_dropped(data_dir):
 def test_microstation_gaps_fewer_geometric_free_edges(data_dir):
     """occt_k1geo_microstation.stp: a face soup with real gaps of 0.01-0.1 mm. Free edges
     when the faces are sewn at 1e-7 x size (i.e. not closed in the geometry) drop
-    (measured 70 -> 24 replacing the faces with a defect, the default, 28 before inner
+    (measured 70 -> 22 replacing the faces with a defect, the default, 24 before faces were
+    re-trimmed to their neighbours' edges, 28 before inner
     loops were paired; 70 -> 24 replacing every face, measured before), free edges at
     gap_tol do not grow (5 -> 5), the shape stays valid and joins between approximants
     are closed. The mouth
