@@ -36,7 +36,8 @@ refusal in :func:`why_not_decomposable`):
   boundary isocurves;
 * other faces of one loop: :func:`decompose_loop` on its outer loop
   (:func:`loop_edges`);
-* faces with inner loops (holes), seam edges, loop ends further apart than
+* a face with one hole: the four blocks round it of :func:`decompose_ring`;
+* faces with two or more holes, seam edges, loop ends further apart than
   ``gap_tol``, very non-convex outlines: not decomposable.
 
 :func:`surfprep.heal` approximates every sub-patch with
@@ -511,5 +512,9 @@ def _boundaries(face: TrimmedFace, gap_tol: float, smooth_angle: float
         return [four]
     if not face.loops:
         return [_surface_sides(face)]
-    decomposition = decompose_face(face, gap_tol=gap_tol, smooth_angle=smooth_angle)
+    if len(face.loops) == 2:
+        outer, inner = ring_edges(face, gap_tol=gap_tol)
+        decomposition = decompose_ring(face.surface, outer, inner, smooth_angle=smooth_angle)
+    else:
+        decomposition = decompose_face(face, gap_tol=gap_tol, smooth_angle=smooth_angle)
     return [list(q) for q in decomposition.quads]

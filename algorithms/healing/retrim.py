@@ -18,22 +18,27 @@ Partners
     A free edge ``a`` of face F and a free edge ``b`` of another face are partners
     when each is the other's nearest free edge by the Hausdorff distance of their
     samples (both ways), and that distance is at most :data:`RETRIM_WIDTH` times the
-    shorter edge's length. A face may be re-trimmed with its partners when its
-    surface holds their edges within ``tol`` (a dense sample projected, started from
-    the face's own pcurve). Where both surfaces hold the other's edge (two faces
-    meeting along a crease, one edge longer), the face with more edges off is tried
-    first and the pairs it uses are not used the other way round.
+    shorter edge's length; two edges paired within ``gap_tol`` but apart in the
+    geometry (a *loose* pair, each in no other pair) are partners too. A face may be
+    re-trimmed with its partners when its surface holds their edges: within ``tol``
+    and within :data:`ON_SURFACE` of how far the edges are apart (a dense sample
+    projected, started from the face's own pcurve); otherwise the gap is in the
+    geometry, and re-trimming would only hide it in an edge tolerance. Where both
+    surfaces hold the other's edge (two faces meeting along a crease, one edge
+    longer), the face with more edges off is tried first and the pairs it uses are
+    not used the other way round.
 
 The new loop
     An edge paired with a neighbour (within ``gap_tol``) but ending more than
     ``tol`` from the replaced edge next to it is replaced by its pair too, when that
-    lies on the surface: the corner moves with the loop. Every replaced edge's pcurve interpolates the projections; at a corner with an
-    edge kept, the replaced edge's pcurve ends on the kept edge's pcurve end, at a
-    corner between two replaced edges both end on the mean of their projections, so
-    the loop closes exactly in ``(u, v)``. A face is re-trimmed only when every new
-    edge lies within ``tol`` of its surface on a dense sample (the pinned corners
-    included), the loop keeps its orientation, and no seam edge is involved;
-    otherwise it is left and the note says why.
+    lies on the surface: the corner moves with the loop. Every replaced edge's
+    pcurve interpolates the projections; at a corner with an edge kept, the replaced
+    edge's pcurve ends on the kept edge's pcurve end, at a corner between two
+    replaced edges both end on the mean of their projections, so the loop closes
+    exactly in ``(u, v)``. A face is re-trimmed only when every new edge lies within
+    ``tol`` of its surface on a dense sample (the pinned corners included), the loop
+    keeps its orientation, and no seam edge is involved; otherwise it is left and
+    the note says why.
 """
 
 from __future__ import annotations
@@ -51,10 +56,14 @@ from .adjacency import FaceEdge, dense_edge, polyline_distance
 from .approximant import DEFAULT_RELATIVE_TOL
 from .loop_sides import reverse_curve, signed_area
 
-__all__ = ["CORNER", "OFF", "PROJECTION_SAMPLES", "RETRIM_WIDTH", "TURNED", "Retrim", "retrim_faces", "retrim_partners"]
+__all__ = ["CORNER", "OFF", "ON_SURFACE", "PROJECTION_SAMPLES", "RETRIM_WIDTH", "TURNED", "Retrim", "retrim_faces", "retrim_partners"]
 
 #: partners lie at most this share of the shorter edge's length apart
 RETRIM_WIDTH = 0.2
+#: a partner lies on the face's surface when it is within tol and within this share of
+#: how far it is from the face's own edge (else it is a gap in the geometry, not in
+#: the trim: re-trimming would only hide it in the edge's tolerance)
+ON_SURFACE = 0.1
 #: samples of a partner edge projected onto the face (the pcurve interpolates them)
 PROJECTION_SAMPLES = 33
 #: why a face was not re-trimmed: its loop would not close at a corner next to an edge
@@ -172,35 +181,53 @@ def _trim_edge(face: TrimmedFace, edge: FaceEdge) -> TrimEdge:
 
 
 def retrim_partners(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
-                    free: Sequence[int], *, tol: float | None = None
-                    ) -> list[tuple[int, int, float, float]]:
-    """Which free edges could be replaced by which: ``(a, b, width, distance)`` with
-    ``a`` an edge of the face to re-trim, ``b`` its partner (indices into ``edges``),
-    their Hausdorff distance and ``b``'s largest distance from ``a``'s surface
-    (module docstring); a pair whose surfaces both hold the other's edge (two faces
-    meeting along a crease, one edge longer) is listed both ways. ``tol``: model
-    units; default 1e-3 x each face's edge-box diagonal."""
+                    free: Sequence[int], *, loose: Sequence[tuple[int, int, float]] = (),
+                    tol: float | None = None) -> list[tuple[int, int, float, float]]:
+    """Which edges could be replaced by which: ``(a, b, width, distance)`` with ``a`` an
+    edge of the face to re-trim, ``b`` its partner (indices into ``edges``), how far
+    apart they are and ``b``'s largest distance from ``a``'s surface (module
+    docstring). Candidates are the free edges that are each other's nearest, and the
+    ``loose`` pairs ``(a, b, gap)`` (paired at ``gap_tol`` but ``gap`` apart in the
+    geometry; ``a``'s face the one to re-trim, each edge in one such pair). A pair whose surfaces both hold the other's edge (two faces meeting
+    along a crease, one edge longer) is listed both ways. ``tol``: model units;
+    default 1e-3 x each face's edge-box diagonal."""
     nearest = _nearest(edges, free)
-    out, seen = [], set()
+    candidates, seen = [], set()
     for a, (b, width) in nearest.items():
-        if nearest.get(b, (None,))[0] != a or (b, a) in seen:
-            continue
-        seen.add((a, b))
-        for own, other in ((a, b), (b, a)):
+        if nearest.get(b, (None,))[0] == a and (b, a) not in seen:
+            seen.add((a, b))
+            candidates.append((a, b, width))
+    directions = [((a, b), (b, a)) for a, b, _ in candidates]
+    once = _once(loose)
+    loose = [(a, b, gap) for a, b, gap in loose if a in once and b in once]
+    candidates += loose
+    directions += [((a, b),) for a, b, _ in loose]
+    out = []
+    for (a, b, width), ways in zip(candidates, directions):
+        for own, other in ways:
             face = faces[edges[own].face]
             if face is None or faces[edges[other].face] is None or any(
                     e.is_seam for loop in face.loops for e in loop.edges):
                 continue
             mine = [e for e in edges if e.face == edges[own].face]
             distance = _projection(face, edges[own], edges[other], 17)[3]
-            if distance <= _face_tol(face, mine, tol):
+            if distance <= min(_face_tol(face, mine, tol), ON_SURFACE * width):
                 out.append((own, other, width, distance))
     return out
 
 
+def _once(pairs: Sequence[tuple[int, int, float]]) -> set[int]:
+    """The edges that occur in exactly one of ``pairs``."""
+    count: dict[int, int] = {}
+    for a, b, _ in pairs:
+        count[a] = count.get(a, 0) + 1
+        count[b] = count.get(b, 0) + 1
+    return {k for k, n in count.items() if n == 1}
+
+
 def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
                  free: Sequence[int], *, pairs: Sequence[tuple[int, int]] = (),
-                 tol: float | None = None
+                 loose: Sequence[tuple[int, int, float]] = (), tol: float | None = None
                  ) -> tuple[list[TrimmedFace | None], list[Retrim],
                             list[tuple[int, str, float]]]:
     """The faces with their free edges replaced by their partners' (module docstring).
@@ -216,6 +243,10 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
         The edges paired at ``gap_tol``: an edge of a re-trimmed face whose end is off
         its re-trimmed neighbour's by more than ``tol`` is replaced by its pair's
         curve too (the corner moves with the loop).
+    loose : sequence of (int, int, float)
+        Pairs of ``pairs`` not closed in the geometry, with their gap, the first
+        edge's face the one that may be re-trimmed: candidates too (an edge written
+        beside its neighbour's within ``gap_tol`` on a face nothing else will close).
     tol : float, optional
         Model units: how far from the face's surface a new edge may lie (on
         :data:`_CHECK_SAMPLES` samples, closest-point projection). Default 1e-3 x
@@ -232,7 +263,7 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
     """
     out = list(faces)
     by_face: dict[int, list[tuple[int, int, float]]] = {}
-    for a, b, width, _ in retrim_partners(faces, edges, free, tol=tol):
+    for a, b, width, _ in retrim_partners(faces, edges, free, loose=loose, tol=tol):
         by_face.setdefault(edges[a].face, []).append((a, b, width))
     retrims, refused = [], []
     partner_of: dict[int, int] = {}

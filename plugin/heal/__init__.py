@@ -15,9 +15,12 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; a face
    whose free edges run beside its neighbours' free edges (farther than ``gap_tol``,
-   within a fifth of their length) that lie on its surface within ``tol`` is
-   re-trimmed to them, its surface untouched (:mod:`.retrim`: a loop written off by
-   the exporter, not a gap in the geometry); free
+   within a fifth of their length), or that no approximant will replace (not
+   four-sided, not split) and whose paired edges are apart in the geometry from a
+   neighbour no approximant will replace either, is
+   re-trimmed to those neighbours' edges where they lie on its surface (within
+   ``tol`` and a tenth of the gap), its surface untouched (:mod:`.retrim`: a loop
+   written off by the exporter, not a gap in the geometry); free
    edges chained into loops from two or more faces are classified by their
    surroundings (:mod:`.loops`): holes (the surroundings continue across them) are
    filled, open boundaries (a sheet's edge) are not, unless ``fill`` says otherwise;
@@ -86,6 +89,7 @@ from ...algorithms.healing.adjacency import (
     pair_gaps,
 )
 from ...algorithms.healing.clipping import face_source
+from ...algorithms.healing.decompose import quad_boundaries
 from ...algorithms.healing.fidelity import InputFaces
 from ...algorithms.healing.strip_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from ...algorithms.tolerance import check_tolerance
@@ -283,8 +287,12 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     if cut.cuts or partial:
         edges = face_edges(faces)
     pairs = pair_edges(edges, gap_tol)
+    whole = {i for i, f in enumerate(faces) if f is not None
+             and four_sided_boundary(f) is None
+             and (not split_faces or quad_boundaries(f, gap_tol=gap_tol) is None)}
     work, faces, retrims = retrim_to_neighbours(work, faces, edges, pairs, tol=tol,
-                                                skipped=skipped)
+                                                tight=TIGHT_FACTOR * model.size,
+                                                kept=whole, skipped=skipped)
     if retrims:
         edges = face_edges(faces)
         pairs = pair_edges(edges, gap_tol)
@@ -323,6 +331,13 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     done = approximate(jobs, sources, {i: k for k, i in enumerate(kept)}, tol, gap_tol,
                        skipped, inputs, progress)
     done += directed_jobs(directed, cut)
+    if replace == "defects" and not directed:
+        # faces whose approximant failed are kept as they are: a gap between two of
+        # them that is only in their trims is closed by re-trimming
+        work, faces, late = retrim_to_neighbours(
+            work, faces, edges, pairs, tol=tol, tight=TIGHT_FACTOR * model.size,
+            kept=set(kept) - replaced_faces(done), skipped=skipped, wide=False)
+        retrims += late
     say("joining, sewing and checking")
     before = Before.of(model, gap_tol)
     again = functools.partial(

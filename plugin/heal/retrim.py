@@ -10,7 +10,7 @@ is kept as it was, with a note.
 
 from __future__ import annotations
 
-from ...algorithms.healing.adjacency import FaceEdge
+from ...algorithms.healing.adjacency import FaceEdge, pair_gaps
 from ...algorithms.healing.retrim import retrim_faces
 from ...algorithms.trimmed import TrimmedFace
 from ...errors import SurfprepError
@@ -21,10 +21,15 @@ __all__ = ["retrim_to_neighbours"]
 
 
 def retrim_to_neighbours(model, faces: list[TrimmedFace | None], edges: list[FaceEdge],
-                         pairs: list[tuple[int, int]], *, tol: float | None,
-                         skipped: list[str]):
+                         pairs: list[tuple[int, int]], *, tol: float | None, tight: float,
+                         kept: set[int], skipped: list[str], wide: bool = True):
     """The faces of ``model`` whose free edges run beside neighbours' edges lying on
-    their surfaces, re-trimmed to those edges.
+    their surfaces, re-trimmed to those edges; so are the faces in ``kept`` (no
+    approximant will replace them: not four-sided and not split) whose edges are
+    paired with an edge of another face in ``kept`` but farther than ``tight`` from
+    it (where a neighbour is re-approximated, its approximant's side is fitted to
+    the kept face's edge and closes the gap entirely). ``wide`` False: the paired
+    edges only (after the approximants, for the faces whose approximant failed).
 
     Returns
     -------
@@ -36,18 +41,22 @@ def retrim_to_neighbours(model, faces: list[TrimmedFace | None], edges: list[Fac
     retrims : list of Retrim
     """
     paired = {k for pair in pairs for k in pair}
-    free = [k for k in range(len(edges)) if k not in paired]
-    if not free:
+    free = [k for k in range(len(edges)) if k not in paired] if wide else []
+    loose = [(own, other, float(gap))
+             for (a, b), gap in zip(pairs, pair_gaps(edges, pairs)) if gap > tight
+             if edges[a].face in kept and edges[b].face in kept for own, other in ((a, b), (b, a))]
+    if not free and not loose:
         return model, faces, []
-    new, found, refused = retrim_faces(faces, edges, free, pairs=pairs, tol=tol)
+    new, found, refused = retrim_faces(faces, edges, free, pairs=pairs, loose=loose, tol=tol)
     by_why: dict[str, list[tuple[int, float]]] = {}
     for face, why, figure in refused:
         by_why.setdefault(why, []).append((face, figure))
     for why, group in by_why.items():
         worst = max(figure for _, figure in group)
-        skipped.append(f"faces {', '.join(str(f) for f, _ in group)}: not re-trimmed to their "
-                       f"neighbours' edges ({why}" + (f", up to {worst:.3g} off)" if worst
-                                                     else ")"))
+        which = (f"face {group[0][0]}: not re-trimmed to its" if len(group) == 1 else
+                 f"faces {', '.join(str(f) for f, _ in group)}: not re-trimmed to their")
+        skipped.append(f"{which} neighbours' edges ({why}"
+                       + (f", up to {worst:.3g} off)" if worst else ")"))
     occ, out, done = list(model.faces), list(faces), []
     for r in found:
         name = model.face_names[r.face]
@@ -59,7 +68,8 @@ def retrim_to_neighbours(model, faces: list[TrimmedFace | None], edges: list[Fac
             continue
         occ[r.face], out[r.face] = face, read_back
         done.append(r)
-        skipped.append(f"face {r.face}: re-trimmed to {len(r.partners)} edges of its "
+        edges_word = "edge" if len(r.partners) == 1 else "edges"
+        skipped.append(f"face {r.face}: re-trimmed to {len(r.partners)} {edges_word} of its "
                        f"neighbours lying on its surface (its loop moved up to {r.width:.3g}; "
                        f"the new edges within {r.deviation:.3g} of the surface)")
     if not done:

@@ -24,10 +24,13 @@ from surfprep.algorithms.healing.adjacency import four_sided_boundary
 from surfprep.algorithms.healing.clipping import face_source
 from surfprep.algorithms.healing.decompose import (
     decompose_face,
+    decompose_ring,
     quad_boundaries,
     reverse_curve,
+    ring_edges,
     why_not_decomposable,
 )
+from surfprep.algorithms.healing.loop_sides import signed_area
 from surfprep.algorithms.projection import distance_to_surface
 from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
 from surfprep.plugin.occ.faces import face_to_nurbs, make_face
@@ -75,13 +78,32 @@ def test_four_sided_face_is_its_own_boundary():
     assert decompose_face(face, gap_tol=GAP) is None
 
 
-def test_face_with_a_hole_is_not_decomposable_and_says_why():
+def test_face_with_a_hole_and_three_corners_is_not_decomposable_and_says_why():
     outer = polygon_loop(SURFACE, [(0.05, 0.05), (0.95, 0.05), (0.5, 0.95)])
     hole = [edge_from_uv(SURFACE, line(a, b)) for a, b in
             [((0.4, 0.3), (0.5, 0.5)), ((0.5, 0.5), (0.6, 0.3)), ((0.6, 0.3), (0.4, 0.3))]]
     face = occ_face([outer, hole])
     assert quad_boundaries(face, gap_tol=GAP) is None
-    assert "inner loop" in why_not_decomposable(face, gap_tol=GAP)
+    assert "3 outer corners" in why_not_decomposable(face, gap_tol=GAP)
+
+
+def test_face_with_one_hole_is_four_blocks_round_it_covering_the_ring():
+    """A square with a square hole (clockwise, as a face stores it): four quads whose
+    (u, v) outlines tile the ring exactly (areas add up to 0.64 - 0.04), each a closed
+    boundary, approximated on the face and joined along the four spokes."""
+    outer = polygon_loop(SURFACE, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)])
+    hole = polygon_loop(SURFACE, [(0.4, 0.4), (0.4, 0.6), (0.6, 0.6), (0.6, 0.4)])
+    face = occ_face([outer, hole])
+    quads = quad_boundaries(face, gap_tol=GAP)
+    assert quads is not None and len(quads) == 4
+    assert all(len(q) == 4 and _ends_meet(q) for q in quads)
+    d = decompose_ring(face.surface, *ring_edges(face, gap_tol=GAP))
+    assert sum(signed_area(uv) for uv in d.quads_uv) == pytest.approx(0.64 - 0.04, abs=1e-6)
+    source = face_source(face)
+    las = [local_approximant(q, [source], preferred_source=0) for q in quads]
+    assert all(la.converged for la in las)
+    net = connect(las, continuity="G0")
+    assert len(net.joins) == 4 and max(j.max_gap for j in net.joins) <= 1e-9
 
 
 def test_triangle_sub_patches_follow_the_trimmed_face_and_join_g1():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from surfprep.algorithms.healing.adjacency import face_edges, pair_edges
+from surfprep.algorithms.healing.adjacency import face_edges, pair_edges, pair_gaps
 from surfprep.algorithms.healing.loop_sides import signed_area
 from surfprep.algorithms.healing.retrim import retrim_faces, retrim_partners
 from surfprep.algorithms.projection import distance_to_surface
@@ -83,3 +83,25 @@ def test_a_gap_wider_than_the_retrim_width_is_left():
     faces = short_lid_box(short=0.3)         # 0.3 of an edge of 0.8: no partners
     edges, _pairs, free = _free(faces)
     assert retrim_partners(faces, edges, free) == []
+
+
+def test_loose_pairs_of_a_face_nothing_else_closes_are_retrimmed_too():
+    """The lid 0.005 short: its edges pair with the walls' within gap_tol (0.01), 0.005
+    apart in the geometry. Given as loose pairs (the lid the face to re-trim), the lid
+    takes the walls' edges; without them nothing happens."""
+    faces = short_lid_box(short=0.005)
+    edges, pairs, free = _free(faces)
+    gaps = pair_gaps(edges, pairs)
+    loose = [(own, other, float(gap)) for (a, b), gap in zip(pairs, gaps) if gap > 1e-3
+             for own, other in ((a, b), (b, a)) if edges[own].face == 0]
+    assert len(loose) == 3                              # south, east, north
+    assert retrim_faces(faces, edges, free, pairs=pairs)[1] == []
+    new, retrims, refused = retrim_faces(faces, edges, free, pairs=pairs, loose=loose)
+    assert refused == [] and [r.face for r in retrims] == [0]
+    outline = _uv_outline(new[0])
+    assert outline.max(axis=0) == pytest.approx([0.9, 0.9], abs=1e-5)
+    assert retrims[0].width == pytest.approx(0.005, rel=0.05)
+    # the walls' edges now are the lid's: closed in the geometry to the deviation
+    edges_after = face_edges(new)
+    gaps_after = pair_gaps(edges_after, pair_edges(edges_after, GAP_TOL))
+    assert gaps_after.max() < 1e-4

@@ -52,7 +52,7 @@ def test_k1_theorem_faces_retrimmed_to_their_neighbours(data_dir):
     free_before = len(edges) - len({k for p in pairs for k in p})
     notes: list[str] = []
     work, new, retrims = retrim_to_neighbours(model, faces, edges, pairs, tol=None,
-                                              skipped=notes)
+                                              tight=1e-7 * model.size, kept=set(), skipped=notes)
     assert free_before == 32
     assert sorted(r.face for r in retrims) == [54, 55]
     assert all(0.09 < r.width < 0.11 and r.deviation < 2e-4 for r in retrims)
