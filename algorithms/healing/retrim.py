@@ -18,8 +18,12 @@ Partners
     A free edge ``a`` of face F and a free edge ``b`` of another face are partners
     when each is the other's nearest free edge by the Hausdorff distance of their
     samples (both ways), and that distance is at most :data:`RETRIM_WIDTH` times the
-    shorter edge's length; two edges paired within ``gap_tol`` but apart in the
-    geometry (a *loose* pair, each in no other pair) are partners too. A face may be
+    shorter edge's length; a free edge and a chain of shorter free edges of other
+    faces lying along it end to end (a T-junction, occt_k1geo_autocad.stp: a circle
+    of 2.8 mm against three edges of two faces, 6e-4 mm off it and exactly on its
+    surface) are partners, the edge replaced by the chain; two edges paired within
+    ``gap_tol`` but apart in the geometry (a *loose* pair, each in no other pair) are
+    partners too. Of several options for one edge the narrowest is taken. A face may be
     re-trimmed with its partners when its surface holds their edges: within ``tol``
     and within :data:`ON_SURFACE` of how far the edges are apart (a dense sample
     projected, started from the face's own pcurve); otherwise the gap is in the
@@ -51,7 +55,7 @@ from numpy.typing import NDArray
 
 from ..fitting import interpolate_curve
 from ..projection import project_to_surface
-from ..trimmed import TrimEdge, TrimLoop, TrimmedFace
+from ..trimmed import DEFAULT_TOLERANCE, TrimEdge, TrimLoop, TrimmedFace
 from .adjacency import FaceEdge, dense_edge, polyline_distance
 from .approximant import DEFAULT_RELATIVE_TOL
 from .loop_sides import reverse_curve, signed_area
@@ -152,12 +156,18 @@ def _projection(face: TrimmedFace, own: FaceEdge, other: FaceEdge, n: int
 
 
 def _oriented(curve, like):
-    """``curve`` run the way ``like`` runs (ends matched)."""
+    """``curve`` run the way ``like`` runs: its start nearer ``like``'s start than its
+    end is, along ``like`` (a partner of the whole edge or one piece of a chain)."""
+    line = like.evaluate(np.linspace(*like.domain, 65))
     p0, p1 = curve.evaluate(np.array(curve.domain))
-    q0, q1 = like.evaluate(np.array(like.domain))
-    same = np.linalg.norm(p0 - q0) + np.linalg.norm(p1 - q1)
-    crossed = np.linalg.norm(p0 - q1) + np.linalg.norm(p1 - q0)
-    return curve if same <= crossed else reverse_curve(curve)
+    i0 = np.argmin(np.linalg.norm(line - p0, axis=1))
+    i1 = np.argmin(np.linalg.norm(line - p1, axis=1))
+    if i0 != i1:
+        closed = np.linalg.norm(line[0] - line[-1]) <= 1e-6 * np.ptp(line, axis=0).max()
+        forward = (i0 > i1) if closed and abs(int(i0) - int(i1)) > len(line) // 2 else i0 < i1
+        return curve if forward else reverse_curve(curve)
+    ahead = float(np.dot(p1 - p0, line[-1] - line[0]))
+    return curve if ahead >= 0 else reverse_curve(curve)
 
 
 def _positions(face: TrimmedFace) -> dict[int, tuple[int, int]]:
@@ -182,38 +192,113 @@ def _trim_edge(face: TrimmedFace, edge: FaceEdge) -> TrimEdge:
 
 def retrim_partners(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
                     free: Sequence[int], *, loose: Sequence[tuple[int, int, float]] = (),
-                    tol: float | None = None) -> list[tuple[int, int, float, float]]:
-    """Which edges could be replaced by which: ``(a, b, width, distance)`` with ``a`` an
-    edge of the face to re-trim, ``b`` its partner (indices into ``edges``), how far
-    apart they are and ``b``'s largest distance from ``a``'s surface (module
-    docstring). Candidates are the free edges that are each other's nearest, and the
-    ``loose`` pairs ``(a, b, gap)`` (paired at ``gap_tol`` but ``gap`` apart in the
-    geometry; ``a``'s face the one to re-trim, each edge in one such pair). A pair whose surfaces both hold the other's edge (two faces meeting
-    along a crease, one edge longer) is listed both ways. ``tol``: model units;
-    default 1e-3 x each face's edge-box diagonal."""
+                    tol: float | None = None
+                    ) -> list[tuple[int, tuple[int, ...], float, float]]:
+    """Which edges could be replaced by which: ``(a, (b, ...), width, distance)`` with
+    ``a`` an edge of the face to re-trim, its partner or its chain of partners in
+    order along ``a`` (indices into ``edges``), how far apart they are and the
+    partners' largest distance from ``a``'s surface (module docstring). Candidates
+    are the free edges that are each other's nearest, a free edge and the free edges
+    of other faces lying along it end to end (a T-junction: one long edge against a
+    chain of short ones), and the ``loose`` pairs ``(a, b, gap)`` (paired at
+    ``gap_tol`` but ``gap`` apart in the geometry; ``a``'s face the one to re-trim,
+    each edge in one such pair). A pair whose surfaces both hold the other's edge
+    (two faces meeting along a crease, one edge longer) is listed both ways.
+    ``tol``: model units; default 1e-3 x each face's edge-box diagonal."""
     nearest = _nearest(edges, free)
     candidates, seen = [], set()
     for a, (b, width) in nearest.items():
         if nearest.get(b, (None,))[0] == a and (b, a) not in seen:
             seen.add((a, b))
-            candidates.append((a, b, width))
-    directions = [((a, b), (b, a)) for a, b, _ in candidates]
+            candidates.append((a, (b,), width))
+    directions = [((a, bs), (bs[0], (a,))) for a, bs, _ in candidates]
+    chains = _chains(edges, free)
+    candidates += chains
+    directions += [((a, bs),) for a, bs, _ in chains]
     once = _once(loose)
-    loose = [(a, b, gap) for a, b, gap in loose if a in once and b in once]
+    loose = [(a, (b,), gap) for a, b, gap in loose if a in once and b in once]
     candidates += loose
-    directions += [((a, b),) for a, b, _ in loose]
+    directions += [((a, bs),) for a, bs, _ in loose]
     out = []
-    for (a, b, width), ways in zip(candidates, directions):
-        for own, other in ways:
+    for (_, _, width), ways in zip(candidates, directions):
+        for own, others in ways:
             face = faces[edges[own].face]
-            if face is None or faces[edges[other].face] is None or any(
+            if face is None or any(faces[edges[b].face] is None for b in others) or any(
                     e.is_seam for loop in face.loops for e in loop.edges):
                 continue
             mine = [e for e in edges if e.face == edges[own].face]
-            distance = _projection(face, edges[own], edges[other], 17)[3]
+            distance = max(_projection(face, edges[own], edges[b], 17)[3] for b in others)
             if distance <= min(_face_tol(face, mine, tol), ON_SURFACE * width):
-                out.append((own, other, width, distance))
+                out.append((own, others, width, distance))
+    best: dict[int, tuple] = {}            # per edge the narrowest of its options
+    for option in out:
+        if option[0] not in best or option[2] < best[option[0]][2]:
+            best[option[0]] = option
+    return list(best.values())
+
+
+def _chains(edges: Sequence[FaceEdge], free: Sequence[int]
+            ) -> list[tuple[int, tuple[int, ...], float]]:
+    """Free edges covered end to end by two or more free edges of other faces, each
+    lying along it within :data:`RETRIM_WIDTH` of its own length and meeting the next
+    within that share of the shortest: ``(a, (b1, b2, ...), width)``, the chain in
+    order along ``a``'s natural direction, ``width`` the Hausdorff distance between
+    ``a`` and the chain. An edge is in at most one chain."""
+    length = dict(zip(free, _lengths([edges[k] for k in free])))
+    dense = {k: dense_edge(edges[k]) for k in free}
+    lo = {k: edges[k].samples.min(axis=0) for k in free}
+    hi = {k: edges[k].samples.max(axis=0) for k in free}
+    out, used = [], set()
+    for a in sorted(free, key=lambda k: -length[k]):
+        if a in used:
+            continue
+        reach = RETRIM_WIDTH * length[a]
+        closed = bool(np.linalg.norm(np.diff(edges[a].ends, axis=0)) <= 1e-6 * length[a])
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(dense[a], axis=0),
+                                                              axis=1))])
+        pieces = []
+        for b in free:
+            if (b in used or b == a or edges[b].face == edges[a].face
+                    or length[b] >= length[a] or np.any(lo[b] > hi[a] + reach)
+                    or np.any(hi[b] < lo[a] - reach)):
+                continue
+            off = float(polyline_distance(edges[b].samples, dense[a]).max())
+            if off > RETRIM_WIDTH * length[b]:
+                continue
+            ends = sorted(arc[np.argmin(np.linalg.norm(dense[a] - p, axis=1))]
+                          for p in edges[b].ends)
+            if closed and ends[1] - ends[0] > 1.5 * length[b]:    # across a's start
+                ends = [ends[1], arc[-1]]
+            pieces.append((ends[0], ends[1], b, off))
+        chain = _covering(sorted(pieces), arc[-1], length)
+        if chain is None or len(chain) < 2:
+            continue
+        joined = np.concatenate([dense[b] for b in chain])
+        width = max(float(polyline_distance(edges[a].samples, joined).max()),
+                    max(p[3] for p in pieces if p[2] in chain))
+        if width > RETRIM_WIDTH * min(length[b] for b in chain):
+            continue
+        out.append((a, tuple(chain), width))
+        used.update((a, *chain))
     return out
+
+
+def _covering(pieces: list, total: float, length: dict) -> list[int] | None:
+    """The pieces ``(start, end, edge, offset)`` (arc positions along the long edge,
+    sorted) that tile ``[0, total]``, each next one starting where the last ended
+    within :data:`RETRIM_WIDTH` of the shorter's length; None when they do not."""
+    chain, at = [], 0.0
+    while at < total:
+        slack = [p for p in pieces if abs(p[0] - at) <= RETRIM_WIDTH * length[p[2]]
+                 and p[1] > at and p[2] not in chain]
+        if not slack:
+            return None
+        _start, end, b, _ = min(slack, key=lambda p: (abs(p[0] - at), p[3]))
+        chain.append(b)
+        at = end
+        if total - at <= RETRIM_WIDTH * length[b]:
+            return chain
+    return chain
 
 
 def _once(pairs: Sequence[tuple[int, int, float]]) -> set[int]:
@@ -262,9 +347,9 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
         :data:`OFF` or :data:`TURNED`) and the distance that stopped it.
     """
     out = list(faces)
-    by_face: dict[int, list[tuple[int, int, float]]] = {}
-    for a, b, width, _ in retrim_partners(faces, edges, free, loose=loose, tol=tol):
-        by_face.setdefault(edges[a].face, []).append((a, b, width))
+    by_face: dict[int, list[tuple[int, tuple[int, ...], float]]] = {}
+    for a, bs, width, _ in retrim_partners(faces, edges, free, loose=loose, tol=tol):
+        by_face.setdefault(edges[a].face, []).append((a, bs, width))
     retrims, refused = [], []
     partner_of: dict[int, int] = {}
     for a, b in pairs:
@@ -274,7 +359,7 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
     # the face with most edges off first: of two faces meeting along a crease, the one
     # whose whole loop is off (a lid trimmed short) is re-trimmed, not its walls
     for f, swaps in sorted(by_face.items(), key=lambda item: (-len(item[1]), item[0])):
-        swaps = [s for s in swaps if frozenset(s[:2]) not in consumed]
+        swaps = [s for s in swaps if not {frozenset((s[0], b)) for b in s[1]} & consumed]
         if not swaps:
             continue
         face = faces[f]
@@ -287,9 +372,10 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
             refused.append((f, exc.why, exc.figure))
             continue
         out[f] = new
-        consumed.update(frozenset(s[:2]) for s in swaps)
+        consumed.update(frozenset((a, b)) for a, bs, _ in swaps for b in bs)
         retrims.append(Retrim(f, tuple(edges[a].k for a, _, _ in swaps),
-                              tuple((edges[b].face, edges[b].k) for _, b, _ in swaps),
+                              tuple((edges[b].face, edges[b].k) for _, bs, _ in swaps
+                                    for b in bs),
                               max(w for _, _, w in swaps), deviation))
     return out, retrims, refused
 
@@ -303,22 +389,22 @@ class _Refused(Exception):
 def _with_corners_moved(face: TrimmedFace, edges: Sequence[FaceEdge], swaps: list,
                         partner_of: dict[int, int], tol: float) -> list:
     """``swaps`` grown by the paired edges of ``face`` next to a replaced edge whose end
-    is more than ``tol`` from the replacing curve's: each replaced by its pair's curve
-    when that lies on the surface within ``tol``."""
-    by_k = {e.k: n for n, e in enumerate(edges) if e is not None and e.face == edges[
-        swaps[0][0]].face}
+    is more than ``tol`` from the replacing curves' ends: each replaced by its pair's
+    curve when that lies on the surface within ``tol``."""
+    f = edges[swaps[0][0]].face
+    by_k = {e.k: n for n, e in enumerate(edges) if e.face == f}
     where = _positions(face)
     at = {v: k for k, v in where.items()}
     swaps = list(swaps)
     grown = True
     while grown:
         grown = False
-        taken = {edges[a].k: (a, b) for a, b, _ in swaps}
-        for k, (a, b) in list(taken.items()):
+        taken = {edges[a].k: (a, bs) for a, bs, _ in swaps}
+        for k, (a, bs) in list(taken.items()):
             n, p = where[k]
             size = len(face.loops[n].edges)
-            new_ends = _oriented(edges[b].curve, edges[a].curve).evaluate(
-                np.array(edges[b].curve.domain))
+            new_ends = np.array([_oriented(edges[b].curve, edges[a].curve).evaluate(
+                np.array(edges[b].curve.domain)) for b in bs]).reshape(-1, 3)
             for q in ((p + 1) % size, (p - 1) % size):
                 kq = at.get((n, q))
                 c = by_k.get(kq)
@@ -330,53 +416,44 @@ def _with_corners_moved(face: TrimmedFace, edges: Sequence[FaceEdge], swaps: lis
                 other = partner_of[c]
                 if _projection(face, edges[c], edges[other], 17)[3] > tol:
                     continue
-                swaps.append((c, other, float(np.max(polyline_distance(
+                swaps.append((c, (other,), float(np.max(polyline_distance(
                     edges[c].samples, dense_edge(edges[other]))))))
-                taken[kq] = (c, other)
+                taken[kq] = (c, (other,))
                 grown = True
     return swaps
 
 
 def _retrimmed(face: TrimmedFace, edges: Sequence[FaceEdge], swaps, tol: float
                ) -> tuple[TrimmedFace, float]:
-    """``face`` with the edges of ``swaps`` (``(a, b, width)``) replaced; the new edges'
-    largest distance from the surface."""
+    """``face`` with the edges of ``swaps`` (``(a, (b, ...), width)``) replaced, each by
+    its partner or by its chain of partners; the new edges' largest distance from the
+    surface."""
     where = _positions(face)
-    plan: dict[tuple[int, int], tuple[FaceEdge, FaceEdge]] = {}
-    for a, b, _ in swaps:
-        plan[where[edges[a].k]] = (edges[a], edges[b])
-    # projections in each edge's natural direction
-    proj = {}
-    for key, (own, other) in plan.items():
-        t, uv, _points, distance = _projection(face, own, other, PROJECTION_SAMPLES)
-        if distance > tol:
-            raise _Refused(OFF, distance)
-        proj[key] = [t, uv.copy(), _oriented(other.curve, own.curve)]
-    _pin_corners(face, proj)
-    for t, uv, curve in proj.values():
-        ends = face.surface.evaluate(uv[[0, -1], 0], uv[[0, -1], 1])
-        off = float(np.linalg.norm(ends - curve.evaluate(np.array([t[0], t[-1]])), axis=1).max())
-        if off > tol:
-            raise _Refused(CORNER, off)
+    plan = {where[edges[a].k]: (edges[a], [edges[b] for b in bs]) for a, bs, _ in swaps}
     loops, deviation = [], 0.0
     for n, loop in enumerate(face.loops):
-        new_edges = []
+        slots = []                  # loop order: a kept TrimEdge, or [t, uv, curve, reversed]
         for p, e in enumerate(loop.edges):
-            if (n, p) not in proj:
-                new_edges.append(e)
+            if (n, p) not in plan:
+                slots.append(e)
                 continue
-            t, uv, curve = proj[(n, p)]
-            pcurve = interpolate_curve(uv, parameters=t)
-            check = np.linspace(t[0], t[-1], _CHECK_SAMPLES)
-            on = pcurve.evaluate(check)
-            gap = float(np.linalg.norm(face.surface.evaluate(on[:, 0], on[:, 1])
-                                       - curve.evaluate(check), axis=1).max())
-            if gap > tol:
-                raise _Refused(OFF, gap)
+            own, others = plan[(n, p)]
+            pieces = []
+            for other in others:    # along own's natural direction
+                t, uv, _points, distance = _projection(face, own, other, PROJECTION_SAMPLES)
+                if distance > tol:
+                    raise _Refused(OFF, distance)
+                pieces.append([t, uv.copy(), _oriented(other.curve, own.curve), e.reversed])
+            slots.extend(pieces[::-1] if e.reversed else pieces)
+        _pin_corners(slots)
+        new_edges = []
+        for slot in slots:
+            if isinstance(slot, TrimEdge):
+                new_edges.append(slot)
+                continue
+            edge, gap = _new_edge(face, slot, tol)
             deviation = max(deviation, gap)
-            new_edges.append(TrimEdge(curve, pcurve, t[0], t[-1], e.reversed,
-                                      max(e.tolerance, 1.001 * gap),
-                                      vertex_tolerances=(1.001 * gap, 1.001 * gap)))
+            new_edges.append(edge)
         loops.append(TrimLoop(new_edges))
     new = replace(face, loops=tuple(loops))
     for old_loop, new_loop in zip(face.loops, new.loops):
@@ -385,30 +462,54 @@ def _retrimmed(face: TrimmedFace, edges: Sequence[FaceEdge], swaps, tol: float
     return new, deviation
 
 
-def _ends_uv(edge: TrimEdge) -> tuple[NDArray, NDArray]:
-    """A kept edge's pcurve at its start and end in loop direction."""
-    uv = edge.pcurve.evaluate(np.array([edge.t0, edge.t1]))
-    return (uv[1], uv[0]) if edge.reversed else (uv[0], uv[1])
+def _new_edge(face: TrimmedFace, slot, tol: float) -> tuple[TrimEdge, float]:
+    """The edge of a replacing curve: pcurve through its (pinned) projections; refused
+    when its ends (pinned to a neighbour) or its samples are farther than ``tol``
+    from the curve."""
+    t, uv, curve, reversed_ = slot
+    ends = face.surface.evaluate(uv[[0, -1], 0], uv[[0, -1], 1])
+    off = float(np.linalg.norm(ends - curve.evaluate(np.array([t[0], t[-1]])), axis=1).max())
+    if off > tol:
+        raise _Refused(CORNER, off)
+    pcurve = interpolate_curve(uv, parameters=t)
+    check = np.linspace(t[0], t[-1], _CHECK_SAMPLES)
+    on = pcurve.evaluate(check)
+    gap = float(np.linalg.norm(face.surface.evaluate(on[:, 0], on[:, 1])
+                               - curve.evaluate(check), axis=1).max())
+    if gap > tol:
+        raise _Refused(OFF, gap)
+    return TrimEdge(curve, pcurve, t[0], t[-1], reversed_, max(DEFAULT_TOLERANCE, 1.001 * gap),
+                    vertex_tolerances=(1.001 * gap, 1.001 * gap)), gap
 
 
-def _pin_corners(face: TrimmedFace, proj: dict) -> None:
-    """Make the projected uv of replaced edges meet their neighbours in the loop:
-    a kept neighbour's pcurve end wins, two replaced edges meet at their mean."""
-    for (n, p), entry in list(proj.items()):
-        loop = face.loops[n].edges
-        q = (p + 1) % len(loop)                  # the next edge in loop direction
-        end_row = 0 if loop[p].reversed else -1   # this edge's end, in its natural order
-        if (n, q) in proj:
-            start_row = -1 if loop[q].reversed else 0
-            mean = 0.5 * (entry[1][end_row] + proj[(n, q)][1][start_row])
-            entry[1][end_row] = mean
-            proj[(n, q)][1][start_row] = mean
+def _ends_uv(slot) -> tuple[NDArray, NDArray]:
+    """A slot's uv at its start and its end in loop direction."""
+    if isinstance(slot, TrimEdge):
+        uv = slot.pcurve.evaluate(np.array([slot.t0, slot.t1]))
+        reversed_ = slot.reversed
+    else:
+        uv, reversed_ = slot[1][[0, -1]], slot[3]
+    return (uv[1], uv[0]) if reversed_ else (uv[0], uv[1])
+
+
+def _pin_corners(slots: list) -> None:
+    """Make the projected uv of replacing curves meet their neighbours in the loop: a
+    kept edge's pcurve end wins, two replacing curves meet at their mean."""
+    for k, slot in enumerate(slots):
+        following = slots[(k + 1) % len(slots)]
+        if isinstance(slot, TrimEdge) and isinstance(following, TrimEdge):
+            continue
+        end, start = _ends_uv(slot)[1], _ends_uv(following)[0]
+        if isinstance(slot, TrimEdge):
+            corner = end
+        elif isinstance(following, TrimEdge):
+            corner = start
         else:
-            entry[1][end_row] = _ends_uv(loop[q])[0]
-        r = (p - 1) % len(loop)                  # the previous edge
-        if (n, r) not in proj:
-            start_row = -1 if loop[p].reversed else 0
-            entry[1][start_row] = _ends_uv(loop[r])[1]
+            corner = 0.5 * (end + start)
+        if not isinstance(slot, TrimEdge):
+            slot[1][0 if slot[3] else -1] = corner
+        if not isinstance(following, TrimEdge):
+            following[1][-1 if following[3] else 0] = corner
 
 
 def _outline(loop: TrimLoop) -> NDArray:

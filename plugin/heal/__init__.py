@@ -15,7 +15,8 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    :mod:`surfprep.algorithms.healing.strip_overlap`): no doubled area is left;
 2. edges of different faces within ``gap_tol`` of each other are paired; a face
    whose free edges run beside its neighbours' free edges (farther than ``gap_tol``,
-   within a fifth of their length), or that no approximant will replace (not
+   within a fifth of their length; one long edge along a chain of short ones, a
+   T-junction, too), or that no approximant will replace (not
    four-sided, not split) and whose paired edges are apart in the geometry from a
    neighbour no approximant will replace either, is
    re-trimmed to those neighbours' edges where they lie on its surface (within

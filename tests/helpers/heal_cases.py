@@ -379,18 +379,19 @@ def _wall(top, depth: float = 0.5) -> NurbsSurface:
     return interpolate_surface(pts, params_u=t, params_v=d / depth)
 
 
-def short_lid_box(short: float = LID_SHORT, lid_surface: NurbsSurface | None = None
-                  ) -> list[TrimmedFace]:
+def short_lid_box(short: float = LID_SHORT, lid_surface: NurbsSurface | None = None,
+                  split_east: bool = False) -> list[TrimmedFace]:
     """A curved lid over ``[0.1, 0.9]^2`` (``(u, v) = (x, y)``) whose loop stops
     ``short`` before its east side, and four walls hanging from the lid surface's
     isocurves at ``x, y = 0.1, 0.9``: the lid's surface holds the walls' top edges,
-    its loop does not (faces: lid, west, east, south, north)."""
+    its loop does not (faces: lid, west, east, south, north; with ``split_east`` the
+    east wall is two faces, y below and above 0.5, appended last: a T-junction)."""
     lid = lid_surface if lid_surface is not None else graph_surface(
         lambda x, y: 0.2 * np.sin(2 * x) * np.cos(1.5 * y), samples=9)
 
-    def along(u=None, v=None):
+    def along(u=None, v=None, s0=0.1, s1=0.9):
         def top(t):
-            s = 0.1 + 0.8 * t
+            s = s0 + (s1 - s0) * t
             uu = np.full_like(s, u) if u is not None else s
             vv = np.full_like(s, v) if v is not None else s
             return lid.evaluate(uu, vv)
@@ -400,6 +401,10 @@ def short_lid_box(short: float = LID_SHORT, lid_surface: NurbsSurface | None = N
     walls = [_face_on(_wall(along(u=0.1)), square), _face_on(_wall(along(u=0.9)), square),
              _face_on(_wall(along(v=0.1)), square), _face_on(_wall(along(v=0.9)), square)]
     top = _face_on(lid, [(0.1, 0.1), (0.9 - short, 0.1), (0.9 - short, 0.9), (0.1, 0.9)])
+    if split_east:
+        walls[1:2] = []
+        walls += [_face_on(_wall(along(u=0.9, s1=0.5)), square),
+                  _face_on(_wall(along(u=0.9, s0=0.5)), square)]
     return [top, *walls]
 
 

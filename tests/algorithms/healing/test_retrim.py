@@ -105,3 +105,32 @@ def test_loose_pairs_of_a_face_nothing_else_closes_are_retrimmed_too():
     edges_after = face_edges(new)
     gaps_after = pair_gaps(edges_after, pair_edges(edges_after, GAP_TOL))
     assert gaps_after.max() < 1e-4
+
+
+def test_an_edge_along_two_shorter_edges_is_replaced_by_both():
+    """A T-junction: the east wall is two faces (y below and above 0.5) and the lid
+    stops 0.005 short of them, within gap_tol: the lid's east edge lies along both
+    walls' tops, neither pairs with it; the lid's east edge becomes the two tops."""
+    faces = short_lid_box(short=0.005, split_east=True)
+    edges, pairs, free = _free(faces)
+    east = next(k for k in free if edges[k].face == 0 and edges[k].k == 1)
+    tops = sorted(k for k in free if edges[k].face in (4, 5) and edges[k].k == 0)
+    assert len(tops) == 2
+    options = [o for o in retrim_partners(faces, edges, free) if o[0] == east]
+    assert len(options) == 1 and sorted(options[0][1]) == tops
+    new, retrims, refused = retrim_faces(faces, edges, free, pairs=pairs)
+    assert refused == []
+    lid = next(r for r in retrims if r.face == 0)
+    # the two east tops, and the south and north walls' tops: paired with the lid's
+    # (within gap_tol), their corner moves 0.005 with the east side, more than tol
+    assert sorted(f for f, _ in lid.partners) == [2, 3, 4, 5]
+    assert len(new[0].loops[0].edges) == 5                 # the east side in two
+    outline = _uv_outline(new[0])
+    assert outline.max(axis=0)[0] == pytest.approx(0.9, abs=1e-5)
+    # the corner between the two new edges lies where the walls meet, y = 0.5
+    middle = new[0].loops[0].edges[1].pcurve
+    ends = middle.evaluate(np.array(middle.domain))
+    assert np.any(np.isclose(ends[:, 1], 0.5, atol=1e-5))
+    # nothing of the lid or the walls' tops is free any more
+    edges_after, _, still_free = _free(new)
+    assert not [k for k in still_free if edges_after[k].face == 0]

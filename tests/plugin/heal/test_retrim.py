@@ -67,3 +67,27 @@ def test_k1_theorem_faces_retrimmed_to_their_neighbours(data_dir):
                 assert distance_to_surface(new[r.face].surface, pts).max() < 2e-4
     untouched = [i for i in range(len(faces)) if i not in (54, 55)]
     assert all(work.faces[i].IsSame(model.faces[i]) for i in untouched)
+
+
+def test_k1_autocad_long_edges_retrimmed_to_chains_of_short_ones(data_dir):
+    """occt_k1geo_autocad.stp: T-junctions within gap_tol (a closed edge of 2.8 mm on
+    faces 0 and 6 against three shorter edges of faces 1 and 2, 6e-4 mm off and on
+    the long edge's surface); pairing edge to edge leaves 58 free at gap_tol, after
+    the re-trimming 18 (measured)."""
+    model = read(data_dir / "occt_k1geo_autocad.stp")
+    faces = [face_to_nurbs(f, n) for f, n in zip(model.faces, model.face_names)]
+    edges = face_edges(faces)
+    gap_tol = _default_gap_tol(model, edges)
+    pairs = pair_edges(edges, gap_tol)
+    assert len(edges) - len({k for p in pairs for k in p}) == 58
+    work, new, retrims = retrim_to_neighbours(model, faces, edges, pairs, tol=None,
+                                              tight=1e-7 * model.size, kept=set(),
+                                              skipped=[])
+    by_face = {r.face: r for r in retrims}
+    assert {0, 6} <= set(by_face)
+    for f in (0, 6):
+        assert {1, 2} <= {p for p, _ in by_face[f].partners}
+        assert by_face[f].deviation < 2e-4 and is_valid(work.faces[f])
+    edges_after = face_edges(new)
+    pairs_after = pair_edges(edges_after, gap_tol)
+    assert len(edges_after) - len({k for p in pairs_after for k in p}) <= 18
