@@ -27,6 +27,7 @@ __all__ = [
     "FaceEdge",
     "dense_edge",
     "duplicate_faces",
+    "edge_positions",
     "face_edges",
     "four_sided_boundary",
     "hole_loops",
@@ -88,6 +89,22 @@ def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
             t0, t1 = e.curve3d.domain
             out.append(FaceEdge(i, k, e.curve3d, e.curve3d.evaluate(np.linspace(t0, t1,
                                                                                 EDGE_SAMPLES))))
+    return out
+
+
+def edge_positions(face: TrimmedFace) -> dict[int, tuple[int, int]]:
+    """``FaceEdge.k`` -> ``(loop index, position in the loop)`` for every edge of ``face``
+    (the numbering of :func:`face_edges`: the outer loop's from 0, the inner loops'
+    from -1 down)."""
+    out = {p: (face.outer_loop_index, p)
+           for p in range(len(face.loops[face.outer_loop_index].edges))}
+    k = -1
+    for n, loop in enumerate(face.loops):
+        if n == face.outer_loop_index:
+            continue
+        for p in range(len(loop.edges)):
+            out[k] = (n, p)
+            k -= 1
     return out
 
 

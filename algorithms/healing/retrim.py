@@ -56,7 +56,7 @@ from numpy.typing import NDArray
 from ..fitting import interpolate_curve
 from ..projection import project_to_surface
 from ..trimmed import DEFAULT_TOLERANCE, TrimEdge, TrimLoop, TrimmedFace
-from .adjacency import FaceEdge, dense_edge, polyline_distance
+from .adjacency import FaceEdge, dense_edge, edge_positions, polyline_distance
 from .approximant import DEFAULT_RELATIVE_TOL
 from .loop_sides import reverse_curve, signed_area
 
@@ -170,23 +170,8 @@ def _oriented(curve, like):
     return curve if ahead >= 0 else reverse_curve(curve)
 
 
-def _positions(face: TrimmedFace) -> dict[int, tuple[int, int]]:
-    """``FaceEdge.k`` -> (loop index, position) for every edge of ``face`` (the
-    numbering of :func:`.adjacency.face_edges`)."""
-    out = {p: (face.outer_loop_index, p)
-           for p in range(len(face.loops[face.outer_loop_index].edges))}
-    k = -1
-    for n, loop in enumerate(face.loops):
-        if n == face.outer_loop_index:
-            continue
-        for p in range(len(loop.edges)):
-            out[k] = (n, p)
-            k -= 1
-    return out
-
-
 def _trim_edge(face: TrimmedFace, edge: FaceEdge) -> TrimEdge:
-    n, p = _positions(face)[edge.k]
+    n, p = edge_positions(face)[edge.k]
     return face.loops[n].edges[p]
 
 
@@ -393,7 +378,7 @@ def _with_corners_moved(face: TrimmedFace, edges: Sequence[FaceEdge], swaps: lis
     curve when that lies on the surface within ``tol``."""
     f = edges[swaps[0][0]].face
     by_k = {e.k: n for n, e in enumerate(edges) if e.face == f}
-    where = _positions(face)
+    where = edge_positions(face)
     at = {v: k for k, v in where.items()}
     swaps = list(swaps)
     grown = True
@@ -428,7 +413,7 @@ def _retrimmed(face: TrimmedFace, edges: Sequence[FaceEdge], swaps, tol: float
     """``face`` with the edges of ``swaps`` (``(a, (b, ...), width)``) replaced, each by
     its partner or by its chain of partners; the new edges' largest distance from the
     surface."""
-    where = _positions(face)
+    where = edge_positions(face)
     plan = {where[edges[a].k]: (edges[a], [edges[b] for b in bs]) for a, bs, _ in swaps}
     loops, deviation = [], 0.0
     for n, loop in enumerate(face.loops):
