@@ -134,4 +134,3 @@ def test_an_edge_along_two_shorter_edges_is_replaced_by_both():
     # nothing of the lid or the walls' tops is free any more
     edges_after, _, still_free = _free(new)
     assert not [k for k in still_free if edges_after[k].face == 0]
-
