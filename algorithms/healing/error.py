@@ -195,8 +195,11 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
     crowded out by a finely triangulated neighbour) give the closest point of
     the triangulation; on a parametric source its barycentric ``(u, v)``
     (eq. 10) starts Newton point inversion on the exact surface (whose foot may
-    leave the triangulated part of a trimmed source: so every source is
-    inverted, none is ruled out by its triangles' distance).
+    leave the triangulated part of a trimmed source: so no source is ruled out by
+    its triangles' distance). The sources are taken nearest first, and a point
+    farther from a surface's control-net box than the best distance found so far is
+    not inverted on it (the surface lies in the box; 65 % of the inversions of a heal
+    of occt_k1_catia_theorem.stp): the result is the same.
 
     Parameters
     ----------
@@ -212,14 +215,27 @@ def distance_to_triangles(points: NDArray, clipped: ClippedTriangles, *, tol: fl
     best = np.full(points.shape[0], np.inf)
     if points.shape[0] == 0 or clipped.n_triangles == 0:
         return best
+    per_source = []
     for s_id in np.unique(clipped.source):
         dist, uv = _source_triangles(points, clipped, np.flatnonzero(clipped.source == s_id))
+        per_source.append((float(np.median(dist)), int(s_id), dist, uv))
+    # nearest sources first: a point farther from a source's control-net box than the
+    # best distance found so far cannot come closer to that surface (it lies in the
+    # convex hull of its control points, its triangles too), so it is not inverted
+    for _, s_id, dist, uv in sorted(per_source, key=lambda item: item[:2]):
         surface = clipped.sources[s_id].surface
         exact = np.all(np.isfinite(uv), axis=1)
         if surface is not None and np.any(exact):
-            # chords, not the surface, where the surface is known
-            dist[exact] = project_to_surface(surface, points[exact], tol=tol,
-                                             guess=uv[exact]).distance
+            box = surface.bounding_box()
+            below = np.linalg.norm(np.maximum(np.maximum(box[0] - points, 0.0),
+                                              points - box[1]), axis=1)
+            beyond = exact & (below >= best)
+            dist[beyond] = np.inf
+            exact &= ~beyond
+            if np.any(exact):
+                # chords, not the surface, where the surface is known
+                dist[exact] = project_to_surface(surface, points[exact], tol=tol,
+                                                 guess=uv[exact]).distance
         np.minimum(best, dist, out=best)
     return best
 

@@ -160,3 +160,31 @@ def test_closest_on_degenerate_triangles_uses_their_edges():
     foot, bary = closest_on_triangles(points, tri)
     assert np.allclose(foot, [[1.5, 0, 0], [1, 1, 1], [0.2, 0.2, 0]])
     assert np.allclose(bary.sum(axis=1), 1.0)
+
+
+def test_a_source_farther_than_the_best_distance_is_not_inverted(monkeypatch):
+    """A copy of the surface lifted by 5 (its control-net box 4.5 and more above every
+    point): no point is inverted on it, as it cannot come nearer than the box; the
+    distances still equal the global inversion onto every source."""
+    from surfprep.algorithms.healing import error
+    s = smooth_surface()
+    far = NurbsSurface(s.control_points + [0, 0, 5.0], s.knots_u, s.knots_v, s.degree_u,
+                       s.degree_v)
+    sources = as_sources([s, far])
+    clipped = clip_sources(sources, np.array([[-1.0, -1.0, -1.0], [2.0, 2.0, 7.0]]),
+                           mesh_tol=0.01)
+    uv = RNG.uniform(0.2, 0.8, (200, 2))
+    pts = s.evaluate(uv[:, 0], uv[:, 1]) + RNG.normal(scale=0.05, size=(200, 3))
+    inverted = []
+    real = error.project_to_surface
+
+    def counted(surface, points, **kw):
+        inverted.append((surface, len(points)))
+        return real(surface, points, **kw)
+
+    monkeypatch.setattr(error, "project_to_surface", counted)
+    local = distance_to_triangles(pts, clipped, tol=1e-12)
+    assert [n for surface, n in inverted if surface is far] == []
+    assert sum(n for _, n in inverted) == sum(n for surface, n in inverted if surface is s) == 200
+    monkeypatch.setattr(error, "project_to_surface", real)
+    np.testing.assert_allclose(local, distance_to_sources(pts, sources, tol=1e-12), atol=1e-10)
