@@ -60,7 +60,8 @@ from .adjacency import FaceEdge, dense_edge, edge_positions, polyline_distance
 from .approximant import DEFAULT_RELATIVE_TOL
 from .loop_sides import reverse_curve, signed_area
 
-__all__ = ["CORNER", "OFF", "ON_SURFACE", "PROJECTION_SAMPLES", "RETRIM_WIDTH", "TURNED", "Retrim", "retrim_faces", "retrim_partners"]
+__all__ = ["CORNER", "OFF", "ON_SURFACE", "PROJECTION_SAMPLES", "RETRIM_WIDTH", "TURNED",
+           "Retrim", "retrim_faces", "retrim_partners"]
 
 #: partners lie at most this share of the shorter edge's length apart
 RETRIM_WIDTH = 0.2
@@ -132,11 +133,17 @@ def _nearest(edges: Sequence[FaceEdge], free: Sequence[int]) -> dict[int, tuple[
     return out
 
 
-def _face_tol(face: TrimmedFace, edges: Sequence[FaceEdge], tol: float | None) -> float:
+def _face_tols(edges: Sequence[FaceEdge], tol: float | None) -> dict[int, float]:
+    """Per face (that has edges) the tolerance a re-trim of it is held to: ``tol``, or
+    :data:`DEFAULT_RELATIVE_TOL` x the diagonal of its edges' box."""
+    lo: dict[int, NDArray] = {}
+    hi: dict[int, NDArray] = {}
+    for e in edges:
+        lo[e.face] = np.minimum(lo.get(e.face, np.inf), e.samples.min(axis=0))
+        hi[e.face] = np.maximum(hi.get(e.face, -np.inf), e.samples.max(axis=0))
     if tol is not None:
-        return tol
-    pts = np.concatenate([e.samples for e in edges])
-    return DEFAULT_RELATIVE_TOL * float(np.linalg.norm(np.ptp(pts, axis=0)))
+        return dict.fromkeys(lo, tol)
+    return {f: DEFAULT_RELATIVE_TOL * float(np.linalg.norm(hi[f] - lo[f])) for f in lo}
 
 
 def _projection(face: TrimmedFace, own: FaceEdge, other: FaceEdge, n: int
@@ -204,16 +211,15 @@ def retrim_partners(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdg
     loose = [(a, (b,), gap) for a, b, gap in loose if a in once and b in once]
     candidates += loose
     directions += [((a, bs),) for a, bs, _ in loose]
-    out = []
+    out, tols = [], _face_tols(edges, tol)
     for (_, _, width), ways in zip(candidates, directions):
         for own, others in ways:
             face = faces[edges[own].face]
             if face is None or any(faces[edges[b].face] is None for b in others) or any(
                     e.is_seam for loop in face.loops for e in loop.edges):
                 continue
-            mine = [e for e in edges if e.face == edges[own].face]
             distance = max(_projection(face, edges[own], edges[b], 17)[3] for b in others)
-            if distance <= min(_face_tol(face, mine, tol), ON_SURFACE * width):
+            if distance <= min(tols[edges[own].face], ON_SURFACE * width):
                 out.append((own, others, width, distance))
     best: dict[int, tuple] = {}            # per edge the narrowest of its options
     for option in out:
@@ -335,7 +341,7 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
     by_face: dict[int, list[tuple[int, tuple[int, ...], float]]] = {}
     for a, bs, width, _ in retrim_partners(faces, edges, free, loose=loose, tol=tol):
         by_face.setdefault(edges[a].face, []).append((a, bs, width))
-    retrims, refused = [], []
+    retrims, refused, tols = [], [], _face_tols(edges, tol)
     partner_of: dict[int, int] = {}
     for a, b in pairs:
         partner_of.setdefault(a, b)
@@ -348,8 +354,7 @@ def retrim_faces(faces: Sequence[TrimmedFace | None], edges: Sequence[FaceEdge],
         if not swaps:
             continue
         face = faces[f]
-        mine = [e for e in edges if e.face == f]
-        face_tol = _face_tol(face, mine, tol)
+        face_tol = tols[f]
         swaps = _with_corners_moved(face, edges, swaps, partner_of, face_tol)
         try:
             new, deviation = _retrimmed(face, edges, swaps, face_tol)
