@@ -163,7 +163,8 @@ def basis_functions(knots: NDArray, degree: int, t: ArrayLike,
 
 
 def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
-                      span: NDArray | None = None) -> tuple[NDArray, NDArray]:
+                      span: NDArray | None = None, *, compiled: bool = True
+                      ) -> tuple[NDArray, NDArray]:
     """Basis functions and their derivatives up to ``order`` (A2.3 of [PT]), vectorized.
 
     Parameters
@@ -175,6 +176,12 @@ def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
         Derivatives above ``degree`` are zero.
     span : (m,) int, optional
         Precomputed :func:`find_span` result.
+    compiled : bool, default True
+        Use the compiled kernel (a few microseconds a call). False runs the numpy
+        form, vectorized over all of ``t`` (tens of microseconds a call, whatever
+        ``m``): what a tensor grid's two per-direction calls want, since compiling
+        buys them nothing and the first compiled call in a process loads numba
+        (about half a second). Both run the same recurrences.
 
     Returns
     -------
@@ -187,7 +194,7 @@ def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
     t = np.asarray(t, dtype=float).reshape(-1)
     if span is None:
         span = find_span(knots, p, t)
-    if basis_kernels.AVAILABLE:                               # same recurrences, compiled
+    if compiled and basis_kernels.AVAILABLE:                  # same recurrences, compiled
         return basis_kernels.basis_derivatives_compiled(knots, p, t, span,
                                                         max(int(order), 0)), span
     return _basis_derivatives_numpy(knots, p, t, order, span), span

@@ -33,9 +33,10 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
-from scipy.special import comb
 
 from ..errors import InvalidGeometryError
 from .bezier import bezier_decompose_array
@@ -62,8 +63,13 @@ def bezier_elevation_matrix(degree: int, t: int) -> NDArray:
     i = np.arange(p + t + 1)[:, None]
     j = np.arange(p + 1)[None, :]
     valid = (i - j >= 0) & (i - j <= t)
-    numer = comb(p, j) * comb(t, np.clip(i - j, 0, t))
-    return np.where(valid, numer / comb(p + t, i), 0.0)
+    numer = _binomials(p)[j] * _binomials(t)[np.clip(i - j, 0, t)]
+    return np.where(valid, numer / _binomials(p + t)[i], 0.0)
+
+
+def _binomials(n: int) -> NDArray:
+    """Row ``n`` of Pascal's triangle, ``(n + 1,) float``: ``C(n, k)`` exact, then rounded."""
+    return np.array([math.comb(n, k) for k in range(n + 1)], dtype=float)
 
 
 def elevate_degree_array(points_w: NDArray, knots: NDArray, degree: int, t: int

@@ -29,7 +29,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 
 from .face_region_kernels import ray_crossings
 from .surface import NurbsSurface
@@ -94,6 +93,9 @@ def _join_edge_ends(segments: list[NDArray], eps: float) -> None:
     of each other take the value of the first of them."""
     ends = np.concatenate([[s[0, 0], s[-1, 1]] for s in segments])      # (2 edges, 2)
     first = np.arange(ends.shape[0])
+    # scipy on first use: importing it costs 0.3 s
+    from scipy.spatial import cKDTree
+
     for i, j in sorted(cKDTree(ends).query_pairs(eps)):
         first[j] = min(first[j], first[i])
     for k, s in enumerate(segments):

@@ -26,7 +26,6 @@ References
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import DegenerateGeometryError, InvalidGeometryError
@@ -264,6 +263,9 @@ def solve_banded_rows(cols: NDArray, values: NDArray, rhs: NDArray) -> NDArray:
     upper = int(max(np.max(cols - rows), 0))
     ab = np.zeros((lower + upper + 1, n))
     ab[upper + rows - cols, cols] = values
+    # scipy on first use: importing it costs 0.3 s
+    import scipy.linalg
+
     try:
         x = scipy.linalg.solve_banded((lower, upper), ab, rhs, check_finite=False)
     except np.linalg.LinAlgError as exc:
@@ -590,6 +592,9 @@ def _least_squares_interior(knots: NDArray, p: int, t: NDArray, q: NDArray,
         if not ab[-1, 0] > 0:
             raise DegenerateGeometryError("singular least-squares system (Schoenberg-Whitney)")
         return rhs / ab[-1, 0]
+    # scipy on first use: importing it costs 0.3 s
+    import scipy.linalg
+
     try:
         return scipy.linalg.solveh_banded(ab, rhs, check_finite=False)
     except np.linalg.LinAlgError:

@@ -3,31 +3,81 @@
 Every ``*_kernels.py`` module of :mod:`surfprep.algorithms` decorates its loops
 with :func:`jit` and keeps a numpy form of each beside it (the reference the
 tests compare against, and the fallback). ``AVAILABLE`` is False when numba
-cannot be imported; the callers use their numpy forms then.
+cannot be found; the callers use their numpy forms then.
 
-The kernels are compiled on first use and cached on disk (``cache=True``): a
-cold first call (no cache) costs about a second per kernel, a warm one (cache
-present) a few milliseconds. They release the GIL (``nogil=True``).
+numba is imported when a kernel is first *called*, not when a module defining
+one is imported: importing numba and loading its compilation context costs
+about half a second, which a command that never reaches a hot loop (``info``,
+``--help``, an error) should not pay. :func:`jit` returns a
+:class:`LazyKernel`; its first call compiles it (``njit(cache=True,
+nogil=True)``: from the on-disk cache in a few milliseconds when present, about
+a second per kernel without) and later calls go straight to numba's dispatcher.
+A kernel calling another one inside compiled code works unchanged: numba types
+a :class:`LazyKernel` as the dispatcher it stands for.
 """
 
 from __future__ import annotations
 
+import importlib.util
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar
 
-try:                                    # numba is optional: the numpy forms remain
-    import numba
-except ImportError:                     # pragma: no cover - numba is installed in CI
-    numba = None
+__all__ = ["AVAILABLE", "LazyKernel", "jit"]
 
-__all__ = ["AVAILABLE", "jit"]
-
-#: True when numba is importable and :func:`jit` compiles
-AVAILABLE = numba is not None
+#: True when numba is installed and :func:`jit` compiles (found without importing it)
+AVAILABLE = importlib.util.find_spec("numba") is not None
 
 F = TypeVar("F", bound=Callable)
 
 
+class LazyKernel:
+    """A numba kernel compiled on its first call; calls it afterwards.
+
+    Parameters
+    ----------
+    py_func : callable
+        The plain Python function (numba's ``nopython`` subset).
+    """
+
+    def __init__(self, py_func: Callable) -> None:
+        self.py_func = py_func
+        self.__wrapped__ = py_func
+        self.__name__ = py_func.__name__
+        self.__qualname__ = py_func.__qualname__
+        self.__doc__ = py_func.__doc__
+        self._dispatcher: Any = None
+
+    @property
+    def dispatcher(self) -> Any:
+        """numba's dispatcher of :attr:`py_func` (numba imported on the first access)."""
+        if self._dispatcher is None:
+            self._dispatcher = _numba_njit()(self.py_func)
+        return self._dispatcher
+
+    def __call__(self, *args: Any) -> Any:
+        return self.dispatcher(*args)
+
+    def __repr__(self) -> str:
+        state = "compiled" if self._dispatcher is not None else "not yet compiled"
+        return f"<LazyKernel {self.__qualname__} ({state})>"
+
+
+def _numba_njit() -> Callable:
+    """``numba.njit(cache=True, nogil=True)``, numba imported and taught :class:`LazyKernel`."""
+    import numba
+    from numba.extending import typeof_impl
+
+    if LazyKernel not in typeof_impl.registry:          # once per process: typed as its dispatcher
+        typeof_impl.register(LazyKernel)(_typeof_lazy_kernel)
+    return numba.njit(cache=True, nogil=True)
+
+
+def _typeof_lazy_kernel(value: LazyKernel, context: Any) -> Any:
+    from numba.core.typing.typeof import typeof_impl
+
+    return typeof_impl(value.dispatcher, context)
+
+
 def jit(fn: F) -> F:
-    """``numba.njit(cache=True, nogil=True)(fn)``, or ``fn`` itself without numba."""
-    return numba.njit(cache=True, nogil=True)(fn) if AVAILABLE else fn
+    """``fn`` as a :class:`LazyKernel` (compiled on first call), or ``fn`` itself without numba."""
+    return LazyKernel(fn) if AVAILABLE else fn   # type: ignore[return-value]

@@ -218,8 +218,9 @@ class NurbsSurface:
         u = np.asarray(u, dtype=float).reshape(-1)
         v = np.asarray(v, dtype=float).reshape(-1)
         p, q = self.degree_u, self.degree_v
-        du, su = basis_derivatives(self.knots_u, p, u, order)      # (a, o+1, p+1)
-        dv, sv = basis_derivatives(self.knots_v, q, v, order)      # (b, o+1, q+1)
+        # one vectorized call per direction: no kernel (nor numba) needed for a grid
+        du, su = basis_derivatives(self.knots_u, p, u, order, compiled=False)  # (a, o+1, p+1)
+        dv, sv = basis_derivatives(self.knots_v, q, v, order, compiled=False)  # (b, o+1, q+1)
         iu = su[:, None] - p + np.arange(p + 1)                    # (a, p+1)
         pw = self.homogeneous_net
         # contract u first: (a, o+1, n_v, d+1)

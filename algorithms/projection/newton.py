@@ -22,15 +22,18 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
 
 from ...errors import InvalidGeometryError
 from ..basis import distinct_knots
 from ..creases import CreasePieces
 from ..tolerance import check_tolerance
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 __all__ = [
     "DEFAULT_RELATIVE_TOL",
@@ -193,6 +196,9 @@ def seed_grid(geometry, key, build: Callable[[], tuple[tuple[NDArray, ...], NDAr
         params, grid, pieces = build()
         for a in (*params, grid):
             a.setflags(write=False)
+        # scipy on first use: importing it costs 0.3 s
+        from scipy.spatial import cKDTree
+
         found = SeedGrid(params, grid, cKDTree(grid.reshape(-1, grid.shape[-1])), pieces,
                           _grid_spacing(grid))
         cache[key] = found

@@ -71,3 +71,13 @@ def test_a_real_run_still_loads_opencascade():
     result = _probe("info", str(SAMPLE), "--json", "-")
     assert result["code"] == 0
     assert "OCP" in result["loaded"]
+
+
+def test_info_loads_neither_numba_nor_scipy():
+    """``info`` describes every face (types, areas, the parametrization figure on a grid)
+    with numpy alone: numba's import and context (half a second) and scipy's (0.3 s)
+    are for the commands whose hot loops need them."""
+    result = _probe("info", str(SAMPLE), "--json", "-")
+    assert result["code"] == 0
+    assert "surfprep.algorithms" in result["loaded"]
+    assert "numba" not in result["loaded"] and "scipy" not in result["loaded"]
