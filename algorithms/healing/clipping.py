@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError, SurfprepError
 from ..face_region import inside_loops
+from ..intersection.culling import patch_rectangles
 from ..intersection.mesh import TriangleMesh
 from ..intersection.tessellation import tessellate
 from ..surface import NurbsSurface
@@ -41,11 +42,15 @@ __all__ = [
     "as_sources",
     "clip_sources",
     "face_source",
+    "trim_regions",
     "trimmed_source",
 ]
 
 #: default chord tolerance of :func:`trimmed_source`, fraction of the surface's box diagonal
 TRIM_MESH_FRACTION = 1e-3
+#: rectangles across the trimming loops' (u, v) box, per direction, that a trimmed
+#: face's triangulation has at least (a narrow face on a flat surface is resolved)
+TRIM_CELLS = 8
 #: a surface at most this many times the clipping box's size is triangulated whole and kept
 CACHE_SIZE_RATIO = 4.0
 #: a kept triangulation serves chord tolerances up to this factor coarser than its own
@@ -99,14 +104,21 @@ Source = NurbsSurface | TriangleMesh | SurfaceSource
 
 
 def trimmed_source(surface: NurbsSurface, loops: Sequence[NDArray], *,
-                   mesh_tol: float | None = None, name: str = "") -> SurfaceSource:
+                   mesh_tol: float | None = None, name: str = "",
+                   straddle: bool = True) -> SurfaceSource:
     """A trimmed face as a source: its surface and a triangulation of the part that exists.
 
     The surface is triangulated (:func:`..intersection.tessellation.tessellate`)
-    and the triangles whose parameter centroid lies outside the trimming loops
-    (even-odd, :func:`inside_loops`) are dropped, so projections onto the face
-    miss its holes and the parts trimmed away (the rim is as fine as the
-    triangulation).
+    over the Bézier patches that meet the loops' ``(u, v)`` box, split so that
+    each is at most :data:`TRIM_CELLS`-th of that box per direction (the chord
+    tolerance alone leaves a flat surface a few triangles, and a face trimmed
+    narrow on it — a lens 4 mm wide on a 25 mm patch — would keep none inside
+    its loops), and the triangles that lie outside the trimming loops (even-odd,
+    :func:`inside_loops`) are dropped, so projections onto the face miss its holes
+    and the parts trimmed away. The rim is as fine as the triangulation: with
+    ``straddle`` a triangle with a corner inside is kept (the face reaches a
+    triangle beyond its loops, where a trim gap to its neighbours lies), without
+    it only those whose centroid is inside.
 
     Parameters
     ----------
@@ -117,17 +129,53 @@ def trimmed_source(surface: NurbsSurface, loops: Sequence[NDArray], *,
         Chord tolerance, model units; default :data:`TRIM_MESH_FRACTION` times
         the control-net box diagonal.
     name : str
+    straddle : bool
+        Keep the triangles across the loops too (a corner inside).
     """
     if mesh_tol is None:
         mesh_tol = TRIM_MESH_FRACTION * float(np.linalg.norm(np.ptp(surface.bounding_box(),
                                                                       axis=0)))
-    mesh = tessellate(surface, mesh_tol).mesh
-    keep = inside_loops(mesh.triangle_uv().mean(axis=1), loops)
+    mesh = tessellate(surface, mesh_tol, trim_regions(surface, loops)).mesh
+    corners = mesh.triangle_uv()                                         # (t, 3, 2)
+    keep = inside_loops(corners.mean(axis=1), loops)
+    if straddle:
+        keep |= inside_loops(corners.reshape(-1, 2), loops).reshape(-1, 3).any(axis=1)
     if not np.any(keep):
         raise InvalidGeometryError(
             f"no part of the surface lies inside the trimming loops{f' of {name}' if name else ''}")
     trimmed = TriangleMesh.from_arrays(mesh.vertices, mesh.triangles[keep], mesh.uv)
     return SurfaceSource(surface, trimmed, name)
+
+
+def trim_regions(surface: NurbsSurface, loops: Sequence[NDArray], cells: int = TRIM_CELLS
+                 ) -> NDArray:
+    """Parameter rectangles to triangulate a trimmed face over: ``(r, 4) float``.
+
+    The Bézier patches of ``surface`` that meet the bounding box of ``loops``
+    (``(n_k, 2) float`` each), halved (at the floating-point midpoint, as the
+    tessellation splits, so shared edges keep bitwise equal parameters) in u
+    while wider than ``1 / cells`` of the box's u extent, likewise in v.
+    """
+    uv = np.concatenate([np.asarray(lp, dtype=float).reshape(-1, 2) for lp in loops])
+    lo, hi = uv.min(axis=0), uv.max(axis=0)
+    rects = patch_rectangles(surface)
+    meets = ((rects[:, 0] <= hi[0]) & (rects[:, 1] >= lo[0])
+             & (rects[:, 2] <= hi[1]) & (rects[:, 3] >= lo[1]))
+    rects = rects[meets] if np.any(meets) else rects
+    width = np.maximum(hi - lo, 1e-12 * (np.ptp(rects[:, :2]) + np.ptp(rects[:, 2:])))
+    for axis in (0, 1):
+        a, b = 2 * axis, 2 * axis + 1
+        for _ in range(16):                    # 2^16 halvings at most
+            wide = rects[:, b] - rects[:, a] > width[axis] / cells
+            if not np.any(wide):
+                break
+            mid = 0.5 * (rects[wide, a] + rects[wide, b])
+            first, second = rects[wide].copy(), rects[wide].copy()
+            first[:, b], second[:, a] = mid, mid
+            rects = np.concatenate([rects[~wide], first, second])
+            keep = ((rects[:, a] <= hi[axis]) & (rects[:, b] >= lo[axis]))
+            rects = rects[keep]
+    return rects
 
 
 def as_sources(sources: Sequence[Source] | Source) -> tuple[SurfaceSource, ...]:
