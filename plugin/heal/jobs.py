@@ -100,6 +100,13 @@ def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: b
         else:
             boundaries, split = _face_boundaries(faces[i], i, split_faces, gap_tol,
                                                  [] if skipped is None else skipped)
+        short = min((_side_length(c) for curves in boundaries for c in curves), default=np.inf)
+        if short < gap_tol:
+            if skipped is not None:
+                skipped.append(f"face {i}: an approximant side {short:.3g} long, shorter than "
+                               f"gap_tol {gap_tol:.3g} (sewing at gap_tol would collapse it); "
+                               "kept as it is")
+            continue
         for n, curves in enumerate(boundaries):
             name = faces[i].name if len(boundaries) == 1 or not faces[i].name \
                 else f"{faces[i].name}_{n}"
@@ -111,6 +118,14 @@ def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: b
             jobs.append(Job(PatchOrigin("hole", loop.faces, loop.index), curves, name, None,
                             many, tuple(rim), loop.cap))
     return jobs
+
+
+def _side_length(curve) -> float:
+    """Length of a boundary side: a NurbsCurve's arc length, or a polyline's."""
+    if hasattr(curve, "arc_length"):
+        return float(curve.arc_length())
+    points = np.asarray(curve, dtype=float)
+    return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
 
 
 def replaced_faces(done) -> set[int]:
@@ -184,9 +199,16 @@ def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped
                        f"({type(exc).__name__}: {exc}); left as it was")
         return None
     if job.origin.kind in ("face", "union") and not la.converged:
-        skipped.append(f"face {job.origin.index}: approximant error {la.max_error:.3g} > "
-                       f"tol {la.tol:.3g} up to resolution {la.history[-1].resolution}; "
-                       "kept as it was")
+        last = la.history[-1]
+        if la.max_error <= la.tol:      # met tol only with points filled, not projected
+            why = (f"approximant within tol {la.tol:.3g} only at resolution {la.resolution} "
+                   f"({la.max_error:.3g}, {100 * la.artificial_share:.0f}% of its points "
+                   f"filled where no face was hit), {last.max_error:.3g} refined to "
+                   f"{last.resolution}")
+        else:
+            why = (f"approximant error {la.max_error:.3g} > tol {la.tol:.3g} up to "
+                   f"resolution {last.resolution}")
+        skipped.append(f"face {job.origin.index}: {why}; kept as it was")
         return None
     if job.origin.kind == "hole" and not la.converged:
         # the error is measured only where segments land on the originals: over a real
