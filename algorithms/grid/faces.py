@@ -1,7 +1,7 @@
 """Which trimmed faces a structured grid can cover: four-sided on their surface's rectangle,
 bounded by one loop of four edges, or (:func:`face_regions`) split into four-sided
 sub-patches around a centre (a butterfly for a disc) when bounded by one loop of
-another number of sides, or four blocks round a single hole.
+another number of sides, or blocks round a single hole (one per outer corner).
 
 A face is gridded as one block when its boundary is the whole parameter
 rectangle of its surface: one loop, every edge's pcurve on a side of the
@@ -103,8 +103,9 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     loop of four corners made of more edges is one region over its four sides; a
     loop of at most two corners (a disc, a lens) five, the butterfly: an inner quad
     and four between it and the loop (its O-grid remapped to an H-grid). A face with
-    one hole: four blocks round it (:func:`..healing.decompose.decompose_ring`, spokes
-    from the outer loop's four corners or cut points to the hole). Faces with more
+    one hole: blocks round it, one per corner of its outer loop
+    (:func:`..healing.decompose.decompose_ring`, spokes from the corners, or four cut
+    points when it has at most two, to the hole). Faces with more
     holes and loops the split refuses (a spoke leaving a very non-convex outline, a
     cusp) get the reason.
 
@@ -133,7 +134,7 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
         try:
             ring = decompose_ring(face.surface, *ring_edges(face, gap_tol=gap_tol))
         except (NotDecomposableError, DegenerateGeometryError) as exc:
-            return f"it has 1 hole: not split into four blocks round it ({exc})"
+            return f"it has 1 hole: not split into blocks round it ({exc})"
         return [Region.from_runs(face.surface, [(pc, *pc.domain) for pc in quad],
                                  clockwise=bool(face.reversed)) for quad in ring.quads_pcurves]
     if len(face.loops) != 1:

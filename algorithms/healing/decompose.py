@@ -36,7 +36,8 @@ refusal in :func:`why_not_decomposable`):
   boundary isocurves;
 * other faces of one loop: :func:`decompose_loop` on its outer loop
   (:func:`loop_edges`);
-* a face with one hole: the four blocks round it of :func:`decompose_ring`;
+* a face with one hole: the blocks round it of :func:`decompose_ring` (one per outer
+  corner, four when it has at most two);
 * faces with two or more holes, seam edges, loop ends further apart than
   ``gap_tol``, very non-convex outlines: not decomposable.
 
@@ -101,6 +102,13 @@ __all__ = [
 
 #: a vertex turning by less than this (radians) joins its two edges into one side
 DEFAULT_SMOOTH_ANGLE = np.radians(20.0)
+#: most blocks round a hole :func:`quad_boundaries` (healing) accepts; grids take any
+#: number (occt_k1_catia_theorem.stp faces 1 and 58, eight corners each, as eight
+#: approximants: free edges at 1e-7 x size 12 -> 40)
+MAX_RING_BLOCKS = 4
+#: a cut on a hole this close to one of its corners (fraction of its perimeter in
+#: ``(u, v)``) is moved to the corner
+HOLE_CORNER_SNAP = 0.05
 #: most sides handled by the split around a centre
 MAX_SIDES = 16
 #: a vertex turning by more than this (radians) is a cusp: no sub-patch fits in it
@@ -314,16 +322,36 @@ def _inner_cut(real_inner, centre: NDArray, towards: NDArray) -> tuple[int, floa
     return where
 
 
+def _snap_to_corners(hole: Sequence[LoopEdge], cuts: list[tuple[int, float]],
+                     outline: NDArray, smooth_angle: float) -> list[tuple[int, float]]:
+    """``cuts`` on the hole moved to the hole's corners within :data:`HOLE_CORNER_SNAP`
+    of its ``(u, v)`` perimeter: a block's hole side would otherwise turn a corner a
+    sliver before its end."""
+    turning = turning_angles(hole)
+    corners = [(int(k), float(hole[k].pcurve.domain[0])) for k in
+               np.flatnonzero(turning > smooth_angle)]
+    if not corners:
+        return cuts
+    at = np.array([hole[k].pcurve.evaluate(t) for k, t in corners]).reshape(-1, 2)
+    reach = HOLE_CORNER_SNAP * polyline_lengths(np.vstack([outline, outline[:1]]))[-1]
+    out = []
+    for k, t in cuts:
+        d = np.linalg.norm(at - hole[k].pcurve.evaluate(t), axis=1)
+        out.append(corners[int(np.argmin(d))] if d.min() <= reach else (k, t))
+    return out
+
+
 def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge], *,
                    smooth_angle: float = DEFAULT_SMOOTH_ANGLE) -> Decomposition:
-    """Four quads covering a face with one hole (an annulus: the O-grid round a hole cut
-    into four blocks).
+    """Quads covering a face with one hole (an annulus: the O-grid round a hole cut into
+    blocks), one per outer corner.
 
-    The outer loop is cut at its four corners (or, with at most two, at four points
-    spread in arc length as :func:`decompose_loop` spreads them); the hole's loop at
-    the points seen from its centre in the directions of those cuts; quad ``i`` runs
-    along the outer loop from cut ``i`` to ``i + 1``, in along a straight spoke in
-    ``(u, v)``, back along the hole and out along the next spoke.
+    The outer loop is cut at its corners, three or more (with at most two, at four
+    points spread in arc length as :func:`decompose_loop` spreads them); the hole's
+    loop at the points seen from its centre in the directions of those cuts; quad
+    ``i`` runs along the outer loop from cut ``i`` to ``i + 1``, in along a straight
+    spoke in ``(u, v)``, back along the hole and out along the next spoke. Every
+    block's outer side is then free of corners, so each is a proper quad.
 
     Parameters
     ----------
@@ -335,8 +363,8 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
     Raises
     ------
     NotDecomposableError
-        Three or more than four outer corners, a spoke crossing the hole or leaving
-        the face, a folding quad.
+        Cut points on the hole that coincide, a spoke crossing the hole or leaving the
+        face, a folding quad.
     """
     real = [e for e in outer if e.curve is not None]
     hole = [e for e in inner if e.curve is not None]
@@ -344,9 +372,6 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
         raise NotDecomposableError("a loop without an edge with a 3D curve")
     turning = turning_angles(outer)
     corners = np.flatnonzero(turning > smooth_angle)
-    if corners.size not in (0, 1, 2, 4):
-        raise NotDecomposableError(f"a face with a hole and {corners.size} outer corners: "
-                                   "four blocks round the hole need four or at most two")
     cuts = [(int(k), real[k].curve.domain[0]) for k in corners]
     if len(cuts) <= 2:
         seeds = [(k, real[k].curve.domain[0]) for k in range(len(real))] if len(real) <= 4 \
@@ -358,24 +383,26 @@ def decompose_ring(surface, outer: Sequence[LoopEdge], inner: Sequence[LoopEdge]
                                    for e in inner])
     orientation = np.sign(signed_area(outline)) or 1.0
     centre = hole_outline.mean(axis=0)
-    outer_uv = np.array([real[k].pcurve.evaluate(t) for k, t in cuts]).reshape(4, 2)
-    outer_xyz = np.array([real[k].curve.evaluate(t) for k, t in cuts]).reshape(4, 3)
-    hole_cuts = [_inner_cut(hole, centre, p) for p in outer_uv]
-    if len({c for c in hole_cuts}) != 4:
+    n = len(cuts)
+    outer_uv = np.array([real[k].pcurve.evaluate(t) for k, t in cuts]).reshape(n, 2)
+    outer_xyz = np.array([real[k].curve.evaluate(t) for k, t in cuts]).reshape(n, 3)
+    hole_cuts = _snap_to_corners(hole, [_inner_cut(hole, centre, p) for p in outer_uv],
+                                 hole_outline, smooth_angle)
+    if len({c for c in hole_cuts}) != n:
         raise NotDecomposableError("the hole's cut points coincide (a hole far off centre)")
-    hole_uv = np.array([hole[k].pcurve.evaluate(t) for k, t in hole_cuts]).reshape(4, 2)
-    spokes = [spoke_curve(surface, hole_uv[i], outer_uv[i], outer_xyz[i]) for i in range(4)]
+    hole_uv = np.array([hole[k].pcurve.evaluate(t) for k, t in hole_cuts]).reshape(n, 2)
+    spokes = [spoke_curve(surface, hole_uv[i], outer_uv[i], outer_xyz[i]) for i in range(n)]
     for _, uv in spokes:
         inside = inside_loops(uv[1:-1], [outline, hole_outline])
         if not np.all(inside):
             raise NotDecomposableError("a spoke from the hole to the outer loop leaves the face")
-    outer_sides = [loop_side(real, loop_pieces(real, cuts[i], cuts[(i + 1) % 4])) for i in range(4)]
-    hole_sides = [loop_side(hole, loop_pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % 4]))
-                  for i in range(4)]
+    outer_sides = [loop_side(real, loop_pieces(real, cuts[i], cuts[(i + 1) % n])) for i in range(n)]
+    hole_sides = [loop_side(hole, loop_pieces(hole, hole_cuts[i], hole_cuts[(i + 1) % n]))
+                  for i in range(n)]
 
     quads = []
-    for i in range(4):
-        j = (i + 1) % 4
+    for i in range(n):
+        j = (i + 1) % n
         o, h, s_in, s_out = outer_sides[i], hole_sides[i], spokes[j], spokes[i]
         curves = [o.curve, reverse_curve(s_in[0]), reverse_curve(h.curve), s_out[0]]
         pcurves = [o.pcurve, uv_segment(outer_uv[j], hole_uv[j]), reverse_curve(h.pcurve),
@@ -515,6 +542,11 @@ def _boundaries(face: TrimmedFace, gap_tol: float, smooth_angle: float
     if len(face.loops) == 2:
         outer, inner = ring_edges(face, gap_tol=gap_tol)
         decomposition = decompose_ring(face.surface, outer, inner, smooth_angle=smooth_angle)
+        if len(decomposition.quads) > MAX_RING_BLOCKS:
+            raise NotDecomposableError(
+                f"a face with a hole and {len(decomposition.quads)} outer corners: healing "
+                f"replaces a ring by at most {MAX_RING_BLOCKS} blocks (the blocks would meet "
+                "its kept neighbours within tol where its edges now meet them exactly)")
     else:
         decomposition = decompose_face(face, gap_tol=gap_tol, smooth_angle=smooth_angle)
     return [list(q) for q in decomposition.quads]

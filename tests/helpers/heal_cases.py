@@ -220,10 +220,11 @@ def _loop(edges) -> TrimLoop:
     return TrimLoop([TrimEdge(e.curve, e.pcurve, 0.0, 1.0) for e in edges])
 
 
-def plane_with_hole() -> TrimmedFace:
-    """z = 0 trimmed to the square [0.1, 0.9]^2 with a disc hole (radius 0.3) inside."""
+def plane_with_hole(outline=((0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9))) -> TrimmedFace:
+    """z = 0 trimmed to the polygon ``outline`` (counter-clockwise; default the square
+    [0.1, 0.9]^2) with a disc hole (radius 0.3) inside."""
     plane = graph_surface(lambda x, y: 0.0 * x, samples=9)
-    outer = polygon_loop(plane, [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)])
+    outer = polygon_loop(plane, list(outline))
     # the hole clockwise, in four arcs
     hole = [edge_from_uv(plane, lambda t, k=k: HOLE_CENTRE + HOLE_RADIUS * np.column_stack(
         [np.cos(-(k + t) * np.pi / 2), np.sin(-(k + t) * np.pi / 2)]), n=129) for k in range(4)]

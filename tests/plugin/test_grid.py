@@ -235,6 +235,22 @@ def test_a_face_with_a_hole_is_gridded_as_four_blocks_round_it():
     assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(0.64 - np.pi * 0.09, rel=2e-3)
 
 
+def test_a_hexagon_with_a_hole_is_gridded_as_six_blocks_round_it():
+    """One block per outer corner: six, spokes from the corners to the hole, every cell
+    unfolded and the cells adding up to the hexagon less the disc."""
+    from helpers.heal_cases import HOLE_CENTRE, HOLE_RADIUS, plane_with_hole
+    angles = np.radians(60.0 * np.arange(6))
+    hexagon = [tuple(HOLE_CENTRE + 0.45 * np.array([np.cos(a), np.sin(a)])) for a in angles]
+    result = surfprep.grid(plane_with_hole(hexagon), size=0.04)
+    assert len(result.blocks) == 6 and len(result.network.interfaces) == 6
+    _assert_point_matched(result)
+    assert result.report()["worst"]["folded_cells"] == 0
+    nodes = np.concatenate([b.reshape(-1, 3) for b in result.blocks])
+    assert np.linalg.norm(nodes[:, :2] - HOLE_CENTRE, axis=1).min() > HOLE_RADIUS * (1 - 1e-9)
+    exact = 1.5 * np.sqrt(3) * 0.45 ** 2 - np.pi * HOLE_RADIUS ** 2
+    assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(exact, rel=2e-3)
+
+
 def test_a_spoke_through_a_collapsed_point_is_a_reason_not_a_crash(data_dir):
     """occt_turbine_euclid.stp face 1 has a hole round a point where its surface collapses:
     the spokes of the four blocks round the hole run through it (their points coincide
