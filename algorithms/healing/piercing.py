@@ -27,9 +27,10 @@ from numpy.typing import NDArray
 
 from ..intersection.culling import candidate_pairs
 from ..surface import NurbsSurface
+from . import piercing_kernels
 from .clipping import ClippedTriangles
 
-__all__ = ["SegmentHits", "intersect_segments", "project_grid"]
+__all__ = ["SegmentHits", "intersect_segments", "moller_trumbore", "project_grid"]
 
 _EDGE_SLACK = 1e-9          # barycentric slack: hits on shared edges are not lost
 _NEWTON_STEPS = 12
@@ -69,7 +70,10 @@ def _all_hits(a: NDArray, b: NDArray, triangles: NDArray
     if pairs.shape[0] == 0:
         return empty
     s, k = pairs[:, 0], pairs[:, 1]
-    t, w1, w2, ok = _moller_trumbore(a[s], b[s] - a[s], triangles[k])
+    if piercing_kernels.AVAILABLE:               # the same arithmetic, pair by pair
+        t, w1, w2, ok = piercing_kernels.hits_on_pairs(a, b, triangles, s, k, _EDGE_SLACK)
+    else:                                        # pragma: no cover - numba is installed in CI
+        t, w1, w2, ok = moller_trumbore(a[s], b[s] - a[s], triangles[k])
     w1, w2 = np.clip(w1[ok], 0, 1), np.clip(w2[ok], 0, 1)
     total = np.maximum(1.0, w1 + w2)
     w1, w2 = w1 / total, w2 / total
@@ -107,9 +111,23 @@ def intersect_segments(a: NDArray, b: NDArray, triangles: NDArray) -> SegmentHit
     return SegmentHits(out_tri >= 0, out_t, out_tri, out_bary)
 
 
-def _moller_trumbore(origin: NDArray, direction: NDArray, tri: NDArray
-                     ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-    """Segment parameter, two barycentric weights and hit mask of pairs (vectorized)."""
+def moller_trumbore(origin: NDArray, direction: NDArray, tri: NDArray
+                    ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Segment parameter, two barycentric weights and hit mask of pairs (vectorized).
+
+    The numpy form of :func:`.piercing_kernels.hits_on_pairs` (its reference).
+
+    Parameters
+    ----------
+    origin, direction : (M, 3) float
+        Segment ``origin + t direction``, ``t`` in ``[0, 1]``.
+    tri : (M, 3, 3) float
+
+    Returns
+    -------
+    t, w1, w2 : (M,) float
+    ok : (M,) bool
+    """
     e1 = tri[:, 1] - tri[:, 0]
     e2 = tri[:, 2] - tri[:, 0]
     h = np.cross(direction, e2)
