@@ -73,7 +73,7 @@ def _numba_njit() -> Callable:
 
 
 def _typeof_lazy_kernel(value: LazyKernel, context: Any) -> Any:
-    from numba.core.typing.typeof import typeof_impl
+    from numba.extending import typeof_impl
 
     return typeof_impl(value.dispatcher, context)
 
