@@ -46,7 +46,7 @@ if TYPE_CHECKING:
     from .algorithms import Direction, NurbsCurve, NurbsSurface
     from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
     from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
-    from .algorithms.compose import Composition, compose
+    from .algorithms.composition import Composition, compose
     from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
     from .algorithms.reparam import ReparametrizationResult
     from .algorithms.volume import NurbsVolume
@@ -167,8 +167,8 @@ _LAZY_EXPORTS = {
     "boolean": "surfprep.plugin.split",
     "BooleanResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",
-    "compose": "surfprep.algorithms.compose",
-    "Composition": "surfprep.algorithms.compose",
+    "compose": "surfprep.algorithms.composition",
+    "Composition": "surfprep.algorithms.composition",
     "boundary_solid": "surfprep.plugin.volume_boundary",
     "BoundarySolid": "surfprep.plugin.volume_boundary",
     "composed_volumes": "surfprep.plugin.volume_boundary",

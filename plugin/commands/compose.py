@@ -60,7 +60,7 @@ def _points(path: Path) -> np.ndarray:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    from ...algorithms.compose import compose
+    from ...algorithms.composition import compose
     from ...atomic_files import atomic_output
     inputs = (args.a, args.b) + ((args.classify,) if args.classify is not None else ())
     check_outputs(inputs, None, json_path=args.json_path, model=False)

@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InvalidGeometryError
-from .intersection import intersect_surfaces
-from .volume import NurbsVolume
+from ...errors import InvalidGeometryError
+from ..intersection import intersect_surfaces
+from ..volume import NurbsVolume
 
 __all__ = ["Composition", "compose"]
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from surfprep.algorithms.compose import compose
+from surfprep.algorithms.composition import compose
 from surfprep.algorithms.volume_builders import block, solid_sphere
 from surfprep.errors import InvalidGeometryError
 
