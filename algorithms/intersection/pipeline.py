@@ -392,6 +392,34 @@ def _folded(curve: RefinedCurve) -> bool:
     return bool(np.any((cos < np.cos(_FOLD_ANGLE)) & ~middle))
 
 
+def _trim_overshoot(curve: RefinedCurve) -> RefinedCurve:
+    """An open curve without the samples its end point lies behind: where the last
+    (first) chord turns back by more than ``_FOLD_ANGLE`` from the one before it, the
+    sample before the end ran past the end point -- a chain cut at a seam whose
+    refined samples near the cut crossed the seam -- and is dropped, repeatedly. What
+    is dropped lies on the curve's continuation beyond the seam (another curve's
+    stretch)."""
+    if curve.closed or curve.points.shape[0] < 4:
+        return curve
+    keep = np.ones(curve.points.shape[0], dtype=bool)
+    limit = np.cos(_FOLD_ANGLE)
+    for end in (-1, 0):
+        while keep.sum() >= 4:
+            idx = np.flatnonzero(keep)
+            k = idx[::-1][:3] if end == -1 else idx[:3]            # end, next, next-but-one
+            p = curve.points[k]
+            d1, d0 = p[0] - p[1], p[1] - p[2]
+            cos = float(np.dot(d0, d1)) / max(float(np.linalg.norm(d0) * np.linalg.norm(d1)),
+                                              np.finfo(float).tiny)
+            if cos >= limit:
+                break
+            keep[k[1]] = False
+    if keep.all():
+        return curve
+    return RefinedCurve(curve.points[keep], curve.uv_a[keep], curve.uv_b[keep], False,
+                        curve.converged[keep], curve.singular[keep])
+
+
 def _off_tangential(chains: list[Chain], dense: list[RefinedCurve],
                     tangential: tuple[IntersectionCurve, ...], reach: float
                     ) -> tuple[list[Chain], list[RefinedCurve]]:
@@ -448,6 +476,7 @@ def _intersect(a: Operand, b: Operand, tol: float, mesh_tol: float, max_depth: i
               EndKind.OPEN if (i, -1) in left else c.end_kind) for i, c in enumerate(chains)]
     dense, kinds = _extend(dense, kinds, surface_a, surface_b, tol, mesh_tol)
     dense, kinds = _along_sides(dense, kinds, topology, chains, surface_a, surface_b, tol)
+    dense = [_trim_overshoot(c) for c in dense]
     curves, worst = checked_curves(dense, kinds, surface_a, surface_b, tol=tol)
     # a curve whose kept samples still turn back on themselves runs over one stretch
     # twice: within tol of both surfaces, but not the intersection curve

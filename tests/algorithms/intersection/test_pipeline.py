@@ -234,6 +234,25 @@ def test_torus_plane_through_the_axis_two_circles():
     check_against_occ(curves, a, b, expect_branches=2)
 
 
+
+def test_misaligned_tori_curves_cut_at_seams_do_not_run_past_their_ends():
+    """Two tori of 004 Fig. 8 (rational biquadratic, both directions closed): the chains
+    cut at B's seam used to keep refined samples beyond the cut, so the curve's end
+    point lay behind its last samples and the result was refused as folded."""
+    from surfprep.algorithms.volume_builders import solid_torus
+    a = solid_torus(3.0, 1.0).exterior_faces()["u1"]
+    b = solid_torus(3.0, 1.0, (1.0, 0.5, 0.3), (0.2, 0.1, 1.0)).exterior_faces()["u1"]
+    tol = 1e-6
+    curves = intersect_surfaces(a, b, tol=tol)
+    check_on_surfaces(curves, a, b, tol)
+    for c in curves:       # no chord turns back on the one before it
+        d = np.diff(c.points, axis=0)
+        cos = np.einsum("ij,ij->i", d[:-1], d[1:]) / (
+            np.linalg.norm(d[:-1], axis=1) * np.linalg.norm(d[1:], axis=1))
+        assert cos.min() > -0.5
+    assert connected_branches(curves, 1e3 * tol) == 2
+    check_against_occ(curves, a, b, tol=tol, expect_branches=2)
+
 # ---------------------------------------------------------------- free form
 def contour_reference(surface: NurbsSurface, level: float, n: int = 1201):
     """Marching-squares contour of z(u, v) = level on an n x n grid, mapped to 3D."""
