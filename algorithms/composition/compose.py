@@ -62,6 +62,32 @@ class Composition:
         ia, ib = self.a.invert(p, tol=self.tol), self.b.invert(p, tol=self.tol)
         return {"in_a": ia.inside, "uvw_a": ia.uvw, "in_b": ib.inside, "uvw_b": ib.uvw}
 
+    def volume(self, which: str) -> float:
+        """Volume of ``"A"``, ``"B"``, ``"A only"``, ``"B only"``, ``"common"``, ``"union"``
+        or ``"A-B"`` (= ``"A only"``): the solids' own volumes, the others by the
+        divergence theorem over the faces' parts inside the other solid
+        (:func:`.regions.region_volumes`)."""
+        kinds = ("A", "B", "A only", "B only", "common", "union", "A-B")
+        if which not in kinds:
+            raise InvalidGeometryError(f"which must be one of {', '.join(map(repr, kinds))}, "
+                                       f"got {which!r}")
+        if which in ("A", "B"):
+            return float((self.a if which == "A" else self.b).volume())
+        from .regions import region_volumes
+        v = region_volumes(self)
+        return {"A only": v.a_only, "A-B": v.a_only, "B only": v.b_only, "common": v.both,
+                "union": v.union}[which]
+
+    def boundary(self, which: str) -> list:
+        """The pieces of the exterior faces bounding ``"A"``, ``"B"``, ``"union"``,
+        ``"common"`` or ``"A-B"`` (:func:`.regions.boundary_pieces`: a list of
+        :class:`~.regions.BoundaryPiece`)."""
+        from .regions import BOUNDARIES, boundary_pieces
+        if which not in BOUNDARIES:
+            raise InvalidGeometryError(f"which must be one of {', '.join(map(repr, BOUNDARIES))}, "
+                                       f"got {which!r}")
+        return boundary_pieces(self, which)
+
 
 def _boxes_overlap(a: NDArray, b: NDArray, pad: float) -> bool:
     return bool(np.all(a[0] - pad <= b[1]) and np.all(b[0] - pad <= a[1]))
