@@ -11,15 +11,22 @@ sample within ``tol`` of both surfaces, the curves with their images in both
 parameter domains). A point is classified by inverting it into each solid (Newton
 on ``x(u, v, w) = p``): 0 outside both, 1 in A only, 2 in B only, 3 in both.
 
-What 004 adds beyond this -- the hierarchy of Bézier patches, overlap boxes and
-selective tessellation reused across queries, the kd-tree sweep, and the volumes
-of the composed regions -- is not built here: the intersection's own tree descent
-finds the curves.
+004's hybrid hierarchy (Bézier patches and their boxes, overlap boxes, local
+triangulations, kd-trees, merged loops: :mod:`.hierarchy`) is built on first use of
+:attr:`Composition.hierarchy` and kept; a solid's level 1 (its Bézier patches) is
+reused when it is composed again with another partner (``compose(a, c,
+reuse=composition)``). The curves come from the surface--surface intersection, not
+from the hierarchy's loops: on the same pairs it is 1.5-2.5x faster and certifies that
+no loop is missed (``benchmarks/compose.py`` measures both). The volumes and the
+boundaries of the composed regions: :meth:`Composition.volume`,
+:meth:`Composition.boundary` (:mod:`.regions`).
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,8 +34,12 @@ from numpy.typing import ArrayLike, NDArray
 from ...errors import InvalidGeometryError
 from ..intersection import intersect_surfaces
 from ..volume import NurbsVolume
+from .hierarchy import BoundaryPatches, Hierarchy, build_hierarchy
 
 __all__ = ["Composition", "compose"]
+
+#: default chord tolerance of the hierarchy's triangulations, times the solids' diagonal
+MESH_SHARE = 2e-3
 
 @dataclass(frozen=True)
 class Composition:
@@ -48,6 +59,40 @@ class Composition:
     curves: tuple
     tol: float
     time_s: float = field(default=0.0, compare=False)
+    #: level 1 of the hierarchy of each solid when already known (``compose(reuse=)``)
+    level1: tuple = field(default=(None, None), compare=False, repr=False)
+
+    @property
+    def size(self) -> float:
+        """Diagonal of both solids' box."""
+        box = np.vstack([self.a.bounding_box(), self.b.bounding_box()])
+        return float(np.linalg.norm(box.max(axis=0) - box.min(axis=0)))
+
+    def build_hierarchy(self, *, mesh_tol: float | None = None, candidates: str = "descent"
+                        ) -> Hierarchy:
+        """004's hybrid hierarchy of the two solids (:func:`.hierarchy.build_hierarchy`).
+
+        Parameters
+        ----------
+        mesh_tol : float, optional
+            Chord tolerance of the local triangulations; default ``MESH_SHARE`` of the
+            solids' diagonal (and at least ``tol``).
+        candidates : {"descent", "sweep"}
+            Triangle pairs by the box-tree descent (the default: as fast or faster on
+            every pair measured) or by 004's kd-tree sweep; the same pairs either way.
+        """
+        mesh_tol = max(MESH_SHARE * self.size, self.tol) if mesh_tol is None else float(mesh_tol)
+        if not (np.isfinite(mesh_tol) and mesh_tol >= self.tol):
+            raise InvalidGeometryError(f"mesh_tol must be >= tol = {self.tol!r}, got {mesh_tol!r}")
+        la, lb = self.level1
+        return build_hierarchy(la if la is not None else BoundaryPatches.of(self.a),
+                               lb if lb is not None else BoundaryPatches.of(self.b),
+                               tol=self.tol, mesh_tol=mesh_tol, candidates=candidates)
+
+    @cached_property
+    def hierarchy(self) -> Hierarchy:
+        """:meth:`build_hierarchy` with its defaults, built on first use and kept."""
+        return self.build_hierarchy()
 
     def classify(self, points: ArrayLike) -> NDArray:
         """``(n,)`` labels of points ``(n, 3)``: 0 outside both, 1 A only, 2 B only, 3 both."""
@@ -93,7 +138,19 @@ def _boxes_overlap(a: NDArray, b: NDArray, pad: float) -> bool:
     return bool(np.all(a[0] - pad <= b[1]) and np.all(b[0] - pad <= a[1]))
 
 
-def compose(a: NurbsVolume, b: NurbsVolume, *, tol: float | None = None) -> Composition:
+def _level1(volume: NurbsVolume, reuse) -> BoundaryPatches | None:
+    """The level 1 of ``volume`` that ``reuse`` (a Composition) has built, if any."""
+    built = None if reuse is None else reuse.__dict__.get("hierarchy")
+    if built is None:
+        return None
+    for patches in (built.a, built.b):
+        if patches.volume is volume:
+            return patches
+    return None
+
+
+def compose(a: NurbsVolume, b: NurbsVolume, *, tol: float | None = None,
+            reuse: Composition | None = None) -> Composition:
     """Compose two solids: the curves where their boundaries meet, for classification
     and volumes (see the module doc).
 
@@ -102,16 +159,20 @@ def compose(a: NurbsVolume, b: NurbsVolume, *, tol: float | None = None) -> Comp
     a, b : NurbsVolume (3D)
     tol : float, optional
         Model units; default 1e-6 of the diagonal of both solids' box.
+    reuse : Composition, optional
+        An earlier composition of one of the same solids: its level 1 of the hierarchy
+        (the Bézier patches of that solid's boundary) is reused, not rebuilt.
 
     Returns
     -------
     Composition
     """
-    import time
     started = time.perf_counter()
     for name, v in (("a", a), ("b", b)):
         if not isinstance(v, NurbsVolume) or v.dimension != 3:
             raise InvalidGeometryError(f"{name} must be a 3D NurbsVolume")
+    if reuse is not None and not isinstance(reuse, Composition):
+        raise InvalidGeometryError(f"reuse must be a Composition, got {type(reuse).__name__}")
     box = np.vstack([a.bounding_box(), b.bounding_box()])
     size = float(np.linalg.norm(box.max(axis=0) - box.min(axis=0)))
     tol = 1e-6 * size if tol is None else float(tol)
@@ -126,4 +187,5 @@ def compose(a: NurbsVolume, b: NurbsVolume, *, tol: float | None = None) -> Comp
                 continue
             for curve in intersect_surfaces(sa, sb, tol=tol):
                 curves.append((name_a, name_b, curve))
-    return Composition(a, b, tuple(curves), tol, time.perf_counter() - started)
+    return Composition(a, b, tuple(curves), tol, time.perf_counter() - started,
+                       (_level1(a, reuse), _level1(b, reuse)))

@@ -51,3 +51,25 @@ def test_compose_refuses_what_is_not_a_solid():
         compose(solid_sphere(1.0), "ball")
     with pytest.raises(InvalidGeometryError, match="tol"):
         compose(solid_sphere(1.0), solid_sphere(1.0, (1, 0, 0)), tol=-1.0)
+
+
+def test_the_hierarchy_is_built_once_and_a_solid_s_level_1_is_reused():
+    ball = solid_sphere(5.0)
+    first = compose(ball, solid_sphere(5.0, (6, 0, 0)))
+    h = first.hierarchy
+    assert first.hierarchy is h                          # kept
+    assert h.counts()["loops"] == 1
+    # the hierarchy's loop and the intersection's curves: the same circle
+    for points in [h.loops[0].points] + [c.points for _, _, c in first.curves]:
+        np.testing.assert_allclose(points[:, 0], 3.0, atol=first.tol)
+        np.testing.assert_allclose(np.hypot(points[:, 1], points[:, 2]), 4.0, atol=first.tol)
+    second = compose(ball, solid_sphere(5.0, (0, 7, 0)), reuse=first)
+    assert second.hierarchy.a is h.a                     # the ball's Bezier patches
+    assert second.hierarchy.b is not h.b
+    assert second.hierarchy.counts()["loops"] == 1
+    with pytest.raises(InvalidGeometryError, match="reuse"):
+        compose(ball, ball, reuse="first")
+    with pytest.raises(InvalidGeometryError, match="mesh_tol"):
+        first.build_hierarchy(mesh_tol=0.1 * first.tol)
+    sweep = first.build_hierarchy(candidates="sweep")
+    assert sweep.counts() == h.counts()
