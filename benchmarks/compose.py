@@ -11,7 +11,9 @@ within 1e-7 of the exact ones) and run its Booleans. Three pairs with exact answ
   sqrt(25 - y^2 - z^2) - 3 over the square (scipy ``dblquad`` to 1e-13);
 * a torus R 3, r 1 and a ball of radius 1.5 at (3, 0, 0): the curve lies on both
   ``|p - c| = 1.5`` and ``(sqrt(x^2 + y^2) - 3)^2 + z^2 = 1`` (no closed-form volume:
-  the two common volumes are compared with each other).
+  the two common volumes are compared with each other);
+* two misaligned tori R 3, r 1 (004 Fig. 8), the second centred at (1, 0.5, 0.3)
+  with its axis along (0.2, 0.1, 1): two loops on both tori's implicit equations.
 
 Measured, each on the same solids, warm, best of 3:
 
@@ -19,13 +21,20 @@ Measured, each on the same solids, warm, best of 3:
   overlap) vs ``BRepAlgoAPI_Section`` of the two boundary solids: time and the
   largest distance of the curve points (ours: the curves' points; OpenCascade: 50
   points per section edge) from the exact surfaces;
-* volumes: ``surfprep.composed_volumes`` (the common solid from our curves) vs
-  ``BRepAlgoAPI_Common`` (``IsDone`` checked), both integrated by
-  ``BRepGProp.VolumeProperties`` at 1e-9: time and the error against the exact
-  volume;
+* volumes: ``Composition.volumes`` (the divergence theorem over the faces cut along
+  our curves, in the math layer) vs ``BRepAlgoAPI_Common`` (``IsDone`` checked)
+  integrated by ``BRepGProp.VolumeProperties`` at 1e-9: time and the error against
+  the exact volume;
 * classification of 2000 random points in the pair's box: ``Composition.classify``
   (Newton inversion into each solid) vs one ``BRepClass3d_SolidClassifier`` call per
   point and solid; disagreements between the two counted.
+
+004's hierarchy (second table), on the same pairs: the counts per level (004 §7
+reports 16 Bézier patches, 17 overlap boxes, 26 sub-patch triangulations and two
+loops for its tori, whose placement it does not give), its time with the triangle
+pairs found by the box-tree descent and by 004's kd-tree sweep (the same pairs; the
+candidate stage alone in brackets), the loops' largest gap between their feet on the
+two boundaries, and the surface--surface intersection's time for the same curves.
 
 Run:  python benchmarks/compose.py
 """
@@ -47,6 +56,7 @@ from OCP.TopoDS import TopoDS
 from scipy.integrate import dblquad
 
 import surfprep
+from surfprep.algorithms.composition.regions import region_volumes
 from surfprep.algorithms.volume_builders import block, solid_sphere, solid_torus
 
 REPEATS = 3
@@ -59,6 +69,17 @@ def _sphere(centre, radius):
 
 def _torus(major, minor):
     return lambda p: np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - major, p[:, 2]) - minor)
+
+
+def _tilted_torus(centre, axis, major, minor):
+    c, n = np.asarray(centre, float), np.asarray(axis, float) / np.linalg.norm(axis)
+
+    def distance(p):
+        q = p - c
+        z = q @ n
+        rho = np.linalg.norm(q - z[:, None] * n, axis=1)
+        return np.abs(np.hypot(rho - major, z) - minor)
+    return distance
 
 
 def _block_faces(lo, hi):
@@ -81,6 +102,9 @@ CASES = (
      _sphere((0, 0, 0), 5), _block_faces((3, -2, -2), (7, 2, 2)), None),
     ("torus R 3 r 1 and a ball r 1.5 on it", solid_torus(3.0, 1.0),
      solid_sphere(1.5, (3.0, 0.0, 0.0)), _torus(3, 1), _sphere((3, 0, 0), 1.5), None),
+    ("two misaligned tori (004 Fig. 8)", solid_torus(3.0, 1.0),
+     solid_torus(3.0, 1.0, (1.0, 0.5, 0.3), (0.2, 0.1, 1.0)), _torus(3, 1),
+     _tilted_torus((1.0, 0.5, 0.3), (0.2, 0.1, 1.0), 3, 1), None),
 )
 
 
@@ -141,7 +165,7 @@ def _case(name, a, b, dist_a, dist_b, both) -> list[str]:
         else float("nan")
     out.append(f"| {name} | curves | {t_ours:.3f} | {dev_ours:.2g} | {t_occ:.3f} | "
                f"{dev_occ:.2g} (IsDone {sec.IsDone()}) | {t_ours / t_occ:.1f} |")
-    tv_ours, vol = _best(lambda: surfprep.composed_volumes(a, b))
+    tv_ours, vol = _best(lambda: region_volumes(comp))
 
     def common():
         c = BRepAlgoAPI_Common(ba.shape, bb.shape)
@@ -178,8 +202,37 @@ def rows() -> list[str]:
     return head + out
 
 
+def _hierarchy_row(name, a, b, dist_a, dist_b) -> str:
+    comp = surfprep.compose(a, b)
+    t_ssi, _ = _best(lambda: surfprep.compose(a, b))
+    timed = {}
+    for candidates in ("descent", "sweep"):
+        timed[candidates] = _best(lambda c=candidates: comp.build_hierarchy(candidates=c))
+    h = timed["descent"][1]
+    k = h.counts()
+    pts = np.concatenate([lp.points for lp in h.loops]) if h.loops else np.empty((0, 3))
+    dev = float(max(dist_a(pts).max(), dist_b(pts).max())) if pts.size else float("nan")
+    stage = {c: t[1].times["candidates"] * 1e3 for c, t in timed.items()}
+    return (f"| {name} | {k['bezier_patches_a']} / {k['bezier_patches_b']} | "
+            f"{k['patch_box_pairs']} | {k['overlap_boxes']} | {k['subpatches']} | "
+            f"{k['triangles']} | {k['closed_loops']} of {k['loops']} | {dev:.2g} | "
+            f"{timed['descent'][0]:.3f} ({stage['descent']:.1f} ms) | "
+            f"{timed['sweep'][0]:.3f} ({stage['sweep']:.1f} ms) | {t_ssi:.3f} |")
+
+
+def hierarchy_rows() -> list[str]:
+    head = [("| pair | Bezier patches A / B | patch box pairs | overlap boxes | sub-patches | "
+             "triangles | closed loops | loops' largest distance from the exact surfaces | "
+             "hierarchy s, descent (candidates) | hierarchy s, kd-tree sweep (candidates) | "
+             "SSI curves s |"), "|---|---|---|---|---|---|---|---|---|---|---|"]
+    return head + [_hierarchy_row(name, a, b, da, db) for name, a, b, da, db, _ in CASES]
+
+
 def main() -> None:
     for line in rows():
+        print(line)
+    print()
+    for line in hierarchy_rows():
         print(line)
 
 

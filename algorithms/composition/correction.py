@@ -45,6 +45,8 @@ from ..tolerance import check_tolerance
 
 __all__ = ["CorrectedPoints", "closed_directions", "correct_points", "three_planes"]
 
+#: a point whose feet's gap shrinks by less than this factor in a step has stalled
+STALL = 0.5
 #: |n_B x n_G| below this: the surfaces are tangent there and the point is left as is
 TANGENT_SIN = 1e-8
 
@@ -63,7 +65,8 @@ class CorrectedPoints:
         Distance between the two feet: the point is within ``gap / 2`` of both
         surfaces.
     converged : (n,) bool
-        ``gap <= tol``.
+        ``gap <= tol``. A point whose true position lies off either face (beyond its
+        boundary: a foot is held there) stalls and is not converged.
     iterations : int
     """
 
@@ -184,8 +187,14 @@ def correct_points(surface_a: NurbsSurface, surface_b: NurbsSurface, points: Arr
     for iterations in range(1, max_iter + 1):
         ua[active], foot_a[active] = _feet(surface_a, p[active], ua[active], closed_a, foot_tol)
         ub[active], foot_b[active] = _feet(surface_b, p[active], ub[active], closed_b, foot_tol)
+        previous = gap[active]
         gap[active] = np.linalg.norm(foot_a[active] - foot_b[active], axis=1)
-        active = active[gap[active] > tol]
+        # converged, or stalled (the gap no longer halves: a foot held on a face's
+        # boundary, the curve leaving the face there) from the third step on
+        going = gap[active] > tol
+        if iterations >= 3:
+            going &= gap[active] <= STALL * previous
+        active = active[going]
         if active.size == 0:
             break
         na, nb = _normals(surface_a, ua[active]), _normals(surface_b, ub[active])

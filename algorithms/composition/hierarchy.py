@@ -28,7 +28,9 @@ Levels, each kept for later queries (a :class:`Hierarchy`):
    (:func:`~surfprep.algorithms.intersection.triangles.intersect_triangles`), merged
    into bidirectional lists per box (:func:`.sweep.link_segments`), every point
    moved onto both exact surfaces by triple-plane intersection
-   (:func:`.correction.correct_points`), then the hanging ends of neighbouring boxes
+   (:func:`.correction.correct_points`; a point that does not converge lies beyond a
+   face's boundary, where the curve passes to the next face, and is dropped), then
+   the hanging ends of neighbouring boxes
    joined -- mutually nearest ends within a reach of a few triangle edges -- until
    none hangs (:class:`Loop`).
 
@@ -44,7 +46,7 @@ References
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -302,9 +304,9 @@ def _lap(times: dict, stage: str, since: float) -> float:
 
 
 # ------------------------------------------------------------------ level 5
-@dataclass
+@dataclass(frozen=True)
 class _Piece:
-    """A chain of one box, its points corrected (mutable while loops are assembled)."""
+    """A chain (or a run of one) of one box, its points corrected."""
 
     points: NDArray
     uv_a: NDArray
@@ -350,6 +352,7 @@ def _pieces(patches_a: BoundaryPatches, patches_b: BoundaryPatches, boxes: list[
     groups: dict = {}
     for i, (piece, _) in enumerate(raw):
         groups.setdefault((piece.face_a, piece.face_b), []).append(i)
+    out = []
     for (fa, fb), members in groups.items():
         sizes = [len(raw[i][0].points) for i in members]
         fixed = correct_points(patches_a.surfaces[fa], patches_b.surfaces[fb],
@@ -357,10 +360,24 @@ def _pieces(patches_a: BoundaryPatches, patches_b: BoundaryPatches, boxes: list[
                                np.vstack([raw[i][0].uv_a for i in members]),
                                np.vstack([raw[i][0].uv_b for i in members]), tol=tol)
         for i, part in zip(members, np.split(np.arange(sum(sizes)), np.cumsum(sizes)[:-1])):
-            piece = raw[i][0]
-            piece.points, piece.uv_a, piece.uv_b = fixed.points[part], fixed.uv_a[part], fixed.uv_b[part]
-            piece.gap = fixed.gap[part]
-    return raw
+            piece, closed = raw[i]
+            kept = fixed.converged[part]
+            if kept.all():
+                out.append((replace(piece, points=fixed.points[part], uv_a=fixed.uv_a[part],
+                                    uv_b=fixed.uv_b[part], gap=fixed.gap[part]), closed))
+                continue
+            # points that do not converge lie off a face (the curve leaves it there): the
+            # chain is cut into its runs of converged points
+            if closed:                                   # start the runs after a dropped point
+                part = np.roll(part, -int(np.flatnonzero(~kept)[0]))
+                kept = fixed.converged[part]
+            edges = np.diff(np.concatenate([[0], kept.astype(np.int8), [0]]))
+            for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+                if hi - lo >= 2:
+                    run = part[lo:hi]
+                    out.append((replace(piece, points=fixed.points[run], uv_a=fixed.uv_a[run],
+                                        uv_b=fixed.uv_b[run], gap=fixed.gap[run]), False))
+    return out
 
 
 def _as_loop(parts: list[tuple[_Piece, bool]], closed: bool, tol: float) -> Loop:

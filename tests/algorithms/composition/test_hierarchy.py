@@ -118,3 +118,22 @@ def test_bad_candidates_name():
     a = BoundaryPatches.of(solid_sphere(1.0))
     with pytest.raises(ValueError, match="candidates"):
         build_hierarchy(a, a, tol=1e-6, mesh_tol=1e-3, candidates="brute")
+
+
+def test_a_loop_crossing_a_block_s_edges_joins_its_pieces_on_four_faces():
+    """A ball of radius 5 and the block [3, 7] x [-2, 2]^2: the curve runs over the faces
+    y = +-2 and z = +-2 and passes from one to the next over the block's edges; the
+    points beyond a face (their correction stalls there) are dropped, the runs joined."""
+    ball, box = solid_sphere(5.0), block((4.0, 4.0, 4.0), origin=(3.0, -2.0, -2.0))
+    h = hierarchy(ball, box)
+    assert h.counts()["loops"] == h.counts()["closed_loops"] == 1
+    loop = h.loops[0]
+    assert loop.gap.max() <= h.tol
+    np.testing.assert_allclose(np.linalg.norm(loop.points, axis=1), 5.0, atol=h.tol)
+    on_face = np.minimum(np.abs(np.abs(loop.points[:, 1]) - 2), np.abs(np.abs(loop.points[:, 2]) - 2))
+    assert on_face.max() <= h.tol
+    assert len(np.unique(loop.face_b)) == 4
+    # the whole loop: around the x axis once, no step longer than a few mesh edges
+    angle = np.unwrap(np.arctan2(loop.points[:, 2], loop.points[:, 1]))
+    assert abs(angle[-1] - angle[0]) > 2 * np.pi - 0.3
+    assert np.max(np.linalg.norm(np.diff(loop.points, axis=0), axis=1)) < 0.5
