@@ -92,6 +92,8 @@ CURVE_GAUSS = 8
 PROBE_STEP = 64.0
 #: where along a curve (fractions of its parameter range) its sides are probed
 PROBE_FRACTIONS = (0.1, 0.3, 0.5, 0.7, 0.9)
+#: the end of one curve and the start of the next nearer than this times tol: one point
+JUNCTION = 64.0
 
 
 @functools.cache
@@ -309,14 +311,46 @@ def _share(integral: _FaceIntegral, pcurves: list[NurbsCurve], partners: list, v
     n = len(PROBE_FRACTIONS)
     s1 = integral.surface.domain[1]
     total = 0.0
+    runs = []
     for k, pc in enumerate(pcurves):
         left, right = inside[2 * k * n:(2 * k + 1) * n], inside[(2 * k + 1) * n:(2 * k + 2) * n]
         vote = int(np.sum((left.astype(int) - right.astype(int))[valid[k * n:(k + 1) * n]]))
         if vote:
             total += (1.0 if vote > 0 else -1.0) * integral.line(pc, partner=partners[k], tol=tol)
+            ends = pc.evaluate(np.array(pc.domain))
+            runs.append(ends if vote > 0 else ends[::-1])
+    total += _junctions(integral, runs, tol)
     for (ta, tb), keep in zip(itertools.pairwise(ts), inside[inside.size - ts.size + 1:]):
         if keep:
             total += integral.line(_segment((s1, ta), (s1, tb)))
+    return total
+
+
+def _junctions(integral: _FaceIntegral, runs: list[NDArray], tol: float) -> float:
+    """``oint F dt`` over the short gaps where one curve of the region's boundary ends and
+    the next begins: two intersection curves meeting where the curve passes from one face
+    of the other solid to the next end within ``tol`` of each other, not exactly at one
+    point, and ``dR`` must close there (else an error of ``tol`` times the region's size).
+
+    ``runs`` are the oriented curves' ``(start, end)`` in ``(u, v)``; each end is joined
+    to the nearest start within :data:`JUNCTION` ``tol`` in space and a thousandth of
+    the domain in ``(u, v)`` (a seam's two sides are far apart in ``(u, v)``)."""
+    if not runs:
+        return 0.0
+    s0, s1, t0, t1 = integral.surface.domain
+    ends = np.array([r[1] for r in runs])
+    starts = np.array([r[0] for r in runs])
+    x_end = integral.surface.evaluate(ends[:, 0], ends[:, 1])
+    x_start = integral.surface.evaluate(starts[:, 0], starts[:, 1])
+    space = np.linalg.norm(x_end[:, None] - x_start[None], axis=2)
+    scale = np.array([s1 - s0, t1 - t0])
+    plane = np.max(np.abs(ends[:, None] - starts[None]) / scale, axis=2)
+    space[(space > JUNCTION * tol) | (plane > 1e-3)] = np.inf
+    total = 0.0
+    for i in range(len(runs)):
+        j = int(np.argmin(space[i]))
+        if np.isfinite(space[i, j]) and np.any(ends[i] != starts[j]):
+            total += integral.line(_segment(ends[i], starts[j]))
     return total
 
 

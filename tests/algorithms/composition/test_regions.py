@@ -115,6 +115,21 @@ def _grid_area(face: TrimmedFace, n: int = 500) -> float:
     return float(np.linalg.norm(np.cross(d[:, 1, 0], d[:, 0, 1]), axis=1).sum() * du * dv)
 
 
+
+def test_a_ball_cut_by_a_block_whose_edges_the_curve_crosses():
+    """The curve of a ball r 5 and the block [3, 7] x [-2, 2]^2 passes over four faces of
+    the block; on the ball it is four curves whose ends, computed on different face
+    pairs, meet only to the tolerance: the region's boundary must close there.
+    Exact common volume: integral of sqrt(25 - y^2 - z^2) - 3 over the square (smooth:
+    a 200-point Gauss rule is exact to rounding)."""
+    x, w = np.polynomial.legendre.leggauss(200)
+    y, z = np.meshgrid(2 * x, 2 * x)
+    exact = float(np.sum(np.outer(2 * w, 2 * w) * (np.sqrt(25 - y ** 2 - z ** 2) - 3)))
+    ball, box = solid_sphere(5.0), block((4.0, 4.0, 4.0), origin=(3.0, -2.0, -2.0))
+    c = compose(ball, box)
+    assert c.volume("common") == pytest.approx(exact, rel=1e-10)
+    assert c.volume("union") == pytest.approx(ball.volume() + 64.0 - exact, rel=1e-12)
+
 def test_the_common_boundary_of_two_balls_is_two_caps(balls):
     pieces = boundary_pieces(balls, "common")
     assert all(isinstance(p, BoundaryPiece) and p.inside_other and not p.reversed for p in pieces)
