@@ -33,8 +33,11 @@ Measured, each on the same solids, warm, best of 3:
 reports 16 Bézier patches, 17 overlap boxes, 26 sub-patch triangulations and two
 loops for its tori, whose placement it does not give), its time with the triangle
 pairs found by the box-tree descent and by 004's kd-tree sweep (the same pairs; the
-candidate stage alone in brackets), the loops' largest gap between their feet on the
-two boundaries, and the surface--surface intersection's time for the same curves.
+candidate stage alone in brackets), the loops' largest distance from the exact
+surfaces, the surface--surface intersection's time for the same curves, and the
+hierarchy's time per stage (level 1: the Bezier patches and their boxes; overlap
+boxes with their sub-patches; tessellation; candidate pairs; segments and their
+lists; triple-plane correction; merging the boxes' chains into loops).
 
 Run:  python benchmarks/compose.py
 """
@@ -217,14 +220,16 @@ def _hierarchy_row(name, a, b, dist_a, dist_b) -> str:
             f"{k['patch_box_pairs']} | {k['overlap_boxes']} | {k['subpatches']} | "
             f"{k['triangles']} | {k['closed_loops']} of {k['loops']} | {dev:.2g} | "
             f"{timed['descent'][0]:.3f} ({stage['descent']:.1f} ms) | "
-            f"{timed['sweep'][0]:.3f} ({stage['sweep']:.1f} ms) | {t_ssi:.3f} |")
+            f"{timed['sweep'][0]:.3f} ({stage['sweep']:.1f} ms) | {t_ssi:.3f} | "
+            + ", ".join(f"{k} {v * 1e3:.0f}" for k, v in h.times.items()) + " |")
 
 
 def hierarchy_rows() -> list[str]:
     head = [("| pair | Bezier patches A / B | patch box pairs | overlap boxes | sub-patches | "
              "triangles | closed loops | loops' largest distance from the exact surfaces | "
              "hierarchy s, descent (candidates) | hierarchy s, kd-tree sweep (candidates) | "
-             "SSI curves s |"), "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "SSI curves s | stages, descent (ms) |"),
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     return head + [_hierarchy_row(name, a, b, da, db) for name, a, b, da, db, _ in CASES]
 
 

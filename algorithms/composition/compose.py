@@ -25,8 +25,9 @@ boundaries of the composed regions: :meth:`Composition.volume`,
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,6 +36,9 @@ from ...errors import InvalidGeometryError
 from ..intersection import intersect_surfaces
 from ..volume import NurbsVolume
 from .hierarchy import BoundaryPatches, Hierarchy, build_hierarchy
+
+if TYPE_CHECKING:                                        # pragma: no cover
+    from .regions import RegionVolumes
 
 __all__ = ["Composition", "compose"]
 
@@ -84,10 +88,13 @@ class Composition:
         mesh_tol = max(MESH_SHARE * self.size, self.tol) if mesh_tol is None else float(mesh_tol)
         if not (np.isfinite(mesh_tol) and mesh_tol >= self.tol):
             raise InvalidGeometryError(f"mesh_tol must be >= tol = {self.tol!r}, got {mesh_tol!r}")
+        started = time.perf_counter()
         la, lb = self.level1
-        return build_hierarchy(la if la is not None else BoundaryPatches.of(self.a),
-                               lb if lb is not None else BoundaryPatches.of(self.b),
-                               tol=self.tol, mesh_tol=mesh_tol, candidates=candidates)
+        la = la if la is not None else BoundaryPatches.of(self.a)
+        lb = lb if lb is not None else BoundaryPatches.of(self.b)
+        level1 = time.perf_counter() - started
+        built = build_hierarchy(la, lb, tol=self.tol, mesh_tol=mesh_tol, candidates=candidates)
+        return replace(built, times={"level1": level1, **built.times})
 
     @cached_property
     def hierarchy(self) -> Hierarchy:
@@ -118,10 +125,16 @@ class Composition:
                                        f"got {which!r}")
         if which in ("A", "B"):
             return float((self.a if which == "A" else self.b).volume())
-        from .regions import region_volumes
-        v = region_volumes(self)
+        v = self.volumes
         return {"A only": v.a_only, "A-B": v.a_only, "B only": v.b_only, "common": v.both,
                 "union": v.union}[which]
+
+    @cached_property
+    def volumes(self) -> RegionVolumes:
+        """The volumes of A only, B only, both and the union
+        (:func:`.regions.region_volumes`), computed on first use and kept."""
+        from .regions import region_volumes
+        return region_volumes(self)
 
     def boundary(self, which: str) -> list:
         """The pieces of the exterior faces bounding ``"A"``, ``"B"``, ``"union"``,

@@ -25,7 +25,7 @@ def test_two_balls_meet_in_one_circle_and_points_are_classified_exactly():
     angles = np.sort(np.arctan2(points[:, 2], points[:, 1]))
     assert np.max(np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))) < 0.5
     rng = np.random.default_rng(7)
-    samples = rng.uniform([-6, -6, -6], [12, 6, 6], (3000, 3))
+    samples = rng.uniform([-6, -6, -6], [12, 6, 6], (10_000, 3))
     exact = (np.linalg.norm(samples, axis=1) <= r).astype(int) \
         + 2 * (np.linalg.norm(samples - [d, 0, 0], axis=1) <= r).astype(int)
     labels = c.classify(samples)
@@ -33,6 +33,15 @@ def test_two_balls_meet_in_one_circle_and_points_are_classified_exactly():
                       np.abs(np.linalg.norm(samples - [d, 0, 0], axis=1) - r)) < 1e-6
     assert np.array_equal(labels[~near], exact[~near])
     assert {0, 1, 2, 3} <= set(labels.tolist())
+
+
+def test_tangent_balls_touch_in_one_point_and_have_no_curve():
+    c = compose(solid_sphere(1.0), solid_sphere(1.0, (2, 0, 0)))
+    assert c.curves == () and c.hierarchy.loops == ()
+    assert c.volume("common") == 0.0
+    assert c.volume("union") == pytest.approx(8 / 3 * math.pi, rel=1e-12)
+    # the contact point is on both boundaries: in both, within tol
+    assert c.classify([[1, 0, 0], [0.5, 0, 0], [1.5, 0, 0], [1, 0.1, 0]]).tolist() == [3, 1, 2, 0]
 
 
 def test_a_ball_inside_a_block_meets_nothing():
