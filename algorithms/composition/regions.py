@@ -92,6 +92,8 @@ CURVE_GAUSS = 8
 PROBE_STEP = 64.0
 #: where along a curve (fractions of its parameter range) its sides are probed
 PROBE_FRACTIONS = (0.1, 0.3, 0.5, 0.7, 0.9)
+#: safeguarded Newton steps for a pcurve's crossing of a knot line
+CROSSING_STEPS = 12
 #: the end of one curve and the start of the next nearer than this times tol: one point
 JUNCTION = 64.0
 
@@ -161,16 +163,14 @@ class _FaceIntegral:
                                         own[(own > lo) & (own < hi)]]))
         uv = pcurve.evaluate(tau)
         found = [tau[[0, -1]], own[(own > lo) & (own < hi)]]
+        brackets = []                                  # (a, b, level, axis) of every crossing
         for axis, lines in ((0, self.breaks_s[1:-1]), (1, self.breaks_t[1:-1])):
             gap = uv[:, axis, None] - lines[None, :]                       # (n, lines)
             k, j = np.nonzero((gap[:-1] < 0) != (gap[1:] < 0))
-            a, b, level = tau[k], tau[k + 1], lines[j]
-            below = gap[k, j] < 0
-            for _ in range(60):                                            # bisection
-                mid = 0.5 * (a + b)
-                under = (pcurve.evaluate(mid)[:, axis] < level) == below
-                a, b = np.where(under, mid, a), np.where(under, b, mid)
-            found.append(0.5 * (a + b))
+            brackets.append((tau[k], tau[k + 1], lines[j], np.full(k.size, axis)))
+        a, b, level, axis = (np.concatenate(x) for x in zip(*brackets))
+        if a.size:
+            found.append(_crossings(pcurve, a, b, level, axis))
         out = np.unique(np.concatenate(found))
         return out[np.concatenate([[True], np.diff(out) > 1e-13 * max(hi - lo, 1e-300)])]
 
@@ -228,6 +228,27 @@ class _FaceIntegral:
                                - self.surface.evaluate(d[:, 0, 0], d[:, 0, 1]), axis=1)
         good = (residual <= max(1e-3 * tol, 1e-13)) & (moved <= 16.0 * tol)
         return np.where(good, eta, 0.0)
+
+
+def _crossings(pcurve: NurbsCurve, a: NDArray, b: NDArray, level: NDArray, axis: NDArray
+               ) -> NDArray:
+    """Parameters where coordinate ``axis`` of the pcurve equals ``level``, one in each
+    bracket ``[a, b]`` (a sign change): safeguarded Newton from the secant's root, all
+    brackets at once, bisection where a step would leave its bracket."""
+    rows = np.arange(a.size)
+    fa = pcurve.evaluate(a)[rows, axis] - level
+    fb = pcurve.evaluate(b)[rows, axis] - level
+    x = np.where(fb != fa, a - fa * (b - a) / np.where(fb != fa, fb - fa, 1.0), 0.5 * (a + b))
+    for _ in range(CROSSING_STEPS):
+        d = pcurve.derivatives(x, 1)
+        f, df = d[rows, 0, axis] - level, d[rows, 1, axis]
+        below = (f < 0) == (fa < 0)                  # x on a's side: the root lies above it
+        a, b = np.where(below, x, a), np.where(below, b, x)
+        fa = np.where(below, f, fa)
+        step = x - f / np.where(df != 0, df, np.inf)
+        inside = (step >= a) & (step <= b) & np.isfinite(step)
+        x = np.where(f == 0, x, np.where(inside, step, 0.5 * (a + b)))
+    return x
 
 
 def _segment(a: ArrayLike, b: ArrayLike) -> NurbsCurve:
