@@ -404,6 +404,23 @@ def _as_loop(parts: list[tuple[_Piece, bool]], closed: bool, tol: float) -> Loop
                 data["box"], data["gap"], bool(closed))
 
 
+def _nearest_other_end(ends: NDArray, short: NDArray) -> tuple[NDArray, NDArray]:
+    """For every end ``(2n, 3)`` (ends ``2i``, ``2i + 1`` of piece ``i``) the nearest other
+    end and its distance, by a kd-tree; a ``short`` piece's ends may not pair with each
+    other (a piece too short to close on itself). ``-1`` where there is none."""
+    from scipy.spatial import cKDTree
+    m = ends.shape[0]
+    k = min(m, 3)                           # itself, maybe its own other end, the next
+    distance, index = cKDTree(ends).query(ends, k=k)
+    distance, index = distance.reshape(m, k), index.reshape(m, k)
+    me = np.arange(m)[:, None]
+    banned = (index == me) | ((index // 2 == me // 2) & short[me // 2])
+    distance = np.where(banned, np.inf, distance)
+    pick = np.argmin(distance, axis=1)
+    best = distance[np.arange(m), pick]
+    return np.where(np.isfinite(best), index[np.arange(m), pick], -1), best
+
+
 def _join(pieces: list[tuple[_Piece, bool]], tol: float) -> list[Loop]:
     """Join the hanging ends of open pieces (mutually nearest within reach) into loops."""
     loops = [_as_loop([(p, False)], True, tol) for p, closed in pieces if closed]
@@ -412,16 +429,11 @@ def _join(pieces: list[tuple[_Piece, bool]], tol: float) -> list[Loop]:
         return loops
     ends = np.array([[p.points[0], p.points[-1]] for p in open_]).reshape(-1, 3)   # end 2i, 2i+1
     reach = np.repeat([p.reach for p in open_], 2)
-    d = np.linalg.norm(ends[:, None] - ends[None], axis=2)
-    np.fill_diagonal(d, np.inf)
-    for i, p in enumerate(open_):
-        if len(p.points) < 4:                 # a piece too short to close on itself
-            d[2 * i, 2 * i + 1] = d[2 * i + 1, 2 * i] = np.inf
-    nearest = np.argmin(d, axis=1)
+    nearest, distance = _nearest_other_end(ends, np.array([len(p.points) < 4 for p in open_]))
     mate = np.full(ends.shape[0], -1)
     for e in range(ends.shape[0]):
         f = nearest[e]
-        if nearest[f] == e and d[e, f] <= max(reach[e], reach[f]):
+        if f >= 0 and nearest[f] == e and distance[e] <= max(reach[e], reach[f]):
             mate[e] = f
     used = np.zeros(len(open_), dtype=bool)
     order = list(np.flatnonzero(mate[0::2] < 0)) + list(np.flatnonzero(mate[1::2] < 0)) \
