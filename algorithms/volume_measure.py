@@ -43,16 +43,20 @@ if TYPE_CHECKING:                                        # pragma: no cover
     from .volume import NurbsVolume
 
 __all__ = [
+    "OUTWARD",
     "RATIONAL_EXTRA",
     "VolumeInversion",
     "collapsed_faces",
     "exterior_faces",
     "gauss_rule",
+    "handedness",
     "invert_points",
     "solid_volume",
     "surface_area",
 ]
 
+#: faces whose normal ``S_a x S_b`` points out of a right-handed solid (``det J > 0``)
+OUTWARD = frozenset({"u1", "v0", "w1"})
 #: Gauss points per span and direction added for rational solids
 RATIONAL_EXTRA = 10
 #: default relative tolerance of the collapsed-face and seam tests (times the box diagonal)
@@ -493,3 +497,22 @@ def _outside(setup: _Setup, faces: dict[str, NurbsSurface], targets: NDArray, uv
         distance[found] = residual[residual <= tol]
         inside[found] = True
     return uvw, distance, inside
+
+
+def handedness(volume) -> float:
+    """Sign of ``det J`` at the centre of the solid's parameter box: +1 for a right-handed
+    solid (its :data:`OUTWARD` faces' normals ``S_a x S_b`` point out of it), -1 for a
+    left-handed one (they point in).
+
+    Raises
+    ------
+    InvalidGeometryError
+        ``det J`` vanishes or is not finite there: no orientation for the boundary.
+    """
+    u0, u1, v0, v1, w0, w1 = volume.domain
+    jac = volume.jacobian(0.5 * (u0 + u1), 0.5 * (v0 + v1), 0.5 * (w0 + w1))
+    det = float(np.linalg.det(np.asarray(jac).reshape(3, 3)))
+    if not np.isfinite(det) or det == 0:
+        raise InvalidGeometryError("the solid's Jacobian vanishes at the centre of its "
+                                   "parameter box: no orientation for its boundary")
+    return float(np.sign(det))

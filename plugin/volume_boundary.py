@@ -23,14 +23,13 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_SOLID
 from OCP.TopoDS import TopoDS_Shape
 
 from ..algorithms.volume import NurbsVolume
+from ..algorithms.volume_measure import OUTWARD, handedness
 from ..errors import InvalidGeometryError, OpenCascadeError
 from .occ.faces import make_face
 from .occ.shapes import count_free_edges, is_valid, sew, shell_or_solid
 
 __all__ = ["BoundarySolid", "ComposedVolumes", "boundary_solid", "composed_volumes"]
 
-#: faces pointing out of a right-handed solid (``det J > 0``)
-OUTWARD = {"u1", "v0", "w1"}
 #: relative accuracy of OpenCascade's volume integration of the result
 VOLUME_EPS = 1e-9
 
@@ -59,17 +58,6 @@ class BoundarySolid:
     volume: float
 
 
-def _handedness(volume: NurbsVolume) -> float:
-    """Sign of ``det J`` at the centre of the parameter box."""
-    u0, u1, v0, v1, w0, w1 = volume.domain
-    jac = volume.jacobian(0.5 * (u0 + u1), 0.5 * (v0 + v1), 0.5 * (w0 + w1))
-    det = float(np.linalg.det(np.asarray(jac).reshape(3, 3)))
-    if not np.isfinite(det) or det == 0:
-        raise InvalidGeometryError("the solid's Jacobian vanishes at the centre of its "
-                                   "parameter box: no orientation for its boundary")
-    return np.sign(det)
-
-
 def boundary_solid(volume: NurbsVolume, *, tol: float | None = None) -> BoundarySolid:
     """The solid's exterior boundary faces sewn into an OpenCascade solid (module docstring).
 
@@ -96,7 +84,7 @@ def boundary_solid(volume: NurbsVolume, *, tol: float | None = None) -> Boundary
         raise InvalidGeometryError("boundary_solid needs a NurbsVolume in 3D")
     if tol is None:
         tol = 1e-7 * float(np.linalg.norm(np.ptp(volume.bounding_box(), axis=0)))
-    right = _handedness(volume) > 0
+    right = handedness(volume) > 0
     faces = volume.exterior_faces()
     if not faces:
         raise InvalidGeometryError("the solid has no exterior face (every face collapsed)")

@@ -74,16 +74,14 @@ from ..face_split import Cut, split_face
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
 from ..volume import NurbsVolume
-from ..volume_measure import RATIONAL_EXTRA
+from ..volume_measure import OUTWARD, RATIONAL_EXTRA, handedness
 
 if TYPE_CHECKING:                                        # pragma: no cover
     from .compose import Composition
 
-__all__ = ["BOUNDARIES", "OUTWARD", "BoundaryPiece", "RegionVolumes", "boundary_pieces",
-           "face_integral", "handedness", "region_volumes"]
+__all__ = ["BOUNDARIES", "BoundaryPiece", "RegionVolumes", "boundary_pieces",
+           "face_integral", "region_volumes"]
 
-#: faces whose normal ``S_a x S_b`` points out of a right-handed solid (``det J > 0``)
-OUTWARD = frozenset({"u1", "v0", "w1"})
 #: the boundaries :func:`boundary_pieces` builds
 BOUNDARIES = ("A", "B", "union", "common", "A-B")
 #: Gauss points per piece of a curve in the line integral, at least
@@ -101,17 +99,6 @@ JUNCTION = 64.0
 @functools.cache
 def _legendre(n: int) -> tuple[NDArray, NDArray]:
     return np.polynomial.legendre.leggauss(n)
-
-
-def handedness(volume: NurbsVolume) -> float:
-    """Sign of ``det J`` at the centre of the solid's parameter box (+1 right-handed)."""
-    u0, u1, v0, v1, w0, w1 = volume.domain
-    jac = volume.jacobian(0.5 * (u0 + u1), 0.5 * (v0 + v1), 0.5 * (w0 + w1))
-    det = float(np.linalg.det(np.asarray(jac).reshape(3, 3)))
-    if not np.isfinite(det) or det == 0:
-        raise InvalidGeometryError("the solid's Jacobian vanishes at the centre of its "
-                                   "parameter box: no orientation for its boundary")
-    return float(np.sign(det))
 
 
 def _outward_sign(volume: NurbsVolume, name: str, right: float | None = None) -> float:
