@@ -476,10 +476,14 @@ def _regions(face: TrimmedFace, cycles: list[list[TrimEdge]]) -> list[TrimmedFac
     outer = [k for k, a in enumerate(areas) if a > 0]
     holes = [k for k, a in enumerate(areas) if a <= 0]
     members: dict[int, list[int]] = {k: [] for k in outer}
+    keys = [_cycle_key(cycle) for cycle in cycles]
     for h in holes:
         point = samples[h][len(samples[h]) // 2:len(samples[h]) // 2 + 1]
-        containing = [k for k in outer if inside_loops(point, [samples[k]])[0]
-                      and areas[k] > -areas[h]]
+        # a region bounded by the hole's own edges run the other way (the island inside a
+        # closed cut) does not contain it: its area equals the hole's to rounding, and
+        # the hole's points lie on its boundary
+        containing = [k for k in outer if keys[k] != keys[h]
+                      and inside_loops(point, [samples[k]])[0] and areas[k] > -areas[h]]
         if not containing:
             raise InvalidGeometryError("a clockwise boundary lies in no region (are the loops oriented?)")
         members[min(containing, key=lambda k: areas[k])].append(h)
@@ -490,6 +494,12 @@ def _regions(face: TrimmedFace, cycles: list[list[TrimEdge]]) -> list[TrimmedFac
         loops = [TrimLoop(tuple(_unpaired_seam(e, edges) for e in cycle)) for cycle in region]
         out.append(TrimmedFace(face.surface, tuple(loops), 0, face.reversed, face.name))
     return out
+
+
+def _cycle_key(cycle: list[TrimEdge]) -> frozenset:
+    """The edges of a cycle whatever their direction: its curves and parameter ranges."""
+    return frozenset((id(e.curve3d) if e.curve3d is not None else id(e.pcurve),
+                      round(e.t0, 12), round(e.t1, 12)) for e in cycle)
 
 
 def _unpaired_seam(edge: TrimEdge, edges: list[TrimEdge]) -> TrimEdge:

@@ -7,6 +7,7 @@ import math
 import cadquery as cq
 import numpy as np
 import pytest
+from helpers.paths import SAMPLES
 
 from surfprep.plugin.occ.shapes import face_area
 from surfprep.plugin.split import split
@@ -121,3 +122,37 @@ def test_a_real_hull_cut_at_a_waterline(data_dir):
             BRepBndLib.AddOptimal_s(piece, box, False, False)
             tops.append(box.CornerMax().Z())
         assert min(tops) == pytest.approx(z, abs=1e-3 * (zmax - zmin))
+
+
+def _wing():
+    """A wing-like B-spline solid through the bundled fuselage: a closed, cambered
+    spline section lofted from y = -16 m to 16 m (periodic: its seam runs along the
+    trailing edge)."""
+    def section(y, chord, x0, z0, n=24):
+        th = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        x = x0 + chord * 0.5 * (1 + np.cos(th))
+        z = z0 + chord * 0.12 * np.sin(th) * (0.6 + 0.4 * np.cos(th))
+        return [cq.Vector(a, y, b) for a, b in zip(x, z)]
+    wires = [cq.Wire.assembleEdges([cq.Edge.makeSpline(section(y, c, x0, z0), periodic=True)])
+             for y, c, x0, z0 in ((-16000, 9000, 24000, -1200), (16000, 7000, 26000, -800))]
+    return cq.Solid.makeLoft(wires, True)
+
+
+def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
+    """A real B-spline pair: the wing's root loops lie inside two fuselage faces, each an
+    open curve cut at the wing's seam whose ends meet inside the face. Each face becomes
+    its island and the rest with the island as a hole (the hole once went to the island
+    and the face was refused), the areas adding up to the face's."""
+    import surfprep
+    fuselage = surfprep.read(SAMPLES / "occt_fuselage.stp")
+    out = split(fuselage, _wing())
+    assert out.valid
+    cut = [f for f in out.faces if f.operand == "a"]
+    assert [f.index for f in cut] == [2, 3]
+    for f in cut:
+        assert f.kept is None and len(f.pieces) == 2
+        whole = face_area(fuselage.faces[f.index], 1e-9)
+        assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(whole, rel=1e-6)
+    wing = next(f for f in out.faces if f.operand == "b")
+    assert wing.kept is None and len(wing.pieces) == 3         # inside the body, and out on both sides
+    assert out.shared_edges.get(4) == 2                  # each root loop: one edge, four faces
