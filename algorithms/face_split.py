@@ -40,6 +40,7 @@ from .trimmed import (
     TrimmedFace,
     curve3d_points,
     edge_deviation,
+    natural_loop,
 )
 
 __all__ = ["Cut", "split_face"]
@@ -76,27 +77,6 @@ class Cut:
     def samples(self) -> NDArray:
         t0, t1 = self.range
         return self.pcurve.evaluate(np.linspace(t0, t1, CUT_SAMPLES))
-
-
-def _rectangle_loop(face: TrimmedFace) -> TrimLoop:
-    """The surface's whole rectangle as a counter-clockwise loop of four edges (the
-    pcurves on the surface's own parameters, the iso-lines as 3D curves; a side of no
-    length is a degenerated edge)."""
-    surface = face.surface
-    u0, u1, v0, v1 = surface.domain
-    box = surface.bounding_box()
-    tiny = 1e-12 * float(np.linalg.norm(box[1] - box[0]))
-    sides = (((u0, v0), (u1, v0), "v", v0, u0, u1, False), ((u1, v0), (u1, v1), "u", u1, v0, v1, False),
-             ((u0, v1), (u1, v1), "v", v1, u0, u1, True), ((u0, v0), (u0, v1), "u", u0, v0, v1, True))
-    edges = []
-    for a, b, held, value, t0, t1, backwards in sides:
-        pcurve = NurbsCurve(np.array([a, b], float), np.array([t0, t0, t1, t1]), 1)
-        curve3d = surface.isocurve(value, "u" if held == "u" else "v")
-        ends = curve3d.evaluate(np.array([t0, 0.5 * (t0 + t1), t1]))
-        degenerate = float(np.max(np.linalg.norm(ends - ends[0], axis=1))) <= tiny
-        edges.append(TrimEdge(None if degenerate else curve3d, pcurve, t0, t1, backwards,
-                              degenerated=degenerate))
-    return TrimLoop(tuple(edges))
 
 
 @dataclass
@@ -228,7 +208,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     u0, u1, v0, v1 = face.surface.domain
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
-    loops = list(face.loops) if face.loops else [_rectangle_loop(face)]
+    loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]

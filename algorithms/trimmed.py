@@ -26,14 +26,15 @@ from .surface import NurbsSurface
 
 __all__ = [
     "DEFAULT_TOLERANCE",
+    "LOOP_SAMPLES_PER_EDGE",
     "TrimEdge",
     "TrimLoop",
     "TrimmedFace",
-    "LOOP_SAMPLES_PER_EDGE",
     "curve3d_points",
     "edge_deviation",
     "is_natural",
     "loop_uv",
+    "natural_loop",
 ]
 
 #: Default tolerance of edges, vertices and faces (OpenCascade's Precision::Confusion).
@@ -221,3 +222,23 @@ def is_natural(face: TrimmedFace) -> bool:
     on_side = ((np.abs(uv[:, 0] - u0) <= eps) | (np.abs(uv[:, 0] - u1) <= eps)
                | (np.abs(uv[:, 1] - v0) <= eps) | (np.abs(uv[:, 1] - v1) <= eps))
     return bool(np.all(on_side))
+
+
+def natural_loop(surface: NurbsSurface) -> TrimLoop:
+    """The surface's whole rectangle as a counter-clockwise loop of four edges: the loop
+    of an untrimmed face (the pcurves on the surface's own parameters, the iso-lines as
+    3D curves; a side of no length, a pole, is a degenerated edge)."""
+    u0, u1, v0, v1 = surface.domain
+    box = surface.bounding_box()
+    tiny = 1e-12 * float(np.linalg.norm(box[1] - box[0]))
+    sides = (((u0, v0), (u1, v0), "v", v0, u0, u1, False), ((u1, v0), (u1, v1), "u", u1, v0, v1, False),
+             ((u0, v1), (u1, v1), "v", v1, u0, u1, True), ((u0, v0), (u0, v1), "u", u0, v0, v1, True))
+    edges = []
+    for a, b, held, value, t0, t1, backwards in sides:
+        pcurve = NurbsCurve(np.array([a, b], float), np.array([t0, t0, t1, t1]), 1)
+        curve3d = surface.isocurve(value, "u" if held == "u" else "v")
+        ends = curve3d.evaluate(np.array([t0, 0.5 * (t0 + t1), t1]))
+        degenerate = float(np.max(np.linalg.norm(ends - ends[0], axis=1))) <= tiny
+        edges.append(TrimEdge(None if degenerate else curve3d, pcurve, t0, t1, backwards,
+                              degenerated=degenerate))
+    return TrimLoop(tuple(edges))
