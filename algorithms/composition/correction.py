@@ -40,10 +40,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
 from ..intersection.refine import project_points
+from ..intersection.seams import closed_directions
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 
-__all__ = ["CorrectedPoints", "closed_directions", "correct_points", "three_planes"]
+__all__ = ["CorrectedPoints", "correct_points", "three_planes"]
 
 #: a point whose feet's gap shrinks by less than this factor in a step has stalled
 STALL = 0.5
@@ -114,17 +115,6 @@ def three_planes(normals: NDArray, offsets: NDArray) -> tuple[NDArray, NDArray]:
 def _normals(surface: NurbsSurface, uv: NDArray) -> NDArray:
     d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
     return _unit(np.cross(d[:, 1, 0], d[:, 0, 1]))[0]
-
-
-def closed_directions(surface: NurbsSurface, tol: float) -> tuple[bool, bool]:
-    """Whether the surface closes in ``u`` (``S(u_min, v) = S(u_max, v)`` within ``tol`` on
-    17 values of ``v``) and in ``v``: a seam a foot point may cross."""
-    u0, u1, v0, v1 = surface.domain
-    s = np.linspace(0.0, 1.0, 17)
-    u, v = u0 + (u1 - u0) * s, v0 + (v1 - v0) * s
-    in_u = np.linalg.norm(surface.evaluate(np.full(17, u0), v) - surface.evaluate(np.full(17, u1), v), axis=1)
-    in_v = np.linalg.norm(surface.evaluate(u, np.full(17, v0)) - surface.evaluate(u, np.full(17, v1)), axis=1)
-    return bool(np.all(in_u <= tol)), bool(np.all(in_v <= tol))
 
 
 def _feet(surface: NurbsSurface, x: NDArray, uv: NDArray, closed: tuple[bool, bool], tol: float

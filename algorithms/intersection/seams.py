@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from ..surface import NurbsSurface
 from .topology import Chain, EndKind, SegmentTopology
 
-__all__ = ["cut_at_seams", "other_side", "seam_jumps"]
+__all__ = ["closed_directions", "cut_at_seams", "other_side", "seam_jumps"]
 
 
 def seam_jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
@@ -179,3 +179,14 @@ def cut_at_seams(topology: SegmentTopology, surface_a: NurbsSurface | None,
                    uv_a=None if uv_a is None else np.concatenate(uv_a),
                    uv_b=None if uv_b is None else np.concatenate(uv_b),
                    chains=tuple(chains))
+
+
+def closed_directions(surface: NurbsSurface, tol: float) -> tuple[bool, bool]:
+    """Whether the surface closes in ``u`` (``S(u_min, v) = S(u_max, v)`` within ``tol`` on
+    17 values of ``v``) and in ``v``: a seam a foot point may cross."""
+    u0, u1, v0, v1 = surface.domain
+    s = np.linspace(0.0, 1.0, 17)
+    u, v = u0 + (u1 - u0) * s, v0 + (v1 - v0) * s
+    in_u = np.linalg.norm(surface.evaluate(np.full(17, u0), v) - surface.evaluate(np.full(17, u1), v), axis=1)
+    in_v = np.linalg.norm(surface.evaluate(u, np.full(17, v0)) - surface.evaluate(u, np.full(17, v1)), axis=1)
+    return bool(np.all(in_u <= tol)), bool(np.all(in_v <= tol))

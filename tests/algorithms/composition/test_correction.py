@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from surfprep.algorithms.composition.correction import closed_directions, correct_points, three_planes
+from surfprep.algorithms.composition.correction import correct_points, three_planes
+from surfprep.algorithms.intersection.seams import closed_directions
 from surfprep.algorithms.volume_builders import block, solid_sphere, solid_torus
 
 

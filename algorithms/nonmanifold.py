@@ -1,0 +1,267 @@
+"""A use-based non-manifold boundary representation of trimmed faces (002 §1).
+
+Faces cut along their intersection curves meet in edges that two, three, four or more
+faces use: where two surfaces cross, the intersection edge bounds two pieces of each.
+:class:`NonManifoldModel` records that structure as plain data, NOODLES-style (every
+occurrence of an edge in a face's loop is a *use* of the edge, with its own pcurve and
+its direction along the edge):
+
+* **vertices** -- points where edges end, ends within ``tol`` of each other merged;
+* **edges** -- one 3D curve over a parameter range and two vertices; an edge is the
+  class of the loops' edge occurrences that run over the same points (start, end and
+  three interior points within ``tol``, either way round: a closed edge is told from
+  its reverse by its quarter points);
+* **uses** -- per edge, the occurrences ``(face, loop, position)`` with their pcurve
+  and whether they run against the edge, in **radial order**: the faces around the
+  edge sorted by the angle of the direction pointing into each face, in the plane
+  normal to the edge at its middle. A face's loops are stored for the face seen
+  FORWARD (outer loop counter-clockwise in ``(u, v)``), so with ``N = S_u x S_v`` and
+  ``t`` the loop's direction along the edge the face lies on the side ``N x t``;
+* **faces** -- the :class:`~.trimmed.TrimmedFace` s with their origin (operand and
+  index in it).
+
+Queries: the faces around an edge (:meth:`NonManifoldModel.faces_around`), the
+edges of a face, free edges (one use), the number of edges by their number of uses,
+connected components, which operand a face came from.
+
+Degenerated edges (a pole: no extent in space) are left out: they join no face to
+another.
+
+References
+----------
+002 §1 (see ``surfprep.algorithms`` References).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InvalidGeometryError
+from .curve import NurbsCurve
+from .trimmed import TrimEdge, TrimmedFace, curve3d_points, natural_loop
+
+__all__ = ["EdgeUse", "NonManifoldModel"]
+
+#: parameters (fractions of an occurrence's range) compared to tell two occurrences
+#: apart: the ends, the quarter points and the middle
+_FRACTIONS = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+
+
+@dataclass(frozen=True)
+class EdgeUse:
+    """One occurrence of an edge in a face's loop.
+
+    Attributes
+    ----------
+    face, loop, position : int
+        Where: ``faces[face].loops[loop].edges[position]``.
+    against : bool
+        The loop runs along the edge against the edge's direction.
+    angle : float
+        Radians, in ``[0, 2 pi)``: the direction into the face around the edge at its
+        middle (the radial order), from the edge's first use.
+    """
+
+    face: int
+    loop: int
+    position: int
+    against: bool
+    angle: float
+
+    def occurrence(self, faces) -> TrimEdge:
+        return faces[self.face].loops[self.loop].edges[self.position]
+
+
+class _Union:
+    def __init__(self, n: int) -> None:
+        self.parent = np.arange(n)
+
+    def find(self, k: int) -> int:
+        root = k
+        while self.parent[root] != root:
+            root = self.parent[root]
+        while self.parent[k] != root:
+            self.parent[k], k = root, self.parent[k]
+        return int(root)
+
+    def join(self, a: int, b: int) -> None:
+        ra, rb = self.find(a), self.find(b)
+        if ra != rb:
+            self.parent[max(ra, rb)] = min(ra, rb)
+
+    def labels(self) -> NDArray:
+        roots = np.array([self.find(k) for k in range(self.parent.size)], dtype=np.int64)
+        return np.unique(roots, return_inverse=True)[1]
+
+
+def _loop_points(edge: TrimEdge, surface) -> NDArray:
+    """``(5, 3)`` points of an occurrence at :data:`_FRACTIONS` of its range, in the
+    edge's own direction (``t0`` to ``t1``)."""
+    t = edge.t0 + (edge.t1 - edge.t0) * _FRACTIONS
+    return curve3d_points(edge, surface, t)
+
+
+def _normal_and_tangent(edge: TrimEdge, surface, pcurve: NurbsCurve) -> tuple[NDArray, NDArray, NDArray]:
+    """At the occurrence's middle: the point, ``S_u x S_v`` and the tangent in space
+    along ``t0 -> t1`` (through the pcurve and the surface)."""
+    t = np.array([0.5 * (edge.t0 + edge.t1)])
+    d = pcurve.derivatives(t, 1)[0]                                   # (2, 2)
+    s = surface.derivatives(d[0, 0:1], d[0, 1:2], 1)[0]               # (2, 2, 3)
+    tangent = s[1, 0] * d[1, 0] + s[0, 1] * d[1, 1]
+    return s[0, 0], np.cross(s[1, 0], s[0, 1]), tangent
+
+
+def _unit(v: NDArray) -> NDArray:
+    n = float(np.linalg.norm(v))
+    return v / n if n > 0 else v
+
+
+@dataclass(frozen=True, eq=False)
+class NonManifoldModel:
+    """Faces and the edges they share, by use (the module doc).
+
+    Attributes
+    ----------
+    faces : tuple of TrimmedFace
+        The faces given, an untrimmed one with its rectangle as its loop
+        (:func:`~.trimmed.natural_loop`).
+    origins : tuple of (str, int)
+        Per face, the operand it came from and its index there.
+    vertices : (nv, 3) float
+    edge_vertices : (ne, 2) int
+        Start and end vertex of each edge (equal for a closed edge).
+    uses : tuple of tuple of EdgeUse
+        Per edge, its uses in radial order.
+    tol : float
+    """
+
+    faces: tuple
+    origins: tuple
+    vertices: NDArray
+    edge_vertices: NDArray
+    uses: tuple
+    tol: float
+
+    @classmethod
+    def build(cls, faces: list[TrimmedFace], origins: list[tuple[str, int]] | None = None, *,
+              tol: float) -> NonManifoldModel:
+        """The structure of ``faces``: their edge occurrences matched in space within
+        ``tol`` (model units).
+
+        Raises
+        ------
+        InvalidGeometryError
+            ``tol`` not positive, or ``origins`` of another length than ``faces``.
+        """
+        from scipy.spatial import cKDTree
+        if not (np.isfinite(tol) and tol > 0):
+            raise InvalidGeometryError(f"tol must be a positive length, got {tol!r}")
+        faces = tuple(f if f.loops else TrimmedFace(f.surface, (natural_loop(f.surface),), 0,
+                                                    f.reversed, f.name) for f in faces)
+        origins = tuple(origins) if origins is not None else tuple(("a", k) for k in range(len(faces)))
+        if len(origins) != len(faces):
+            raise InvalidGeometryError("origins needs one (operand, index) per face")
+        where, samples = [], []
+        for f, face in enumerate(faces):
+            for li, loop in enumerate(face.loops):
+                for k, edge in enumerate(loop.edges):
+                    if edge.degenerated:
+                        continue
+                    where.append((f, li, k))
+                    samples.append(_loop_points(edge, face.surface))
+        if not where:
+            return cls(faces, origins, np.zeros((0, 3)), np.zeros((0, 2), np.int64), (), float(tol))
+        pts = np.array(samples)                                           # (m, 5, 3)
+        union = _Union(len(where))
+        flip = np.zeros(len(where), dtype=bool)                           # against its class's first
+        for i, j in cKDTree(pts[:, 2]).query_pairs(tol, output_type="ndarray"):
+            same = np.max(np.linalg.norm(pts[i] - pts[j], axis=1))
+            other = np.max(np.linalg.norm(pts[i] - pts[j, ::-1], axis=1))
+            if min(same, other) <= tol:
+                union.join(int(i), int(j))
+        label = union.labels()
+        first = np.full(label.max() + 1, -1)
+        for m in range(len(where)):
+            if first[label[m]] < 0:
+                first[label[m]] = m
+        for m in range(len(where)):
+            ref = pts[first[label[m]]]
+            flip[m] = (np.max(np.linalg.norm(pts[m, ::-1] - ref, axis=1))
+                       < np.max(np.linalg.norm(pts[m] - ref, axis=1)))
+        # vertices: the edges' ends merged within tol
+        ends = np.stack([pts[first, 0], pts[first, -1]], axis=1).reshape(-1, 3)
+        vunion = _Union(ends.shape[0])
+        for i, j in cKDTree(ends).query_pairs(tol, output_type="ndarray"):
+            vunion.join(int(i), int(j))
+        vlabel = vunion.labels()
+        vertices = np.array([ends[vlabel == v].mean(axis=0) for v in range(vlabel.max() + 1)])
+        edge_vertices = vlabel.reshape(-1, 2)
+        uses = []
+        for e in range(first.size):
+            members = np.flatnonzero(label == e)
+            uses.append(cls._radial(faces, [where[m] for m in members], flip[members]))
+        return cls(faces, origins, vertices, edge_vertices, tuple(uses), float(tol))
+
+    @staticmethod
+    def _radial(faces, where: list[tuple[int, int, int]], flip: NDArray) -> tuple[EdgeUse, ...]:
+        """The uses of one edge in radial order (the module doc)."""
+        directions, axis = [], None
+        for (f, li, k), flipped in zip(where, flip):
+            face = faces[f]
+            edge = face.loops[li].edges[k]
+            _, normal, tangent = _normal_and_tangent(edge, face.surface, edge.pcurve)
+            along = tangent * (-1.0 if edge.reversed else 1.0)          # the loop's direction
+            directions.append(np.cross(normal, along))
+            if axis is None:
+                axis = _unit(tangent * (-1.0 if flipped else 1.0))      # the edge's direction
+        e1 = directions[0] - np.dot(directions[0], axis) * axis
+        e1 = _unit(e1)
+        e2 = np.cross(axis, e1)
+        out = []
+        for (f, li, k), flipped, d in zip(where, flip, directions):
+            edge = faces[f].loops[li].edges[k]
+            angle = float(np.arctan2(np.dot(d, e2), np.dot(d, e1))) % (2 * np.pi)
+            out.append(EdgeUse(f, li, k, bool(edge.reversed != flipped), angle))
+        return tuple(sorted(out, key=lambda u: u.angle))
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def n_edges(self) -> int:
+        return len(self.uses)
+
+    def faces_around(self, edge: int) -> tuple[int, ...]:
+        """The faces using ``edge``, in radial order (a face twice on a seam)."""
+        return tuple(u.face for u in self.uses[edge])
+
+    def edges_of(self, face: int) -> tuple[int, ...]:
+        """The edges ``face`` uses (sorted; a seam once)."""
+        return tuple(sorted({e for e, uses in enumerate(self.uses) for u in uses if u.face == face}))
+
+    def use_counts(self) -> NDArray:
+        """``(ne,)`` how many uses each edge has."""
+        return np.array([len(u) for u in self.uses], dtype=np.int64)
+
+    def edges_by_uses(self) -> dict[int, int]:
+        """Number of edges by their number of uses (``{1: free, 2: manifold, 4: ...}``)."""
+        counts = self.use_counts()
+        return {int(k): int(np.sum(counts == k)) for k in np.unique(counts)}
+
+    def free_edges(self) -> NDArray:
+        """The edges one face uses."""
+        return np.flatnonzero(self.use_counts() == 1)
+
+    def operand(self, face: int) -> str:
+        return self.origins[face][0]
+
+    def components(self) -> list[list[int]]:
+        """Faces connected through shared edges, each component sorted, largest first."""
+        union = _Union(len(self.faces))
+        for uses in self.uses:
+            for u in uses[1:]:
+                union.join(uses[0].face, u.face)
+        label = union.labels() if self.faces else np.zeros(0, np.int64)
+        groups = [list(np.flatnonzero(label == c)) for c in range(label.max() + 1)] if label.size else []
+        return sorted(([int(f) for f in g] for g in groups), key=lambda g: (-len(g), g[0]))
