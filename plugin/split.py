@@ -18,8 +18,11 @@ from typing import Any
 
 import numpy as np
 
+from ..algorithms.containment import INSIDE, ON, classify_points, interior_point
 from ..algorithms.face_split import Cut, split_face
+from ..algorithms.nonmanifold import NonManifoldModel
 from ..errors import OpenCascadeError, SurfprepError
+from .convert import to_nurbs
 from .intersect import IntersectionResult, intersect
 from .io import as_model
 from .occ.faces import trimmed_face_to_occ
@@ -70,6 +73,10 @@ class SplitResult:
     time_s: float = field(default=0.0, compare=False)
     pieces_a: tuple = field(default=(), repr=False, compare=False)
     pieces_b: tuple = field(default=(), repr=False, compare=False)
+    #: the pieces and uncut faces as trimmed faces, with the edges they share by use
+    #: (:class:`~surfprep.algorithms.nonmanifold.NonManifoldModel`, same order as
+    #: ``pieces_a + pieces_b``)
+    structure: NonManifoldModel | None = field(default=None, repr=False, compare=False)
 
     @property
     def geometry(self) -> Any:
@@ -81,7 +88,10 @@ class SplitResult:
                 "curves": len(self.curves), "pieces": sum(len(f.pieces) for f in self.faces),
                 "free_edges": self.free_edges,
                 "edges_by_faces": {str(k): v for k, v in sorted(self.shared_edges.items())},
-                "valid": self.valid, "time_s": self.time_s}
+                "valid": self.valid, "time_s": self.time_s,
+                **({} if self.structure is None else {"structure": {
+                    "edges_by_uses": {str(k): v for k, v in self.structure.edges_by_uses().items()},
+                    "components": len(self.structure.components())}})}
 
 
 def _edge_uses(shape) -> dict:
@@ -143,14 +153,17 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
             trimmed[key] = face.trimmed
     done: list[SplitFace] = []
     by_operand: dict[str, list] = {"a": [], "b": []}
+    trims: dict[str, list] = {"a": [], "b": []}              # the same faces as trimmed faces
     cut_faces = set(cuts)
     for operand, model in (("a", model_a), ("b", None if tool else model_b)):
         if model is None:
             continue
+        whole = to_nurbs(model)
         for k, occ_face in enumerate(model.faces):
             key = (operand, k)
             if key not in cut_faces:
                 by_operand[operand].append(occ_face)
+                trims[operand].append((whole[k], (operand, k)))
                 continue
             try:
                 regions = split_face(trimmed[key], cuts[key], tol3d=10.0 * (curves.tol or 0.0))
@@ -158,16 +171,21 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
             except SurfprepError as exc:
                 done.append(SplitFace(operand, k, len(cuts[key]), (occ_face,), str(exc)))
                 by_operand[operand].append(occ_face)
+                trims[operand].append((whole[k], (operand, k)))
                 continue
             done.append(SplitFace(operand, k, len(cuts[key]), pieces))
             by_operand[operand].extend(pieces)
+            trims[operand].extend((region, (operand, k)) for region in regions)
     faces = by_operand["a"] + by_operand["b"]
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
     shape = sew(faces, sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
     valid = all(is_valid(p) for f in done for p in f.pieces)
+    listed = trims["a"] + trims["b"]
+    structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
-                       time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]))
+                       time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]),
+                       structure)
 
 
 #: the operations and, per operand, which pieces they keep: (of a, of b), each "in" or "out"
@@ -220,32 +238,26 @@ def _solid_of(model, tol: float):
     return shape
 
 
-def _inside(piece, solid, tol: float) -> bool:
-    """Is a point inside the piece (away from its edges) inside the solid?"""
-    from OCP.BRep import BRep_Tool
-    from OCP.BRepClass import BRepClass_FaceClassifier
-    from OCP.BRepClass3d import BRepClass3d_SolidClassifier
-    from OCP.BRepTools import BRepTools
-    from OCP.gp import gp_Pnt2d
-    from OCP.TopAbs import TopAbs_IN
-    u0, u1, v0, v1 = BRepTools.UVBounds_s(piece)
-    surface = BRep_Tool.Surface_s(piece)
-    best = None
-    for n in (5, 9, 17, 33):
-        for a in (np.arange(n) + 0.5) / n:
-            for b in (np.arange(n) + 0.5) / n:
-                uv = gp_Pnt2d(u0 + a * (u1 - u0), v0 + b * (v1 - v0))
-                if BRepClass_FaceClassifier(piece, uv, 1e-9).State() == TopAbs_IN:
-                    centred = abs(a - 0.5) + abs(b - 0.5)
-                    if best is None or centred < best[0]:
-                        best = (centred, uv)
-        if best is not None:
-            break
-    if best is None:
-        raise OpenCascadeError("no point found inside a piece to classify it")
-    point = surface.Value(best[1].X(), best[1].Y())
-    classifier = BRepClass3d_SolidClassifier(solid, point, tol)
-    return classifier.State() == TopAbs_IN
+def _pieces_inside(cut: SplitResult, faces_a: list, faces_b: list, tol: float) -> list[bool]:
+    """Whether each piece (``pieces_a + pieces_b``) lies inside the other operand: a point
+    well inside the piece (:func:`~surfprep.algorithms.containment.interior_point`)
+    classified against the other operand's faces by ray parity on their exact surfaces
+    (:func:`~surfprep.algorithms.containment.classify_points`). A piece whose point lies
+    on the other operand (a coincident face) raises: coincident faces are not handled."""
+    pieces = cut.structure.faces
+    points = np.array([interior_point(piece)[1] for piece in pieces]).reshape(-1, 3)
+    operand = np.array([origin[0] for origin in cut.structure.origins])
+    out = np.zeros(len(pieces), dtype=bool)
+    for side, other in (("a", faces_b), ("b", faces_a)):
+        rows = np.flatnonzero(operand == side)
+        if rows.size == 0:
+            continue
+        label = classify_points(other, points[rows], tol=tol)
+        if np.any(label == ON):
+            raise OpenCascadeError("a piece lies on the other operand's boundary (coincident "
+                                   "faces): not handled")
+        out[rows] = label == INSIDE
+    return out.tolist()
 
 
 def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method: str = "auto") -> BooleanResult:
@@ -253,7 +265,8 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
 
     Every face of ``a`` and of ``b`` is cut along the intersection curves
     (:func:`split`); each piece is classified by a point inside it against the
-    other solid, and the operation keeps (fuse) the pieces of each outside the
+    other solid (ray parity on the exact trimmed surfaces, in the math layer:
+    :func:`~surfprep.algorithms.containment.classify_points`), and the operation keeps (fuse) the pieces of each outside the
     other, (common) those inside, (cut) ``a``'s outside ``b`` and ``b``'s inside
     ``a`` turned over. The kept pieces are sewn into the result.
 
@@ -274,10 +287,12 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     cut = split(model_a, model_b, tol=tol, method=method)
     size = max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
-    solid_a, solid_b = _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)
+    _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
     keep_a, keep_b = OPERATIONS[operation]
-    chosen_a = [p for p in cut.pieces_a if _inside(p, solid_b, sew_tol) == (keep_a == "in")]
-    chosen_b = [p for p in cut.pieces_b if _inside(p, solid_a, sew_tol) == (keep_b == "in")]
+    inside = _pieces_inside(cut, to_nurbs(model_a), to_nurbs(model_b), sew_tol)
+    n_a = len(cut.pieces_a)
+    chosen_a = [p for p, i in zip(cut.pieces_a, inside[:n_a]) if i == (keep_a == "in")]
+    chosen_b = [p for p, i in zip(cut.pieces_b, inside[n_a:]) if i == (keep_b == "in")]
     if operation == "cut":
         chosen_b = [p.Reversed() for p in chosen_b]
     faces = chosen_a + chosen_b

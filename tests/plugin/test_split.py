@@ -24,6 +24,11 @@ def test_two_crossing_sheets_become_four_pieces_around_one_edge():
     assert report["pieces"] == 4 and out.valid
     assert out.shared_edges.get(4) == 1                   # the intersection edge: four faces
     assert out.free_edges == 12                           # the sheets' outer borders, cut in two
+    # the same by our own structure, and the four faces alternate around the edge
+    structure = out.structure
+    assert structure.edges_by_uses() == {1: 12, 4: 1}
+    (edge,) = [e for e in range(structure.n_edges) if len(structure.uses[e]) == 4]
+    assert [structure.operand(f) for f in structure.faces_around(edge)] in (list("abab"), list("baba"))
     for f in out.faces:
         assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(4.0, rel=1e-9)
 
@@ -40,6 +45,7 @@ def test_a_sphere_through_a_plate_is_cut_into_its_exact_zones():
                                               2 * math.pi * radius * (radius - 5.5),
                                               2 * math.pi * radius * (radius + 4.5)]), rtol=1e-6)
     assert out.shared_edges.get(4) == 2                   # both circles bound four faces
+    assert out.structure.edges_by_uses() == {2: 15, 4: 2} # ours: the same (poles are no edges)
 
 
 def test_a_face_whose_curves_cross_is_cut_into_four():
@@ -156,3 +162,5 @@ def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
     wing = next(f for f in out.faces if f.operand == "b")
     assert wing.kept is None and len(wing.pieces) == 3         # inside the body, and out on both sides
     assert out.shared_edges.get(4) == 2                  # each root loop: one edge, four faces
+    assert out.structure.edges_by_uses() == {2: 19, 4: 2}
+    assert len(out.structure.components()) == 1
