@@ -26,7 +26,7 @@ from .convert import to_nurbs
 from .intersect import IntersectionResult, intersect
 from .io import as_model
 from .occ.faces import trimmed_face_to_occ
-from .occ.shapes import compound, count_free_edges, is_valid, sew, shell_or_solid
+from .occ.shapes import compound, count_free_edges, face_area, is_valid, sew, shell_or_solid
 
 __all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split"]
 
@@ -83,15 +83,42 @@ class SplitResult:
         return self.shape
 
     def report(self) -> dict:
+        """Plain JSON: per cut face its curves and pieces (or why it was kept whole); per
+        output face its origin, name and area; per intersection edge its faces, length
+        and largest distance from each surface; the edges by the number of faces using
+        them (OpenCascade's sewing, and ours by use), free edges, validity, time."""
         return {"faces": [{"operand": f.operand, "index": f.index, "cuts": f.cuts, "pieces": len(f.pieces),
                            "kept_whole": f.kept} for f in self.faces],
                 "curves": len(self.curves), "pieces": sum(len(f.pieces) for f in self.faces),
                 "free_edges": self.free_edges,
                 "edges_by_faces": {str(k): v for k, v in sorted(self.shared_edges.items())},
                 "valid": self.valid, "time_s": self.time_s,
+                "intersection_edges": [
+                    {"faces": list(r.faces), "closed": r.closed, "length": r.length,
+                     "max_distance_a": d.to_a, "max_distance_b": d.to_b}
+                    for r, d in ((r, r.max_deviation()) for r in self.curves)],
+                "output_faces": self.output_faces(),
                 **({} if self.structure is None else {"structure": {
                     "edges_by_uses": {str(k): v for k, v in self.structure.edges_by_uses().items()},
                     "components": len(self.structure.components())}})}
+
+    def output_faces(self) -> list[dict]:
+        """Per output face (``pieces_a + pieces_b``): the operand and face it came from,
+        its name (an uncut face keeps its own; the pieces of a cut face get it with a
+        suffix ``.1``, ``.2``, ...) and its area (GProp, 1e-9)."""
+        if self.structure is None:
+            return []
+        out, seen = [], {}
+        cut = {(f.operand, f.index) for f in self.faces if f.kept is None}
+        for face, trimmed, (operand, index) in zip(self.pieces_a + self.pieces_b, self.structure.faces,
+                                                   self.structure.origins):
+            name = trimmed.name
+            if (operand, index) in cut:
+                seen[(operand, index)] = seen.get((operand, index), 0) + 1
+                name = f"{name or f'{operand}{index}'}.{seen[(operand, index)]}"
+            out.append({"operand": operand, "face": index, "name": name,
+                        "area": face_area(face, 1e-9)})
+        return out
 
 
 def _edge_uses(shape) -> dict:

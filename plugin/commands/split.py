@@ -25,28 +25,41 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="intersection method (as surfprep intersect)")
     parser.add_argument("--tool", action="store_true",
                         help="B only cuts: write A's faces split, not B's (a hull cut at a waterline)")
+    parser.add_argument("--op", choices=("split", "fuse", "cut", "common"), default=None,
+                        help="split (default: every piece), or fuse, cut (A minus B) or common of "
+                             "two solids: write the pieces that operation keeps, sewn")
     parser.add_argument("--boolean", choices=("fuse", "cut", "common"), default=None, metavar="OP",
-                        help="fuse, cut (A minus B) or common of two solids: write the pieces "
-                             "that operation keeps, sewn, instead of all of them")
+                        help="the same as --op OP")
+    parser.add_argument("--compare-occ", action="store_true",
+                        help="also run OpenCascade on the same input (the General Fuse, or "
+                             "BRepAlgoAPI_Splitter with --tool, or BRepAlgoAPI_Fuse/Cut/Common) "
+                             "and report its faces, validity, largest edge tolerance, area, "
+                             "volume and time")
+    parser.add_argument("--plot", type=Path, metavar="PNG",
+                        help="draw the intersection curves in space and in each face's (u, v) "
+                             "domain (needs matplotlib)")
     parser.add_argument("--json", metavar="PATH", dest="json_path",
                         help="write the report as JSON to PATH ('-' for stdout)")
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
     inputs = tuple(p for p in (args.a, args.b) if p is not None)
-    check_outputs(inputs, args.output, json_path=args.json_path)
+    check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     check_inputs(*inputs)
+    from ...errors import InvalidGeometryError
+    if args.op is not None and args.boolean is not None and args.op != args.boolean:
+        raise InvalidGeometryError(f"--op {args.op} and --boolean {args.boolean} disagree")
+    op = args.boolean or (args.op if args.op != "split" else None)
     from ..io import staged_write
     from ..split import split
     model_a = read_model(args.a, console, strict=args.strict)
     model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
     operation = None
-    if args.boolean is not None:
-        from ...errors import InvalidGeometryError
+    if op is not None:
         from ..split import boolean
         if model_b is None:
-            raise InvalidGeometryError("--boolean needs two files, A and B")
-        operation = boolean(model_a, model_b, args.boolean, tol=args.tol, method=args.method)
+            raise InvalidGeometryError(f"--op {op} needs two files, A and B")
+        operation = boolean(model_a, model_b, op, tol=args.tol, method=args.method)
         result = operation.split
     else:
         result = split(model_a, model_b, tol=args.tol, method=args.method, tool=args.tool)
@@ -57,6 +70,11 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                   "output": str(staged.target), **result.report()}
         if operation is not None:
             report["boolean"] = {k: v for k, v in operation.report().items() if k != "split"}
+        if args.compare_occ:
+            report["occ"] = _occ_figures(model_a, model_b, op, args.tool)
+        if args.plot is not None:
+            from .intersect import plot_curves
+            report["plot"] = str(plot_curves(result.curves, args.plot, two_models=model_b is not None))
         report_path = publish(staged, report, args.json_path, console, protected=inputs)
     if args.json_path != STDOUT:
         for f in result.faces:
@@ -70,11 +88,77 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                       f"written to {staged.target}")
         if operation is not None:
             volume = "open" if operation.volume is None else f"volume {operation.volume:.10g}"
-            console.print(f"{args.boolean}: {operation.kept[0]} piece(s) of A and {operation.kept[1]} "
+            console.print(f"{op}: {operation.kept[0]} piece(s) of A and {operation.kept[1]} "
                           f"of B kept, {volume}, {'valid' if operation.valid else 'INVALID'}")
+        if args.compare_occ:
+            occ = report["occ"]
+            volume = "" if occ["volume"] is None else f", volume {occ['volume']:.10g}"
+            console.print(f"OpenCascade ({occ['method']}): {occ['faces']} face(s), "
+                          f"{'valid' if occ['valid'] else 'INVALID'}, largest edge tolerance "
+                          f"{occ['max_edge_tolerance']:.2g}{volume}; {occ['time_s']:.2f} s")
         if report_path is not None:
             console.note(f"report written to {report_path}")
     return done_code(model_a, model_b, skipped=bool(kept))
+
+
+def _occ_figures(model_a, model_b, op: str | None, tool: bool) -> dict:
+    """OpenCascade's answer on the same input: its Boolean (``op``), else the General
+    Fuse of A and B (``BRepAlgoAPI_Splitter`` with ``tool``: B only cuts; A's faces
+    against one another without B), with its figures (``IsDone`` checked)."""
+    import time
+
+    from OCP.BRepAlgoAPI import (
+        BRepAlgoAPI_BuilderAlgo,
+        BRepAlgoAPI_Common,
+        BRepAlgoAPI_Cut,
+        BRepAlgoAPI_Fuse,
+        BRepAlgoAPI_Splitter,
+    )
+    from OCP.TopTools import TopTools_ListOfShape
+
+    from ...errors import OpenCascadeError
+    from ..occ.shapes import all_faces, face_area, is_valid, max_edge_tolerance
+    start = time.perf_counter()
+    if op is not None:
+        method = {"fuse": "BRepAlgoAPI_Fuse", "cut": "BRepAlgoAPI_Cut", "common": "BRepAlgoAPI_Common"}[op]
+        algo = {"fuse": BRepAlgoAPI_Fuse, "cut": BRepAlgoAPI_Cut,
+                "common": BRepAlgoAPI_Common}[op](model_a.shape, model_b.shape)
+    else:
+        arguments, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
+        if model_b is not None and tool:
+            method, algo = "BRepAlgoAPI_Splitter", BRepAlgoAPI_Splitter()
+            arguments.Append(model_a.shape)
+            tools.Append(model_b.shape)
+            algo.SetTools(tools)
+        else:
+            method, algo = "BRepAlgoAPI_BuilderAlgo (General Fuse)", BRepAlgoAPI_BuilderAlgo()
+            for face in (model_a.faces if model_b is None else [model_a.shape, model_b.shape]):
+                arguments.Append(face)
+        algo.SetArguments(arguments)
+    algo.Build()
+    seconds = time.perf_counter() - start
+    if not algo.IsDone():
+        raise OpenCascadeError(f"{method} failed on this input")
+    shape = algo.Shape()
+    volume = None
+    if op is not None:
+        from OCP.BRepGProp import BRepGProp
+        from OCP.GProp import GProp_GProps
+        props = GProp_GProps()
+        BRepGProp.VolumeProperties_s(shape, props, 1e-9)
+        volume = abs(float(props.Mass()))
+    # each face once: the General Fuse's result holds the split solids, which share the
+    # faces between them (exploring would count those twice, and their area)
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp
+    from OCP.TopTools import TopTools_IndexedMapOfShape
+    unique = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(shape, TopAbs_FACE, unique)
+    faces = [unique.FindKey(k) for k in range(1, unique.Extent() + 1)]
+    return {"method": method, "faces": len(faces), "face_occurrences": len(all_faces(shape)),
+            "valid": is_valid(shape), "max_edge_tolerance": max_edge_tolerance(shape),
+            "area": float(sum(face_area(f, 1e-9) for f in faces)), "volume": volume,
+            "time_s": seconds}
 
 
 COMMAND = Command(
@@ -87,12 +171,15 @@ COMMAND = Command(
         "surfaces cross, four pieces share one intersection edge (a non-manifold shell). A "
         "face a curve stops inside is kept whole and named (exit 1). The report gives "
         "per face its curves and pieces, the edges by the number of faces using them, the free "
-        "edges and BRepCheck validity. With --boolean, two solids are fused, cut or intersected "
-        "by keeping the pieces of each that lie outside (inside) the other, sewn into the result."),
+        "edges and BRepCheck validity, every output face's origin, name and area, every "
+        "intersection edge's length and distance from both surfaces. With --op fuse|cut|common "
+        "(or --boolean), two solids are fused, cut or intersected by keeping the pieces of "
+        "each that lie outside (inside) the other, sewn into the result. --compare-occ runs "
+        "OpenCascade's General Fuse / Splitter / Boolean on the same input beside ours."),
     epilog=(
         "examples:\n"
         "  surfprep split wing.step fuselage.step -o cut.step\n"
-        "  surfprep split a.step b.step -o common.step --boolean common\n"
+        "  surfprep split a.step b.step -o common.step --op common --compare-occ\n"
         "  surfprep split model.step -o cut.step --json r.json\n"
         "\n"
         "Lengths and tolerances are in millimetres."),

@@ -65,3 +65,54 @@ def test_tool_writes_only_the_first_models_faces(tmp_path, capsys, sphere_and_pl
     assert code == 0, err
     assert surfprep.read(out).n_faces == 3                # the sphere's three zones only
     assert "face b:" not in stdout
+
+
+def test_the_report_names_every_output_face_and_measures_the_intersection_edges(
+        tmp_path, capsys, sphere_and_plate):
+    import math
+    a, b = sphere_and_plate
+    out, report, png = tmp_path / "cut.step", tmp_path / "cut.json", tmp_path / "curves.png"
+    code, stdout, err = run(capsys, "split", a, b, "-o", out, "--json", report, "--compare-occ",
+                            *(["--plot", png] if _has_matplotlib() else []))
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    faces = data["output_faces"]
+    assert len(faces) == 11 and {f["operand"] for f in faces} == {"a", "b"}
+    # the sphere's three zones: areas 2 pi R h (Archimedes), named after the sphere's face
+    zones = sorted(f["area"] for f in faces if f["operand"] == "a")
+    exact = sorted(2 * math.pi * 10 * h for h in (1.0, 10 - 5.5, 10 + 4.5))
+    assert zones == pytest.approx(exact, rel=1e-6)
+    assert all(f["name"].endswith((".1", ".2", ".3")) for f in faces if f["operand"] == "a")
+    # the two circles z = 4.5 and 5.5 on the sphere of radius 10, within tol of both surfaces
+    edges = data["intersection_edges"]
+    lengths = sorted(e["length"] for e in edges)
+    assert lengths == pytest.approx(sorted(2 * math.pi * math.sqrt(100 - z * z) for z in (4.5, 5.5)),
+                                    rel=1e-6)
+    tol = max(e["max_distance_a"] for e in edges)
+    assert tol < 1e-4 and all(e["closed"] for e in edges)
+    assert data["structure"]["edges_by_uses"]["4"] == 2
+    occ = data["occ"]
+    assert occ["method"].startswith("BRepAlgoAPI_BuilderAlgo") and occ["valid"]
+    assert occ["area"] == pytest.approx(sum(f["area"] for f in faces), rel=1e-6)
+    assert occ["faces"] == len(faces)
+    assert "OpenCascade (BRepAlgoAPI_BuilderAlgo" in stdout
+    if _has_matplotlib():
+        assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_op_is_the_boolean_and_compares_with_opencascade(tmp_path, capsys, sphere_and_plate):
+    a, b = sphere_and_plate
+    out, report = tmp_path / "common.step", tmp_path / "common.json"
+    code, _, err = run(capsys, "split", a, b, "-o", out, "--op", "common", "--compare-occ",
+                       "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["boolean"]["volume"] == pytest.approx(data["occ"]["volume"], rel=1e-6)
+    assert data["occ"]["method"] == "BRepAlgoAPI_Common"
+    code, _, err = run(capsys, "split", a, b, "-o", out, "--op", "fuse", "--boolean", "cut")
+    assert code == 2 and "disagree" in err
+
+
+def _has_matplotlib() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("matplotlib") is not None
