@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -220,7 +221,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
 OPERATIONS = {"fuse": ("out", "out"), "common": ("in", "in"), "cut": ("out", "in")}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BooleanResult:
     """A Boolean of two solids as a selection of split pieces (002 §1).
 
@@ -232,20 +233,36 @@ class BooleanResult:
     split : SplitResult
     kept : (int, int)
         Pieces of ``a`` and of ``b`` kept.
-    volume : float
-        Of ``shape`` when it is a closed solid, else None.
+    closed : bool
+        The kept pieces close into solids.
+    valid : bool
     """
 
     shape: Any
     operation: str
     split: SplitResult
     kept: tuple[int, int]
-    volume: float | None
+    closed: bool
     valid: bool
 
     @property
     def geometry(self) -> Any:
         return self.shape
+
+    @cached_property
+    def volume(self) -> float | None:
+        """Of ``shape`` when it is closed, else None: OpenCascade's GProp at 1e-9 (its
+        default is 0.1 % off), computed on first use."""
+        if not self.closed:
+            return None
+        from OCP.BRepGProp import BRepGProp
+        from OCP.GProp import GProp_GProps
+        total = 0.0
+        for solid in _solids(self.shape):
+            props = GProp_GProps()
+            BRepGProp.VolumeProperties_s(solid, props, 1e-9)
+            total += abs(float(props.Mass()))
+        return total
 
     def report(self) -> dict:
         return {"operation": self.operation, "kept_pieces_a": self.kept[0], "kept_pieces_b": self.kept[1],
@@ -304,9 +321,6 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     OpenCascadeError
         An operand that is not a closed solid.
     """
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
     from ..errors import InvalidGeometryError
     if operation not in OPERATIONS:
         raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
@@ -324,20 +338,15 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
         chosen_b = [p.Reversed() for p in chosen_b]
     faces = chosen_a + chosen_b
     if not faces:
-        return BooleanResult(compound([]), operation, cut, (0, 0), 0.0, True)
+        return BooleanResult(compound([]), operation, cut, (0, 0), True, True)
     # sewn as split() sews (OpenCascade's manifold sewing loses the seam halves of a cap
     # cut across a sphere's seam: every edge came out degenerated)
     shape = sew(faces, sew_tol, non_manifold=True)[0]
     solids = _solids(shape)
-    volume = None
     if solids:
-        volume = 0.0
-        for solid in solids:
-            props = GProp_GProps()
-            BRepGProp.VolumeProperties_s(solid, props, 1e-9)          # GProp's default is 0.1 % off
-            volume += abs(float(props.Mass()))
         shape = solids[0] if len(solids) == 1 else compound(solids)
-    return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), volume, is_valid(shape))
+    return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), bool(solids),
+                         is_valid(shape))
 
 
 def _solids(shape) -> list:
