@@ -36,7 +36,7 @@ from .intersection.culling import patch_rectangles, subpatch_boxes
 from .intersection.seams import closed_directions
 from .trimmed import TrimmedFace, natural_loop
 
-__all__ = ["INSIDE", "ON", "OUTSIDE", "classify_points", "interior_point"]
+__all__ = ["INSIDE", "ON", "OUTSIDE", "classify_points", "interior_point", "sheet_side"]
 
 INSIDE, OUTSIDE, ON = 1, 0, -1
 #: ray directions tried in turn (fixed: the answer does not depend on a seed)
@@ -47,6 +47,8 @@ _DIRECTIONS = np.array([[0.5377, 0.1834, 0.8229], [-0.3412, 0.8733, 0.3478],
 EDGE_MARGIN = 20.0
 #: a crossing with |n . d| below this (unit vectors) grazes the surface
 GRAZING = 0.05
+#: a foot on a sheet counts where p - q makes at most acos(this) with the normal
+SHEET_NORMAL = 0.99
 #: leaf sub-patches' box diagonal, times the shell's diagonal
 LEAF_SHARE = 0.02
 #: halvings of a Bézier patch at most
@@ -243,6 +245,49 @@ def classify_points(faces: Sequence[TrimmedFace], points: ArrayLike, *, tol: flo
         raise InvalidGeometryError(f"{todo.size} point(s) lie where every ray passes a face's "
                                    "trimming edge or grazes a surface: no parity")
     return label
+
+
+def sheet_side(faces: Sequence[TrimmedFace], points: ArrayLike, *, tol: float) -> NDArray:
+    """``(n,)`` +1 / -1 / 0: the side of an open sheet of trimmed faces each point lies on,
+    that the faces' normals point to (+1) or the other (-1), or on the sheet (0).
+
+    The side is that of the nearest foot point on the sheet: every face's surface is
+    projected on (:func:`~surfprep.algorithms.projection.project_to_surface`), feet
+    outside a face's trimming loops are left out, and so are feet where ``p - q`` is
+    not along the normal (held on the surface's edge: the point lies beyond it); the
+    sign of ``(p - q) . n`` at the nearest foot ``q`` decides (``n`` the face's normal, ``S_u x S_v`` turned over
+    for a reversed face). A point within ``tol`` of the sheet is on it.
+
+    Raises
+    ------
+    InvalidGeometryError
+        A point none of whose feet lies inside a face (the sheet does not reach over it:
+        its side is not defined), no face, a bad tolerance.
+    """
+    from .projection import project_to_surface
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    if not faces:
+        raise InvalidGeometryError("sheet_side needs the faces of a sheet")
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidGeometryError(f"tol must be a positive length, got {tol!r}")
+    best = np.full(p.shape[0], np.inf)
+    side = np.zeros(p.shape[0], dtype=np.int64)
+    for face in faces:
+        foot = project_to_surface(face.surface, p)
+        d = face.surface.derivatives(foot.uv[:, 0], foot.uv[:, 1], 1)
+        normal = np.cross(d[:, 1, 0], d[:, 0, 1]) * (-1.0 if face.reversed else 1.0)
+        offset = np.einsum("ij,ij->i", p - foot.points, normal)
+        # a foot held on the surface's boundary (the point lies beyond the sheet's edge)
+        # is no foot: the point is over the face only where p - q runs along the normal
+        along = np.abs(offset) >= SHEET_NORMAL * foot.distance * np.linalg.norm(normal, axis=1)
+        usable = FaceRegion(face).contains(foot.uv, tol=tol) & (along | (foot.distance <= tol))
+        nearer = usable & (foot.distance < best)
+        best[nearer] = foot.distance[nearer]
+        side[nearer] = np.where(foot.distance[nearer] <= tol, 0, np.sign(offset[nearer]).astype(np.int64))
+    if np.any(np.isinf(best)):
+        raise InvalidGeometryError(f"{int(np.sum(np.isinf(best)))} point(s) lie where the sheet "
+                                   "does not reach: no side")
+    return side
 
 
 def interior_point(face: TrimmedFace, samples: int = 33) -> tuple[NDArray, NDArray]:

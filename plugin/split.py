@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..algorithms.containment import INSIDE, ON, classify_points, interior_point
+from ..algorithms.containment import INSIDE, ON, classify_points, interior_point, sheet_side
 from ..algorithms.face_split import Cut, split_face
 from ..algorithms.nonmanifold import NonManifoldModel
 from ..errors import OpenCascadeError, SurfprepError
@@ -29,7 +29,7 @@ from .io import as_model
 from .occ.faces import trimmed_face_to_occ
 from .occ.shapes import compound, count_free_edges, face_area, is_valid, sew, shell_or_solid
 
-__all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split"]
+__all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split", "trim"]
 
 
 @dataclass(frozen=True)
@@ -347,6 +347,54 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
         shape = solids[0] if len(solids) == 1 else compound(solids)
     return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), bool(solids),
                          is_valid(shape))
+
+
+def trim(a: Any, b: Any, *, keep: str = "front", tol: float | None = None,
+         method: str = "auto") -> BooleanResult:
+    """The faces of ``a`` trimmed by a sheet ``b``: cut where they meet it and the pieces on
+    one side of it kept (002 §1's "trim A by B" for an open sheet: the side by its
+    normal).
+
+    Parameters
+    ----------
+    a, b
+        What :func:`split` takes; ``b`` an open sheet (or any faces) reaching over the
+        pieces of ``a`` to be judged.
+    keep : {"front", "back"}
+        The side ``b``'s normals point to, or the other.
+    tol, method
+        As :func:`split`.
+
+    Returns
+    -------
+    BooleanResult
+        ``operation`` ``"trim-front"`` / ``"trim-back"``, ``kept`` (pieces of a, 0), the
+        kept pieces sewn (closed only if they close).
+
+    Raises
+    ------
+    InvalidGeometryError
+        An unknown ``keep``, or a piece of ``a`` the sheet does not reach over (its side
+        is not defined).
+    """
+    from ..errors import InvalidGeometryError
+    if keep not in ("front", "back"):
+        raise InvalidGeometryError(f"keep must be 'front' or 'back', got {keep!r}")
+    model_a, model_b = as_model(a), as_model(b)
+    cut = split(model_a, model_b, tol=tol, method=method, tool=True)
+    size = max(model_a.size, model_b.size)
+    sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
+    points = np.array([interior_point(face)[1] for face in cut.structure.faces]).reshape(-1, 3)
+    side = sheet_side(to_nurbs(model_b), points, tol=sew_tol)
+    want = 1 if keep == "front" else -1
+    chosen = [p for p, s in zip(cut.pieces_a, side) if s == want]
+    if not chosen:
+        return BooleanResult(compound([]), f"trim-{keep}", cut, (0, 0), False, True)
+    shape = sew(chosen, sew_tol, non_manifold=True)[0] if len(chosen) > 1 else compound(chosen)
+    solids = _solids(shape)
+    if solids:
+        shape = solids[0] if len(solids) == 1 else compound(solids)
+    return BooleanResult(shape, f"trim-{keep}", cut, (len(chosen), 0), bool(solids), is_valid(shape))
 
 
 def _solids(shape) -> list:

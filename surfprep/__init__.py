@@ -44,11 +44,11 @@ from .inputs import ShapeLike
 
 if TYPE_CHECKING:
     from .algorithms import Direction, NurbsCurve, NurbsSurface
-    from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
-    from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
     from .algorithms.composition import Composition, compose
     from .algorithms.grid import Spacing, SurfaceGrid, grid_surface
+    from .algorithms.parametrization import ParametrizationQuality, parametrization_quality
     from .algorithms.reparam import ReparametrizationResult
+    from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
     from .algorithms.volume import NurbsVolume
     from .plugin.convert import to_nurbs, to_occ
     from .plugin.grid import GridResult, grid
@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from .plugin.occ.faces import make_face
     from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
-    from .plugin.split import BooleanResult, SplitResult, boolean, split
+    from .plugin.split import BooleanResult, SplitResult, boolean, split, trim
     from .plugin.volume_boundary import (
         BoundarySolid,
         ComposedVolumes,
@@ -105,6 +105,7 @@ __all__ = [
     "split",
     "SplitResult",
     "boolean",
+    "trim",
     "BooleanResult",
     # trivariate solids (numpy only)
     "NurbsVolume",
@@ -165,6 +166,7 @@ _LAZY_EXPORTS = {
     "split": "surfprep.plugin.split",
     "SplitResult": "surfprep.plugin.split",
     "boolean": "surfprep.plugin.split",
+    "trim": "surfprep.plugin.split",
     "BooleanResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",
     "compose": "surfprep.algorithms.composition",

@@ -25,9 +25,13 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="intersection method (as surfprep intersect)")
     parser.add_argument("--tool", action="store_true",
                         help="B only cuts: write A's faces split, not B's (a hull cut at a waterline)")
-    parser.add_argument("--op", choices=("split", "fuse", "cut", "common"), default=None,
+    parser.add_argument("--op", choices=("split", "fuse", "cut", "common", "trim"), default=None,
                         help="split (default: every piece), or fuse, cut (A minus B) or common of "
-                             "two solids: write the pieces that operation keeps, sewn")
+                             "two solids, or trim A by the sheet B (--keep): write the pieces "
+                             "that operation keeps, sewn")
+    parser.add_argument("--keep", choices=("front", "back"), default="front",
+                        help="with --op trim: keep A's pieces on the side B's normal points to "
+                             "(front, the default) or on the other")
     parser.add_argument("--boolean", choices=("fuse", "cut", "common"), default=None, metavar="OP",
                         help="the same as --op OP")
     parser.add_argument("--compare-occ", action="store_true",
@@ -56,10 +60,11 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
     operation = None
     if op is not None:
-        from ..split import boolean
+        from ..split import boolean, trim
         if model_b is None:
             raise InvalidGeometryError(f"--op {op} needs two files, A and B")
-        operation = boolean(model_a, model_b, op, tol=args.tol, method=args.method)
+        operation = (trim(model_a, model_b, keep=args.keep, tol=args.tol, method=args.method)
+                     if op == "trim" else boolean(model_a, model_b, op, tol=args.tol, method=args.method))
         result = operation.split
     else:
         result = split(model_a, model_b, tol=args.tol, method=args.method, tool=args.tool)
@@ -71,7 +76,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         if operation is not None:
             report["boolean"] = {k: v for k, v in operation.report().items() if k != "split"}
         if args.compare_occ:
-            report["occ"] = _occ_figures(model_a, model_b, op, args.tool)
+            report["occ"] = _occ_figures(model_a, model_b, op, args.tool or op == "trim")
         if args.plot is not None:
             from .intersect import plot_curves
             report["plot"] = str(plot_curves(result.curves, args.plot, two_models=model_b is not None))
@@ -119,7 +124,7 @@ def _occ_figures(model_a, model_b, op: str | None, tool: bool) -> dict:
     from ...errors import OpenCascadeError
     from ..occ.shapes import all_faces, face_area, is_valid, max_edge_tolerance
     start = time.perf_counter()
-    if op is not None:
+    if op is not None and op != "trim":
         method = {"fuse": "BRepAlgoAPI_Fuse", "cut": "BRepAlgoAPI_Cut", "common": "BRepAlgoAPI_Common"}[op]
         algo = {"fuse": BRepAlgoAPI_Fuse, "cut": BRepAlgoAPI_Cut,
                 "common": BRepAlgoAPI_Common}[op](model_a.shape, model_b.shape)
@@ -141,7 +146,7 @@ def _occ_figures(model_a, model_b, op: str | None, tool: bool) -> dict:
         raise OpenCascadeError(f"{method} failed on this input")
     shape = algo.Shape()
     volume = None
-    if op is not None:
+    if op is not None and op != "trim":
         from OCP.BRepGProp import BRepGProp
         from OCP.GProp import GProp_GProps
         props = GProp_GProps()
@@ -180,6 +185,7 @@ COMMAND = Command(
         "examples:\n"
         "  surfprep split wing.step fuselage.step -o cut.step\n"
         "  surfprep split a.step b.step -o common.step --op common --compare-occ\n"
+        "  surfprep split hull.step waterplane.step -o below.step --op trim --keep back\n"
         "  surfprep split model.step -o cut.step --json r.json\n"
         "\n"
         "Lengths and tolerances are in millimetres."),

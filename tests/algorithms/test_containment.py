@@ -76,3 +76,28 @@ def test_bad_input_is_refused():
         classify_points(faces, [[0, 0, 0]], tol=-1.0)
     with pytest.raises(InvalidGeometryError, match="NaN"):
         classify_points(faces, [[np.nan, 0, 0]], tol=1e-9)
+
+
+def test_the_side_of_an_open_sheet_by_its_normal():
+    from surfprep import NurbsSurface
+    from surfprep.algorithms.containment import sheet_side
+    # a bent sheet z = 0.3 x^2 over [-1, 1]^2 (Bezier, degree 2 in x), normal +z-ish
+    cp = np.zeros((3, 2, 3))
+    for i, x in enumerate((-1.0, 0.0, 1.0)):
+        for j, y in enumerate((-1.0, 1.0)):
+            cp[i, j] = (x, y, 0.3 if i != 1 else -0.3)
+    sheet = NurbsSurface(cp, [0, 0, 0, 1, 1, 1], [0, 0, 1, 1], 2, 1)
+    rng = np.random.default_rng(1)
+    xy = rng.uniform(-0.6, 0.6, (200, 2))
+    u = (xy[:, 0] + 1) / 2
+    z_on = sheet.evaluate(u, (xy[:, 1] + 1) / 2)[:, 2]
+    dz = rng.choice([-1.0, 1.0], 200) * rng.uniform(0.01, 0.2, 200)
+    points = np.column_stack([sheet.evaluate(u, (xy[:, 1] + 1) / 2)[:, :2], z_on + dz])
+    up = np.sign(np.cross(*sheet.derivatives(np.array([0.5]), np.array([0.5]), 1)[0, [1, 0], [0, 1]])[2])
+    side = sheet_side([TrimmedFace(sheet)], points, tol=1e-9)
+    np.testing.assert_array_equal(side, np.sign(dz) * up)
+    flipped = sheet_side([TrimmedFace(sheet, reversed=True)], points, tol=1e-9)
+    np.testing.assert_array_equal(flipped, -side)
+    assert sheet_side([TrimmedFace(sheet)], sheet.evaluate(np.array([0.3]), np.array([0.6])), tol=1e-9).tolist() == [0]
+    with pytest.raises(InvalidGeometryError, match="does not reach"):
+        sheet_side([TrimmedFace(sheet)], [[5.0, 0.0, 0.0]], tol=1e-9)

@@ -164,3 +164,19 @@ def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
     assert out.shared_edges.get(4) == 2                  # each root loop: one edge, four faces
     assert out.structure.edges_by_uses() == {2: 19, 4: 2}
     assert len(out.structure.components()) == 1
+
+
+def test_a_sphere_trimmed_by_a_sheet_keeps_one_side_by_its_normal():
+    """The sheet z = 5 (normal +z) cuts the sphere of radius 10: in front of it the cap of
+    height 5, behind it the rest; areas 2 pi R h (Archimedes)."""
+    from surfprep.plugin.split import trim
+    sphere = cq.Workplane().sphere(10.0)
+    sheet = cq.Workplane("XY").rect(30, 30).extrude(0.001).faces(">Z").val().translate(cq.Vector(0, 0, 5 - 0.001))
+    front = trim(sphere, sheet, keep="front")
+    back = trim(sphere, sheet, keep="back")
+    assert front.kept == (1, 0) and back.kept == (1, 0) and front.valid and back.valid
+    assert face_area(front.shape, 1e-9) == pytest.approx(2 * math.pi * 10 * 5, rel=1e-6)
+    assert face_area(back.shape, 1e-9) == pytest.approx(2 * math.pi * 10 * 15, rel=1e-6)
+    assert front.operation == "trim-front"
+    with pytest.raises(Exception, match="keep"):
+        trim(sphere, sheet, keep="above")

@@ -116,3 +116,19 @@ def test_op_is_the_boolean_and_compares_with_opencascade(tmp_path, capsys, spher
 def _has_matplotlib() -> bool:
     import importlib.util
     return importlib.util.find_spec("matplotlib") is not None
+
+
+def test_op_trim_keeps_the_side_of_the_sheet(tmp_path, capsys):
+    import math
+    a, b = tmp_path / "sphere.step", tmp_path / "sheet.step"
+    cq.exporters.export(cq.Workplane().sphere(10), str(a))
+    cq.exporters.export(cq.Workplane("XY").rect(30, 30).extrude(0.001).faces(">Z").val()
+                        .translate(cq.Vector(0, 0, 5 - 0.001)), str(b))
+    out, report = tmp_path / "cap.step", tmp_path / "cap.json"
+    code, _, err = run(capsys, "split", a, b, "-o", out, "--op", "trim", "--keep", "front",
+                            "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["boolean"]["operation"] == "trim-front"
+    from surfprep.plugin.occ.shapes import face_area
+    assert face_area(surfprep.read(out).shape, 1e-9) == pytest.approx(2 * math.pi * 10 * 5, rel=1e-6)
