@@ -82,3 +82,16 @@ def test_the_hierarchy_is_built_once_and_a_solid_s_level_1_is_reused():
         first.build_hierarchy(mesh_tol=0.1 * first.tol)
     sweep = first.build_hierarchy(candidates="sweep")
     assert sweep.counts() == h.counts()
+
+
+def test_ray_and_inversion_classify_alike():
+    a, b = block(4.0, origin=(-2, -2, -2)), solid_sphere(2.5)
+    c = compose(a, b)
+    points = np.random.default_rng(5).uniform(-3, 3, (3000, 3))
+    ray, inversion = c.classify(points), c.classify(points, method="inversion")
+    np.testing.assert_array_equal(ray, inversion)
+    exact = np.all(np.abs(points) <= 2, axis=1).astype(int) + 2 * (np.linalg.norm(points, axis=1) <= 2.5)
+    np.testing.assert_array_equal(ray, exact)
+    with pytest.raises(InvalidGeometryError, match="method"):
+        c.classify(points, method="winding")
+    assert [f.name for f in c.boundary_faces("B")] == ["u1"]
