@@ -207,8 +207,8 @@ COMMAND = Command(
         "patches, overlap boxes, local triangulations, loops) and the volumes of the common "
         "part and the union (divergence theorem over the faces cut along the curves); "
         "with --classify, label "
-        "each point 0 outside both, 1 in A only, 2 in B only, 3 in both (Newton inversion into "
-        "each solid); with --shell, write both solids' boundaries (their non-degenerate "
+        "each point 0 outside both, 1 in A only, 2 in B only, 3 in both (ray parity on each "
+        "solid's exact boundary); with --shell, write both solids' boundaries (their non-degenerate "
         "exterior faces, oriented outward, sewn) as OpenCascade solids to STEP or IGES, or "
         "with --boundary union|common|A-B the boundary of that region (the boundary solids "
         "cut along the curves); with --volumes, OpenCascade's volumes as a cross-check."),
