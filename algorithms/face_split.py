@@ -15,10 +15,13 @@ the face are one vertex. At each vertex the half-edges leave in the order of
 their angles; a face is traced by taking, at each vertex, the first half-edge
 clockwise from the way back, so the region stays on the left. Every cycle traced
 counter-clockwise bounds a region; clockwise cycles (a hole of the face, the
-outside of a closed cut) are holes of the smallest region that contains them. A
-cut end that is neither on the boundary nor on another cut is refused (a curve
-that stops inside a face cannot divide it), as are two cuts ending at one
-boundary point.
+outside of a closed cut) are holes of the smallest region that contains them.
+
+A cut with both ends inside the face that meets no other cut divides nothing (a
+curve that stops inside the face, where a fin stands on a sheet): it becomes an
+internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`) of the
+region it lies in. A cut with one end inside the face and one on its boundary or
+another cut (a spur) is refused, as are two cuts ending at one boundary point.
 """
 
 from __future__ import annotations
@@ -202,7 +205,8 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     Raises
     ------
     InvalidGeometryError
-        A cut's end neither on the boundary nor on another cut, two cuts ending at one
+        A cut with one end neither on the boundary nor on another cut (a spur; a cut
+        with both ends inside becomes an internal edge), two cuts ending at one
         boundary point, cuts that overlap.
     """
     u0, u1, v0, v1 = face.surface.domain
@@ -219,10 +223,11 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                 graph.vertex(point, _cut_point_at(cuts[i], face, s), _cut_point_at(cuts[j], face, t))
                 params[i].append(s)
                 params[j].append(t)
+    dangling = _dangling(face, loops, cuts, params, eps, tol3d)
     marks: list[_Mark] = []
     for c, cut in enumerate(cuts):
         line = cut.samples()
-        if np.linalg.norm(line[0] - line[-1]) <= eps:
+        if c in dangling or np.linalg.norm(line[0] - line[-1]) <= eps:
             continue                                             # closed: its ends are one vertex
         for end, point in ((0, line[0]), (1, line[-1])):
             where = _locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d))
@@ -245,6 +250,8 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         seen[key] = m.cut
     # the cut segments between consecutive split parameters, both ways
     for c, cut in enumerate(cuts):
+        if c in dangling:
+            continue
         ts = np.sort(np.clip(np.asarray(params[c], dtype=float), *cut.range))
         width = 1e-12 * max(abs(cut.range[1] - cut.range[0]), 1.0)
         kept = [ts[0]] + [t for t in ts[1:-1] if t - ts[0] > width and ts[-1] - t > width]
@@ -263,7 +270,53 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     for li, loop in enumerate(loops):
         if li not in by_loop:
             cycles.append(list(loop.edges))
-    return _regions(face, cycles)
+    return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling)])
+
+
+def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
+              eps: float, tol3d: float | None) -> set[int]:
+    """The cuts that divide nothing: open, both ends inside the face (on no loop, at no
+    other cut's end) and crossing no other cut -- a curve that stops inside the face.
+    They become internal edges of the region they lie in."""
+    ends = []
+    for cut in cuts:
+        line = cut.samples()
+        ends.append((line[0], line[-1]))
+    out = set()
+    for c, cut in enumerate(cuts):
+        first, last = ends[c]
+        if np.linalg.norm(first - last) <= eps or len(params[c]) > 2:
+            continue                                   # closed, or crossing another cut
+        if any(_locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d)) is not None
+               for end, point in ((0, first), (1, last))):
+            continue
+        met = any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends) if d != c
+                  for p in (first, last) for q in pair)
+        if not met:
+            out.add(c)
+    return out
+
+
+def _with_internal(face: TrimmedFace, regions: list[TrimmedFace], dangling: list[Cut]
+                   ) -> list[TrimmedFace]:
+    """Each dangling cut as an internal edge of the region its middle lies in."""
+    if not dangling:
+        return regions
+    extra: list[list[TrimEdge]] = [[] for _ in regions]
+    samples = [[_loop_samples(list(loop.edges)) for loop in region.loops] for region in regions]
+    for cut in dangling:
+        t0, t1 = cut.range
+        middle = cut.pcurve.evaluate(np.array([0.5 * (t0 + t1)]))
+        k = next((k for k, loops in enumerate(samples) if inside_loops(middle, loops)[0]), None)
+        if k is None:
+            raise InvalidGeometryError("a curve that stops inside the face lies in no region of it")
+        edge = TrimEdge(cut.curve3d, cut.pcurve, t0, t1, False, 0.0)
+        extra[k].append(TrimEdge(cut.curve3d, cut.pcurve, t0, t1, False,
+                                 max(DEFAULT_TOLERANCE, edge_deviation(edge, face.surface))))
+    return [region if not more else
+            TrimmedFace(region.surface, region.loops, region.outer_loop_index, region.reversed,
+                        region.name, region.internal + tuple(more))
+            for region, more in zip(regions, extra)]
 
 
 def _cut_point_at(cut: Cut, face: TrimmedFace, t: float) -> NDArray:
@@ -472,7 +525,7 @@ def _regions(face: TrimmedFace, cycles: list[list[TrimEdge]]) -> list[TrimmedFac
         region = [cycles[k]] + [cycles[h] for h in members[k]]
         edges = [e for cycle in region for e in cycle]
         loops = [TrimLoop(tuple(_unpaired_seam(e, edges) for e in cycle)) for cycle in region]
-        out.append(TrimmedFace(face.surface, tuple(loops), 0, face.reversed, face.name))
+        out.append(TrimmedFace(face.surface, tuple(loops), 0, face.reversed, face.name, face.internal))
     return out
 
 

@@ -57,7 +57,9 @@ class EdgeUse:
     Attributes
     ----------
     face, loop, position : int
-        Where: ``faces[face].loops[loop].edges[position]``.
+        Where: ``faces[face].loops[loop].edges[position]``; ``loop`` -1 for an internal
+        edge (``faces[face].internal[position]``: the face lies on both sides of it,
+        counted as one use).
     against : bool
         The loop runs along the edge against the edge's direction.
     angle : float
@@ -72,7 +74,8 @@ class EdgeUse:
     angle: float
 
     def occurrence(self, faces) -> TrimEdge:
-        return faces[self.face].loops[self.loop].edges[self.position]
+        face = faces[self.face]
+        return face.internal[self.position] if self.loop < 0 else face.loops[self.loop].edges[self.position]
 
 
 class _Union:
@@ -160,7 +163,7 @@ class NonManifoldModel:
         if not (np.isfinite(tol) and tol > 0):
             raise InvalidGeometryError(f"tol must be a positive length, got {tol!r}")
         faces = tuple(f if f.loops else TrimmedFace(f.surface, (natural_loop(f.surface),), 0,
-                                                    f.reversed, f.name) for f in faces)
+                                                    f.reversed, f.name, f.internal) for f in faces)
         origins = tuple(origins) if origins is not None else tuple(("a", k) for k in range(len(faces)))
         if len(origins) != len(faces):
             raise InvalidGeometryError("origins needs one (operand, index) per face")
@@ -172,6 +175,9 @@ class NonManifoldModel:
                         continue
                     where.append((f, li, k))
                     samples.append(_loop_points(edge, face.surface))
+            for k, edge in enumerate(face.internal):          # loop -1: the internal edges
+                where.append((f, -1, k))
+                samples.append(_loop_points(edge, face.surface))
         if not where:
             return cls(faces, origins, np.zeros((0, 3)), np.zeros((0, 2), np.int64), (), float(tol))
         pts = np.array(samples)                                           # (m, 5, 3)
@@ -211,7 +217,7 @@ class NonManifoldModel:
         directions, axis = [], None
         for (f, li, k), flipped in zip(where, flip):
             face = faces[f]
-            edge = face.loops[li].edges[k]
+            edge = face.internal[k] if li < 0 else face.loops[li].edges[k]
             _, normal, tangent = _normal_and_tangent(edge, face.surface, edge.pcurve)
             along = tangent * (-1.0 if edge.reversed else 1.0)          # the loop's direction
             directions.append(np.cross(normal, along))
@@ -222,7 +228,7 @@ class NonManifoldModel:
         e2 = np.cross(axis, e1)
         out = []
         for (f, li, k), flipped, d in zip(where, flip, directions):
-            edge = faces[f].loops[li].edges[k]
+            edge = faces[f].internal[k] if li < 0 else faces[f].loops[li].edges[k]
             angle = float(np.arctan2(np.dot(d, e2), np.dot(d, e1))) % (2 * np.pi)
             out.append(EdgeUse(f, li, k, bool(edge.reversed != flipped), angle))
         return tuple(sorted(out, key=lambda u: u.angle))

@@ -152,6 +152,11 @@ class TrimmedFace:
         The face's orientation: True when its normal is opposite to
         ``S_u x S_v``.
     name : str or None
+    internal : tuple of TrimEdge
+        Edges inside the face that bound nothing: an intersection curve that stops
+        inside it (the edge where a fin stands on a sheet), OpenCascade's INTERNAL
+        edges. Each runs ``t0 -> t1`` (``reversed`` False); the loops do not include
+        them, so which points lie inside the face does not depend on them.
     """
 
     surface: NurbsSurface
@@ -159,17 +164,20 @@ class TrimmedFace:
     outer_loop_index: int = 0
     reversed: bool = False
     name: str | None = None
+    internal: tuple[TrimEdge, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "loops", tuple(self.loops))
+        object.__setattr__(self, "internal", tuple(self.internal))
         if self.loops and not 0 <= self.outer_loop_index < len(self.loops):
             raise InvalidGeometryError(
                 f"outer_loop_index {self.outer_loop_index} out of range for {len(self.loops)} loops")
 
     def __repr__(self) -> str:
+        inner = f", internal={len(self.internal)}" if self.internal else ""
         return (f"TrimmedFace({self.surface!r}, loops={[len(lp.edges) for lp in self.loops]}, "
                 f"outer_loop_index={self.outer_loop_index}, reversed={self.reversed}, "
-                f"name={self.name!r})")
+                f"name={self.name!r}{inner})")
 
     @property
     def edges(self) -> tuple[TrimEdge, ...]:

@@ -5,9 +5,11 @@
 parameters (each curve has a pcurve on both faces) to
 :func:`~surfprep.algorithms.face_split.split_face`, rebuilds the pieces as
 OpenCascade faces and sews them (non-manifold: where two surfaces cross, four
-pieces share one intersection edge). A face a curve stops inside (it cannot divide
-it), or that the builder refuses, is kept whole and named with the reason; nothing
-is dropped.
+pieces share one intersection edge). A curve that stops inside a face (where a fin
+stands on a sheet) divides nothing: it becomes an INTERNAL edge of the face, shared
+with the faces that end on it (a T-junction: one edge, three faces). A face a curve
+runs into from its boundary and stops inside (a spur), or that the builder refuses,
+is kept whole and named with the reason; nothing is dropped.
 """
 
 from __future__ import annotations
@@ -122,6 +124,52 @@ class SplitResult:
         return out
 
 
+def _share_internal_edges(shape, tol: float):
+    """``shape`` with every INTERNAL edge of a face (a curve that stops inside it, where a
+    fin stands on a sheet) replaced by the edge of the other faces lying on it, when
+    there is one over the same points and parameters: sewing joins boundary edges only,
+    and the T-junction is then one edge used by all three faces. The face's pcurve is
+    added to the shared edge. Unchanged when nothing matches."""
+    from OCP.BRep import BRep_Builder, BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepTools import BRepTools_ReShape
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_INTERNAL
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    def probe(edge) -> tuple[np.ndarray, float, float]:
+        c = BRepAdaptor_Curve(edge)
+        a, b = c.FirstParameter(), c.LastParameter()
+        return np.array([[c.Value(t).X(), c.Value(t).Y(), c.Value(t).Z()]
+                         for t in (a, 0.5 * (a + b), b)]), a, b
+    internal, others = [], []
+    faces = TopExp_Explorer(shape, TopAbs_FACE)
+    while faces.More():
+        face = TopoDS.Face_s(faces.Current())
+        faces.Next()
+        edges = TopExp_Explorer(face, TopAbs_EDGE)
+        while edges.More():
+            edge = TopoDS.Edge_s(edges.Current())
+            edges.Next()
+            (internal if edge.Orientation() == TopAbs_INTERNAL else others).append((edge, face))
+    if not internal:
+        return shape
+    reshape, builder = BRepTools_ReShape(), BRep_Builder()
+    changed = False
+    probes = [probe(e) for e, _ in others]
+    for edge, face in internal:
+        p, a, b = probe(edge)
+        span = max(abs(b - a), 1e-300)
+        for (other, _), (q, c, d) in zip(others, probes):
+            if np.max(np.abs(p - q)) <= tol and abs(a - c) + abs(b - d) <= 1e-9 * span:
+                pcurve = BRep_Tool.CurveOnSurface_s(edge, face, a, b)
+                builder.UpdateEdge(other, pcurve, face, max(BRep_Tool.Tolerance_s(edge), tol))
+                reshape.Replace(edge, other.Oriented(TopAbs_INTERNAL))
+                changed = True
+                break
+    return reshape.Apply(shape) if changed else shape
+
+
 def _edge_uses(shape) -> dict:
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
     from OCP.TopExp import TopExp
@@ -208,6 +256,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
     shape = sew(faces, sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
+    shape = _share_internal_edges(shape, sew_tol)
     valid = all(is_valid(p) for f in done for p in f.pieces)
     listed = trims["a"] + trims["b"]
     structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)

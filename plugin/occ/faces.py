@@ -34,7 +34,7 @@ from OCP.Geom import Geom_BSplineSurface, Geom_TrimmedCurve
 from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_Face
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_WIRE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Vertex, TopoDS_Wire
@@ -48,8 +48,13 @@ from .failures import describe, is_occ_failure
 from .geom import surface_from_occ, surface_to_occ
 from .shapes import check_valid
 
-__all__ = ["face_to_nurbs", "make_face", "trimmed_face_to_occ", "needs_nurbs_convert",
-           "checked_or_fixed"]
+__all__ = [
+    "checked_or_fixed",
+    "face_to_nurbs",
+    "make_face",
+    "needs_nurbs_convert",
+    "trimmed_face_to_occ",
+]
 
 #: make_face refuses a loop whose consecutive edge ends are further apart than this many
 #: times ``tol``, or this many times the largest edge or vertex tolerance of the two edges.
@@ -101,6 +106,7 @@ def face_to_nurbs(face: TopoDS_Face, name: str | None = None) -> TrimmedFace:
 
     outer = BRepTools.OuterWire_s(forward)
     loops: list[TrimLoop] = []
+    internal: list[TrimEdge] = []
     outer_index = 0
     curves3d: list[tuple[TopoDS_Edge, NurbsCurve]] = []   # seam edges, read once
     wires = TopExp_Explorer(forward, TopAbs_WIRE)
@@ -109,10 +115,14 @@ def face_to_nurbs(face: TopoDS_Face, name: str | None = None) -> TrimmedFace:
         wires.Next()
         if not outer.IsNull() and wire.IsSame(outer):
             outer_index = len(loops)
-        edges = [read_trim_edge(e, forward, curves3d) for e in _wire_edges(wire, forward)]
+        occ_edges = _wire_edges(wire, forward)
+        if occ_edges and all(e.Orientation() == TopAbs_INTERNAL for e in occ_edges):
+            internal.extend(read_trim_edge(e, forward, curves3d) for e in occ_edges)
+            continue                              # edges inside the face, bounding nothing
+        edges = [read_trim_edge(e, forward, curves3d) for e in occ_edges]
         if edges:
             loops.append(TrimLoop(tuple(edges)))
-    return TrimmedFace(surface, tuple(loops), outer_index, reversed_, name)
+    return TrimmedFace(surface, tuple(loops), outer_index, reversed_, name, tuple(internal))
 
 
 def _wire_edges(wire: TopoDS_Wire, face: TopoDS_Face) -> list[TopoDS_Edge]:
@@ -139,7 +149,8 @@ def _wire_edges(wire: TopoDS_Wire, face: TopoDS_Face) -> list[TopoDS_Edge]:
 
 # ----------------------------------------------------------------- building
 def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
-              tol: float = DEFAULT_TOLERANCE, *, reversed: bool = False) -> TopoDS_Face:
+              tol: float = DEFAULT_TOLERANCE, *, reversed: bool = False,
+              internal: Sequence[TrimEdge] = ()) -> TopoDS_Face:
     """A ``TopoDS_Face`` on ``surface``.
 
     Parameters
@@ -156,6 +167,9 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
         the edges they join.
     reversed : bool
         Orientation of the face (see :attr:`TrimmedFace.reversed`).
+    internal : sequence of TrimEdge
+        Edges inside the face that bound nothing (:attr:`TrimmedFace.internal`): each
+        in a wire of its own, oriented INTERNAL, after the loops have been checked.
 
     Raises
     ------
@@ -183,6 +197,8 @@ def make_face(surface: NurbsSurface, loops: Sequence[TrimLoop] | None = None,
         for loop in loops:
             brep.Add(face, _make_wire(surface, occ_surface, loop, tol, corners))
         face = checked_or_fixed(face, tol)
+    if internal:
+        face = _with_internal_edges(face, surface, occ_surface, internal, tol)
     if reversed:
         face = TopoDS.Face_s(face.Reversed())
     check_valid(face, "face")
@@ -215,7 +231,7 @@ def _check_pcurve_in_domain(surface: NurbsSurface, edge: TrimEdge, index: int) -
 
 def trimmed_face_to_occ(face: TrimmedFace, tol: float = DEFAULT_TOLERANCE) -> TopoDS_Face:
     """:func:`make_face` on a :class:`TrimmedFace`."""
-    return make_face(face.surface, face.loops, tol, reversed=face.reversed)
+    return make_face(face.surface, face.loops, tol, reversed=face.reversed, internal=face.internal)
 
 
 def checked_or_fixed(face: TopoDS_Face, tol: float) -> TopoDS_Face:
@@ -299,6 +315,31 @@ def _make_wire(surface: NurbsSurface, occ_surface, loop: TrimLoop, tol: float,
         brep.Add(wire, occ_edge.Oriented(TopAbs_REVERSED if e.reversed else TopAbs_FORWARD))
     wire.Closed(True)
     return wire
+
+
+def _with_internal_edges(face: TopoDS_Face, surface: NurbsSurface, occ_surface,
+                         internal: Sequence[TrimEdge], tol: float) -> TopoDS_Face:
+    """``face`` (just built, so it is changed in place) with each of ``internal`` as an
+    INTERNAL edge in an open wire of its own: the edge lies in the face and bounds
+    nothing (OpenCascade's convention, as its General Fuse writes it). The pcurves are
+    put on the face's own surface (``checked_or_fixed`` may have given it a new one)."""
+    face.Free(True)
+    occ_surface = BRep_Tool.Surface_s(face)
+    brep = BRep_Builder()
+    for e in internal:
+        ends = curve3d_points(e, surface, np.array([e.t0, e.t1]))
+        vertices = []
+        for p in ends:
+            v = TopoDS_Vertex()
+            brep.MakeVertex(v, gp_Pnt(*p.tolist()), max(tol, e.tolerance))
+            vertices.append(v)
+        occ_edge = build_trim_edge(surface, occ_surface, e, vertices[0], vertices[1], tol)
+        wire = TopoDS_Wire()
+        brep.MakeWire(wire)
+        brep.Add(wire, occ_edge.Oriented(TopAbs_INTERNAL))
+        wire.Closed(False)
+        brep.Add(face, wire)
+    return face
 
 
 def _same_seam(a: TrimEdge, b: TrimEdge) -> bool:

@@ -145,3 +145,22 @@ def test_cuts_joined_end_to_end_inside_the_face_make_one_closed_chain():
     assert len(island.loops) == 1 and len(island.loops[0].edges) == 2
     np.testing.assert_allclose(_area(island), np.pi * 0.04, rtol=1e-5)
     _closed(island)
+
+
+def test_a_cut_that_stops_inside_the_face_becomes_an_internal_edge():
+    """Where a fin stands on a sheet the curve ends inside the sheet: it divides nothing
+    and is kept as an internal edge of the region it lies in."""
+    inner = _line((0.3, 0.4), (0.6, 0.5))
+    parts = split_face(TrimmedFace(_plane()), [inner])
+    assert len(parts) == 1
+    (face,) = parts
+    assert len(face.internal) == 1 and face.internal[0].pcurve is inner.pcurve
+    np.testing.assert_allclose(_area(face), 1.0, atol=1e-12)
+    # beside a line across the face: the internal edge goes to the half it lies in
+    parts = split_face(TrimmedFace(_plane()), [_line((0.8, 0.0), (0.8, 1.0)), inner])
+    assert sorted(len(p.internal) for p in parts) == [0, 1]
+    holder = next(p for p in parts if p.internal)
+    np.testing.assert_allclose(_area(holder), 0.8, atol=1e-12)
+    # a spur (one end on the boundary, one inside) still divides nothing and is refused
+    with pytest.raises(InvalidGeometryError, match="neither on the"):
+        split_face(TrimmedFace(_plane()), [_line((0.0, 0.5), (0.5, 0.5))])

@@ -33,11 +33,32 @@ def test_split_writes_the_pieces_and_a_report(tmp_path, capsys, sphere_and_plate
 
 
 def test_a_face_kept_whole_is_exit_1(tmp_path, capsys):
+    """A fin over the sheet's edge: the curve runs in from the sheet's border and stops
+    inside it (a spur), which divides nothing and cannot be an internal edge either."""
+    a, b = tmp_path / "sheet.step", tmp_path / "fin.step"
+    cq.exporters.export(cq.Workplane("XY").rect(2, 2).extrude(0.001).faces(">Z"), str(a))
+    cq.exporters.export(cq.Workplane("YZ").rect(1, 2).extrude(0.001).faces(">X").val()
+                        .translate(cq.Vector(0, 1.0, 0)), str(b))
+    code, stdout, _ = run(capsys, "split", a, b, "-o", tmp_path / "cut.step")
+    assert code == 1 and "kept whole" in stdout and "nor on another cut" in stdout
+
+
+def test_a_fin_standing_on_a_sheet_shares_its_edge_with_the_sheet(tmp_path, capsys):
+    """The curve stops inside the sheet: an INTERNAL edge of the sheet, the same edge as
+    the one the fin's two pieces share (one edge, three faces). STEP has no internal
+    edges (OpenCascade's writer leaves them out): read back, the sheet is whole and the
+    fin's edge lies on it."""
     a, b = tmp_path / "sheet.step", tmp_path / "fin.step"
     cq.exporters.export(cq.Workplane("XY").rect(2, 2).extrude(0.001).faces(">Z"), str(a))
     cq.exporters.export(cq.Workplane("YZ").rect(1, 2).extrude(0.001).faces(">X"), str(b))
-    code, stdout, _ = run(capsys, "split", a, b, "-o", tmp_path / "cut.step")
-    assert code == 1 and "kept whole" in stdout and "nor on another cut" in stdout
+    out, report = tmp_path / "cut.step", tmp_path / "cut.json"
+    code, _, err = run(capsys, "split", a, b, "-o", out, "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["valid"] and data["pieces"] == 3
+    assert data["edges_by_faces"]["3"] == 1 and data["structure"]["edges_by_uses"]["3"] == 1
+    faces = surfprep.to_nurbs(surfprep.read(out))
+    assert len(faces) == 3 and not any(t.internal for t in faces)
 
 
 def test_the_output_is_checked_before_the_work(tmp_path, capsys, sphere_and_plate):
