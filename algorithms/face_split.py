@@ -101,22 +101,30 @@ def _locate(loops: list[TrimLoop], point: NDArray, eps: float,
     """The loop, edge and edge parameter nearest to a point of the domain: within ``eps``
     in the parameters, or where ``near(best)`` accepts it (a test in space)."""
     best = None
+    coarse = []                                   # per edge: samples, nearest one, its distance
     for li, loop in enumerate(loops):
         for ei, e in enumerate(loop.edges):
             t = np.linspace(e.t0, e.t1, 4 * LOOP_SAMPLES_PER_EDGE)
             uv = e.pcurve.evaluate(t)
             d = np.linalg.norm(uv - point, axis=1)
             k = int(np.argmin(d))
-            # refine on the segment either side by a few bisections of the distance
-            lo, hi = t[max(k - 1, 0)], t[min(k + 1, t.size - 1)]
-            for _ in range(40):
-                m1, m2 = lo + (hi - lo) / 3, hi - (hi - lo) / 3
-                d1, d2 = (np.linalg.norm(e.pcurve.evaluate(np.array([m]))[0] - point) for m in (m1, m2))
-                lo, hi = (lo, m2) if d1 < d2 else (m1, hi)
-            tt = 0.5 * (lo + hi)
-            dist = float(np.linalg.norm(e.pcurve.evaluate(np.array([tt]))[0] - point))
-            if best is None or dist < best[3]:
-                best = (li, ei, tt, dist)
+            # the nearest point lies within a sample spacing of the nearest sample
+            reach = float(np.max(np.linalg.norm(np.diff(uv, axis=0), axis=1))) if t.size > 1 else 0.0
+            coarse.append((li, ei, e, t, k, float(d[k]), reach))
+    closest = min(c[5] for c in coarse) if coarse else np.inf
+    for li, ei, e, t, k, d_k, reach in coarse:
+        if d_k - reach > closest:
+            continue                              # no point of this edge can be the nearest
+        # refine on the segment either side by ternary search of the distance
+        lo, hi = t[max(k - 1, 0)], t[min(k + 1, t.size - 1)]
+        for _ in range(40):
+            m = np.array([lo + (hi - lo) / 3, hi - (hi - lo) / 3])
+            d1, d2 = np.linalg.norm(e.pcurve.evaluate(m) - point, axis=1)
+            lo, hi = (lo, m[1]) if d1 < d2 else (m[0], hi)
+        tt = 0.5 * (lo + hi)
+        dist = float(np.linalg.norm(e.pcurve.evaluate(np.array([tt]))[0] - point))
+        if best is None or dist < best[3]:
+            best = (li, ei, tt, dist)
     if best is None or best[3] > eps and not near(best):
         return None
     return best[0], best[1], best[2]
