@@ -203,9 +203,21 @@ def _densified(own: NurbsSurface, other: NurbsSurface, side: DomainSide, t: NDAr
             np.concatenate([foot, found.uv])[order])
 
 
-def _side_runs(own: NurbsSurface, other: NurbsSurface, side: DomainSide, tol: float
-               ) -> list[SideRun]:
+def _near_boxes(points: NDArray, boxes: NDArray, pad: float) -> bool:
+    """True when some point ``(n, 3)`` lies within ``pad`` of some box ``(m, 2, 3)``."""
+    lo, hi = boxes[:, 0] - pad, boxes[:, 1] + pad
+    return bool(np.any(np.all((points[:, None] >= lo[None]) & (points[:, None] <= hi[None]), axis=2)))
+
+
+def _side_runs(own: NurbsSurface, other: NurbsSurface, side: DomainSide, tol: float,
+               boxes: NDArray | None = None) -> list[SideRun]:
     t = _side_samples(own, side.coord)
+    if boxes is not None:
+        # a run holds samples on ``other``, which lie in its Bezier patches' control-net
+        # boxes: none near a box, no run (the projections would all come back far)
+        uv = _uv_on_side(side, t)
+        if not _near_boxes(own.evaluate(uv[:, 0], uv[:, 1]), boxes, tol):
+            return []
     found = _gap(own, other, side, t, tol)[2]
     limit = _SHARE * tol
     t, dist, foot = _densified(own, other, side, t, found.distance, found.uv, tol)
@@ -325,11 +337,15 @@ def side_curves(surface_a: NurbsSurface, surface_b: NurbsSurface, sides: list[Do
         and the runs they came from. A stretch along a side of both surfaces is
         returned once (from surface a's side).
     """
+    from .culling import surface_patch_boxes
     surfaces = (surface_a, surface_b)
+    boxes = [None, None]
     curves, runs = [], []
     for side in dict.fromkeys(sides):
         own, other = surfaces[side.owner], surfaces[1 - side.owner]
-        for run in _side_runs(own, other, side, tol):
+        if boxes[1 - side.owner] is None:
+            boxes[1 - side.owner] = surface_patch_boxes(other)[0]
+        for run in _side_runs(own, other, side, tol, boxes[1 - side.owner]):
             curve = _run_curve(own, other, run, tol)
             if curve is None:
                 continue
