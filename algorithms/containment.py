@@ -36,7 +36,8 @@ from .intersection.culling import patch_rectangles, subpatch_boxes
 from .intersection.seams import closed_directions
 from .trimmed import TrimmedFace, natural_loop
 
-__all__ = ["INSIDE", "ON", "OUTSIDE", "classify_points", "interior_point", "sheet_side"]
+__all__ = ["INSIDE", "ON", "OUTSIDE", "classify_points", "interior_point", "piece_states",
+           "sheet_side"]
 
 INSIDE, OUTSIDE, ON = 1, 0, -1
 #: ray directions tried in turn (fixed: the answer does not depend on a seed)
@@ -319,3 +320,58 @@ def interior_point(face: TrimmedFace, samples: int = 33) -> tuple[NDArray, NDArr
     else:
         best = int(np.argmax(region.edge_distance(xyz)))
     return uv[best], xyz[best]
+
+
+def _normal(face: TrimmedFace, uv: NDArray) -> NDArray:
+    """Unit normals ``(n, 3)`` of a face at ``uv (n, 2)``, turned over for a reversed face."""
+    d = face.surface.derivatives(uv[:, 0], uv[:, 1], 1)
+    n = np.cross(d[:, 1, 0], d[:, 0, 1]) * (-1.0 if face.reversed else 1.0)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def piece_states(pieces: Sequence[TrimmedFace], others: Sequence[Sequence[TrimmedFace]], *,
+                 tol: float) -> list[str]:
+    """Where each piece of a split lies against the other operand's closed shell:
+    ``"in"``, ``"out"``, or on it -- ``"shared"`` (its normal along the shell's there:
+    the operands' boundaries overlap, as coplanar faces of two boxes) or
+    ``"opposite"`` (normals opposed: two solids touching along the face).
+
+    A point well inside each piece (:func:`interior_point`) is classified by ray parity
+    (:func:`classify_points`); one on the shell is compared with the nearest face of the
+    shell containing its foot. Faces are oriented (``reversed``) out of their solids.
+
+    Parameters
+    ----------
+    pieces : sequence of TrimmedFace
+    others : sequence of sequences of TrimmedFace
+        Per piece, the faces of the other operand's closed shell (the same list object
+        for the pieces of one operand: the classification is done once per list).
+    tol : float > 0
+    """
+    from .projection import project_to_surface
+    uvs, points = zip(*(interior_point(piece) for piece in pieces)) if pieces else ((), ())
+    points = np.array(points).reshape(-1, 3)
+    out = [""] * len(pieces)
+    groups: dict[int, list[int]] = {}
+    for k, shell in enumerate(others):
+        groups.setdefault(id(shell), []).append(k)
+    for rows in groups.values():
+        shell = others[rows[0]]
+        label = classify_points(shell, points[rows], tol=tol)
+        for k, lab in zip(rows, label):
+            out[k] = "in" if lab == INSIDE else "out" if lab == OUTSIDE else ""
+        on = [k for k, lab in zip(rows, label) if lab == ON]
+        if not on:
+            continue
+        best = np.full(len(on), np.inf)
+        normal = np.zeros((len(on), 3))
+        for face in shell:
+            foot = project_to_surface(face.surface, points[on])
+            usable = FaceRegion(face).contains(foot.uv, tol=tol) & (foot.distance < best)
+            if np.any(usable):
+                best[usable] = foot.distance[usable]
+                normal[usable] = _normal(face, foot.uv[usable])
+        for j, k in enumerate(on):
+            own = _normal(pieces[k], np.asarray(uvs[k]).reshape(1, 2))[0]
+            out[k] = "shared" if float(own @ normal[j]) > 0 else "opposite"
+    return out

@@ -17,7 +17,9 @@ clockwise from the way back, so the region stays on the left. Every cycle traced
 counter-clockwise bounds a region; clockwise cycles (a hole of the face, the
 outside of a closed cut) are holes of the smallest region that contains them.
 
-A cut with both ends inside the face that meets no other cut divides nothing (a
+A cut that runs along the face's boundary divides nothing and is left out (faces
+meeting along a shared edge, touching solids). A cut with both ends inside the face
+that meets no other cut divides nothing either (a
 curve that stops inside the face, where a fin stands on a sheet): it becomes an
 internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`) of the
 region it lies in. A cut with one end inside the face and one on its boundary or
@@ -34,7 +36,7 @@ from numpy.typing import NDArray
 
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
-from .face_region import inside_loops
+from .face_region import FaceRegion, inside_loops
 from .trimmed import (
     DEFAULT_TOLERANCE,
     LOOP_SAMPLES_PER_EDGE,
@@ -221,6 +223,9 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
+    cuts = [cut for cut in cuts if not _along_boundary(face, loops, cut, eps, tol3d)]
+    if not cuts:
+        return [face]
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]
@@ -279,6 +284,22 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         if li not in by_loop:
             cycles.append(list(loop.edges))
     return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling)])
+
+
+def _along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: float,
+                    tol3d: float | None) -> bool:
+    """True when the cut runs along the face's boundary (every sample within ``tol3d`` of
+    a trimming edge in space, or ``eps`` in the parameters): it divides nothing -- two
+    faces of one model meeting another along a shared edge, two touching solids."""
+    region = FaceRegion(TrimmedFace(face.surface, tuple(loops), 0, face.reversed))
+    uv = cut.samples()[::8]
+    if tol3d is not None:
+        t0, t1 = cut.range
+        points = (cut.curve3d.evaluate(np.linspace(t0, t1, uv.shape[0])) if cut.curve3d is not None
+                  else face.surface.evaluate(uv[:, 0], uv[:, 1]))
+        return bool(np.all(region.edge_distance(points) <= tol3d))
+    index = region.loop_index()
+    return index is not None and bool(np.all(index.uv_tree.distance(uv) <= eps))
 
 
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..algorithms.containment import INSIDE, ON, classify_points, interior_point, sheet_side
+from ..algorithms.containment import interior_point, piece_states, sheet_side
 from ..algorithms.face_split import Cut, split_face
 from ..algorithms.nonmanifold import NonManifoldModel
 from ..errors import OpenCascadeError, SurfprepError
@@ -265,9 +265,11 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
                        structure)
 
 
-#: the operations and, per operand, which pieces they keep: (of a, of b), each "in" or "out"
-#: of the other solid; "cut" also turns b's pieces over
-OPERATIONS = {"fuse": ("out", "out"), "common": ("in", "in"), "cut": ("out", "in")}
+#: the operations and, per operand, the states of the pieces they keep (of a, of b): "in" or
+#: "out" of the other solid, or on its boundary, "shared" (the normals agree: one copy,
+#: a's, is kept) or "opposite" (two solids touching there); "cut" turns b's pieces over
+OPERATIONS = {"fuse": (("out", "shared"), ("out",)), "common": (("in", "shared"), ("in",)),
+              "cut": (("out", "opposite"), ("in",))}
 
 
 @dataclass(frozen=True, eq=False)
@@ -331,37 +333,19 @@ def _solid_of(model, tol: float):
     return shape
 
 
-def _pieces_inside(cut: SplitResult, faces_a: list, faces_b: list, tol: float) -> list[bool]:
-    """Whether each piece (``pieces_a + pieces_b``) lies inside the other operand: a point
-    well inside the piece (:func:`~surfprep.algorithms.containment.interior_point`)
-    classified against the other operand's faces by ray parity on their exact surfaces
-    (:func:`~surfprep.algorithms.containment.classify_points`). A piece whose point lies
-    on the other operand (a coincident face) raises: coincident faces are not handled."""
-    pieces = cut.structure.faces
-    points = np.array([interior_point(piece)[1] for piece in pieces]).reshape(-1, 3)
-    operand = np.array([origin[0] for origin in cut.structure.origins])
-    out = np.zeros(len(pieces), dtype=bool)
-    for side, other in (("a", faces_b), ("b", faces_a)):
-        rows = np.flatnonzero(operand == side)
-        if rows.size == 0:
-            continue
-        label = classify_points(other, points[rows], tol=tol)
-        if np.any(label == ON):
-            raise OpenCascadeError("a piece lies on the other operand's boundary (coincident "
-                                   "faces): not handled")
-        out[rows] = label == INSIDE
-    return out.tolist()
-
-
 def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method: str = "auto") -> BooleanResult:
     """Fuse, cut (``a`` minus ``b``) or common of two solids, from their split pieces.
 
     Every face of ``a`` and of ``b`` is cut along the intersection curves
     (:func:`split`); each piece is classified by a point inside it against the
     other solid (ray parity on the exact trimmed surfaces, in the math layer:
-    :func:`~surfprep.algorithms.containment.classify_points`), and the operation keeps (fuse) the pieces of each outside the
-    other, (common) those inside, (cut) ``a``'s outside ``b`` and ``b``'s inside
-    ``a`` turned over. The kept pieces are sewn into the result.
+    :func:`~surfprep.algorithms.containment.piece_states`), and the operation keeps
+    (fuse) the pieces of each outside the other, (common) those inside, (cut) ``a``'s
+    outside ``b`` and ``b``'s inside ``a`` turned over. Pieces on the other's boundary
+    (coincident faces) count once: where the normals agree (coplanar faces of two
+    overlapping boxes) ``a``'s piece is kept by fuse and common; where they are opposed
+    (two solids touching) fuse and common drop both and cut keeps ``a``'s. The kept
+    pieces are sewn into the result.
 
     Raises
     ------
@@ -378,11 +362,14 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     size = max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
-    keep_a, keep_b = OPERATIONS[operation]
-    inside = _pieces_inside(cut, to_nurbs(model_a), to_nurbs(model_b), sew_tol)
+    shell_a, shell_b = to_nurbs(model_a), to_nurbs(model_b)
+    states = piece_states(cut.structure.faces,
+                          [shell_b if o[0] == "a" else shell_a for o in cut.structure.origins],
+                          tol=sew_tol)
     n_a = len(cut.pieces_a)
-    chosen_a = [p for p, i in zip(cut.pieces_a, inside[:n_a]) if i == (keep_a == "in")]
-    chosen_b = [p for p, i in zip(cut.pieces_b, inside[n_a:]) if i == (keep_b == "in")]
+    keep_a, keep_b = OPERATIONS[operation]
+    chosen_a = [p for p, s in zip(cut.pieces_a, states[:n_a]) if s in keep_a]
+    chosen_b = [p for p, s in zip(cut.pieces_b, states[n_a:]) if s in keep_b]
     if operation == "cut":
         chosen_b = [p.Reversed() for p in chosen_b]
     faces = chosen_a + chosen_b

@@ -164,3 +164,15 @@ def test_a_cut_that_stops_inside_the_face_becomes_an_internal_edge():
     # a spur (one end on the boundary, one inside) still divides nothing and is refused
     with pytest.raises(InvalidGeometryError, match="neither on the"):
         split_face(TrimmedFace(_plane()), [_line((0.0, 0.5), (0.5, 0.5))])
+
+
+def test_cuts_along_the_boundary_divide_nothing():
+    """Two faces of one model meeting another along a shared edge, or touching solids:
+    their curve runs along the face's edge and is left out."""
+    along = _line((0.0, 0.3), (0.0, 0.9))                     # on the side u = 0
+    across = _line((0.5, 0.0), (0.5, 1.0))
+    parts = split_face(TrimmedFace(_plane()), [along, across])
+    assert len(parts) == 2
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.5, 0.5], atol=1e-12)
+    whole = TrimmedFace(_plane())
+    assert split_face(whole, [along]) == [whole]              # nothing left to cut: the face itself

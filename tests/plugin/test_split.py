@@ -197,3 +197,20 @@ def test_a_sphere_trimmed_by_a_sheet_keeps_one_side_by_its_normal():
     assert front.operation == "trim-front"
     with pytest.raises(Exception, match="keep"):
         trim(sphere, sheet, keep="above")
+
+
+@pytest.mark.parametrize(("offset", "volumes"), [
+    ((10, 0, 0), {"fuse": 2000.0, "common": 0.0, "cut": 1000.0}),      # touching along x = 5
+    ((5, 5, 0), {"fuse": 1750.0, "common": 250.0, "cut": 750.0}),       # top and bottom coplanar
+])
+def test_booleans_of_boxes_with_coincident_faces(offset, volumes):
+    """Coincident faces count once: touching solids (normals opposed) lose the face they
+    share in fuse, keep A's in cut; coplanar overlapping faces (normals along) keep one
+    copy. Curves along the faces' edges divide nothing and are left out."""
+    from surfprep.plugin.split import boolean
+    a = cq.Workplane().box(10, 10, 10)
+    b = cq.Workplane().box(10, 10, 10).translate(offset)
+    for operation, exact in volumes.items():
+        result = boolean(a, b, operation)
+        assert result.valid and result.closed
+        assert result.volume == pytest.approx(exact, rel=1e-9, abs=1e-9)
