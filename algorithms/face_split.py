@@ -299,7 +299,11 @@ def _along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: flo
                   else face.surface.evaluate(uv[:, 0], uv[:, 1]))
         return bool(np.all(region.edge_distance(points) <= tol3d))
     index = region.loop_index()
-    return index is not None and bool(np.all(index.uv_tree.distance(uv) <= eps))
+    if index is not None:
+        return bool(np.all(index.uv_tree.distance(uv) <= eps))
+    u0, u1, v0, v1 = face.surface.domain          # the loops are the parameter rectangle
+    side = np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])), axis=0)
+    return bool(np.all(side <= eps))
 
 
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
