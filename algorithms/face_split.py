@@ -224,8 +224,6 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
     cuts = [cut for cut in cuts if not _along_boundary(face, loops, cut, eps, tol3d)]
-    if not cuts:
-        return [face]
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]

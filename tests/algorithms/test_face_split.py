@@ -174,5 +174,6 @@ def test_cuts_along_the_boundary_divide_nothing():
     parts = split_face(TrimmedFace(_plane()), [along, across])
     assert len(parts) == 2
     np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.5, 0.5], atol=1e-12)
-    whole = TrimmedFace(_plane())
-    assert split_face(whole, [along]) == [whole]              # nothing left to cut: the face itself
+    (whole,) = split_face(TrimmedFace(_plane()), [along])     # nothing left to cut: the face
+    assert len(whole.loops) == 1 and len(whole.loops[0].edges) == 4
+    np.testing.assert_allclose(_area(whole), 1.0, atol=1e-12)
