@@ -80,6 +80,33 @@ class SplitResult:
     #: (:class:`~surfprep.algorithms.nonmanifold.NonManifoldModel`, same order as
     #: ``pieces_a + pieces_b``)
     structure: NonManifoldModel | None = field(default=None, repr=False, compare=False)
+    #: the models cut (``a``, ``b`` or None) and the sewing tolerance, for :meth:`select`
+    operands: tuple = field(default=(), repr=False, compare=False)
+    sew_tol: float = field(default=0.0, compare=False)
+
+    def select(self, operation: str, *, keep: str = "front") -> BooleanResult:
+        """A Boolean-like result as a selection of this split's pieces (002 §1), without
+        cutting again: ``"fuse"``, ``"cut"`` (a minus b), ``"common"`` of two solids
+        (:func:`boolean`), or ``"trim"``: a's pieces on the ``keep`` side (``"front"``:
+        where b's normals point, or ``"back"``) of the sheet b (:func:`trim`)."""
+        from ..errors import InvalidGeometryError
+        if len(self.operands) != 2 or self.operands[1] is None:
+            raise InvalidGeometryError(f"{operation} needs the split of two operands, a and b")
+        if operation == "trim":
+            return _trimmed(self, keep)
+        if operation not in OPERATIONS:
+            raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of "
+                                       f"{', '.join(OPERATIONS)} or trim")
+        return _selected(self, operation)
+
+    def fuse(self) -> BooleanResult:
+        return self.select("fuse")
+
+    def cut(self) -> BooleanResult:
+        return self.select("cut")
+
+    def common(self) -> BooleanResult:
+        return self.select("common")
 
     @property
     def geometry(self) -> Any:
@@ -262,7 +289,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
                        time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]),
-                       structure)
+                       structure, (model_a, model_b), sew_tol)
 
 
 #: the operations and, per operand, the states of the pieces they keep (of a, of b): "in" or
@@ -357,10 +384,13 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     from ..errors import InvalidGeometryError
     if operation not in OPERATIONS:
         raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
-    model_a, model_b = as_model(a), as_model(b)
-    cut = split(model_a, model_b, tol=tol, method=method)
-    size = max(model_a.size, model_b.size)
-    sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
+    return split(as_model(a), as_model(b), tol=tol, method=method).select(operation)
+
+
+def _selected(cut: SplitResult, operation: str) -> BooleanResult:
+    """:meth:`SplitResult.select` of a Boolean (the docstring of :func:`boolean`)."""
+    model_a, model_b = cut.operands
+    sew_tol = cut.sew_tol
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
     shell_a, shell_b = to_nurbs(model_a), to_nurbs(model_b)
     states = piece_states(cut.structure.faces,
@@ -416,12 +446,18 @@ def trim(a: Any, b: Any, *, keep: str = "front", tol: float | None = None,
     from ..errors import InvalidGeometryError
     if keep not in ("front", "back"):
         raise InvalidGeometryError(f"keep must be 'front' or 'back', got {keep!r}")
-    model_a, model_b = as_model(a), as_model(b)
-    cut = split(model_a, model_b, tol=tol, method=method, tool=True)
-    size = max(model_a.size, model_b.size)
-    sew_tol = max(1e-7 * size, 10.0 * (cut.curves.tol or 0.0))
-    points = np.array([interior_point(face)[1] for face in cut.structure.faces]).reshape(-1, 3)
-    side = sheet_side(to_nurbs(model_b), points, tol=sew_tol)
+    return split(as_model(a), as_model(b), tol=tol, method=method, tool=True).select("trim", keep=keep)
+
+
+def _trimmed(cut: SplitResult, keep: str) -> BooleanResult:
+    """:meth:`SplitResult.select` of ``"trim"`` (the docstring of :func:`trim`)."""
+    from ..errors import InvalidGeometryError
+    if keep not in ("front", "back"):
+        raise InvalidGeometryError(f"keep must be 'front' or 'back', got {keep!r}")
+    sew_tol = cut.sew_tol
+    faces_a = cut.structure.faces[:len(cut.pieces_a)]
+    points = np.array([interior_point(face)[1] for face in faces_a]).reshape(-1, 3)
+    side = sheet_side(to_nurbs(cut.operands[1]), points, tol=sew_tol)
     want = 1 if keep == "front" else -1
     chosen = [p for p, s in zip(cut.pieces_a, side) if s == want]
     if not chosen:

@@ -214,3 +214,21 @@ def test_booleans_of_boxes_with_coincident_faces(offset, volumes):
         result = boolean(a, b, operation)
         assert result.valid and result.closed
         assert result.volume == pytest.approx(exact, rel=1e-9, abs=1e-9)
+
+
+def test_one_split_serves_every_boolean():
+    """The pieces are cut once; fuse, cut and common are selections of them."""
+    from surfprep.errors import InvalidGeometryError
+    cube = cq.Workplane().box(10, 10, 10)
+    bar = cq.Workplane("YZ").circle(3).extrude(20).translate((-10, 0, 0))
+    pieces = split(cube, bar)
+    inside = math.pi * 9 * 10
+    exact = {"common": inside, "fuse": 1000 + math.pi * 9 * 20 - inside, "cut": 1000 - inside}
+    for operation, volume in exact.items():
+        result = getattr(pieces, operation)()
+        assert result.split is pieces and result.valid
+        assert result.volume == pytest.approx(volume, rel=1e-6)
+    with pytest.raises(InvalidGeometryError, match="two operands"):
+        split(cube).select("fuse")
+    with pytest.raises(InvalidGeometryError, match="unknown operation"):
+        pieces.select("xor")
