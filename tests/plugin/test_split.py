@@ -232,3 +232,34 @@ def test_one_split_serves_every_boolean():
         split(cube).select("fuse")
     with pytest.raises(InvalidGeometryError, match="unknown operation"):
         pieces.select("xor")
+
+
+def _cylinder(axis: str, radius: float):
+    """A cylinder of ``radius``, 20 long along x ("YZ") or y ("XZ"), centred at 0."""
+    shift = (-10, 0, 0) if axis == "YZ" else (0, 10, 0)
+    return cq.Workplane(axis).circle(radius).extrude(20).translate(shift)
+
+
+def test_two_cylinders_crossing_at_right_angles():
+    """Equal radii: the curves are two ellipses crossing at two double points where four
+    faces meet; common = the Steinmetz solid 16 r^3 / 3. Unequal radii: common by the
+    integral of the cross-sections 4 sqrt((r2^2 - z^2)(r1^2 - z^2)) (scipy quad)."""
+    from scipy.integrate import quad
+    for r2, common in ((3.0, 16 * 27 / 3),
+                       (2.0, quad(lambda z: 4 * math.sqrt((4 - z * z) * (9 - z * z)), -2, 2,
+                                  epsabs=1e-13, epsrel=1e-13)[0])):
+        pieces = split(_cylinder("YZ", 3.0), _cylinder("XZ", r2))
+        assert all(f.kept is None for f in pieces.faces)
+        va, vb = math.pi * 9 * 20, math.pi * r2 * r2 * 20
+        for operation, exact in (("common", common), ("fuse", va + vb - common), ("cut", va - common)):
+            result = pieces.select(operation)
+            assert result.valid and result.volume == pytest.approx(exact, rel=1e-6)
+
+
+def test_a_box_minus_a_sphere_poking_out_of_its_top():
+    box, ball = cq.Workplane().box(10, 10, 10), cq.Workplane().sphere(3).translate((0, 0, 5))
+    half = 2 / 3 * math.pi * 27
+    pieces = split(box, ball)
+    for operation, exact in (("cut", 1000 - half), ("common", half), ("fuse", 1000 + half)):
+        result = pieces.select(operation)
+        assert result.valid and result.volume == pytest.approx(exact, rel=1e-6)
