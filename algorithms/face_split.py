@@ -18,7 +18,8 @@ counter-clockwise bounds a region; clockwise cycles (a hole of the face, the
 outside of a closed cut) are holes of the smallest region that contains them.
 
 A cut that runs along the face's boundary divides nothing and is left out (faces
-meeting along a shared edge, touching solids). A cut with both ends inside the face
+meeting along a shared edge, touching solids), and so is a cut that repeats another
+(the same curve reported twice). A cut with both ends inside the face
 that meets no other cut divides nothing either (a
 curve that stops inside the face, where a fin stands on a sheet): it becomes an
 internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`) of the
@@ -142,7 +143,8 @@ def _param(edge: TrimEdge, fraction: float) -> float:
     return edge.t1 - fraction * (edge.t1 - edge.t0) if edge.reversed else edge.t0 + fraction * (edge.t1 - edge.t0)
 
 
-def _runs(loop: TrimLoop, marks: list[_Mark]) -> list[tuple[list[TrimEdge], _Mark, _Mark]]:
+def _runs(loop: TrimLoop, marks: list[_Mark], eps: float = 0.0
+          ) -> list[tuple[list[TrimEdge], _Mark, _Mark]]:
     """The loop split at its marks: the runs of edge pieces from each mark to the next.
 
     Positions along the loop run from 0 to ``n`` (edge ``k`` covers ``[k, k + 1)`` in
@@ -165,8 +167,11 @@ def _runs(loop: TrimLoop, marks: list[_Mark]) -> list[tuple[list[TrimEdge], _Mar
             edge = edges[k_edge % n]
             lo = position - k_edge
             hi = min(b - k_edge, 1.0)
-            if hi - lo > 1e-12:
-                ta, tb = _param(edge, lo), _param(edge, hi)
+            ta, tb = _param(edge, lo), _param(edge, hi)
+            # a piece of no length: a mark at an edge's end, a rounding apart from it
+            sliver = hi - lo <= 1e-6 and np.linalg.norm(np.subtract(*edge.pcurve.evaluate(
+                np.array([ta, tb])))) <= eps
+            if hi - lo > 1e-12 and not sliver:
                 pieces.append(TrimEdge(edge.curve3d, edge.pcurve, min(ta, tb), max(ta, tb), edge.reversed,
                                        edge.tolerance, edge.seam_pcurve, edge.degenerated,
                                        edge.vertex_tolerances))
@@ -223,7 +228,8 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
-    cuts = [cut for cut in cuts if not _along_boundary(face, loops, cut, eps, tol3d)]
+    cuts = _distinct([cut for cut in cuts if not _along_boundary(face, loops, cut, eps, tol3d)],
+                     face, eps, tol3d)
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]
@@ -246,6 +252,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                 continue                                         # an inner end: joined below
             li, ei, t = where
             e = loops[li].edges[ei]
+            t = _snap_to_corner(e, face.surface, t, eps, tol3d)
             frac = (t - e.t0) / (e.t1 - e.t0)
             gap = float(np.linalg.norm(curve3d_points(e, face.surface, np.array([t]))[0]
                                        - _cut_point(cut, face, end)))
@@ -274,7 +281,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     for m in marks:
         by_loop.setdefault(m.loop, []).append(m)
     for li, ms in by_loop.items():
-        for pieces, start, stop in _runs(loops[li], ms):
+        for pieces, start, stop in _runs(loops[li], ms, eps):
             graph.run(pieces, start, stop)
     graph.check_ends()
     cycles = graph.cycles()
@@ -282,6 +289,51 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         if li not in by_loop:
             cycles.append(list(loop.edges))
     return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling)])
+
+
+def _snap_to_corner(edge: TrimEdge, surface, t: float, eps: float, tol3d: float | None) -> float:
+    """``t`` moved to the edge's end when its point lies that close to it (within ``tol3d``
+    in space, else ``eps`` in the parameters): a cut ending at a corner of the loop,
+    found a tolerance away from it, would leave a sliver of the edge."""
+    ends = np.array([edge.t0, edge.t1])
+    if tol3d is not None:
+        pts = curve3d_points(edge, surface, np.array([t, edge.t0, edge.t1]))
+        near, limit = np.linalg.norm(pts[1:] - pts[0], axis=1), tol3d
+    else:
+        uv = edge.pcurve.evaluate(np.array([t, edge.t0, edge.t1]))
+        near, limit = np.linalg.norm(uv[1:] - uv[0], axis=1), eps
+    k = int(np.argmin(near))
+    return float(ends[k]) if near[k] <= limit else t
+
+
+def _distinct(cuts: list[Cut], face: TrimmedFace, eps: float, tol3d: float | None) -> list[Cut]:
+    """The cuts without repeats: a cut whose every sample lies within ``tol3d`` in space
+    (``eps`` in the parameters) of a cut kept before it is the same curve found twice
+    (as an intersection can report it from two methods or two passes) and is left out."""
+    kept: list[tuple[Cut, NDArray]] = []
+    for cut in cuts:
+        uv = cut.samples()
+        points = (face.surface.evaluate(uv[:, 0], uv[:, 1]) if tol3d is not None else uv)
+        limit = tol3d if tol3d is not None else eps
+        same = False
+        for _, other in kept:
+            ends = min(np.linalg.norm(points[[0, -1]] - other[[0, -1]], axis=1).max(),
+                       np.linalg.norm(points[[0, -1]] - other[[-1, 0]], axis=1).max())
+            if ends > limit:
+                continue
+            gaps = np.min(np.linalg.norm(points[::16, None] - other[None], axis=2), axis=1)
+            if np.all(gaps <= limit + _chord(other)):
+                same = True
+                break
+        if not same:
+            kept.append((cut, points))
+    return [cut for cut, _ in kept]
+
+
+def _chord(points: NDArray) -> float:
+    """Half the longest step between consecutive samples: how far a point of the curve can
+    lie from the nearest sample."""
+    return 0.5 * float(np.max(np.linalg.norm(np.diff(points, axis=0), axis=1))) if len(points) > 1 else 0.0
 
 
 def _along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: float,

@@ -263,3 +263,23 @@ def test_a_box_minus_a_sphere_poking_out_of_its_top():
     for operation, exact in (("cut", 1000 - half), ("common", half), ("fuse", 1000 + half)):
         result = pieces.select(operation)
         assert result.valid and result.volume == pytest.approx(exact, rel=1e-6)
+
+
+@pytest.mark.slow
+def test_a_real_solid_cut_at_mid_height(data_dir):
+    """occt_k1_catia_debis.stp (a closed CATIA solid, 70 trimmed faces) cut by the plane at
+    half its height: no face is kept whole -- one is met at a corner of its loop, and a
+    cut found a tolerance from the corner used to leave a sliver of the edge there (the
+    face built was refused) -- and every cut face's pieces add up to its area."""
+    import surfprep
+    model = surfprep.read(data_dir / "occt_k1_catia_debis.stp")
+    xmin, ymin, zmin, xmax, ymax, zmax = model.bounding_box
+    z = zmin + 0.5 * (zmax - zmin)
+    plane = cq.Workplane("XY").rect(3 * (xmax - xmin), 3 * (ymax - ymin)).extrude(0.001).faces(">Z").val()
+    plane = plane.translate(cq.Vector((xmin + xmax) / 2, (ymin + ymax) / 2, z - 0.001))
+    out = split(model, plane, tool=True)
+    assert out.valid and all(f.kept is None for f in out.faces)
+    assert len(out.faces) >= 20
+    for f in out.faces:
+        whole = face_area(model.faces[f.index], 1e-9)
+        assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(whole, rel=1e-5)
