@@ -37,7 +37,8 @@ from numpy.typing import NDArray
 
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
-from .face_region import FaceRegion, inside_loops
+from .cuts import CUT_SAMPLES, Cut, cut_point_at, distinct_cuts, runs_along_boundary, snap_to_corner
+from .face_region import inside_loops
 from .trimmed import (
     DEFAULT_TOLERANCE,
     LOOP_SAMPLES_PER_EDGE,
@@ -50,40 +51,6 @@ from .trimmed import (
 )
 
 __all__ = ["Cut", "split_face"]
-
-#: samples of a cut's pcurve for the topology (crossings, containment)
-CUT_SAMPLES = 257
-
-
-@dataclass(frozen=True, eq=False)
-class Cut:
-    """A curve to cut a face along.
-
-    Attributes
-    ----------
-    pcurve : NurbsCurve (2D)
-        The curve in the face's ``(u, v)``, over its whole domain.
-    curve3d : NurbsCurve (3D) or None
-        The same curve in space, on the same parameter.
-    """
-
-    pcurve: NurbsCurve
-    curve3d: NurbsCurve | None = None
-
-    def __post_init__(self) -> None:
-        if self.pcurve.dimension != 2:
-            raise InvalidGeometryError(f"a cut's pcurve must be 2D, got dimension {self.pcurve.dimension}")
-        if self.curve3d is not None and self.curve3d.dimension != 3:
-            raise InvalidGeometryError("a cut's 3D curve must be 3D")
-
-    @property
-    def range(self) -> tuple[float, float]:
-        return self.pcurve.domain
-
-    def samples(self) -> NDArray:
-        t0, t1 = self.range
-        return self.pcurve.evaluate(np.linspace(t0, t1, CUT_SAMPLES))
-
 
 @dataclass
 class _Mark:
@@ -228,7 +195,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
-    cuts = _distinct([cut for cut in cuts if not _along_boundary(face, loops, cut, eps, tol3d)],
+    cuts = distinct_cuts([cut for cut in cuts if not runs_along_boundary(face, loops, cut, eps, tol3d)],
                      face, eps, tol3d)
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
@@ -237,7 +204,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         for j in range(i + 1, len(cuts)):
             for s, t in _crossings(cuts[i], cuts[j], eps):
                 point = cuts[i].pcurve.evaluate(np.array([s]))[0]
-                graph.vertex(point, _cut_point_at(cuts[i], face, s), _cut_point_at(cuts[j], face, t))
+                graph.vertex(point, cut_point_at(cuts[i], face, s), cut_point_at(cuts[j], face, t))
                 params[i].append(s)
                 params[j].append(t)
     dangling = _dangling(face, loops, cuts, params, eps, tol3d)
@@ -252,7 +219,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                 continue                                         # an inner end: joined below
             li, ei, t = where
             e = loops[li].edges[ei]
-            t = _snap_to_corner(e, face.surface, t, eps, tol3d)
+            t = snap_to_corner(e, face.surface, t, eps, tol3d)
             frac = (t - e.t0) / (e.t1 - e.t0)
             gap = float(np.linalg.norm(curve3d_points(e, face.surface, np.array([t]))[0]
                                        - _cut_point(cut, face, end)))
@@ -289,71 +256,6 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         if li not in by_loop:
             cycles.append(list(loop.edges))
     return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling)])
-
-
-def _snap_to_corner(edge: TrimEdge, surface, t: float, eps: float, tol3d: float | None) -> float:
-    """``t`` moved to the edge's end when its point lies that close to it (within ``tol3d``
-    in space, else ``eps`` in the parameters): a cut ending at a corner of the loop,
-    found a tolerance away from it, would leave a sliver of the edge."""
-    ends = np.array([edge.t0, edge.t1])
-    if tol3d is not None:
-        pts = curve3d_points(edge, surface, np.array([t, edge.t0, edge.t1]))
-        near, limit = np.linalg.norm(pts[1:] - pts[0], axis=1), tol3d
-    else:
-        uv = edge.pcurve.evaluate(np.array([t, edge.t0, edge.t1]))
-        near, limit = np.linalg.norm(uv[1:] - uv[0], axis=1), eps
-    k = int(np.argmin(near))
-    return float(ends[k]) if near[k] <= limit else t
-
-
-def _distinct(cuts: list[Cut], face: TrimmedFace, eps: float, tol3d: float | None) -> list[Cut]:
-    """The cuts without repeats: a cut whose every sample lies within ``tol3d`` in space
-    (``eps`` in the parameters) of a cut kept before it is the same curve found twice
-    (as an intersection can report it from two methods or two passes) and is left out."""
-    kept: list[tuple[Cut, NDArray]] = []
-    for cut in cuts:
-        uv = cut.samples()
-        points = (face.surface.evaluate(uv[:, 0], uv[:, 1]) if tol3d is not None else uv)
-        limit = tol3d if tol3d is not None else eps
-        same = False
-        for _, other in kept:
-            ends = min(np.linalg.norm(points[[0, -1]] - other[[0, -1]], axis=1).max(),
-                       np.linalg.norm(points[[0, -1]] - other[[-1, 0]], axis=1).max())
-            if ends > limit:
-                continue
-            gaps = np.min(np.linalg.norm(points[::16, None] - other[None], axis=2), axis=1)
-            if np.all(gaps <= limit + _chord(other)):
-                same = True
-                break
-        if not same:
-            kept.append((cut, points))
-    return [cut for cut, _ in kept]
-
-
-def _chord(points: NDArray) -> float:
-    """Half the longest step between consecutive samples: how far a point of the curve can
-    lie from the nearest sample."""
-    return 0.5 * float(np.max(np.linalg.norm(np.diff(points, axis=0), axis=1))) if len(points) > 1 else 0.0
-
-
-def _along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: float,
-                    tol3d: float | None) -> bool:
-    """True when the cut runs along the face's boundary (every sample within ``tol3d`` of
-    a trimming edge in space, or ``eps`` in the parameters): it divides nothing -- two
-    faces of one model meeting another along a shared edge, two touching solids."""
-    region = FaceRegion(TrimmedFace(face.surface, tuple(loops), 0, face.reversed))
-    uv = cut.samples()[::8]
-    if tol3d is not None:
-        t0, t1 = cut.range
-        points = (cut.curve3d.evaluate(np.linspace(t0, t1, uv.shape[0])) if cut.curve3d is not None
-                  else face.surface.evaluate(uv[:, 0], uv[:, 1]))
-        return bool(np.all(region.edge_distance(points) <= tol3d))
-    index = region.loop_index()
-    if index is not None:
-        return bool(np.all(index.uv_tree.distance(uv) <= eps))
-    u0, u1, v0, v1 = face.surface.domain          # the loops are the parameter rectangle
-    side = np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])), axis=0)
-    return bool(np.all(side <= eps))
 
 
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
@@ -400,14 +302,6 @@ def _with_internal(face: TrimmedFace, regions: list[TrimmedFace], dangling: list
             TrimmedFace(region.surface, region.loops, region.outer_loop_index, region.reversed,
                         region.name, region.internal + tuple(more))
             for region, more in zip(regions, extra)]
-
-
-def _cut_point_at(cut: Cut, face: TrimmedFace, t: float) -> NDArray:
-    """The cut's point in space at its parameter ``t``."""
-    if cut.curve3d is not None:
-        return cut.curve3d.evaluate(np.array([t]))[0]
-    uv = cut.pcurve.evaluate(np.array([t]))
-    return face.surface.evaluate(uv[:, 0], uv[:, 1])[0]
 
 
 def _crossings(a: Cut, b: Cut, eps: float) -> list[tuple[float, float]]:
@@ -493,8 +387,8 @@ class _Graph:
 
     def cut_segment(self, c: int, cut: Cut, a: float, b: float) -> None:
         pa, pb = cut.pcurve.evaluate(np.array([a, b]))
-        va = self.vertex(pa, _cut_point_at(cut, self.face, a))
-        vb = self.vertex(pb, _cut_point_at(cut, self.face, b))
+        va = self.vertex(pa, cut_point_at(cut, self.face, a))
+        vb = self.vertex(pb, cut_point_at(cut, self.face, b))
         for origin, target, forward in ((va, vb, True), (vb, va, False)):
             start, stop = (a, b) if forward else (b, a)
             sign = 1.0 if forward else -1.0
