@@ -18,8 +18,8 @@ kept, and the exact answer: every cut edge lies in the plane, so its largest
 |z - z0| on 200 points an edge is the error of the section curves.
 
 Two B-spline surfaces: the bundled fuselage (``step_samples/occt_fuselage.stp``, 8
-bicubic faces) cut by a wing-like B-spline solid (a closed cambered spline section
-lofted through the body), ``surfprep.split(fuselage, wing)`` against OpenCascade's
+bicubic faces) cut by a wing-like B-spline solid (``step_samples/synthetic_wing.step``:
+a closed cambered spline section lofted through the body), ``surfprep.split(fuselage, wing)`` against OpenCascade's
 General Fuse of the two (``BRepAlgoAPI_BuilderAlgo``, both as arguments, which splits
 both), ours at its default tolerance (1e-6 of the size) and at 1e-3 mm: faces,
 validity, the largest edge tolerance, the time, and the intersection
@@ -136,21 +136,6 @@ def _plane_cut(name: str, fraction: float, label: str) -> list[str]:
     return rows
 
 
-def _wing():
-    """The wing-like B-spline solid of the module doc (periodic section, seam at the
-    trailing edge), from y = -16 m to 16 m through the fuselage."""
-    import numpy as np
-
-    def section(y, chord, x0, z0, n=24):
-        th = np.linspace(0, 2 * np.pi, n, endpoint=False)
-        x = x0 + chord * 0.5 * (1 + np.cos(th))
-        z = z0 + chord * 0.12 * np.sin(th) * (0.6 + 0.4 * np.cos(th))
-        return [cq.Vector(a, y, b) for a, b in zip(x, z)]
-    wires = [cq.Wire.assembleEdges([cq.Edge.makeSpline(section(y, c, x0, z0), periodic=True)])
-             for y, c, x0, z0 in ((-16000, 9000, 24000, -1200), (16000, 7000, 26000, -800))]
-    return cq.Solid.makeLoft(wires, True)
-
-
 def _on_both(shape, a, b, near: float, samples: int = 50) -> tuple[int, float]:
     """Edges of ``shape`` whose middle lies within ``near`` of both ``a`` and ``b`` (the
     intersection edges), and the largest distance from either of ``samples`` points on
@@ -191,8 +176,9 @@ def _wing_fuselage() -> list[str]:
     import surfprep
     from surfprep.plugin.occ.shapes import max_edge_tolerance
     from surfprep.plugin.split import split
-    fuselage = surfprep.read(Path(__file__).resolve().parents[1] / "step_samples" / "occt_fuselage.stp")
-    wing = _wing()
+    samples = Path(__file__).resolve().parents[1] / "step_samples"
+    fuselage = surfprep.read(samples / "occt_fuselage.stp")
+    wing = surfprep.read(samples / "synthetic_wing.step")
     split(fuselage, wing)                 # warm: the kernels load on the first call
     runs = []
     for tol in (None, 1e-3):
@@ -204,7 +190,7 @@ def _wing_fuselage() -> list[str]:
     builder = BRepAlgoAPI_BuilderAlgo()
     arguments = TopTools_ListOfShape()
     arguments.Append(fuselage.shape)
-    arguments.Append(wing.wrapped)
+    arguments.Append(wing.shape)
     builder.SetArguments(arguments)
     builder.Build()
     t_occ = time.perf_counter() - start
@@ -215,7 +201,7 @@ def _wing_fuselage() -> list[str]:
     runs.append(("BRepAlgoAPI_BuilderAlgo (General Fuse)", builder.Shape(), t_occ,
                  builder.IsDone() and BRepCheck_Analyzer(builder.Shape()).IsValid()))
     for name, shape, seconds, ok in runs:
-        edges, off = _on_both(shape, fuselage.shape, wing.wrapped, near)
+        edges, off = _on_both(shape, fuselage.shape, wing.shape, near)
         rows.append(f"| {name} | {_unique_faces(shape)} | {ok} | {max_edge_tolerance(shape):.1e} | "
                     f"{edges} | {off:.1e} | {seconds:.2f} |")
         print(rows[-1], flush=True)

@@ -1,4 +1,4 @@
-"""Regenerate the synthetic sample ``synthetic_named_faces.step``.
+"""Regenerate the synthetic samples ``synthetic_named_faces.step`` and ``synthetic_wing.step``.
 
 Four faces with names and colours, written by surfprep itself (OCCT's
 STEPCAFControl_Writer):
@@ -9,6 +9,11 @@ STEPCAFControl_Writer):
                       a badly parametrized flat patch, figure 7 in u;
 * ``plane``           analytic plane face, 10 x 5;
 * ``cylinder``        analytic half cylinder face, radius 2, height 3.
+
+``synthetic_wing.step`` is a wing-like B-spline solid through the fuselage of
+``occt_fuselage.stp`` (a closed cambered spline section lofted from y = -16 m to
+16 m; its seam runs along the trailing edge): the pair ``surfprep split`` cuts in the
+README and ``benchmarks/split.py`` compares with OpenCascade's General Fuse.
 
 Run from the repository root: ``python step_samples/make_samples.py``.
 """
@@ -24,9 +29,10 @@ from OCP.gp import gp_Ax3, gp_Cylinder, gp_Dir, gp_Pln, gp_Pnt
 from surfprep.algorithms import NurbsSurface
 from surfprep.plugin.io import CadModel, write
 from surfprep.plugin.occ.faces import make_face
-from surfprep.plugin.step_iges import _compound
+from surfprep.plugin.occ.shapes import compound
 
 OUTPUT = Path(__file__).resolve().parent / "synthetic_named_faces.step"
+WING = Path(__file__).resolve().parent / "synthetic_wing.step"
 
 
 def uniform_patch() -> NurbsSurface:
@@ -51,6 +57,21 @@ def _done(maker):
     return maker.Face()
 
 
+def wing():
+    """The wing of the module doc, as a cadquery Solid (mm; the fuselage declares feet,
+    which OpenCascade reads in mm)."""
+    import cadquery as cq
+
+    def section(y, chord, x0, z0, n=24):
+        th = np.linspace(0, 2 * np.pi, n, endpoint=False)
+        x = x0 + chord * 0.5 * (1 + np.cos(th))
+        z = z0 + chord * 0.12 * np.sin(th) * (0.6 + 0.4 * np.cos(th))
+        return [cq.Vector(a, y, b) for a, b in zip(x, z)]
+    wires = [cq.Wire.assembleEdges([cq.Edge.makeSpline(section(y, c, x0, z0), periodic=True)])
+             for y, c, x0, z0 in ((-16000, 9000, 24000, -1200), (16000, 7000, 26000, -800))]
+    return cq.Solid.makeLoft(wires, True)
+
+
 def main() -> Path:
     plane = _done(BRepBuilderAPI_MakeFace(
         gp_Pln(gp_Pnt(0, 12, 0), gp_Dir(0, 0, 1)), 0.0, 10.0, 0.0, 5.0))
@@ -61,9 +82,10 @@ def main() -> Path:
              plane, cylinder)
     names = ("uniform_patch", "cubic_u_patch", "plane", "cylinder")
     colors = ((0.8, 0.2, 0.2), (0.2, 0.8, 0.2), (0.2, 0.2, 0.8), (0.9, 0.9, 0.1))
-    model = CadModel(_compound(faces), faces, names, colors)
+    model = CadModel(compound(faces), faces, names, colors)
+    write(wing().wrapped, WING, overwrite=True)
     return write(model, OUTPUT, overwrite=True)
 
 
 if __name__ == "__main__":
-    print(main())
+    print(main(), WING)

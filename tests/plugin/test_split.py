@@ -147,20 +147,6 @@ def test_a_real_hull_cut_at_a_waterline(data_dir):
         assert min(tops) == pytest.approx(z, abs=1e-3 * (zmax - zmin))
 
 
-def _wing():
-    """A wing-like B-spline solid through the bundled fuselage: a closed, cambered
-    spline section lofted from y = -16 m to 16 m (periodic: its seam runs along the
-    trailing edge)."""
-    def section(y, chord, x0, z0, n=24):
-        th = np.linspace(0, 2 * np.pi, n, endpoint=False)
-        x = x0 + chord * 0.5 * (1 + np.cos(th))
-        z = z0 + chord * 0.12 * np.sin(th) * (0.6 + 0.4 * np.cos(th))
-        return [cq.Vector(a, y, b) for a, b in zip(x, z)]
-    wires = [cq.Wire.assembleEdges([cq.Edge.makeSpline(section(y, c, x0, z0), periodic=True)])
-             for y, c, x0, z0 in ((-16000, 9000, 24000, -1200), (16000, 7000, 26000, -800))]
-    return cq.Solid.makeLoft(wires, True)
-
-
 def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
     """A real B-spline pair: the wing's root loops lie inside two fuselage faces, each an
     open curve cut at the wing's seam whose ends meet inside the face. Each face becomes
@@ -168,7 +154,7 @@ def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
     and the face was refused), the areas adding up to the face's."""
     import surfprep
     fuselage = surfprep.read(SAMPLES / "occt_fuselage.stp")
-    out = split(fuselage, _wing())
+    out = split(fuselage, SAMPLES / "synthetic_wing.step")
     assert out.valid
     cut = [f for f in out.faces if f.operand == "a"]
     assert [f.index for f in cut] == [2, 3]
