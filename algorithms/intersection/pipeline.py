@@ -54,7 +54,14 @@ from .result import (
 )
 from .seams import cut_at_seams
 from .segments import mesh_segments
-from .sides import DomainSide, box_sides, covered_by_sides, may_run_along_many, side_curves
+from .sides import (
+    DomainSide,
+    box_sides,
+    covered_samples,
+    may_run_along_many,
+    side_curves,
+    uncovered_pieces,
+)
 from .singular_join import join_at_singular_points
 from .topology import Chain, EndKind, SegmentTopology, topology_from_soup
 
@@ -219,11 +226,23 @@ def _along_sides(dense: list[RefinedCurve], kinds: list, topology: SegmentTopolo
     extra, runs = side_curves(surface_a, surface_b, sides, tol=tol)
     if not extra:
         return dense, kinds
-    keep = [not covered_by_sides(c, runs, surface_a, surface_b, tol) for c in dense]
-    dense = [c for c, k in zip(dense, keep) if k] + extra
-    kinds = [c for c, k in zip(kinds, keep) if k] + [
-        (EndKind.BOUNDARY, EndKind.BOUNDARY)] * len(extra)
-    return dense, kinds
+    kept, kept_kinds = [], []
+    for c, kind in zip(dense, kinds):
+        covered = covered_samples(c, runs, surface_a, surface_b, tol)
+        if covered.all():
+            continue                       # wholly along a side: the side curve replaces it
+        if c.closed or not covered.any():
+            kept.append(c)
+            kept_kinds.append(kind)
+            continue
+        # partly along a side (a plane through the edges where faces meet: the traced
+        # curve runs along a side, then into the face): the stretches off the runs are
+        # kept, ending where they leave the side, on the domain's boundary
+        for piece, from_side, to_side in uncovered_pieces(c, covered):
+            kept.append(piece)
+            kept_kinds.append((EndKind.BOUNDARY if from_side else kind[0],
+                               EndKind.BOUNDARY if to_side else kind[1]))
+    return kept + extra, kept_kinds + [(EndKind.BOUNDARY, EndKind.BOUNDARY)] * len(extra)
 
 
 def _only_along_sides(a: NurbsSurface, b: NurbsSurface, tol: float, stray) -> list:

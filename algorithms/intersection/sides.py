@@ -35,8 +35,9 @@ from ..surface import NurbsSurface
 from .refine import RefinedCurve
 from .seams import other_side, seam_jumps
 
-__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides", "may_run_along",
-           "may_run_along_many", "side_curves"]
+__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides",
+           "covered_samples", "may_run_along", "may_run_along_many", "side_curves",
+           "uncovered_pieces"]
 
 #: samples of a side curve per knot span (at least ``_MIN_SAMPLES`` in all)
 SIDE_SAMPLES_PER_SPAN = 16
@@ -356,6 +357,27 @@ def side_curves(surface_a: NurbsSurface, surface_b: NurbsSurface, sides: list[Do
     return curves, runs
 
 
+def covered_samples(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsSurface,
+                    surface_b: NurbsSurface, tol: float) -> NDArray:
+    """``(n,) bool``: which samples of ``curve`` lie on a run (within ``tol`` of the side
+    point at their own free parameter, inside the run's range)."""
+    surfaces = (surface_a, surface_b)
+    covered = np.zeros(curve.points.shape[0], dtype=bool)
+    for run in runs:
+        side = run.side
+        uv = curve.uv_a if side.owner == 0 else curve.uv_b
+        t = uv[:, 1 - side.coord]
+        span = 1e-9 * max(abs(run.t1 - run.t0), 1.0)
+        inside = (t >= run.t0 - span) & (t <= run.t1 + span)
+        if not inside.any():
+            continue
+        on = _uv_on_side(side, t[inside])
+        q = surfaces[side.owner].evaluate(on[:, 0], on[:, 1])
+        hit = np.flatnonzero(inside)[np.linalg.norm(q - curve.points[inside], axis=1) <= tol]
+        covered[hit] = True
+    return covered
+
+
 def covered_by_sides(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsSurface,
                      surface_b: NurbsSurface, tol: float) -> bool:
     """True when every sample of ``curve`` lies on one run (within ``tol`` of the
@@ -373,3 +395,21 @@ def covered_by_sides(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsS
         if np.all(np.linalg.norm(q - curve.points, axis=1) <= tol):
             return True
     return False
+
+
+def uncovered_pieces(curve: RefinedCurve, covered: NDArray) -> list[tuple[RefinedCurve, bool, bool]]:
+    """The stretches of an open ``curve`` off the side runs: each maximal run of samples
+    not ``covered``, with the covered sample on either side of it (the point where the
+    curve leaves the side: on the domain's boundary). Returns ``(piece, starts at a
+    junction, ends at a junction)`` for pieces of at least two samples."""
+    n = covered.size
+    edges = np.diff(np.concatenate([[0], (~covered).astype(np.int8), [0]]))
+    out = []
+    for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        a, b = max(lo - 1, 0), min(hi + 1, n)
+        if b - a < 2:
+            continue
+        sl = slice(a, b)
+        out.append((RefinedCurve(curve.points[sl], curve.uv_a[sl], curve.uv_b[sl], False,
+                                 curve.converged[sl], curve.singular[sl]), a < lo, b > hi))
+    return out

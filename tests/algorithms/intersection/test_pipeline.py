@@ -253,6 +253,29 @@ def test_misaligned_tori_curves_cut_at_seams_do_not_run_past_their_ends():
     assert connected_branches(curves, 1e3 * tol) == 2
     check_against_occ(curves, a, b, tol=tol, expect_branches=2)
 
+
+def test_a_plane_through_the_sides_of_a_face_and_across_it():
+    """A face whose sides lie in the plane (a solid cut at its plane of symmetry, where
+    faces meet along edges lying in it) and which crosses the plane inside: the traced
+    curve ran along a side and then across the face and was refused as folded; the
+    stretches along the sides now go to the side curves and the crossing is kept."""
+    from surfprep.algorithms.fitting import interpolate_surface
+    u, v = np.meshgrid(np.linspace(0, 1, 13), np.linspace(0, 1, 9), indexing="ij")
+    a = interpolate_surface(np.stack([10 * u, 6 * v, 3 * np.sin(2 * np.pi * u) * np.sin(np.pi * v)],
+                                     axis=-1))
+    cp = np.zeros((2, 2, 3))
+    cp[..., 0], cp[..., 1] = np.meshgrid([-5.0, 15.0], [-5.0, 11.0], indexing="ij")
+    cp[..., 2] = -1e-6                                   # a hair below the sides, within tol
+    b = NurbsSurface(cp, [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+    tol = 1e-4
+    curves = intersect_surfaces(a, b, tol=tol)
+    check_on_surfaces(curves, a, b, tol)
+    # the crossing: from side v = 0 to side v = 1 in the middle of the face (the sides
+    # u = 0, 1 and v = 0, 1 lie in the plane too and come back as side curves)
+    inside = [c for c in curves if 0.05 < c.uv_a[:, 0].mean() < 0.95 and np.ptp(c.uv_a[:, 1]) > 0.99]
+    assert len(inside) == 1
+    np.testing.assert_allclose(inside[0].uv_a[:, 0], 0.5, atol=0.01)
+
 # ---------------------------------------------------------------- free form
 def contour_reference(surface: NurbsSurface, level: float, n: int = 1201):
     """Marching-squares contour of z(u, v) = level on an n x n grid, mapped to 3D."""
