@@ -19,12 +19,12 @@ outside of a closed cut) are holes of the smallest region that contains them.
 
 A cut that runs along the face's boundary divides nothing and is left out (faces
 meeting along a shared edge, touching solids), and so is a cut that repeats another
-(the same curve reported twice). A cut with both ends inside the face
-that meets no other cut divides nothing either (a
-curve that stops inside the face, where a fin stands on a sheet): it becomes an
-internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`) of the
-region it lies in. A cut with one end inside the face and one on its boundary or
-another cut (a spur) is refused, as are two cuts ending at one boundary point.
+(the same curve reported twice). A cut that stops inside the face and
+meets no other cut divides nothing either (where a fin stands on a sheet): it
+becomes an internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`)
+of the region it lies in; when its other end is on the boundary (a spur) the loop's
+edge is split there, so the two share the vertex. Two cuts ending at one boundary
+point are refused.
 """
 
 from __future__ import annotations
@@ -207,7 +207,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                 graph.vertex(point, cut_point_at(cuts[i], face, s), cut_point_at(cuts[j], face, t))
                 params[i].append(s)
                 params[j].append(t)
-    dangling = _dangling(face, loops, cuts, params, eps, tol3d)
+    dangling, spurs = _dangling(face, loops, cuts, params, eps, tol3d)
     marks: list[_Mark] = []
     for c, cut in enumerate(cuts):
         line = cut.samples()
@@ -235,7 +235,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         seen[key] = m.cut
     # the cut segments between consecutive split parameters, both ways
     for c, cut in enumerate(cuts):
-        if c in dangling:
+        if c in dangling or c in spurs:
             continue
         ts = np.sort(np.clip(np.asarray(params[c], dtype=float), *cut.range))
         width = 1e-12 * max(abs(cut.range[1] - cut.range[0]), 1.0)
@@ -255,31 +255,35 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     for li, loop in enumerate(loops):
         if li not in by_loop:
             cycles.append(list(loop.edges))
-    return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling)])
+    return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling | spurs)])
 
 
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
-              eps: float, tol3d: float | None) -> set[int]:
-    """The cuts that divide nothing: open, both ends inside the face (on no loop, at no
-    other cut's end) and crossing no other cut -- a curve that stops inside the face.
-    They become internal edges of the region they lie in."""
+              eps: float, tol3d: float | None) -> tuple[set[int], set[int]]:
+    """The cuts that divide nothing: open, crossing no other cut, with an end inside the
+    face (on no loop, at no other cut's end) -- a curve that stops inside the face. Both
+    ends inside: *dangling*; one on the boundary: a *spur* (its boundary end splits the
+    loop's edge there, so the edge and the spur share that vertex). Both become internal
+    edges of the region they lie in."""
     ends = []
     for cut in cuts:
         line = cut.samples()
         ends.append((line[0], line[-1]))
-    out = set()
+    dangling, spurs = set(), set()
     for c, cut in enumerate(cuts):
         first, last = ends[c]
         if np.linalg.norm(first - last) <= eps or len(params[c]) > 2:
             continue                                   # closed, or crossing another cut
-        if any(_locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d)) is not None
-               for end, point in ((0, first), (1, last))):
-            continue
-        met = any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends) if d != c
-                  for p in (first, last) for q in pair)
-        if not met:
-            out.add(c)
-    return out
+        on_loop = [_locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d)) is not None
+                   for end, point in ((0, first), (1, last))]
+        if all(on_loop):
+            continue                                   # boundary to boundary: it divides
+        inner = [p for p, on in zip((first, last), on_loop) if not on]
+        if any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends) if d != c
+               for p in inner for q in pair):
+            continue                                   # joined to another cut inside
+        (spurs if any(on_loop) else dangling).add(c)
+    return dangling, spurs
 
 
 def _with_internal(face: TrimmedFace, regions: list[TrimmedFace], dangling: list[Cut]

@@ -6,10 +6,10 @@ parameters (each curve has a pcurve on both faces) to
 :func:`~surfprep.algorithms.face_split.split_face`, rebuilds the pieces as
 OpenCascade faces and sews them (non-manifold: where two surfaces cross, four
 pieces share one intersection edge). A curve that stops inside a face (where a fin
-stands on a sheet) divides nothing: it becomes an INTERNAL edge of the face, shared
-with the faces that end on it (a T-junction: one edge, three faces). A face a curve
-runs into from its boundary and stops inside (a spur), or that the builder refuses,
-is kept whole and named with the reason; nothing is dropped.
+stands on a sheet, or over its border: a spur) divides nothing: it becomes an
+INTERNAL edge of the face, shared with the faces that end on it (a T-junction: one
+edge, three faces). A face the arrangement or the builder refuses is kept whole and
+named with the reason; nothing is dropped.
 """
 
 from __future__ import annotations
@@ -153,9 +153,10 @@ class SplitResult:
 
 def _share_internal_edges(shape, tol: float):
     """``shape`` with every INTERNAL edge of a face (a curve that stops inside it, where a
-    fin stands on a sheet) replaced by the edge of the other faces lying on it, when
-    there is one over the same points and parameters: sewing joins boundary edges only,
-    and the T-junction is then one edge used by all three faces. The face's pcurve is
+    fin stands on a sheet) replaced by the edge of the other faces lying on it -- a
+    boundary edge, or another face's internal edge (a fin over the sheet's border) --
+    when there is one over the same points and parameters: sewing joins boundary edges
+    only, and the junction is then one edge used by all its faces. The face's pcurve is
     added to the shared edge. Unchanged when nothing matches."""
     from OCP.BRep import BRep_Builder, BRep_Tool
     from OCP.BRepAdaptor import BRepAdaptor_Curve
@@ -183,18 +184,75 @@ def _share_internal_edges(shape, tol: float):
         return shape
     reshape, builder = BRepTools_ReShape(), BRep_Builder()
     changed = False
-    probes = [probe(e) for e, _ in others]
-    for edge, face in internal:
+    # an internal edge may be shared with a boundary edge of other faces, or with an
+    # internal edge of another face (a fin over a sheet's border: a spur in both)
+    targets = others + internal
+    probes = [probe(e) for e, _ in targets]
+    replaced: set[int] = set()
+    for k, (edge, face) in enumerate(internal):
+        if k + len(others) in replaced:
+            continue                              # already the shared edge of another face
         p, a, b = probe(edge)
         span = max(abs(b - a), 1e-300)
-        for (other, _), (q, c, d) in zip(others, probes):
+        for j, ((other, other_face), (q, c, d)) in enumerate(zip(targets, probes)):
+            if other.IsSame(edge) or other_face.IsSame(face) or j in replaced:
+                continue
             if np.max(np.abs(p - q)) <= tol and abs(a - c) + abs(b - d) <= 1e-9 * span:
                 pcurve = BRep_Tool.CurveOnSurface_s(edge, face, a, b)
                 builder.UpdateEdge(other, pcurve, face, max(BRep_Tool.Tolerance_s(edge), tol))
                 reshape.Replace(edge, other.Oriented(TopAbs_INTERNAL))
+                replaced.add(k + len(others))
                 changed = True
                 break
-    return reshape.Apply(shape) if changed else shape
+    if not changed:
+        return shape
+    return _merge_internal_vertices(reshape.Apply(shape), tol)
+
+
+def _merge_internal_vertices(shape, tol: float):
+    """The vertices of INTERNAL edges made the same as the other vertices at their place
+    (a spur's end on a face's border is the border's vertex there), so the faces meeting
+    at the junction share it."""
+    from OCP.BRep import BRep_Builder, BRep_Tool
+    from OCP.BRepLib import BRepLib
+    from OCP.BRepTools import BRepTools_ReShape
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_INTERNAL, TopAbs_VERTEX
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    def vertices_of(root):
+        out, explorer = [], TopExp_Explorer(root, TopAbs_VERTEX)
+        while explorer.More():
+            v = TopoDS.Vertex_s(explorer.Current())
+            p = BRep_Tool.Pnt_s(v)
+            out.append((v, np.array([p.X(), p.Y(), p.Z()])))
+            explorer.Next()
+        return out
+    inner, explorer = [], TopExp_Explorer(shape, TopAbs_EDGE)
+    while explorer.More():
+        if explorer.Current().Orientation() == TopAbs_INTERNAL:
+            inner.extend(vertices_of(explorer.Current()))
+        explorer.Next()
+    everything = vertices_of(shape)
+    reshape, changed, builder = BRepTools_ReShape(), False, BRep_Builder()
+    for v, p in inner:
+        for w, q in everything:
+            gap = float(np.linalg.norm(p - q))
+            if not w.IsSame(v) and gap <= max(tol, BRep_Tool.Tolerance_s(w)) \
+                    and not any(w.IsSame(x) for x, _ in inner):
+                # the vertex must hold the internal edge's end as well as its own
+                builder.UpdateVertex(w, max(BRep_Tool.Tolerance_s(w), gap + BRep_Tool.Tolerance_s(v)))
+                # both FORWARD: the reshape then keeps each occurrence's own orientation
+                # (a vertex explored through an INTERNAL edge comes INTERNAL)
+                reshape.Replace(v.Oriented(TopAbs_FORWARD), w.Oriented(TopAbs_FORWARD))
+                changed = True
+                break
+    if not changed:
+        return shape
+    merged = reshape.Apply(shape)
+    # the vertex must hold the ends of the edge's 3D curve and of its pcurves on every face
+    BRepLib.UpdateTolerances_s(merged, True)
+    return merged
 
 
 def _edge_uses(shape) -> dict:

@@ -34,7 +34,14 @@ from OCP.Geom import Geom_BSplineSurface, Geom_TrimmedCurve
 from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_Face
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FORWARD, TopAbs_INTERNAL, TopAbs_REVERSED, TopAbs_WIRE
+from OCP.TopAbs import (
+    TopAbs_EDGE,
+    TopAbs_FORWARD,
+    TopAbs_INTERNAL,
+    TopAbs_REVERSED,
+    TopAbs_VERTEX,
+    TopAbs_WIRE,
+)
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Edge, TopoDS_Face, TopoDS_Iterator, TopoDS_Vertex, TopoDS_Wire
@@ -326,13 +333,23 @@ def _with_internal_edges(face: TopoDS_Face, surface: NurbsSurface, occ_surface,
     face.Free(True)
     occ_surface = BRep_Tool.Surface_s(face)
     brep = BRep_Builder()
+    existing = []                      # the loops' vertices: a spur's end on the boundary is one
+    explorer = TopExp_Explorer(face, TopAbs_VERTEX)
+    while explorer.More():
+        v = TopoDS.Vertex_s(explorer.Current())
+        p = BRep_Tool.Pnt_s(v)
+        existing.append((np.array([p.X(), p.Y(), p.Z()]), BRep_Tool.Tolerance_s(v), v))
+        explorer.Next()
     for e in internal:
         ends = curve3d_points(e, surface, np.array([e.t0, e.t1]))
         vertices = []
         for p in ends:
-            v = TopoDS_Vertex()
-            brep.MakeVertex(v, gp_Pnt(*p.tolist()), max(tol, e.tolerance))
-            vertices.append(v)
+            shared = next((v for q, vt, v in existing
+                           if np.linalg.norm(q - p) <= max(vt, tol, e.tolerance)), None)
+            if shared is None:
+                shared = TopoDS_Vertex()
+                brep.MakeVertex(shared, gp_Pnt(*p.tolist()), max(tol, e.tolerance))
+            vertices.append(shared)
         occ_edge = build_trim_edge(surface, occ_surface, e, vertices[0], vertices[1], tol)
         wire = TopoDS_Wire()
         brep.MakeWire(wire)

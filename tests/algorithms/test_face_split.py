@@ -127,8 +127,10 @@ def test_a_triangle_of_three_crossing_cuts_and_a_circle_across_one():
 
 def test_cuts_that_cannot_be_used_are_refused():
     face = TrimmedFace(_plane())
+    # two cuts joined end to end inside the face, the second stopping inside it: a path
+    # that divides nothing and is no single internal edge
     with pytest.raises(InvalidGeometryError, match="neither on the face's boundary nor on another cut"):
-        split_face(face, [_line((0.2, 0.3), (0.8, 1.0))])
+        split_face(face, [_line((0.0, 0.5), (0.4, 0.5)), _line((0.4, 0.5), (0.6, 0.7))])
     with pytest.raises(InvalidGeometryError, match="same boundary point"):
         split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
 
@@ -161,9 +163,11 @@ def test_a_cut_that_stops_inside_the_face_becomes_an_internal_edge():
     assert sorted(len(p.internal) for p in parts) == [0, 1]
     holder = next(p for p in parts if p.internal)
     np.testing.assert_allclose(_area(holder), 0.8, atol=1e-12)
-    # a spur (one end on the boundary, one inside) still divides nothing and is refused
-    with pytest.raises(InvalidGeometryError, match="neither on the"):
-        split_face(TrimmedFace(_plane()), [_line((0.0, 0.5), (0.5, 0.5))])
+    # a spur (one end on the boundary, one inside) divides nothing either: an internal
+    # edge, and the boundary edge it starts on is split there (they share the vertex)
+    (spurred,) = split_face(TrimmedFace(_plane()), [_line((0.0, 0.5), (0.5, 0.5))])
+    assert len(spurred.internal) == 1 and len(spurred.loops[0].edges) == 5
+    np.testing.assert_allclose(_area(spurred), 1.0, atol=1e-12)
 
 
 def test_cuts_along_the_boundary_divide_nothing():

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from helpers.paths import SAMPLES
 
-from surfprep.plugin.occ.shapes import face_area
+from surfprep.plugin.occ.shapes import face_area, is_valid, max_edge_tolerance
 from surfprep.plugin.split import split
 
 
@@ -75,13 +75,17 @@ def test_a_fin_on_a_plate_is_an_internal_edge_shared_by_three_faces():
     assert len(plate.internal) == 1 and face_area(out.pieces_a[0], 1e-9) == pytest.approx(4.0, rel=1e-9)
 
 
-def test_a_curve_that_runs_in_from_the_border_and_stops_keeps_the_face_whole():
+def test_a_fin_over_the_sheets_border_is_a_spur_in_both_sharing_one_edge():
+    """The fin stands over the sheet's border: the curve runs in from the sheet's border
+    and stops inside it, and from the fin's border and stops inside the fin -- a spur in
+    each, one edge of both faces, its ends on each face's border vertex there."""
     fin = cq.Workplane("YZ").rect(1, 2).extrude(0.001).faces(">X").val().translate(cq.Vector(0, 1.0, 0))
     out = split(_sheet("XY"), fin)
-    kept = [f for f in out.faces if f.kept is not None]
-    assert ("a", 0) in [(f.operand, f.index) for f in kept]
-    assert all("neither on the face's boundary nor on another cut" in f.kept for f in kept)
-    assert out.report()["faces"][0]["kept_whole"] == kept[0].kept
+    assert all(f.kept is None and len(f.pieces) == 1 for f in out.faces) and out.valid
+    assert is_valid(out.shape)
+    assert out.shared_edges.get(2) == 1 and out.structure.edges_by_uses().get(2) == 1
+    assert all(len(face.internal) == 1 for face in out.structure.faces)
+    assert max_edge_tolerance(out.shape) <= 10 * out.curves.tol
 
 
 @pytest.mark.parametrize("operation", ["common", "fuse", "cut"])

@@ -32,15 +32,21 @@ def test_split_writes_the_pieces_and_a_report(tmp_path, capsys, sphere_and_plate
     assert "7 piece(s)" in stdout
 
 
-def test_a_face_kept_whole_is_exit_1(tmp_path, capsys):
-    """A fin over the sheet's edge: the curve runs in from the sheet's border and stops
-    inside it (a spur), which divides nothing and cannot be an internal edge either."""
-    a, b = tmp_path / "sheet.step", tmp_path / "fin.step"
-    cq.exporters.export(cq.Workplane("XY").rect(2, 2).extrude(0.001).faces(">Z"), str(a))
-    cq.exporters.export(cq.Workplane("YZ").rect(1, 2).extrude(0.001).faces(">X").val()
-                        .translate(cq.Vector(0, 1.0, 0)), str(b))
+def test_a_face_kept_whole_is_exit_1(tmp_path, capsys, monkeypatch, sphere_and_plate):
+    """A face the split cannot cut is kept whole and named, and the exit code says so
+    (the arrangement refusing the sphere's cuts, simulated)."""
+    import surfprep.plugin.split as split_module
+    from surfprep.errors import InvalidGeometryError
+    real = split_module.split_face
+
+    def refusing(face, cuts, **kw):
+        if len(cuts) == 2:                       # the sphere's face: both circles
+            raise InvalidGeometryError("two cuts end at one boundary point (simulated)")
+        return real(face, cuts, **kw)
+    monkeypatch.setattr(split_module, "split_face", refusing)
+    a, b = sphere_and_plate
     code, stdout, _ = run(capsys, "split", a, b, "-o", tmp_path / "cut.step")
-    assert code == 1 and "kept whole" in stdout and "nor on another cut" in stdout
+    assert code == 1 and "kept whole" in stdout and "simulated" in stdout
 
 
 def test_a_fin_standing_on_a_sheet_shares_its_edge_with_the_sheet(tmp_path, capsys):
