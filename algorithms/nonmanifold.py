@@ -78,26 +78,13 @@ class EdgeUse:
         return face.internal[self.position] if self.loop < 0 else face.loops[self.loop].edges[self.position]
 
 
-class _Union:
-    def __init__(self, n: int) -> None:
-        self.parent = np.arange(n)
-
-    def find(self, k: int) -> int:
-        root = k
-        while self.parent[root] != root:
-            root = self.parent[root]
-        while self.parent[k] != root:
-            self.parent[k], k = root, self.parent[k]
-        return int(root)
-
-    def join(self, a: int, b: int) -> None:
-        ra, rb = self.find(a), self.find(b)
-        if ra != rb:
-            self.parent[max(ra, rb)] = min(ra, rb)
-
-    def labels(self) -> NDArray:
-        roots = np.array([self.find(k) for k in range(self.parent.size)], dtype=np.int64)
-        return np.unique(roots, return_inverse=True)[1]
+def _groups(n: int, pairs: NDArray) -> NDArray:
+    """``(n,)`` labels of the classes that ``pairs (k, 2)`` join (connected components)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    return connected_components(graph, directed=False)[1]
 
 
 def _loop_points(edge: TrimEdge, surface) -> NDArray:
@@ -181,28 +168,19 @@ class NonManifoldModel:
         if not where:
             return cls(faces, origins, np.zeros((0, 3)), np.zeros((0, 2), np.int64), (), float(tol))
         pts = np.array(samples)                                           # (m, 5, 3)
-        union = _Union(len(where))
-        flip = np.zeros(len(where), dtype=bool)                           # against its class's first
-        for i, j in cKDTree(pts[:, 2]).query_pairs(tol, output_type="ndarray"):
-            same = np.max(np.linalg.norm(pts[i] - pts[j], axis=1))
-            other = np.max(np.linalg.norm(pts[i] - pts[j, ::-1], axis=1))
-            if min(same, other) <= tol:
-                union.join(int(i), int(j))
-        label = union.labels()
+        i, j = cKDTree(pts[:, 2]).query_pairs(tol, output_type="ndarray").T.reshape(2, -1)
+        same = np.max(np.linalg.norm(pts[i] - pts[j], axis=2), axis=1)
+        other = np.max(np.linalg.norm(pts[i] - pts[j, ::-1], axis=2), axis=1)
+        match = np.minimum(same, other) <= tol
+        label = _groups(len(where), np.stack([i[match], j[match]], axis=1))
         first = np.full(label.max() + 1, -1)
-        for m in range(len(where)):
-            if first[label[m]] < 0:
-                first[label[m]] = m
-        for m in range(len(where)):
-            ref = pts[first[label[m]]]
-            flip[m] = (np.max(np.linalg.norm(pts[m, ::-1] - ref, axis=1))
-                       < np.max(np.linalg.norm(pts[m] - ref, axis=1)))
+        first[label[::-1]] = np.arange(len(where))[::-1]                 # each class's first member
+        ref = pts[first[label]]
+        flip = (np.max(np.linalg.norm(pts[:, ::-1] - ref, axis=2), axis=1)
+                < np.max(np.linalg.norm(pts - ref, axis=2), axis=1))
         # vertices: the edges' ends merged within tol
         ends = np.stack([pts[first, 0], pts[first, -1]], axis=1).reshape(-1, 3)
-        vunion = _Union(ends.shape[0])
-        for i, j in cKDTree(ends).query_pairs(tol, output_type="ndarray"):
-            vunion.join(int(i), int(j))
-        vlabel = vunion.labels()
+        vlabel = _groups(ends.shape[0], cKDTree(ends).query_pairs(tol, output_type="ndarray"))
         vertices = np.array([ends[vlabel == v].mean(axis=0) for v in range(vlabel.max() + 1)])
         edge_vertices = vlabel.reshape(-1, 2)
         uses = []
@@ -264,10 +242,9 @@ class NonManifoldModel:
 
     def components(self) -> list[list[int]]:
         """Faces connected through shared edges, each component sorted, largest first."""
-        union = _Union(len(self.faces))
-        for uses in self.uses:
-            for u in uses[1:]:
-                union.join(uses[0].face, u.face)
-        label = union.labels() if self.faces else np.zeros(0, np.int64)
-        groups = [list(np.flatnonzero(label == c)) for c in range(label.max() + 1)] if label.size else []
+        if not self.faces:
+            return []
+        pairs = [(uses[0].face, u.face) for uses in self.uses for u in uses[1:]]
+        label = _groups(len(self.faces), np.array(pairs, dtype=np.int64).reshape(-1, 2))
+        groups = [np.flatnonzero(label == c) for c in range(label.max() + 1)]
         return sorted(([int(f) for f in g] for g in groups), key=lambda g: (-len(g), g[0]))
