@@ -173,8 +173,7 @@ class NonManifoldModel:
         other = np.max(np.linalg.norm(pts[i] - pts[j, ::-1], axis=2), axis=1)
         match = np.minimum(same, other) <= tol
         label = _groups(len(where), np.stack([i[match], j[match]], axis=1))
-        first = np.full(label.max() + 1, -1)
-        first[label[::-1]] = np.arange(len(where))[::-1]                 # each class's first member
+        first = np.unique(label, return_index=True)[1]                   # each class's first member
         ref = pts[first[label]]
         flip = (np.max(np.linalg.norm(pts[:, ::-1] - ref, axis=2), axis=1)
                 < np.max(np.linalg.norm(pts - ref, axis=2), axis=1))
