@@ -33,7 +33,8 @@ from ..errors import InvalidGeometryError
 from .face_region import FaceRegion
 from .healing.piercing import pierce_surface
 from .intersection.culling import patch_rectangles, subpatch_boxes
-from .intersection.seams import closed_directions
+from .intersection.seams import closed_directions, seam_restarts
+from .measure import normals
 from .trimmed import TrimmedFace, natural_loop
 
 __all__ = ["INSIDE", "ON", "OUTSIDE", "classify_points", "interior_point", "piece_states",
@@ -114,17 +115,7 @@ def _across_seams(surface, closed: tuple[bool, bool], origin: NDArray, direction
     """Crossings Newton could not reach because they lie across a seam of a closed
     direction (the step was held at the domain's side): tried again from the other
     side."""
-    lo, hi = np.array(surface.domain[0::2]), np.array(surface.domain[1::2])
-    eps = 1e-9 * (hi - lo)
-    for axis in (0, 1):
-        if not closed[axis]:
-            continue
-        at_lo, at_hi = uv[:, axis] <= lo[axis] + eps[axis], uv[:, axis] >= hi[axis] - eps[axis]
-        rows = np.flatnonzero(~ok & (at_lo | at_hi))
-        if rows.size == 0:
-            continue
-        start = uv[rows].copy()
-        start[:, axis] = np.where(at_lo[rows], hi[axis], lo[axis])
+    for rows, start in seam_restarts(surface, uv, closed, ~ok):
         uv2, t2, ok2 = pierce_surface(surface, origin[rows], direction[rows], start,
                                       t_mesh[rows].copy(), tol)
         uv[rows[ok2]], t[rows[ok2]], ok[rows[ok2]] = uv2[ok2], t2[ok2], True
@@ -324,9 +315,7 @@ def interior_point(face: TrimmedFace, samples: int = 33) -> tuple[NDArray, NDArr
 
 def _normal(face: TrimmedFace, uv: NDArray) -> NDArray:
     """Unit normals ``(n, 3)`` of a face at ``uv (n, 2)``, turned over for a reversed face."""
-    d = face.surface.derivatives(uv[:, 0], uv[:, 1], 1)
-    n = np.cross(d[:, 1, 0], d[:, 0, 1]) * (-1.0 if face.reversed else 1.0)
-    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    return normals(face.surface, uv[:, 0], uv[:, 1]) * (-1.0 if face.reversed else 1.0)
 
 
 def piece_states(pieces: Sequence[TrimmedFace], others: Sequence[Sequence[TrimmedFace]], *,

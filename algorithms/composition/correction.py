@@ -40,7 +40,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
 from ..intersection.refine import project_points
-from ..intersection.seams import closed_directions
+from ..intersection.seams import closed_directions, seam_restarts
+from ..measure import normals
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
 
@@ -112,28 +113,12 @@ def three_planes(normals: NDArray, offsets: NDArray) -> tuple[NDArray, NDArray]:
         return num / det[:, None], det
 
 
-def _normals(surface: NurbsSurface, uv: NDArray) -> NDArray:
-    d = surface.derivatives(uv[:, 0], uv[:, 1], 1)
-    return _unit(np.cross(d[:, 1, 0], d[:, 0, 1]))[0]
-
-
 def _feet(surface: NurbsSurface, x: NDArray, uv: NDArray, closed: tuple[bool, bool], tol: float
           ) -> tuple[NDArray, NDArray]:
     """Feet of ``x`` from ``uv``; a foot stopped on the seam of a closed direction is sought
     again from the seam's other side, and the nearer foot kept."""
     uv, foot, _ = project_points(surface, x, uv, tol=tol)
-    lo = np.array(surface.domain[0::2])
-    hi = np.array(surface.domain[1::2])
-    eps = 1e-9 * (hi - lo)
-    for axis in (0, 1):
-        if not closed[axis]:
-            continue
-        at_lo, at_hi = uv[:, axis] <= lo[axis] + eps[axis], uv[:, axis] >= hi[axis] - eps[axis]
-        rows = np.flatnonzero(at_lo | at_hi)
-        if rows.size == 0:
-            continue
-        start = uv[rows].copy()
-        start[:, axis] = np.where(at_lo[rows], hi[axis], lo[axis])
+    for rows, start in seam_restarts(surface, uv, closed):
         uv2, foot2, _ = project_points(surface, x[rows], start, tol=tol)
         better = (np.linalg.norm(foot2 - x[rows], axis=1)
                   < np.linalg.norm(foot[rows] - x[rows], axis=1))
@@ -187,17 +172,18 @@ def correct_points(surface_a: NurbsSurface, surface_b: NurbsSurface, points: Arr
         active = active[going]
         if active.size == 0:
             break
-        na, nb = _normals(surface_a, ua[active]), _normals(surface_b, ub[active])
+        na = normals(surface_a, ua[active, 0], ua[active, 1])
+        nb = normals(surface_b, ub[active, 0], ub[active, 1])
         along, sin = _unit(np.cross(na, nb))
         third = _unit(np.cross(foot_a[active] - p[active], foot_b[active] - p[active]))[0]
         # p, B, G nearly collinear (p on one surface already, or both feet equal): the
         # cross product is rounding noise; its limit is the normal plane of the curve
         collinear = ~(np.abs(_dot(third, along)) >= 0.5)
         third[collinear] = along[collinear]
-        normals = np.stack([na, nb, third], axis=1)
+        planes = np.stack([na, nb, third], axis=1)
         offsets = np.stack([_dot(na, foot_a[active]), _dot(nb, foot_b[active]),
                             _dot(third, p[active])], axis=1)
-        x, det = three_planes(normals, offsets)
+        x, det = three_planes(planes, offsets)
         ok = (sin > TANGENT_SIN) & (np.abs(det) > TANGENT_SIN) & np.all(np.isfinite(x), axis=1)
         p[active[ok]] = x[ok]
         active = active[ok]          # tangent there: no plane point; the feet stay as found

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from ..surface import NurbsSurface
 from .topology import Chain, EndKind, SegmentTopology
 
-__all__ = ["closed_directions", "cut_at_seams", "other_side", "seam_jumps"]
+__all__ = ["closed_directions", "cut_at_seams", "other_side", "seam_jumps", "seam_restarts"]
 
 
 def seam_jumps(uv: NDArray | None, surface: NurbsSurface | None, closed: bool,
@@ -190,3 +190,26 @@ def closed_directions(surface: NurbsSurface, tol: float) -> tuple[bool, bool]:
     in_u = np.linalg.norm(surface.evaluate(np.full(17, u0), v) - surface.evaluate(np.full(17, u1), v), axis=1)
     in_v = np.linalg.norm(surface.evaluate(u, np.full(17, v0)) - surface.evaluate(u, np.full(17, v1)), axis=1)
     return bool(np.all(in_u <= tol)), bool(np.all(in_v <= tol))
+
+
+def seam_restarts(surface: NurbsSurface, uv: NDArray, closed: tuple[bool, bool],
+                  candidates: NDArray | None = None) -> list[tuple[NDArray, NDArray]]:
+    """Where a Newton search held on a side of a closed direction should start again:
+    per closed direction, the rows of ``uv (n, 2)`` (among ``candidates``, a mask) lying
+    on one of its two sides and their parameters moved to the other side (the seam's
+    other parameter line, the same points in space). ``closed``: as
+    :func:`closed_directions` gives it."""
+    lo, hi = np.array(surface.domain[0::2]), np.array(surface.domain[1::2])
+    eps = 1e-9 * (hi - lo)
+    out = []
+    for axis in (0, 1):
+        if not closed[axis]:
+            continue
+        at_lo, at_hi = uv[:, axis] <= lo[axis] + eps[axis], uv[:, axis] >= hi[axis] - eps[axis]
+        held = at_lo | at_hi if candidates is None else candidates & (at_lo | at_hi)
+        rows = np.flatnonzero(held)
+        if rows.size:
+            start = uv[rows].copy()
+            start[:, axis] = np.where(at_lo[rows], hi[axis], lo[axis])
+            out.append((rows, start))
+    return out
