@@ -51,7 +51,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..intersection.culling import candidate_pairs, subpatch_boxes, surface_patch_boxes
+from ..intersection.culling import candidate_pairs, overlap_boxes, subpatch_boxes, surface_patch_boxes
 from ..intersection.mesh import TriangleMesh
 from ..intersection.tessellation import tessellate
 from ..intersection.triangles import intersect_triangles
@@ -249,11 +249,10 @@ def _split(rects: NDArray, levels: int) -> NDArray:
     return np.stack([us[:, iu], us[:, iu + 1], vs[:, iv], vs[:, iv + 1]], axis=2)
 
 
-def _kept_subpatches(patches: BoundaryPatches, which: NDArray, boxes: NDArray, pad: float
-                     ) -> NDArray:
-    """``(k, 4**SUBDIVISION)`` mask of the sub-patches of patches ``which`` whose boxes
+def _kept_subpatches(patches: BoundaryPatches, which: NDArray, subs: NDArray, boxes: NDArray,
+                     pad: float) -> NDArray:
+    """``(k, m)`` mask of the sub-patches ``subs (k, m, 4)`` of patches ``which`` whose boxes
     meet the overlap boxes ``(k, 2, 3)`` (padded)."""
-    subs = _split(patches.rects[which], SUBDIVISION)                      # (k, m, 4)
     keep = np.zeros(subs.shape[:2], dtype=bool)
     for f, surface in enumerate(patches.surfaces):
         rows = np.flatnonzero(patches.face[which] == f)
@@ -483,14 +482,12 @@ def build_hierarchy(a: BoundaryPatches, b: BoundaryPatches, *, tol: float, mesh_
         raise ValueError(f"candidates must be 'sweep' or 'descent', got {candidates!r}")
     times = {}
     started = time.perf_counter()
-    pairs = candidate_pairs(a.boxes, b.boxes, pad=2 * mesh_tol)
-    lo = np.maximum(a.boxes[pairs[:, 0], 0], b.boxes[pairs[:, 1], 0]) - mesh_tol
-    hi = np.minimum(a.boxes[pairs[:, 0], 1], b.boxes[pairs[:, 1], 1]) + mesh_tol
-    boxes = np.stack([lo, hi], axis=1)
-    keep_a = _kept_subpatches(a, pairs[:, 0], boxes, mesh_tol)
-    keep_b = _kept_subpatches(b, pairs[:, 1], boxes, mesh_tol)
-    live = np.flatnonzero(keep_a.any(axis=1) & keep_b.any(axis=1))
+    overlap = overlap_boxes(a.boxes, b.boxes, pad=2 * mesh_tol)      # widened by mesh_tol each
+    pairs, boxes = overlap.pairs, overlap.boxes
     subs_a, subs_b = _split(a.rects[pairs[:, 0]], SUBDIVISION), _split(b.rects[pairs[:, 1]], SUBDIVISION)
+    keep_a = _kept_subpatches(a, pairs[:, 0], subs_a, boxes, mesh_tol)
+    keep_b = _kept_subpatches(b, pairs[:, 1], subs_b, boxes, mesh_tol)
+    live = np.flatnonzero(keep_a.any(axis=1) & keep_b.any(axis=1))
     times["overlap_boxes"] = time.perf_counter() - started
     under = [_box_under(a, b, int(pairs[k, 0]), int(pairs[k, 1]), boxes[k], subs_a[k][keep_a[k]],
                         subs_b[k][keep_b[k]], mesh_tol, candidates, times) for k in live]

@@ -35,8 +35,8 @@ from ..surface import NurbsSurface
 from .refine import RefinedCurve
 from .seams import other_side, seam_jumps
 
-__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_by_sides",
-           "covered_samples", "may_run_along", "may_run_along_many", "side_curves",
+__all__ = ["SIDE_SAMPLES_PER_SPAN", "DomainSide", "box_sides", "covered_samples",
+           "may_run_along", "may_run_along_many", "side_curves",
            "uncovered_pieces"]
 
 #: samples of a side curve per knot span (at least ``_MIN_SAMPLES`` in all)
@@ -376,25 +376,6 @@ def covered_samples(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsSu
         hit = np.flatnonzero(inside)[np.linalg.norm(q - curve.points[inside], axis=1) <= tol]
         covered[hit] = True
     return covered
-
-
-def covered_by_sides(curve: RefinedCurve, runs: list[SideRun], surface_a: NurbsSurface,
-                     surface_b: NurbsSurface, tol: float) -> bool:
-    """True when every sample of ``curve`` lies on one run (within ``tol`` of the
-    side point at its own free parameter, inside the run's range)."""
-    surfaces = (surface_a, surface_b)
-    for run in runs:
-        side = run.side
-        uv = curve.uv_a if side.owner == 0 else curve.uv_b
-        t = uv[:, 1 - side.coord]
-        span = 1e-9 * max(abs(run.t1 - run.t0), 1.0)
-        if np.any(t < run.t0 - span) or np.any(t > run.t1 + span):
-            continue
-        on = _uv_on_side(side, t)
-        q = surfaces[side.owner].evaluate(on[:, 0], on[:, 1])
-        if np.all(np.linalg.norm(q - curve.points, axis=1) <= tol):
-            return True
-    return False
 
 
 def uncovered_pieces(curve: RefinedCurve, covered: NDArray) -> list[tuple[RefinedCurve, bool, bool]]:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .intersect import equal_extent
 from .plotting import pyplot, save_figure
 
 __all__ = ["plot_composition"]
@@ -34,8 +35,7 @@ def _box_lines(box: np.ndarray) -> list[np.ndarray]:
 
 
 def _equal_axes(ax, points: np.ndarray) -> None:
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    centre, half = 0.5 * (lo + hi), 0.55 * float(np.max(hi - lo)) or 1.0
+    centre, half = equal_extent(points, 1e-9 * max(float(np.max(np.abs(points))), 1.0))
     for axis, c in zip("xyz", centre):
         getattr(ax, f"set_{axis}lim")(c - half, c + half)
     ax.set_box_aspect((1, 1, 1))
