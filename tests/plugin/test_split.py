@@ -125,15 +125,21 @@ def test_two_spheres_cut_across_a_seam_give_the_lens():
     assert [len(f.pieces) for f in out.split.faces] == [3, 2]      # the cap in two halves across the seam
 
 
+def _plane_across(model, fraction: float):
+    """The height ``fraction`` of the way up a model, and a planar face there, normal +z,
+    three times the model's width each way."""
+    xmin, ymin, zmin, xmax, ymax, zmax = model.bounding_box
+    z = zmin + fraction * (zmax - zmin)
+    plane = cq.Workplane("XY").rect(3 * (xmax - xmin), 3 * (ymax - ymin)).extrude(0.001).faces(">Z").val()
+    return z, plane.translate(cq.Vector((xmin + xmax) / 2, (ymin + ymax) / 2, z - 0.001))
+
+
 def test_a_real_hull_cut_at_a_waterline(data_dir):
     """overture_kcs_hull_ideas.igs cut by a plane at 37 % of its depth (the plane only
     cuts): every hull face it crosses comes out in two valid pieces of the same area."""
     import surfprep
     model = surfprep.read(data_dir / "overture_kcs_hull_ideas.igs")
-    xmin, ymin, zmin, xmax, ymax, zmax = model.bounding_box
-    z = zmin + 0.37 * (zmax - zmin)
-    plane = cq.Workplane("XY").rect(3 * (xmax - xmin), 3 * (ymax - ymin)).extrude(0.001).faces(">Z").val()
-    plane = plane.translate(cq.Vector((xmin + xmax) / 2, (ymin + ymax) / 2, z - 0.001))
+    z, plane = _plane_across(model, 0.37)
     out = split(model, plane, tool=True)
     assert len(out.faces) == 6 and all(f.kept is None and len(f.pieces) == 2 for f in out.faces)
     assert out.valid and out.shared_edges.get(4) is None          # the plane itself is not written
@@ -148,7 +154,8 @@ def test_a_real_hull_cut_at_a_waterline(data_dir):
             box = Bnd_Box()
             BRepBndLib.AddOptimal_s(piece, box, False, False)
             tops.append(box.CornerMax().Z())
-        assert min(tops) == pytest.approx(z, abs=1e-3 * (zmax - zmin))
+        height = model.bounding_box[5] - model.bounding_box[2]
+        assert min(tops) == pytest.approx(z, abs=1e-3 * height)
 
 
 def test_the_fuselage_cut_by_a_wing_keeps_every_hole_with_its_face():
@@ -263,10 +270,7 @@ def test_a_real_solid_cut_at_mid_height(data_dir):
     face built was refused) -- and every cut face's pieces add up to its area."""
     import surfprep
     model = surfprep.read(data_dir / "occt_k1_catia_debis.stp")
-    xmin, ymin, zmin, xmax, ymax, zmax = model.bounding_box
-    z = zmin + 0.5 * (zmax - zmin)
-    plane = cq.Workplane("XY").rect(3 * (xmax - xmin), 3 * (ymax - ymin)).extrude(0.001).faces(">Z").val()
-    plane = plane.translate(cq.Vector((xmin + xmax) / 2, (ymin + ymax) / 2, z - 0.001))
+    _, plane = _plane_across(model, 0.5)
     out = split(model, plane, tool=True)
     assert out.valid and all(f.kept is None for f in out.faces)
     assert len(out.faces) >= 20
