@@ -83,6 +83,14 @@ class SplitResult:
     #: the models cut (``a``, ``b`` or None) and the sewing tolerance, for :meth:`select`
     operands: tuple = field(default=(), repr=False, compare=False)
     sew_tol: float = field(default=0.0, compare=False)
+    #: each operand's faces as trimmed faces, when converted (None: not yet)
+    operand_faces: tuple = field(default=(None, None), repr=False, compare=False)
+
+    def faces_of(self, operand: int) -> list:
+        """Operand ``operand``'s (0: a, 1: b) faces as trimmed faces: those the split
+        converted, else converted now."""
+        return (self.operand_faces[operand] if self.operand_faces[operand] is not None
+                else to_nurbs(self.operands[operand]))
 
     def select(self, operation: str, *, keep: str = "front") -> BooleanResult:
         """A Boolean-like result as a selection of this split's pieces (002 §1), without
@@ -315,11 +323,12 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     done: list[SplitFace] = []
     by_operand: dict[str, list] = {"a": [], "b": []}
     trims: dict[str, list] = {"a": [], "b": []}              # the same faces as trimmed faces
+    converted: dict[str, list] = {}
     cut_faces = set(cuts)
     for operand, model in (("a", model_a), ("b", None if tool else model_b)):
         if model is None:
             continue
-        whole = to_nurbs(model)
+        whole = converted[operand] = to_nurbs(model)
         for k, occ_face in enumerate(model.faces):
             key = (operand, k)
             if key not in cut_faces:
@@ -347,7 +356,8 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
                        time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]),
-                       structure, (model_a, model_b), sew_tol)
+                       structure, (model_a, model_b), sew_tol,
+                       (converted.get("a"), converted.get("b")))
 
 
 #: the operations and, per operand, the states of the pieces they keep (of a, of b): "in" or
@@ -450,7 +460,7 @@ def _selected(cut: SplitResult, operation: str) -> BooleanResult:
     model_a, model_b = cut.operands
     sew_tol = cut.sew_tol
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
-    shell_a, shell_b = to_nurbs(model_a), to_nurbs(model_b)
+    shell_a, shell_b = cut.faces_of(0), cut.faces_of(1)
     states = piece_states(cut.structure.faces,
                           [shell_b if o[0] == "a" else shell_a for o in cut.structure.origins],
                           tol=sew_tol)
@@ -515,7 +525,7 @@ def _trimmed(cut: SplitResult, keep: str) -> BooleanResult:
     sew_tol = cut.sew_tol
     faces_a = cut.structure.faces[:len(cut.pieces_a)]
     points = np.array([interior_point(face)[1] for face in faces_a]).reshape(-1, 3)
-    side = sheet_side(to_nurbs(cut.operands[1]), points, tol=sew_tol)
+    side = sheet_side(cut.faces_of(1), points, tol=sew_tol)
     want = 1 if keep == "front" else -1
     chosen = [p for p, s in zip(cut.pieces_a, side) if s == want]
     if not chosen:
