@@ -43,7 +43,7 @@ from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
 from .trimmed import TrimEdge, TrimmedFace, curve3d_points, natural_loop
 
-__all__ = ["EdgeUse", "NonManifoldModel"]
+__all__ = ["EdgeGeometry", "EdgeUse", "NonManifoldModel"]
 
 #: parameters (fractions of an occurrence's range) compared to tell two occurrences
 #: apart: the ends, the quarter points and the middle
@@ -76,6 +76,78 @@ class EdgeUse:
     def occurrence(self, faces) -> TrimEdge:
         face = faces[self.face]
         return face.internal[self.position] if self.loop < 0 else face.loops[self.loop].edges[self.position]
+
+
+@dataclass(frozen=True)
+class EdgeGeometry:
+    """One edge of a :class:`NonManifoldModel` in one parameter for all its uses, as a
+    B-rep kernel stores it (one 3D curve, a pcurve per face on the same parameter).
+
+    Attributes
+    ----------
+    curve3d : NurbsCurve (d=3) or None
+        The 3D curve of the reference use (the first one taken); None when that use has
+        only a pcurve (its points are then its pcurve through its surface).
+    t0, t1 : float
+        The range, in the reference use's parameter.
+    start, end : int
+        The model's vertices at ``t0`` and at ``t1``.
+    uses : tuple of EdgeUse
+        The uses taken, the reference first.
+    pcurves : tuple of NurbsCurve (d=2)
+        Per use, its pcurve mapped onto ``[t0, t1]`` (affinely, turned round where the
+        use's own parameter runs the other way).
+    reversed : tuple of bool
+        Per use, its loop runs from ``t1`` to ``t0`` (the edge appears REVERSED in it).
+    ends : (2, 3) float
+        The edge's points at ``t0`` and ``t1``.
+    end_gap : (float, float)
+        The largest distance from ``ends[0]`` (``ends[1]``) to the uses' pcurves at
+        ``t0`` (``t1``) through their surfaces: what the vertices there must hold.
+    deviation : tuple of float
+        Per use, the largest distance, on four points a knot span of the use's pcurve
+        and of the 3D curve (at least 33, at most 4097), between the edge's points and the
+        pcurve through the use's surface: small when the uses share a parametrization
+        (the same curve, or curves read from one edge), large when they do not.
+    """
+
+    curve3d: NurbsCurve | None
+    t0: float
+    t1: float
+    start: int
+    end: int
+    uses: tuple
+    pcurves: tuple
+    reversed: tuple
+    ends: NDArray
+    end_gap: tuple
+    deviation: tuple
+
+
+def _mapped(curve: NurbsCurve, a: float, b: float, t0: float, t1: float, flip: bool) -> NurbsCurve:
+    """``curve`` reparametrized affinely so that ``[a, b]`` becomes ``[t0, t1]`` (``flip``:
+    ``b`` goes to ``t0``, the control points turned round)."""
+    scale = (t1 - t0) / (b - a)
+    if not flip:
+        if (a, b) == (t0, t1):
+            return curve
+        return NurbsCurve.construct_fast(curve.control_points, t0 + (curve.knots - a) * scale,
+                                         curve.degree, curve.weights)
+    weights = None if curve.weights is None else curve.weights[::-1].copy()
+    return NurbsCurve.construct_fast(curve.control_points[::-1].copy(), t0 + (b - curve.knots[::-1]) * scale,
+                                     curve.degree, weights)
+
+
+def _samples(uses, faces) -> int:
+    """How many points to compare an edge's curves on: four a knot span of the busiest
+    of them (the 3D curve, the pcurves), at least 33 and at most 4097."""
+    spans = 8
+    for use in uses:
+        occurrence = use.occurrence(faces)
+        for curve in (occurrence.curve3d, occurrence.pcurve):
+            if curve is not None:
+                spans = max(spans, np.unique(curve.knots).size - 1)
+    return int(min(4 * spans + 1, 4097))
 
 
 def _groups(n: int, pairs: NDArray) -> NDArray:
@@ -223,6 +295,50 @@ class NonManifoldModel:
         """The edges ``face`` uses (sorted; a seam once)."""
         return tuple(sorted({e for e, uses in enumerate(self.uses) for u in uses if u.face == face}))
 
+    def edge_geometry(self, edge: int, faces=None) -> EdgeGeometry:
+        """``edge`` in one parameter for its uses by ``faces`` (a set of face indices;
+        None: all): :class:`EdgeGeometry`.
+
+        The reference is the first use taken; every other use's pcurve is mapped onto
+        its range affinely (turned round where its parameter runs against it), which is
+        exact for the uses of one curve (an intersection curve's pcurves on both faces,
+        an edge read from a file on both its faces) and measured per use otherwise.
+
+        Raises
+        ------
+        InvalidGeometryError
+            No use of ``edge`` by ``faces``.
+        """
+        uses = [u for u in self.uses[edge] if faces is None or u.face in faces]
+        if not uses:
+            raise InvalidGeometryError(f"edge {edge} has no use by the faces given")
+        ref = uses[0].occurrence(self.faces)
+        ref_flipped = uses[0].against != ref.reversed     # runs against the model's edge
+        s = ref.t0 + (ref.t1 - ref.t0) * np.linspace(0.0, 1.0, _samples(uses, self.faces))
+        if ref.curve3d is not None:
+            points = ref.curve3d.evaluate(s)
+        else:
+            uv = ref.pcurve.evaluate(s)
+            points = self.faces[uses[0].face].surface.evaluate(uv[:, 0], uv[:, 1])
+        pcurves, runs_back, deviation, gap = [], [], [], np.zeros(2)
+        for use in uses:
+            occurrence = use.occurrence(self.faces)
+            flip = (use.against != occurrence.reversed) != ref_flipped
+            pcurve = _mapped(occurrence.pcurve, occurrence.t0, occurrence.t1, ref.t0, ref.t1, flip)
+            uv = pcurve.evaluate(s)
+            on = self.faces[use.face].surface.evaluate(uv[:, 0], uv[:, 1])
+            pcurves.append(pcurve)
+            runs_back.append(bool(use.against != ref_flipped))
+            distance = np.linalg.norm(on - points, axis=1)
+            deviation.append(float(np.max(distance)))
+            gap = np.maximum(gap, distance[[0, -1]])
+        start, end = (int(v) for v in self.edge_vertices[edge])
+        if ref_flipped:
+            start, end = end, start
+        return EdgeGeometry(ref.curve3d, ref.t0, ref.t1, start, end, tuple(uses), tuple(pcurves),
+                            tuple(runs_back), points[[0, -1]], (float(gap[0]), float(gap[1])),
+                            tuple(deviation))
+
     def use_counts(self) -> NDArray:
         """``(ne,)`` how many uses each edge has."""
         return np.array([len(u) for u in self.uses], dtype=np.int64)
@@ -239,11 +355,19 @@ class NonManifoldModel:
     def operand(self, face: int) -> str:
         return self.origins[face][0]
 
-    def components(self) -> list[list[int]]:
-        """Faces connected through shared edges, each component sorted, largest first."""
-        if not self.faces:
+    def components(self, faces=None) -> list[list[int]]:
+        """Faces connected through shared edges, each component sorted, largest first;
+        among ``faces`` only (a collection of indices; None: all), joined by the edges
+        they share with one another."""
+        chosen = np.arange(len(self.faces)) if faces is None else np.unique(np.asarray(list(faces), np.int64))
+        if not chosen.size:
             return []
-        pairs = [(uses[0].face, u.face) for uses in self.uses for u in uses[1:]]
-        label = _groups(len(self.faces), np.array(pairs, dtype=np.int64).reshape(-1, 2))
-        groups = [np.flatnonzero(label == c) for c in range(label.max() + 1)]
+        index = np.full(len(self.faces), -1, dtype=np.int64)
+        index[chosen] = np.arange(chosen.size)
+        pairs = []
+        for uses in self.uses:
+            inside = [int(index[u.face]) for u in uses if index[u.face] >= 0]
+            pairs.extend((inside[0], k) for k in inside[1:])
+        label = _groups(chosen.size, np.array(pairs, dtype=np.int64).reshape(-1, 2))
+        groups = [chosen[label == c] for c in range(label.max() + 1)]
         return sorted(([int(f) for f in g] for g in groups), key=lambda g: (-len(g), g[0]))

@@ -3,9 +3,15 @@
 :func:`split` intersects ``a`` with ``b`` (or ``a`` with itself) by
 :func:`surfprep.intersect`, hands every face its curves as cuts in its own
 parameters (each curve has a pcurve on both faces) to
-:func:`~surfprep.algorithms.face_split.split_face`, rebuilds the pieces as
-OpenCascade faces and sews them (non-manifold: where two surfaces cross, four
-pieces share one intersection edge). A curve that stops inside a face (where a fin
+:func:`~surfprep.algorithms.face_split.split_face`, records the pieces and the uncut
+faces with the edges they share by use
+(:class:`~surfprep.algorithms.nonmanifold.NonManifoldModel`) and builds the
+OpenCascade faces from that structure (:func:`~.occ.structure.structure_to_occ`):
+every edge one ``TopoDS_Edge`` shared by all its faces (where two surfaces cross,
+four pieces share one intersection edge), nothing sewn. Every face comes out on its
+B-spline form (an analytic face converted exactly). Should OpenCascade find a piece
+built so invalid, each face is built on its own and the faces are sewn
+(``SplitResult.assembled``). A curve that stops inside a face (where a fin
 stands on a sheet, or over its border: a spur) divides nothing: it becomes an
 INTERNAL edge of the face, shared with the faces that end on it (a T-junction: one
 edge, three faces). A face the arrangement or the builder refuses is kept whole and
@@ -30,6 +36,7 @@ from .intersect import IntersectionResult, intersect
 from .io import as_model
 from .occ.faces import trimmed_face_to_occ
 from .occ.shapes import compound, count_free_edges, face_area, is_valid, sew, shell_or_solid
+from .occ.structure import structure_to_occ
 
 __all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split", "trim"]
 
@@ -85,6 +92,10 @@ class SplitResult:
     sew_tol: float = field(default=0.0, compare=False)
     #: each operand's faces as trimmed faces, when converted (None: not yet)
     operand_faces: tuple = field(default=(None, None), repr=False, compare=False)
+    #: how ``shape`` was put together: ``"structure"`` (built from ``structure``, every
+    #: edge one TopoDS_Edge shared by its faces) or ``"sewing"`` (a piece was invalid as
+    #: built so: each face built alone and OpenCascade's sewing joined them)
+    assembled: str = "structure"
 
     def faces_of(self, operand: int) -> list:
         """Operand ``operand``'s (0: a, 1: b) faces as trimmed faces: those the split
@@ -130,7 +141,7 @@ class SplitResult:
                 "curves": len(self.curves), "pieces": sum(len(f.pieces) for f in self.faces),
                 "free_edges": self.free_edges,
                 "edges_by_faces": {str(k): v for k, v in sorted(self.shared_edges.items())},
-                "valid": self.valid, "time_s": self.time_s,
+                "valid": self.valid, "time_s": self.time_s, "assembled": self.assembled,
                 "intersection_edges": [
                     {"faces": list(r.faces), "closed": r.closed, "length": r.length,
                      "max_distance_a": d.to_a, "max_distance_b": d.to_b}
@@ -140,23 +151,48 @@ class SplitResult:
                     "edges_by_uses": {str(k): v for k, v in self.structure.edges_by_uses().items()},
                     "components": len(self.structure.components())}})}
 
-    def output_faces(self) -> list[dict]:
-        """Per output face (``pieces_a + pieces_b``): the operand and face it came from,
-        its name (an uncut face keeps its own; the pieces of a cut face get it with a
-        suffix ``.1``, ``.2``, ...) and its area (GProp, 1e-9)."""
+    def names(self) -> list[str | None]:
+        """Per output face (``pieces_a + pieces_b``) its name: an uncut face keeps its own,
+        the pieces of a cut face get it (else ``a3``, ``b0``...) with a suffix ``.1``,
+        ``.2``, ..."""
         if self.structure is None:
-            return []
+            return [None] * (len(self.pieces_a) + len(self.pieces_b))
         out, seen = [], {}
         cut = {(f.operand, f.index) for f in self.faces if f.kept is None}
-        for face, trimmed, (operand, index) in zip(self.pieces_a + self.pieces_b, self.structure.faces,
-                                                   self.structure.origins):
+        for trimmed, (operand, index) in zip(self.structure.faces, self.structure.origins):
             name = trimmed.name
             if (operand, index) in cut:
                 seen[(operand, index)] = seen.get((operand, index), 0) + 1
                 name = f"{name or f'{operand}{index}'}.{seen[(operand, index)]}"
-            out.append({"operand": operand, "face": index, "name": name,
-                        "area": face_area(face, 1e-9)})
+            out.append(name)
         return out
+
+    def output_faces(self) -> list[dict]:
+        """Per output face (``pieces_a + pieces_b``): the operand and face it came from,
+        its name (:meth:`names`) and its area (GProp, 1e-9)."""
+        if self.structure is None:
+            return []
+        return [{"operand": operand, "face": index, "name": name, "area": face_area(face, 1e-9)}
+                for face, name, (operand, index) in zip(self.pieces_a + self.pieces_b, self.names(),
+                                                        self.structure.origins)]
+
+    def as_model(self):
+        """``shape`` as a :class:`~surfprep.plugin.io.CadModel` whose faces carry
+        :meth:`names` (written to STEP through XDE)."""
+        return _named_model(self.shape, self.pieces_a + self.pieces_b, self.names())
+
+
+def _named_model(shape, faces, names):
+    """A CadModel of ``shape`` whose faces are named as ``faces`` (the same faces, in
+    any orientation or location) are by ``names``."""
+    from .io import CadModel
+    from .occ.shapes import FaceNames, all_faces
+    table = FaceNames()
+    for face, name in zip(faces, names):
+        if name is not None:
+            table.add(face, name)
+    out = all_faces(shape)
+    return CadModel(shape, out, tuple(table.get(f) for f in out), (None,) * len(out))
 
 
 def _share_internal_edges(shape, tol: float):
@@ -321,43 +357,81 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
             cuts.setdefault(key, []).append(Cut(pcurve, c.curve3d))
             trimmed[key] = face.trimmed
     done: list[SplitFace] = []
-    by_operand: dict[str, list] = {"a": [], "b": []}
-    trims: dict[str, list] = {"a": [], "b": []}              # the same faces as trimmed faces
+    regions_of: dict[tuple[str, int], list] = {}
+    refused: dict[tuple[str, int], str] = {}
+    listed: list = []                                        # (trimmed face, (operand, index))
     converted: dict[str, list] = {}
-    cut_faces = set(cuts)
-    for operand, model in (("a", model_a), ("b", None if tool else model_b)):
+    operands = [("a", model_a), ("b", None if tool else model_b)]
+    for operand, model in operands:
         if model is None:
             continue
         whole = converted[operand] = to_nurbs(model)
-        for k, occ_face in enumerate(model.faces):
+        for k in range(len(model.faces)):
             key = (operand, k)
-            if key not in cut_faces:
-                by_operand[operand].append(occ_face)
-                trims[operand].append((whole[k], (operand, k)))
-                continue
-            try:
-                regions = split_face(trimmed[key], cuts[key], tol3d=10.0 * (curves.tol or 0.0))
-                pieces = tuple(trimmed_face_to_occ(region) for region in regions)
-            except SurfprepError as exc:
-                done.append(SplitFace(operand, k, len(cuts[key]), (occ_face,), str(exc)))
-                by_operand[operand].append(occ_face)
-                trims[operand].append((whole[k], (operand, k)))
-                continue
-            done.append(SplitFace(operand, k, len(cuts[key]), pieces))
-            by_operand[operand].extend(pieces)
-            trims[operand].extend((region, (operand, k)) for region in regions)
-    faces = by_operand["a"] + by_operand["b"]
+            if key in cuts:
+                try:
+                    regions_of[key] = split_face(trimmed[key], cuts[key], tol3d=10.0 * (curves.tol or 0.0))
+                except SurfprepError as exc:
+                    refused[key] = str(exc)
+            listed.extend(((r, key) for r in regions_of[key]) if key in regions_of else [(whole[k], key)])
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
-    shape = sew(faces, sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
-    shape = _share_internal_edges(shape, sew_tol)
-    valid = all(is_valid(p) for f in done for p in f.pieces)
-    listed = trims["a"] + trims["b"]
     structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
+    try:
+        built = structure_to_occ(structure, tol=sew_tol)
+    except OpenCascadeError:
+        built = None
+    if built is not None and built.valid:
+        shape, faces, assembled = built.shell, list(built.faces), "structure"
+    else:
+        # a piece OpenCascade finds invalid as built from the structure: each face built
+        # on its own (make_face checks and fixes it; a region it refuses keeps its face
+        # whole) and the faces sewn
+        faces, listed = _faces_one_by_one(operands, converted, listed, regions_of, refused)
+        structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
+        shape = sew(faces, sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
+        shape, assembled = _share_internal_edges(shape, sew_tol), "sewing"
+    pieces: dict[tuple[str, int], list] = {}
+    for face, (_, key) in zip(faces, listed):
+        pieces.setdefault(key, []).append(face)
+    for (operand, k), face_cuts in cuts.items():
+        if operand == "b" and tool:
+            continue
+        done.append(SplitFace(operand, k, len(face_cuts), tuple(pieces[(operand, k)]), refused.get((operand, k))))
+    done.sort(key=lambda f: (f.operand, f.index))
+    valid = all(is_valid(p) for f in done for p in f.pieces)
+    n_a = sum(1 for _, (operand, _) in listed if operand == "a")
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
-                       time.perf_counter() - started, tuple(by_operand["a"]), tuple(by_operand["b"]),
+                       time.perf_counter() - started, tuple(faces[:n_a]), tuple(faces[n_a:]),
                        structure, (model_a, model_b), sew_tol,
-                       (converted.get("a"), converted.get("b")))
+                       (converted.get("a"), converted.get("b")), assembled)
+
+
+def _faces_one_by_one(operands, converted, listed, regions_of, refused) -> tuple[list, list]:
+    """Every face of ``listed`` built on its own (:func:`trimmed_face_to_occ`); the regions
+    of a cut face any of which it refuses are replaced by the face whole (its reason in
+    ``refused``). Returns the faces and the (trimmed face, origin) list they match."""
+    faces, kept = [], []
+    shapes = {operand: model for operand, model in operands if model is not None}
+    done_keys = set()
+    for trimmed_face, key in listed:
+        if key in done_keys:
+            continue
+        if key not in regions_of:
+            faces.append(shapes[key[0]].faces[key[1]])
+            kept.append((trimmed_face, key))
+            continue
+        done_keys.add(key)
+        try:
+            built = [trimmed_face_to_occ(region) for region in regions_of[key]]
+        except SurfprepError as exc:
+            refused[key] = str(exc)
+            faces.append(shapes[key[0]].faces[key[1]])
+            kept.append((converted[key[0]][key[1]], key))
+            continue
+        faces.extend(built)
+        kept.extend((region, key) for region in regions_of[key])
+    return faces, kept
 
 
 #: the operations and, per operand, the states of the pieces they keep (of a, of b): "in" or
@@ -390,10 +464,17 @@ class BooleanResult:
     kept: tuple[int, int]
     closed: bool
     valid: bool
+    #: the kept faces as built and their names (:meth:`SplitResult.names`)
+    named: tuple = field(default=(), repr=False)
 
     @property
     def geometry(self) -> Any:
         return self.shape
+
+    def as_model(self):
+        """``shape`` as a :class:`~surfprep.plugin.io.CadModel` whose faces carry the
+        split's names (:meth:`SplitResult.names`)."""
+        return _named_model(self.shape, [f for f, _ in self.named], [n for _, n in self.named])
 
     @cached_property
     def volume(self) -> float | None:
@@ -466,21 +547,40 @@ def _selected(cut: SplitResult, operation: str) -> BooleanResult:
                           tol=sew_tol)
     n_a = len(cut.pieces_a)
     keep_a, keep_b = OPERATIONS[operation]
-    chosen_a = [p for p, s in zip(cut.pieces_a, states[:n_a]) if s in keep_a]
-    chosen_b = [p for p, s in zip(cut.pieces_b, states[n_a:]) if s in keep_b]
-    if operation == "cut":
-        chosen_b = [p.Reversed() for p in chosen_b]
-    faces = chosen_a + chosen_b
-    if not faces:
+    chosen_a = [k for k, s in enumerate(states[:n_a]) if s in keep_a]
+    chosen_b = [n_a + k for k, s in enumerate(states[n_a:]) if s in keep_b]
+    if not chosen_a + chosen_b:
         return BooleanResult(compound([]), operation, cut, (0, 0), True, True)
-    # sewn as split() sews (OpenCascade's manifold sewing loses the seam halves of a cap
-    # cut across a sphere's seam: every edge came out degenerated)
-    shape = sew(faces, sew_tol, non_manifold=True)[0]
+    # "cut" turns b's pieces over
+    shape, named = _assembled(cut, chosen_a + chosen_b, chosen_b if operation == "cut" else [])
     solids = _solids(shape)
     if solids:
         shape = solids[0] if len(solids) == 1 else compound(solids)
     return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), bool(solids),
-                         is_valid(shape))
+                         is_valid(shape), named)
+
+
+def _assembled(cut: SplitResult, chosen: list[int], turned: list[int]) -> tuple[Any, tuple]:
+    """The faces ``chosen`` (indices into ``cut.structure.faces``; those in ``turned``
+    turned over) in a shell per connected component (a compound of them when more
+    than one), built from the structure as :func:`split` builds its
+    shape; when the split itself had to be sewn, or a face built so is invalid, the
+    split's faces sewn (OpenCascade's manifold sewing loses the seam halves of a cap
+    cut across a sphere's seam: every edge came out degenerated, so non-manifold).
+    Returns the shape and the faces built with their names."""
+    names = cut.names()
+    if cut.assembled == "structure":
+        try:
+            built = structure_to_occ(cut.structure, chosen, turned=turned, tol=cut.sew_tol)
+        except OpenCascadeError:
+            built = None
+        if built is not None and built.valid:
+            shape = built.shells[0] if len(built.shells) == 1 else compound(list(built.shells))
+            return shape, tuple(zip(built.faces, (names[k] for k in chosen)))
+    pieces = cut.pieces_a + cut.pieces_b
+    faces = [pieces[k].Reversed() if k in turned else pieces[k] for k in chosen]
+    shape = sew(faces, cut.sew_tol, non_manifold=True)[0] if len(faces) > 1 else compound(faces)
+    return shape, tuple(zip(faces, (names[k] for k in chosen)))
 
 
 def trim(a: Any, b: Any, *, keep: str = "front", tol: float | None = None,
@@ -527,19 +627,21 @@ def _trimmed(cut: SplitResult, keep: str) -> BooleanResult:
     points = np.array([interior_point(face)[1] for face in faces_a]).reshape(-1, 3)
     side = sheet_side(cut.faces_of(1), points, tol=sew_tol)
     want = 1 if keep == "front" else -1
-    chosen = [p for p, s in zip(cut.pieces_a, side) if s == want]
+    chosen = [k for k, s in enumerate(side) if s == want]
     if not chosen:
         return BooleanResult(compound([]), f"trim-{keep}", cut, (0, 0), False, True)
-    shape = sew(chosen, sew_tol, non_manifold=True)[0] if len(chosen) > 1 else compound(chosen)
+    shape, named = _assembled(cut, chosen, [])
     solids = _solids(shape)
     if solids:
         shape = solids[0] if len(solids) == 1 else compound(solids)
-    return BooleanResult(shape, f"trim-{keep}", cut, (len(chosen), 0), bool(solids), is_valid(shape))
+    return BooleanResult(shape, f"trim-{keep}", cut, (len(chosen), 0), bool(solids), is_valid(shape), named)
 
 
 def _solids(shape) -> list:
-    """The solids of a sewn result: itself, or each closed shell of a compound made solid;
-    empty when a shell stays open."""
+    """The solids of an assembled result: itself, or each closed shell of it made a solid;
+    empty when a shell stays open. A closed shell is made a solid as it is (oriented
+    by ``BRepLib::OrientClosedSolid``, its faces unchanged so they keep their names),
+    else through ShapeFix (:func:`shell_or_solid`)."""
     from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
@@ -551,9 +653,28 @@ def _solids(shape) -> list:
     out = []
     explorer = TopExp_Explorer(shape, TopAbs_SHELL)
     while explorer.More():
-        solid = shell_or_solid(TopoDS.Shell_s(explorer.Current()))
+        shell = TopoDS.Shell_s(explorer.Current())
         explorer.Next()
+        solid = _solid_as_it_is(shell)
+        if solid is None:
+            solid = shell_or_solid(shell)
         if solid.ShapeType() != TopAbs_SOLID:
             return []
         out.append(solid)
     return out
+
+
+def _solid_as_it_is(shell):
+    """A solid of the closed ``shell``, oriented, its faces the shell's; None when the
+    shell is open or the solid is not valid."""
+    from OCP.BRep import BRep_Builder, BRep_Tool
+    from OCP.BRepLib import BRepLib
+    from OCP.TopoDS import TopoDS_Solid
+    if not BRep_Tool.IsClosed_s(shell):
+        return None
+    solid, builder = TopoDS_Solid(), BRep_Builder()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shell)
+    if not BRepLib.OrientClosedSolid_s(solid) or not is_valid(solid):
+        return None
+    return solid

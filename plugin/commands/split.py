@@ -69,7 +69,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     else:
         result = split(model_a, model_b, tol=args.tol, method=args.method, tool=args.tool)
     kept = [f for f in result.faces if f.kept is not None]
-    written_shape = result.shape if operation is None else operation.shape
+    written_shape = result.as_model() if operation is None else operation.as_model()
     with staged_write(written_shape, args.output, overwrite=True) as staged:
         report = {"a": str(args.a), "b": None if args.b is None else str(args.b),
                   "output": str(staged.target), **result.report()}

@@ -9,7 +9,10 @@ topological level (as build123d's ``topology/``):
 * :mod:`.faces`: ``TopoDS_Face`` to and from
   :class:`~surfprep.algorithms.trimmed.TrimmedFace`;
 * :mod:`.shapes`: whole shapes (faces of a shape, compounds, face names, areas,
-  sewing, free edges, validity).
+  sewing, free edges, validity);
+* :mod:`.structure`: faces of a use-based non-manifold structure
+  (:class:`~surfprep.algorithms.nonmanifold.NonManifoldModel`) built sharing its
+  edges and vertices, no sewing.
 
 Every builder's status is checked; failures raise
 :class:`~surfprep.errors.OpenCascadeError`.

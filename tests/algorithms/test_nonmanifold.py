@@ -94,3 +94,39 @@ def test_bad_arguments_are_refused():
         NonManifoldModel.build([face], tol=0.0)
     with pytest.raises(InvalidGeometryError, match="origins"):
         NonManifoldModel.build([face], [("a", 0), ("a", 1)], tol=1e-9)
+
+
+def test_an_edge_used_the_other_way_round_and_on_another_range_is_put_on_one_parameter():
+    # A: (u, v) -> (u, v, 0) on [0, 1]^2; B: (u, v) -> (1 - u / 5, 0, v) on [0, 5] x [0, 1]:
+    # their common edge y = z = 0 runs x = 0..1 along A's u and x = 1..0 along B's u / 5
+    a = bilinear([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)])
+    b = NurbsSurface(np.array([[(1, 0, 0), (1, 0, 1)], [(0, 0, 0), (0, 0, 1)]], float),
+                     [0, 0, 5, 5], [0, 0, 1, 1], 1, 1)
+    model = NonManifoldModel.build([TrimmedFace(a), TrimmedFace(b)], tol=1e-9)
+    (edge,) = [e for e in range(model.n_edges) if len(model.uses[e]) == 2]
+    g = model.edge_geometry(edge)
+    s = np.linspace(g.t0, g.t1, 11)
+    reference = g.curve3d.evaluate(s) if g.curve3d is not None else None
+    for use, pcurve in zip(g.uses, g.pcurves):
+        uv = pcurve.evaluate(s)
+        points = model.faces[use.face].surface.evaluate(uv[:, 0], uv[:, 1])
+        if reference is None:
+            reference = points
+        np.testing.assert_allclose(points, reference, atol=1e-12)
+    assert max(g.deviation) < 1e-12 and max(g.end_gap) < 1e-12
+    np.testing.assert_allclose(model.vertices[[g.start, g.end]], g.ends, atol=1e-12)
+    # A's loop (counter-clockwise) runs its side v = 0 along +x, B's (counter-clockwise in
+    # its own (u, v)) along its u: -x; so the two faces run the edge opposite ways
+    assert g.reversed[0] != g.reversed[1]
+    # taken from B alone, B is the reference: its own range, not turned round
+    only_b = model.edge_geometry(edge, {1})
+    assert (only_b.t0, only_b.t1) == (0.0, 5.0) and only_b.uses[0].face == 1 and not only_b.reversed[0]
+    with pytest.raises(InvalidGeometryError, match="no use"):
+        model.edge_geometry(edge, {7})
+
+
+def test_components_among_some_faces_only():
+    model = crossing_sheets()
+    # pieces 0 and 1 of sheet a touch only along the intersection edge: joined by it
+    assert model.components([0, 1]) == [[0, 1]]
+    assert model.components([0]) == [[0]] and model.components([]) == []

@@ -21,7 +21,7 @@ def _sheet(plane: str, offset=(0, 0, 0)):
 def test_two_crossing_sheets_become_four_pieces_around_one_edge():
     out = split(_sheet("XY"), _sheet("YZ"))
     report = out.report()
-    assert report["pieces"] == 4 and out.valid
+    assert report["pieces"] == 4 and out.valid and report["assembled"] == "structure"
     assert out.shared_edges.get(4) == 1                   # the intersection edge: four faces
     assert out.free_edges == 12                           # the sheets' outer borders, cut in two
     # the same by our own structure, and the four faces alternate around the edge
@@ -46,6 +46,25 @@ def test_a_sphere_through_a_plate_is_cut_into_its_exact_zones():
                                               2 * math.pi * radius * (radius + 4.5)]), rtol=1e-6)
     assert out.shared_edges.get(4) == 2                   # both circles bound four faces
     assert out.structure.edges_by_uses() == {2: 15, 4: 2} # ours: the same (poles are no edges)
+    _built_from_the_structure(out)
+
+
+def _built_from_the_structure(out) -> None:
+    """The shape is the structure: one TopoDS_Edge per edge of it, used by the same number
+    of faces, no edge tolerance beyond what the curves measure (here well under the
+    sewing tolerance a sewing would have given them), one shell."""
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_SHELL
+    from OCP.TopExp import TopExp
+    from OCP.TopoDS import TopoDS
+    from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+    assert out.assembled == "structure" and out.shape.ShapeType() == TopAbs_SHELL
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(out.shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    uses = sorted(edge_faces.FindFromIndex(k).Size() for k in range(1, edge_faces.Extent() + 1)
+                  if not BRep_Tool.Degenerated_s(TopoDS.Edge_s(edge_faces.FindKey(k))))
+    assert uses == sorted(out.structure.use_counts().tolist())
+    assert max_edge_tolerance(out.shape) < 0.1 * out.sew_tol
 
 
 def test_a_face_whose_curves_cross_is_cut_into_four():
@@ -247,6 +266,7 @@ def test_two_cylinders_crossing_at_right_angles():
                                   epsabs=1e-13, epsrel=1e-13)[0])):
         pieces = split(_cylinder("YZ", 3.0), _cylinder("XZ", r2))
         assert all(f.kept is None for f in pieces.faces)
+        _built_from_the_structure(pieces)
         va, vb = math.pi * 9 * 20, math.pi * r2 * r2 * 20
         for operation, exact in (("common", common), ("fuse", va + vb - common), ("cut", va - common)):
             result = pieces.select(operation)

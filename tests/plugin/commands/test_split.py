@@ -28,8 +28,15 @@ def test_split_writes_the_pieces_and_a_report(tmp_path, capsys, sphere_and_plate
     assert data["pieces"] == 7 and data["free_edges"] == 0 and data["valid"]
     assert data["edges_by_faces"]["4"] == 2
     # the sphere's face and the plate's two big faces became 3 + 2 + 2 pieces; 4 side faces uncut
-    assert surfprep.read(out).n_faces == 7 + 4
+    back = surfprep.read(out)
+    assert back.n_faces == 7 + 4
     assert "7 piece(s)" in stdout
+    # one shell in the file: read back, each circle is still one edge of four faces (STEP
+    # holds two pcurves an edge, the reader recomputes the others), the pieces named
+    from surfprep.plugin.occ.shapes import count_free_edges, is_valid
+    from surfprep.plugin.split import _edge_uses
+    assert _edge_uses(back.shape).get(4) == 2 and count_free_edges(back.shape) == 0 and is_valid(back.shape)
+    assert sorted(n for n in back.face_names if n is not None and n.startswith("a")) == ["a0.1", "a0.2", "a0.3"]
 
 
 def test_a_face_kept_whole_is_exit_1(tmp_path, capsys, monkeypatch, sphere_and_plate):
@@ -82,7 +89,11 @@ def test_boolean_common_writes_the_slab(tmp_path, capsys, sphere_and_plate):
     data = json.loads(report.read_text())["boolean"]
     assert data["operation"] == "common" and data["valid"]
     assert abs(data["volume"] - 235.3576496) < 1e-3
-    assert surfprep.read(out).n_faces == 3                # the zone and the two discs
+    back = surfprep.read(out)
+    assert back.n_faces == 3                              # the zone and the two discs
+    assert back.shape.ShapeType().name == "TopAbs_SOLID"
+    # named after their faces: the sphere's zone and a piece of each of the plate's big faces
+    assert sorted(n.split(".")[0] for n in back.face_names) == ["a0", "b4", "b5"]
 
 
 def test_tool_writes_only_the_first_models_faces(tmp_path, capsys, sphere_and_plate):
