@@ -7,7 +7,7 @@ structure: an edge used by two, three or four faces is one edge carrying a pcurv
 each of them (:meth:`~surfprep.algorithms.nonmanifold.NonManifoldModel.edge_geometry`
 puts them on one parameter), its ends the structure's vertices. Nothing is sewn:
 the sharing is the structure's, and an edge's tolerance is the distance measured
-between its curves (half as much again as the largest of four points a knot span, at least
+between its curves (10 % over the largest of four points a knot span, at least
 :data:`MIN_TOLERANCE`, and at least the tolerance its occurrences came with), a
 vertex's what holds the ends of its edges' curves: not a tolerance a sewing found
 large enough.
@@ -16,8 +16,9 @@ A face used twice by one edge (a seam of a closed surface) gets both its pcurves
 that edge (the first for the edge FORWARD in the face). Degenerated edges (poles)
 are built per face on the vertex at their point. An edge whose uses do not share a
 parametrization (measured: a use's pcurve through its surface farther than the
-tolerance from the edge's points) is made SameParameter by OpenCascade
-(``BRepLib::SameParameter``) and its tolerance is what that measures.
+tolerance, and than twice the tolerance the file gave the edge, from the edge's points)
+is made SameParameter by OpenCascade (``BRepLib::SameParameter``) and its tolerance is
+what that measures.
 """
 
 from __future__ import annotations
@@ -101,10 +102,13 @@ def structure_to_occ(model: NonManifoldModel, faces: Iterable[int] | None = None
         occ_faces[f] = face
     vertices: dict[int, TopoDS_Vertex] = {}
     vertex_tol: dict[int, float] = {}
+    same_as = _corners(model, chosen, tol)
 
     def vertex(v: int, point: np.ndarray, spread: float = 0.0, edge_tol: float = MIN_TOLERANCE) -> TopoDS_Vertex:
-        """The structure's vertex ``v``, its tolerance raised to hold ``point`` and the
-        curve ends within ``spread`` of it, and no less than ``edge_tol``."""
+        """The structure's vertex ``v`` (or the one a loop's corner makes it), its
+        tolerance raised to hold ``point`` and the curve ends within ``spread`` of it,
+        and no less than ``edge_tol``."""
+        v = same_as[v]
         need = max(edge_tol, 1.001 * (float(np.linalg.norm(point - model.vertices[v])) + spread))
         if v not in vertices:
             vertices[v] = TopoDS_Vertex()
@@ -122,9 +126,11 @@ def structure_to_occ(model: NonManifoldModel, faces: Iterable[int] | None = None
         if not any(u.face in wanted for u in model.uses[e]):
             continue
         g = model.edge_geometry(e, wanted)
-        same = max(g.deviation) <= tol
-        edge_tol = max(MIN_TOLERANCE, 1.5 * max(g.deviation) if same else tol,
-                       *(u.occurrence(model.faces).tolerance for u in g.uses))
+        came_with = max(u.occurrence(model.faces).tolerance for u in g.uses)
+        # uses of one parametrization: within tol, or within what the file's edge said
+        # (its pcurves were that far from its curve; measured densely, a little farther)
+        same = max(g.deviation) <= max(tol, 2.0 * came_with)
+        edge_tol = max(MIN_TOLERANCE, 1.1 * max(g.deviation) if same else tol, came_with)
         v0 = vertex(g.start, g.ends[0], g.end_gap[0], edge_tol)
         v1 = vertex(g.end, g.ends[1], g.end_gap[1], edge_tol)
         if g.curve3d is not None:
@@ -193,6 +199,37 @@ def _shell(builder: BRep_Builder, faces: list) -> TopoDS_Shell:
     for face in faces:
         builder.Add(shell, face)
     return shell
+
+
+def _corners(model: NonManifoldModel, chosen: list[int], tol: float) -> np.ndarray:
+    """``(nv,)`` int: per vertex of ``model`` the vertex it is built as. Consecutive edges
+    of a loop whose ends the structure did not merge (a file's corner wider than ``tol``
+    but within its own tolerances: ten times the edges' and vertices' tolerances it
+    came with) meet at one vertex, the first's."""
+    parent = np.arange(len(model.vertices))
+
+    def root(v: int) -> int:
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return int(v)
+    ends: dict[tuple[int, int, int], tuple[int, int]] = {}      # loop-direction start, end
+    for e, uses in enumerate(model.uses):
+        a, b = (int(x) for x in model.edge_vertices[e])
+        for u in uses:
+            ends[(u.face, u.loop, u.position)] = (b, a) if u.against else (a, b)
+    for f in chosen:
+        for li, loop in enumerate(model.faces[f].loops):
+            present = [k for k in range(len(loop.edges)) if (f, li, k) in ends]
+            for k, j in zip(present, present[1:] + present[:1]):
+                v, w = root(ends[(f, li, k)][1]), root(ends[(f, li, j)][0])
+                if v == w:
+                    continue
+                allowed = 10.0 * max(tol, *loop.edges[k].vertex_tolerances, *loop.edges[j].vertex_tolerances,
+                                     loop.edges[k].tolerance, loop.edges[j].tolerance)
+                if np.linalg.norm(model.vertices[v] - model.vertices[w]) <= allowed:
+                    parent[w] = v
+    return np.array([root(v) for v in range(len(parent))], dtype=np.int64)
 
 
 def _degenerated(model: NonManifoldModel, f: int, e, occ_surface, vertex, tol: float) -> TopoDS_Edge:
