@@ -4,8 +4,9 @@ them divide it.
 A :class:`Cut` is a curve in a face's ``(u, v)`` with its 3D curve when known. Before a
 face is cut, the cuts that divide nothing are left out: a cut running along the face's
 boundary (two faces of one model meeting another along their shared edge, two solids
-touching) and a cut repeating another (the same curve reported twice); and a cut
-ending a tolerance away from a corner of the face's loop is moved onto the corner, so
+touching; the loop's edge is split where such a cut ends inside it:
+:func:`split_where_cuts_end`) and a cut repeating another (the same curve reported
+twice); and a cut ending a tolerance away from a corner of the face's loop is moved onto the corner, so
 no sliver of the edge is left.
 """
 
@@ -19,10 +20,10 @@ from numpy.typing import NDArray
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
 from .face_region import FaceRegion
-from .trimmed import TrimEdge, TrimLoop, TrimmedFace, curve3d_points
+from .trimmed import LOOP_SAMPLES_PER_EDGE, TrimEdge, TrimLoop, TrimmedFace, curve3d_points
 
-__all__ = ["CUT_SAMPLES", "Cut", "cut_point_at", "distinct_cuts", "runs_along_boundary",
-           "snap_to_corner"]
+__all__ = ["CUT_SAMPLES", "Cut", "cut_point_at", "distinct_cuts", "locate_on_loops", "near_in_space",
+           "runs_along_boundary", "snap_to_corner", "split_where_cuts_end"]
 
 #: samples of a cut's pcurve for the topology (crossings, containment)
 CUT_SAMPLES = 257
@@ -103,6 +104,101 @@ def distinct_cuts(cuts: list[Cut], face: TrimmedFace, eps: float, tol3d: float |
         if not same:
             kept.append((cut, points))
     return [cut for cut, _ in kept]
+
+
+def locate_on_loops(loops: list[TrimLoop], point: NDArray, eps: float,
+            near=lambda best: False) -> tuple[int, int, float] | None:
+    """The loop, edge and edge parameter nearest to a point of the domain: within ``eps``
+    in the parameters, or where ``near(best)`` accepts it (a test in space)."""
+    best = None
+    coarse = []                                   # per edge: samples, nearest one, its distance
+    for li, loop in enumerate(loops):
+        for ei, e in enumerate(loop.edges):
+            t = np.linspace(e.t0, e.t1, 4 * LOOP_SAMPLES_PER_EDGE)
+            uv = e.pcurve.evaluate(t)
+            d = np.linalg.norm(uv - point, axis=1)
+            k = int(np.argmin(d))
+            # the nearest point lies within a sample spacing of the nearest sample
+            reach = float(np.max(np.linalg.norm(np.diff(uv, axis=0), axis=1))) if t.size > 1 else 0.0
+            coarse.append((li, ei, e, t, k, float(d[k]), reach))
+    closest = min(c[5] for c in coarse) if coarse else np.inf
+    for li, ei, e, t, k, d_k, reach in coarse:
+        if d_k - reach > closest:
+            continue                              # no point of this edge can be the nearest
+        # refine on the segment either side by ternary search of the distance
+        lo, hi = t[max(k - 1, 0)], t[min(k + 1, t.size - 1)]
+        bracket = (lo, hi)
+        for _ in range(40):
+            m = np.array([lo + (hi - lo) / 3, hi - (hi - lo) / 3])
+            d1, d2 = np.linalg.norm(e.pcurve.evaluate(m) - point, axis=1)
+            lo, hi = (lo, m[1]) if d1 < d2 else (m[0], hi)
+        tt = 0.5 * (lo + hi)
+        # then Newton on |c(t) - p|^2 to the rounding (the search stops ~1e-10 of the span
+        # short), kept if it is no farther
+        dist = float(np.linalg.norm(e.pcurve.evaluate(np.array([tt]))[0] - point))
+        for _ in range(3):
+            c = e.pcurve.derivatives(np.array([tt]), 2)[0]
+            r = c[0] - point
+            slope = float(c[1] @ c[1] + r @ c[2])
+            if slope <= 0.0:
+                break
+            trial = float(np.clip(tt - float(r @ c[1]) / slope, *bracket))
+            d_trial = float(np.linalg.norm(e.pcurve.evaluate(np.array([trial]))[0] - point))
+            if d_trial > dist:
+                break
+            tt, dist = trial, d_trial
+        if best is None or dist < best[3]:
+            best = (li, ei, tt, dist)
+    if best is None or best[3] > eps and not near(best):
+        return None
+    return best[0], best[1], best[2]
+
+
+def near_in_space(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, end: int, tol3d: float | None):
+    """A test that a boundary point found for a cut's end lies within ``tol3d`` of it in space."""
+    if tol3d is None:
+        return lambda best: False
+    point = cut_point_at(cut, face, cut.range[end])
+
+    def near(best) -> bool:
+        edge = loops[best[0]].edges[best[1]]
+        return float(np.linalg.norm(curve3d_points(edge, face.surface, np.array([best[2]]))[0] - point)) <= tol3d
+
+    return near
+
+
+def split_where_cuts_end(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], eps: float,
+                         tol3d: float | None, others: list[Cut] = ()) -> list[TrimLoop]:
+    """``loops`` with their edges split where ``cuts`` (cuts running along the boundary)
+    end inside an edge rather than at a corner: where a face of another solid touches
+    this one along part of an edge, the edge's piece beside it is then an edge of its
+    own, which the other face's edge can share (a T-junction otherwise). An end within
+    ``tol3d`` of an end of ``others`` (the cuts across the face) is left to that cut,
+    which splits the loop there itself: two splits a tolerance apart would leave a
+    sliver."""
+    loops = list(loops)
+    taken = np.array([cut_point_at(c, face, t) for c in others for t in c.range]).reshape(-1, 3)
+    for cut in cuts:
+        line = cut.samples()
+        for end, point in ((0, line[0]), (1, line[-1])):
+            if tol3d is not None and taken.size and np.min(np.linalg.norm(
+                    taken - cut_point_at(cut, face, cut.range[end]), axis=1)) <= tol3d:
+                continue
+            where = locate_on_loops(loops, point, eps, near_in_space(face, loops, cut, end, tol3d))
+            if where is None:
+                continue
+            li, ei, t = where
+            edge = loops[li].edges[ei]
+            if edge.degenerated or snap_to_corner(edge, face.surface, t, eps, tol3d) in (edge.t0, edge.t1):
+                continue
+            first = TrimEdge(edge.curve3d, edge.pcurve, edge.t0, t, edge.reversed, edge.tolerance,
+                             edge.seam_pcurve, False, edge.vertex_tolerances)
+            second = TrimEdge(edge.curve3d, edge.pcurve, t, edge.t1, edge.reversed, edge.tolerance,
+                              edge.seam_pcurve, False, edge.vertex_tolerances)
+            pair = (second, first) if edge.reversed else (first, second)
+            edges = loops[li].edges
+            loops[li] = TrimLoop(edges[:ei] + pair + edges[ei + 1:])
+    return loops
 
 
 def _chord(points: NDArray) -> float:

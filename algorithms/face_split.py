@@ -18,7 +18,9 @@ counter-clockwise bounds a region; clockwise cycles (a hole of the face, the
 outside of a closed cut) are holes of the smallest region that contains them.
 
 A cut that runs along the face's boundary divides nothing and is left out (faces
-meeting along a shared edge, touching solids), and so is a cut that repeats another
+meeting along a shared edge, touching solids) -- but where it ends inside an edge of
+the loop, the edge is split there (a face of another solid touching along part of
+it can then share the piece) -- and so is a cut that repeats another
 (the same curve reported twice). A cut that stops inside the face and
 meets no other cut divides nothing either (where a fin stands on a sheet): it
 becomes an internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`)
@@ -37,7 +39,17 @@ from numpy.typing import NDArray
 
 from ..errors import InvalidGeometryError
 from .curve import NurbsCurve
-from .cuts import CUT_SAMPLES, Cut, cut_point_at, distinct_cuts, runs_along_boundary, snap_to_corner
+from .cuts import (
+    CUT_SAMPLES,
+    Cut,
+    cut_point_at,
+    distinct_cuts,
+    locate_on_loops,
+    near_in_space,
+    runs_along_boundary,
+    snap_to_corner,
+    split_where_cuts_end,
+)
 from .face_region import inside_loops
 from .trimmed import (
     DEFAULT_TOLERANCE,
@@ -64,40 +76,6 @@ class _Mark:
     along: float = 0.0             # position along the loop (edge index + fraction in loop order)
     gap: float = 0.0               # distance in space between the boundary's point and the cut's end
     vertex: int = -1               # its vertex in the arrangement
-
-
-def _locate(loops: list[TrimLoop], point: NDArray, eps: float,
-            near=lambda best: False) -> tuple[int, int, float] | None:
-    """The loop, edge and edge parameter nearest to a point of the domain: within ``eps``
-    in the parameters, or where ``near(best)`` accepts it (a test in space)."""
-    best = None
-    coarse = []                                   # per edge: samples, nearest one, its distance
-    for li, loop in enumerate(loops):
-        for ei, e in enumerate(loop.edges):
-            t = np.linspace(e.t0, e.t1, 4 * LOOP_SAMPLES_PER_EDGE)
-            uv = e.pcurve.evaluate(t)
-            d = np.linalg.norm(uv - point, axis=1)
-            k = int(np.argmin(d))
-            # the nearest point lies within a sample spacing of the nearest sample
-            reach = float(np.max(np.linalg.norm(np.diff(uv, axis=0), axis=1))) if t.size > 1 else 0.0
-            coarse.append((li, ei, e, t, k, float(d[k]), reach))
-    closest = min(c[5] for c in coarse) if coarse else np.inf
-    for li, ei, e, t, k, d_k, reach in coarse:
-        if d_k - reach > closest:
-            continue                              # no point of this edge can be the nearest
-        # refine on the segment either side by ternary search of the distance
-        lo, hi = t[max(k - 1, 0)], t[min(k + 1, t.size - 1)]
-        for _ in range(40):
-            m = np.array([lo + (hi - lo) / 3, hi - (hi - lo) / 3])
-            d1, d2 = np.linalg.norm(e.pcurve.evaluate(m) - point, axis=1)
-            lo, hi = (lo, m[1]) if d1 < d2 else (m[0], hi)
-        tt = 0.5 * (lo + hi)
-        dist = float(np.linalg.norm(e.pcurve.evaluate(np.array([tt]))[0] - point))
-        if best is None or dist < best[3]:
-            best = (li, ei, tt, dist)
-    if best is None or best[3] > eps and not near(best):
-        return None
-    return best[0], best[1], best[2]
 
 
 def _signed_area(uv: NDArray) -> float:
@@ -147,19 +125,6 @@ def _runs(loop: TrimLoop, marks: list[_Mark], eps: float = 0.0
     return runs
 
 
-def _near_in_space(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, end: int, tol3d: float | None):
-    """A test that a boundary point found for a cut's end lies within ``tol3d`` of it in space."""
-    if tol3d is None:
-        return lambda best: False
-    point = _cut_point(cut, face, end)
-
-    def near(best) -> bool:
-        edge = loops[best[0]].edges[best[1]]
-        return float(np.linalg.norm(curve3d_points(edge, face.surface, np.array([best[2]]))[0] - point)) <= tol3d
-
-    return near
-
-
 def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                tol3d: float | None = None) -> list[TrimmedFace]:
     """The regions of a face cut along curves in its domain (see the module doc).
@@ -195,8 +160,10 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
-    cuts = distinct_cuts([cut for cut in cuts if not runs_along_boundary(face, loops, cut, eps, tol3d)],
-                     face, eps, tol3d)
+    along = [runs_along_boundary(face, loops, cut, eps, tol3d) for cut in cuts]
+    loops = split_where_cuts_end(face, loops, [cut for cut, a in zip(cuts, along) if a], eps, tol3d,
+                                 [cut for cut, a in zip(cuts, along) if not a])
+    cuts = distinct_cuts([cut for cut, a in zip(cuts, along) if not a], face, eps, tol3d)
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]
@@ -214,7 +181,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         if c in dangling or np.linalg.norm(line[0] - line[-1]) <= eps:
             continue                                             # closed: its ends are one vertex
         for end, point in ((0, line[0]), (1, line[-1])):
-            where = _locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d))
+            where = locate_on_loops(loops, point, eps, near_in_space(face, loops, cut, end, tol3d))
             if where is None:
                 continue                                         # an inner end: joined below
             li, ei, t = where
@@ -274,7 +241,7 @@ def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params:
         first, last = ends[c]
         if np.linalg.norm(first - last) <= eps or len(params[c]) > 2:
             continue                                   # closed, or crossing another cut
-        on_loop = [_locate(loops, point, eps, _near_in_space(face, loops, cut, end, tol3d)) is not None
+        on_loop = [locate_on_loops(loops, point, eps, near_in_space(face, loops, cut, end, tol3d)) is not None
                    for end, point in ((0, first), (1, last))]
         if all(on_loop):
             continue                                   # boundary to boundary: it divides

@@ -339,6 +339,39 @@ class NonManifoldModel:
                             tuple(runs_back), points[[0, -1]], (float(gap[0]), float(gap[1])),
                             tuple(deviation))
 
+    def coincident_faces(self) -> list[tuple[int, int, bool]]:
+        """Faces of different operands lying on each other: bounded by the same edges
+        (the same set, at least one) and a point well inside the second within ``tol``
+        of the first's surface. Returns ``(f, g, along)`` with ``f < g``; ``along``
+        when their normals (orientation applied) agree there, as coplanar faces of two
+        overlapping boxes do, not when they are opposed, as where two solids touch."""
+        from .containment import interior_point
+        from .measure import normals
+        from .projection.onto_surface import project_to_surface
+        edges: dict[int, set[int]] = {}
+        for e, uses in enumerate(self.uses):
+            for u in uses:
+                edges.setdefault(u.face, set()).add(e)
+        by_edges: dict[frozenset, list[int]] = {}
+        for f, used in edges.items():
+            by_edges.setdefault(frozenset(used), []).append(f)
+        out = []
+        for group in by_edges.values():
+            for i, f in enumerate(sorted(group)):
+                for g in sorted(group)[i + 1:]:
+                    if self.origins[f][0] == self.origins[g][0]:
+                        continue
+                    first, second = self.faces[f], self.faces[g]
+                    uv, xyz = interior_point(second)
+                    foot = project_to_surface(first.surface, xyz[None], tol=0.01 * self.tol)
+                    if float(foot.distance[0]) > self.tol:
+                        continue
+                    n_first = normals(first.surface, foot.uv[:, 0], foot.uv[:, 1])[0]
+                    n_second = normals(second.surface, uv[None, 0], uv[None, 1])[0]
+                    sign = (-1.0 if first.reversed else 1.0) * (-1.0 if second.reversed else 1.0)
+                    out.append((f, g, bool(sign * float(np.dot(n_first, n_second)) > 0)))
+        return out
+
     def use_counts(self) -> NDArray:
         """``(ne,)`` how many uses each edge has."""
         return np.array([len(u) for u in self.uses], dtype=np.int64)

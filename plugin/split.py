@@ -26,6 +26,7 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
+from OCP.TopoDS import TopoDS
 
 from ..algorithms.containment import interior_point, piece_states, sheet_side
 from ..algorithms.face_split import Cut, split_face
@@ -96,6 +97,9 @@ class SplitResult:
     #: edge one TopoDS_Edge shared by its faces) or ``"sewing"`` (a piece was invalid as
     #: built so: each face built alone and OpenCascade's sewing joined them)
     assembled: str = "structure"
+    #: faces of a and b on each other, ``(f, g, along)`` indices into ``structure.faces``
+    #: (normals agreeing or not): ``shape`` holds ``f`` once, ``g``'s piece is it
+    coincident: tuple = field(default=(), compare=False)
 
     def faces_of(self, operand: int) -> list:
         """Operand ``operand``'s (0: a, 1: b) faces as trimmed faces: those the split
@@ -142,6 +146,7 @@ class SplitResult:
                 "free_edges": self.free_edges,
                 "edges_by_faces": {str(k): v for k, v in sorted(self.shared_edges.items())},
                 "valid": self.valid, "time_s": self.time_s, "assembled": self.assembled,
+                "coincident_faces": len(self.coincident),
                 "intersection_edges": [
                     {"faces": list(r.faces), "closed": r.closed, "length": r.length,
                      "max_distance_a": d.to_a, "max_distance_b": d.to_b}
@@ -169,12 +174,15 @@ class SplitResult:
 
     def output_faces(self) -> list[dict]:
         """Per output face (``pieces_a + pieces_b``): the operand and face it came from,
-        its name (:meth:`names`) and its area (GProp, 1e-9)."""
+        its name (:meth:`names`), its area (GProp, 1e-9) and, for a piece of b lying on
+        one of a (:attr:`coincident`), ``same_as``: the index of a's."""
         if self.structure is None:
             return []
-        return [{"operand": operand, "face": index, "name": name, "area": face_area(face, 1e-9)}
-                for face, name, (operand, index) in zip(self.pieces_a + self.pieces_b, self.names(),
-                                                        self.structure.origins)]
+        same = {g: f for f, g, _ in self.coincident}
+        return [{"operand": operand, "face": index, "name": name, "area": face_area(face, 1e-9),
+                 **({"same_as": same[k]} if k in same else {})}
+                for k, (face, name, (operand, index)) in enumerate(zip(self.pieces_a + self.pieces_b, self.names(),
+                                                                       self.structure.origins))]
 
     def as_model(self):
         """``shape`` as a :class:`~surfprep.plugin.io.CadModel` whose faces carry
@@ -377,13 +385,23 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     size = model_a.size if model_b is None else max(model_a.size, model_b.size)
     sew_tol = max(1e-7 * size, 10.0 * (curves.tol or 0.0))
     structure = NonManifoldModel.build([t for t, _ in listed], [o for _, o in listed], tol=sew_tol)
+    # faces of a and b lying on each other (coplanar faces of overlapping solids) are one
+    # face of the result: a's, which b's pieces list as theirs too
+    coincident = tuple(structure.coincident_faces()) if model_b is not None and not tool else ()
+    twin = {g: (f, along) for f, g, along in coincident}
+    unique = [k for k in range(len(structure.faces)) if k not in twin]
     try:
-        built = structure_to_occ(structure, tol=sew_tol)
+        built = structure_to_occ(structure, unique, tol=sew_tol)
     except OpenCascadeError:
         built = None
     if built is not None and built.valid:
-        shape, faces, assembled = built.shell, list(built.faces), "structure"
+        own = dict(zip(unique, built.faces))
+        faces = [own[k] if k not in twin else
+                 (own[twin[k][0]] if twin[k][1] else TopoDS.Face_s(own[twin[k][0]].Reversed()))
+                 for k in range(len(structure.faces))]
+        shape, assembled = built.shell, "structure"
     else:
+        coincident = ()
         # a piece OpenCascade finds invalid as built from the structure: each face built
         # on its own (make_face checks and fixes it; a region it refuses keeps its face
         # whole) and the faces sewn
@@ -404,7 +422,7 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
                        time.perf_counter() - started, tuple(faces[:n_a]), tuple(faces[n_a:]),
                        structure, (model_a, model_b), sew_tol,
-                       (converted.get("a"), converted.get("b")), assembled)
+                       (converted.get("a"), converted.get("b")), assembled, coincident)
 
 
 def _faces_one_by_one(operands, converted, listed, regions_of, refused) -> tuple[list, list]:

@@ -179,5 +179,14 @@ def test_cuts_along_the_boundary_divide_nothing():
     assert len(parts) == 2
     np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.5, 0.5], atol=1e-12)
     (whole,) = split_face(TrimmedFace(_plane()), [along])     # nothing left to cut: the face
-    assert len(whole.loops) == 1 and len(whole.loops[0].edges) == 4
     np.testing.assert_allclose(_area(whole), 1.0, atol=1e-12)
+    _closed(whole)
+    # but its side u = 0 is split where the curve ends (another solid's face touching part
+    # of it then shares that piece): the side in three, 4 + 2 edges, the piece [0.3, 0.9]
+    assert len(whole.loops) == 1 and len(whole.loops[0].edges) == 6
+    ends = [np.array(e.uv_ends()) for e in whole.loops[0].edges]
+    pieces = {tuple(np.round(np.sort(uv[:, 1]), 12)) for uv in ends if np.allclose(uv[:, 0], 0.0)}
+    assert pieces == {(0.0, 0.3), (0.3, 0.9), (0.9, 1.0)}
+    # a curve along a whole side, corner to corner, splits nothing
+    (whole,) = split_face(TrimmedFace(_plane()), [_line((0.0, 0.0), (0.0, 1.0))])
+    assert len(whole.loops[0].edges) == 4

@@ -217,6 +217,9 @@ def test_a_sphere_trimmed_by_a_sheet_keeps_one_side_by_its_normal():
 
 @pytest.mark.parametrize(("offset", "volumes"), [
     ((10, 0, 0), {"fuse": 2000.0, "common": 0.0, "cut": 1000.0}),      # touching along x = 5
+    # touching over part of a face: the edges beside the contact are split where it ends
+    # (a T-junction otherwise: the fuse came out open)
+    ((10, 3, 0), {"fuse": 2000.0, "common": 0.0, "cut": 1000.0}),
     ((5, 5, 0), {"fuse": 1750.0, "common": 250.0, "cut": 750.0}),       # top and bottom coplanar
 ])
 def test_booleans_of_boxes_with_coincident_faces(offset, volumes):
@@ -230,6 +233,21 @@ def test_booleans_of_boxes_with_coincident_faces(offset, volumes):
         result = boolean(a, b, operation)
         assert result.valid and result.closed
         assert result.volume == pytest.approx(exact, rel=1e-9, abs=1e-9)
+
+
+def test_coplanar_faces_of_two_solids_are_one_face_of_the_split():
+    """Overlapping boxes: the regions where their tops (and bottoms) lie on each other are
+    one face of the split (a's; b's piece is the same face), so the split's faces cover
+    a's 600 and b's 600 less the 2 x 25 they share."""
+    from surfprep.plugin.occ.shapes import all_faces
+    out = split(cq.Workplane().box(10, 10, 10), cq.Workplane().box(10, 10, 10).translate((5, 5, 0)))
+    assert len(out.coincident) == 2 and all(along for _, _, along in out.coincident)
+    faces = all_faces(out.shape)
+    assert len(faces) == len(out.structure.faces) - 2 and out.valid and out.free_edges == 0
+    assert sum(face_area(f, 1e-9) for f in faces) == pytest.approx(1150.0, rel=1e-9)
+    report = out.report()
+    assert report["coincident_faces"] == 2
+    assert sum("same_as" in f for f in report["output_faces"]) == 2
 
 
 def test_one_split_serves_every_boolean():
