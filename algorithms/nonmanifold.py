@@ -388,17 +388,28 @@ class NonManifoldModel:
     def operand(self, face: int) -> str:
         return self.origins[face][0]
 
-    def components(self, faces=None) -> list[list[int]]:
+    def regions(self) -> list[list[int]]:
+        """Faces of one operand joined through the edges only they use, two by two (each
+        component sorted, largest first): the pieces of a split that lie on one side of
+        the other operand, whose intersection edges (used by both operands, or by more
+        than two faces) bound them -- 002 §1's connected regions, classified as one."""
+        inner = [e for e, uses in enumerate(self.uses)
+                 if len(uses) == 2 and self.origins[uses[0].face][0] == self.origins[uses[1].face][0]]
+        return self.components(through=inner)
+
+    def components(self, faces=None, *, through=None) -> list[list[int]]:
         """Faces connected through shared edges, each component sorted, largest first;
         among ``faces`` only (a collection of indices; None: all), joined by the edges
-        they share with one another."""
+        they share with one another (those of ``through`` only, when given: a
+        collection of edge indices)."""
         chosen = np.arange(len(self.faces)) if faces is None else np.unique(np.asarray(list(faces), np.int64))
         if not chosen.size:
             return []
         index = np.full(len(self.faces), -1, dtype=np.int64)
         index[chosen] = np.arange(chosen.size)
         pairs = []
-        for uses in self.uses:
+        for e in (range(self.n_edges) if through is None else through):
+            uses = self.uses[e]
             inside = [int(index[u.face]) for u in uses if index[u.face] >= 0]
             pairs.extend((inside[0], k) for k in inside[1:])
         label = _groups(chosen.size, np.array(pairs, dtype=np.int64).reshape(-1, 2))

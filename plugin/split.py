@@ -560,9 +560,17 @@ def _selected(cut: SplitResult, operation: str) -> BooleanResult:
     sew_tol = cut.sew_tol
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
     shell_a, shell_b = cut.faces_of(0), cut.faces_of(1)
-    states = piece_states(cut.structure.faces,
-                          [shell_b if o[0] == "a" else shell_a for o in cut.structure.origins],
-                          tol=sew_tol)
+    # one piece classified per region (pieces joined by edges the other operand does not
+    # use lie on one side of it: 002 §1), its state given to the region
+    structure = cut.structure
+    regions = structure.regions()
+    chosen = [region[0] for region in regions]
+    found = piece_states([structure.faces[k] for k in chosen],
+                         [shell_b if structure.origins[k][0] == "a" else shell_a for k in chosen], tol=sew_tol)
+    states = [""] * len(structure.faces)
+    for region, state in zip(regions, found):
+        for k in region:
+            states[k] = state
     n_a = len(cut.pieces_a)
     keep_a, keep_b = OPERATIONS[operation]
     chosen_a = [k for k, s in enumerate(states[:n_a]) if s in keep_a]

@@ -130,3 +130,16 @@ def test_components_among_some_faces_only():
     # pieces 0 and 1 of sheet a touch only along the intersection edge: joined by it
     assert model.components([0, 1]) == [[0, 1]]
     assert model.components([0]) == [[0]] and model.components([]) == []
+
+
+def test_regions_are_joined_by_edges_of_one_operand_only():
+    # the four pieces of two crossing sheets meet only at the intersection edge (four uses,
+    # both operands): four regions
+    assert crossing_sheets().regions() == [[0], [1], [2], [3]]
+    # a closed block: one region, its twelve edges used twice by its own faces
+    solid = block((1.0, 2.0, 3.0))
+    faces = [TrimmedFace(s, reversed=name not in OUTWARD) for name, s in solid.exterior_faces().items()]
+    assert NonManifoldModel.build(faces, tol=1e-9).regions() == [[0, 1, 2, 3, 4, 5]]
+    # the same block's faces split between two operands: the edges between them join nothing
+    model = NonManifoldModel.build(faces, [("a", 0)] * 3 + [("b", 0)] * 3, tol=1e-9)
+    assert sorted(map(len, model.regions())) == [3, 3]
