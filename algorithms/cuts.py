@@ -12,6 +12,7 @@ no sliver of the edge is left.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +24,7 @@ from .face_region import FaceRegion
 from .trimmed import LOOP_SAMPLES_PER_EDGE, TrimEdge, TrimLoop, TrimmedFace, curve3d_points
 
 __all__ = ["CUT_SAMPLES", "Cut", "cut_point_at", "distinct_cuts", "locate_on_loops", "near_in_space",
-           "runs_along_boundary", "snap_to_corner", "split_where_cuts_end"]
+           "parts_along_boundary", "snap_to_corner", "split_where_cuts_end"]
 
 #: samples of a cut's pcurve for the topology (crossings, containment)
 CUT_SAMPLES = 257
@@ -207,21 +208,62 @@ def _chord(points: NDArray) -> float:
     return 0.5 * float(np.max(np.linalg.norm(np.diff(points, axis=0), axis=1))) if len(points) > 1 else 0.0
 
 
-def runs_along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: float,
-                    tol3d: float | None) -> bool:
-    """True when the cut runs along the face's boundary (every sample within ``tol3d`` of
-    a trimming edge in space, or ``eps`` in the parameters): it divides nothing -- two
-    faces of one model meeting another along a shared edge, two touching solids."""
+def parts_along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps: float,
+                         tol3d: float | None) -> tuple[list[Cut], list[Cut]]:
+    """A cut split into its stretches along the face's boundary and across the face:
+    ``(along, across)``. A curve of another solid's face can run along this face's
+    trimming edge for part of its length and then leave it into the face (where faces
+    of a fused result meet at a reflex corner): the part along divides nothing, the
+    part across does. Near the boundary means within ``tol3d`` in space (``eps`` in
+    the parameters) on :data:`CUT_SAMPLES` samples; a stretch of two samples or fewer near
+    it, or no longer than twice that distance, counts as across (a curve crossing the
+    boundary, steeply or at a shallow angle), a gap of two or fewer between
+    stretches near it as near (a chord of the sampled loops), and a change between the
+    two is found to 1e-12 of the range by bisection."""
     region = FaceRegion(TrimmedFace(face.surface, tuple(loops), 0, face.reversed))
-    uv = cut.samples()[::8]
-    if tol3d is not None:
-        t0, t1 = cut.range
-        points = (cut.curve3d.evaluate(np.linspace(t0, t1, uv.shape[0])) if cut.curve3d is not None
-                  else face.surface.evaluate(uv[:, 0], uv[:, 1]))
-        return bool(np.all(region.edge_distance(points) <= tol3d))
-    index = region.loop_index()
-    if index is not None:
-        return bool(np.all(index.uv_tree.distance(uv) <= eps))
-    u0, u1, v0, v1 = face.surface.domain          # the loops are the parameter rectangle
-    side = np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])), axis=0)
-    return bool(np.all(side <= eps))
+    t0, t1 = cut.range
+    t = np.linspace(t0, t1, CUT_SAMPLES)
+
+    def near(ts: NDArray) -> NDArray:
+        if tol3d is not None:
+            points = (cut.curve3d.evaluate(ts) if cut.curve3d is not None
+                      else face.surface.evaluate(*cut.pcurve.evaluate(ts).T))
+            return region.edge_distance(points) <= tol3d
+        index = region.loop_index()
+        uv = cut.pcurve.evaluate(ts)
+        if index is not None:
+            return index.uv_tree.distance(uv) <= eps
+        u0, u1, v0, v1 = face.surface.domain
+        return np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])),
+                      axis=0) <= eps
+    on = near(t)
+    points = (cut.curve3d.evaluate(t) if cut.curve3d is not None else face.surface.evaluate(*cut.pcurve.evaluate(t).T)
+              ) if tol3d is not None else cut.pcurve.evaluate(t)
+    shortest = 2.0 * (tol3d if tol3d is not None else eps)
+    for value in (True, False):                   # short stretches of either kind count with their neighbours
+        edges = np.diff(np.concatenate([[0], (on != value).astype(np.int8), [0]]))
+        for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            if hi - lo <= 2 and (not value or (lo > 0 and hi < on.size)):
+                on[lo:hi] = value
+            elif (value is False and hi - lo < on.size
+                  and np.linalg.norm(points[hi - 1] - points[lo]) <= shortest):
+                on[lo:hi] = value                 # near it over a tolerance or two: a shallow crossing
+    if not on.any():
+        return [], [cut]
+    if on.all():
+        return [cut], []
+    # the parameters where the kind changes, refined by bisection
+    change = [t0]
+    for k in np.flatnonzero(on[1:] != on[:-1]):
+        lo, hi, first = t[k], t[k + 1], bool(on[k])
+        while hi - lo > 1e-12 * max(abs(t1 - t0), 1.0):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if bool(near(np.array([mid]))[0]) == first else (lo, mid)
+        change.append(0.5 * (lo + hi))
+    change.append(t1)
+    along, across = [], []
+    for k, (a, b) in enumerate(itertools.pairwise(change)):
+        piece = Cut(cut.pcurve.restrict(a, b), None if cut.curve3d is None else cut.curve3d.restrict(a, b))
+        kind = bool(on[np.searchsorted(t, 0.5 * (a + b))])
+        (along if kind else across).append(piece)
+    return along, across

@@ -20,7 +20,8 @@ outside of a closed cut) are holes of the smallest region that contains them.
 A cut that runs along the face's boundary divides nothing and is left out (faces
 meeting along a shared edge, touching solids) -- but where it ends inside an edge of
 the loop, the edge is split there (a face of another solid touching along part of
-it can then share the piece) -- and so is a cut that repeats another
+it can then share the piece); a cut that runs along it for part of its length only
+keeps the part across the face -- and so is a cut that repeats another
 (the same curve reported twice). A cut that stops inside the face and
 meets no other cut divides nothing either (where a fin stands on a sheet): it
 becomes an internal edge (:attr:`~surfprep.algorithms.trimmed.TrimmedFace.internal`)
@@ -46,7 +47,7 @@ from .cuts import (
     distinct_cuts,
     locate_on_loops,
     near_in_space,
-    runs_along_boundary,
+    parts_along_boundary,
     snap_to_corner,
     split_where_cuts_end,
 )
@@ -160,10 +161,13 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     span = max(u1 - u0, v1 - v0)
     eps = 1e-7 * span if tol is None else float(tol)
     loops = list(face.loops) if face.loops else [natural_loop(face.surface)]
-    along = [runs_along_boundary(face, loops, cut, eps, tol3d) for cut in cuts]
-    loops = split_where_cuts_end(face, loops, [cut for cut, a in zip(cuts, along) if a], eps, tol3d,
-                                 [cut for cut, a in zip(cuts, along) if not a])
-    cuts = distinct_cuts([cut for cut, a in zip(cuts, along) if not a], face, eps, tol3d)
+    along, across = [], []
+    for cut in cuts:
+        parts = parts_along_boundary(face, loops, cut, eps, tol3d)
+        along.extend(parts[0])
+        across.extend(parts[1])
+    loops = split_where_cuts_end(face, loops, along, eps, tol3d, across)
+    cuts = distinct_cuts(across, face, eps, tol3d)
     graph = _Graph(face, eps)
     # where each cut is split: its ends and its crossings with the other cuts
     params: list[list[float]] = [[cut.range[0], cut.range[1]] for cut in cuts]

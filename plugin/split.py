@@ -21,6 +21,7 @@ named with the reason; nothing is dropped.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -39,7 +40,7 @@ from .occ.faces import trimmed_face_to_occ
 from .occ.shapes import compound, count_free_edges, face_area, is_valid, sew, shell_or_solid
 from .occ.structure import structure_to_occ
 
-__all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "split", "trim"]
+__all__ = ["OPERATIONS", "BooleanResult", "SplitFace", "SplitResult", "boolean", "boolean_all", "split", "trim"]
 
 
 @dataclass(frozen=True)
@@ -484,6 +485,8 @@ class BooleanResult:
     valid: bool
     #: the kept faces as built and their names (:meth:`SplitResult.names`)
     named: tuple = field(default=(), repr=False)
+    #: for :func:`boolean_all`, the results of the steps before this one, in order
+    steps: tuple = field(default=(), repr=False)
 
     @property
     def geometry(self) -> Any:
@@ -511,7 +514,10 @@ class BooleanResult:
 
     def report(self) -> dict:
         return {"operation": self.operation, "kept_pieces_a": self.kept[0], "kept_pieces_b": self.kept[1],
-                "volume": self.volume, "valid": self.valid, "split": self.split.report()}
+                "volume": self.volume, "valid": self.valid, "split": self.split.report(),
+                **({"steps": [{"volume": step.volume, "valid": step.valid, "time_s": step.split.time_s,
+                               "kept_pieces_a": step.kept[0], "kept_pieces_b": step.kept[1]}
+                              for step in (*self.steps, self)]} if self.steps else {})}
 
 
 def _solid_of(model, tol: float):
@@ -552,6 +558,45 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     if operation not in OPERATIONS:
         raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
     return split(as_model(a), as_model(b), tol=tol, method=method).select(operation)
+
+
+def boolean_all(operands: Sequence[Any], operation: str, *, tol: float | None = None,
+                method: str = "auto") -> BooleanResult:
+    """Fuse or common of N solids, or the first minus all the others (``"cut"``), pairwise:
+    ``((a op b) op c) op ...``, each step a :func:`boolean` of the result so far (its
+    faces on their B-spline form) with the next operand.
+
+    Returns
+    -------
+    BooleanResult
+        The last step's, with the ones before it in ``steps``.
+
+    Raises
+    ------
+    InvalidGeometryError
+        Fewer than two operands, an unknown operation.
+    OpenCascadeError
+        An operand, or a step's result, that is not a closed solid (a common that comes
+        out empty ends the chain here too).
+    """
+    from ..errors import InvalidGeometryError
+    operands = list(operands)
+    if len(operands) < 2:
+        raise InvalidGeometryError(f"boolean_all needs at least two operands, got {len(operands)}")
+    if operation not in OPERATIONS:
+        raise InvalidGeometryError(f"unknown operation {operation!r}; expected one of {', '.join(OPERATIONS)}")
+    steps: list[BooleanResult] = []
+    current: Any = operands[0]
+    for operand in operands[1:]:
+        if steps and not steps[-1].closed:
+            raise OpenCascadeError(f"step {len(steps)} of the {operation} is not a closed solid: "
+                                   "nothing to go on with")
+        step = boolean(current, operand, operation, tol=tol, method=method)
+        steps.append(step)
+        current = step.shape
+    last = steps[-1]
+    return BooleanResult(last.shape, last.operation, last.split, last.kept, last.closed, last.valid,
+                         last.named, tuple(steps[:-1]))
 
 
 def _selected(cut: SplitResult, operation: str) -> BooleanResult:

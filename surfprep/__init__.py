@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from .plugin.occ.faces import make_face
     from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
-    from .plugin.split import BooleanResult, SplitResult, boolean, split, trim
+    from .plugin.split import BooleanResult, SplitResult, boolean, boolean_all, split, trim
     from .plugin.volume_boundary import (
         BoundarySolid,
         ComposedVolumes,
@@ -105,6 +105,7 @@ __all__ = [
     "split",
     "SplitResult",
     "boolean",
+    "boolean_all",
     "trim",
     "BooleanResult",
     # trivariate solids (numpy only)
@@ -166,6 +167,7 @@ _LAZY_EXPORTS = {
     "split": "surfprep.plugin.split",
     "SplitResult": "surfprep.plugin.split",
     "boolean": "surfprep.plugin.split",
+    "boolean_all": "surfprep.plugin.split",
     "trim": "surfprep.plugin.split",
     "BooleanResult": "surfprep.plugin.split",
     "NurbsVolume": "surfprep.algorithms.volume",

@@ -18,7 +18,8 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("b", type=Path, nargs="?", metavar="B",
                         help="second STEP or IGES file (default: A's faces cut where they meet each other)")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="OUT",
-                        help="STEP/IGES file for the pieces and the uncut faces, sewn")
+                        help="STEP/IGES file for the pieces and the uncut faces (one shell), or "
+                             "the result of --op")
     parser.add_argument("--tol", type=float, default=None, metavar="T",
                         help="intersection tolerance in mm (default 1e-6 x the faces' box diagonal)")
     parser.add_argument("--method", choices=METHODS, default="auto",
@@ -32,6 +33,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--keep", choices=("front", "back"), default="front",
                         help="with --op trim: keep A's pieces on the side B's normal points to "
                              "(front, the default) or on the other")
+    parser.add_argument("--with", dest="more", type=Path, action="append", default=[], metavar="C",
+                        help="with --op fuse/cut/common: one more solid (repeatable), taken "
+                             "pairwise: ((A op B) op C) ...; cut takes every one from A")
     parser.add_argument("--boolean", choices=("fuse", "cut", "common"), default=None, metavar="OP",
                         help="the same as --op OP")
     parser.add_argument("--compare-occ", action="store_true",
@@ -47,24 +51,30 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run(args: argparse.Namespace, console: Console) -> int:
-    inputs = tuple(p for p in (args.a, args.b) if p is not None)
+    inputs = tuple(p for p in (args.a, args.b, *args.more) if p is not None)
     check_outputs(inputs, args.output, plot=args.plot, json_path=args.json_path)
     check_inputs(*inputs)
     from ...errors import InvalidGeometryError
     if args.op is not None and args.boolean is not None and args.op != args.boolean:
         raise InvalidGeometryError(f"--op {args.op} and --boolean {args.boolean} disagree")
     op = args.boolean or (args.op if args.op != "split" else None)
+    if args.more and op not in ("fuse", "cut", "common"):
+        raise InvalidGeometryError("--with needs --op fuse, cut or common")
     from ..io import staged_write
     from ..split import split
     model_a = read_model(args.a, console, strict=args.strict)
     model_b = read_model(args.b, console, strict=args.strict) if args.b is not None else None
     operation = None
     if op is not None:
-        from ..split import boolean, trim
+        from ..split import boolean, boolean_all, trim
         if model_b is None:
             raise InvalidGeometryError(f"--op {op} needs two files, A and B")
-        operation = (trim(model_a, model_b, keep=args.keep, tol=args.tol, method=args.method)
-                     if op == "trim" else boolean(model_a, model_b, op, tol=args.tol, method=args.method))
+        if args.more:
+            more = [read_model(path, console, strict=args.strict) for path in args.more]
+            operation = boolean_all([model_a, model_b, *more], op, tol=args.tol, method=args.method)
+        else:
+            operation = (trim(model_a, model_b, keep=args.keep, tol=args.tol, method=args.method)
+                         if op == "trim" else boolean(model_a, model_b, op, tol=args.tol, method=args.method))
         result = operation.split
     else:
         result = split(model_a, model_b, tol=args.tol, method=args.method, tool=args.tool)
@@ -172,8 +182,9 @@ COMMAND = Command(
     description=(
         "Intersect A with B (or A's faces with one another, as surfprep intersect), cut every "
         "face along its curves in its own parameters (open curves from boundary to boundary, "
-        "closed ones as islands) and write the pieces with the uncut faces, sewn: where two "
-        "surfaces cross, four pieces share one intersection edge (a non-manifold shell). A "
+        "closed ones as islands) and write the pieces with the uncut faces as one shell built "
+        "from their shared edges (no sewing): where two surfaces cross, four pieces share one "
+        "intersection edge (non-manifold); faces of A and B lying on each other are one face. A "
         "curve that stops inside a face (a fin on a sheet, also one running in from the "
         "border) becomes an internal edge of it, shared with the fin's pieces; a face the "
         "cutting refuses is kept whole and named (exit 1). The report gives "
@@ -181,12 +192,14 @@ COMMAND = Command(
         "edges and BRepCheck validity, every output face's origin, name and area, every "
         "intersection edge's length and distance from both surfaces. With --op fuse|cut|common "
         "(or --boolean), two solids are fused, cut or intersected by keeping the pieces of "
-        "each that lie outside (inside) the other, sewn into the result. --compare-occ runs "
+        "each that lie outside (inside) the other (--with C: more solids, pairwise), written as "
+        "a solid whose faces carry their origin's names. --compare-occ runs "
         "OpenCascade's General Fuse / Splitter / Boolean on the same input beside ours."),
     epilog=(
         "examples:\n"
         "  surfprep split wing.step fuselage.step -o cut.step\n"
         "  surfprep split a.step b.step -o common.step --op common --compare-occ\n"
+        "  surfprep split block.step drill1.step -o drilled.step --op cut --with drill2.step\n"
         "  surfprep split hull.step waterplane.step -o below.step --op trim --keep back\n"
         "  surfprep split model.step -o cut.step --json r.json\n"
         "\n"

@@ -190,3 +190,22 @@ def test_cuts_along_the_boundary_divide_nothing():
     # a curve along a whole side, corner to corner, splits nothing
     (whole,) = split_face(TrimmedFace(_plane()), [_line((0.0, 0.0), (0.0, 1.0))])
     assert len(whole.loops[0].edges) == 4
+
+
+def test_a_cut_partly_along_the_boundary_keeps_its_part_across():
+    """A curve running up the side u = 0 from v = 0.2 to 0.6 and then across the face
+    to u = 1 (another solid's face meeting this one at a reflex corner): the part along
+    divides nothing, the part across cuts the face in two; the side is split where the
+    curve joins it."""
+    polyline = np.array([(0.0, 0.2), (0.0, 0.6), (1.0, 0.6)])
+    pcurve = NurbsCurve(polyline, [0, 0, 0.4, 1.4, 1.4], 1)
+    curve3d = NurbsCurve(np.column_stack([polyline, np.zeros(3)]), [0, 0, 0.4, 1.4, 1.4], 1)
+    parts = split_face(TrimmedFace(_plane()), [Cut(pcurve, curve3d)], tol3d=1e-9)
+    assert len(parts) == 2
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.4, 0.6], atol=1e-12)
+    for p in parts:
+        _closed(p)
+    lower = max(parts, key=_area)                       # v in [0, 0.6]: its side u = 0 in two
+    ends = [np.array(e.uv_ends()) for e in lower.loops[0].edges]
+    on_side = sorted(tuple(np.round(np.sort(uv[:, 1]), 9)) for uv in ends if np.allclose(uv[:, 0], 0.0))
+    assert on_side == [(0.0, 0.2), (0.2, 0.6)]

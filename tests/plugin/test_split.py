@@ -325,3 +325,22 @@ def test_a_real_solid_cut_at_mid_height(data_dir):
     for f in out.faces:
         whole = face_area(model.faces[f.index], 1e-9)
         assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(whole, rel=1e-5)
+
+
+def test_booleans_of_n_solids_pairwise():
+    """Three boxes fused (each step's result fused with the next; the third touches the
+    first over part of a face and overlaps the second): 2200 exactly. A cube minus two
+    crossing cylinders r = 2: 1000 - 2 (40 pi) + 16 r^3 / 3 (their Steinmetz common)."""
+    from surfprep.errors import InvalidGeometryError
+    from surfprep.plugin.split import boolean_all
+    boxes = [cq.Workplane().box(10, 10, 10).translate((5 * k, 2 * k, 0)) for k in range(3)]
+    fused = boolean_all(boxes, "fuse")
+    assert fused.valid and fused.closed and fused.volume == pytest.approx(2200.0, rel=1e-9)
+    assert [s["volume"] for s in fused.report()["steps"]] == pytest.approx([1600.0, 2200.0], rel=1e-9)
+    cube = cq.Workplane().box(10, 10, 10)
+    drilled = boolean_all([cube, _cylinder("YZ", 2.0), _cylinder("XZ", 2.0)], "cut")
+    assert drilled.valid and drilled.volume == pytest.approx(1000 - 80 * math.pi + 16 * 8 / 3, rel=1e-6)
+    with pytest.raises(InvalidGeometryError, match="at least two"):
+        boolean_all([cube], "fuse")
+    with pytest.raises(InvalidGeometryError, match="unknown operation"):
+        boolean_all([cube, cube], "xor")

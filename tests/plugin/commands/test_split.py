@@ -170,3 +170,24 @@ def test_op_trim_keeps_the_side_of_the_sheet(tmp_path, capsys):
     assert data["boolean"]["operation"] == "trim-front"
     from surfprep.plugin.occ.shapes import face_area
     assert face_area(surfprep.read(out).shape, 1e-9) == pytest.approx(2 * math.pi * 10 * 5, rel=1e-6)
+
+
+def test_with_takes_more_solids_pairwise(tmp_path, capsys):
+    """A cube minus two crossing cylinders (r = 2) from three files: 1000 - 80 pi + 128 / 3."""
+    import math
+    files = []
+    for name, solid in (("cube", cq.Workplane().box(10, 10, 10)),
+                        ("x", cq.Workplane("YZ").circle(2).extrude(20).translate((-10, 0, 0))),
+                        ("y", cq.Workplane("XZ").circle(2).extrude(20).translate((0, 10, 0)))):
+        files.append(tmp_path / f"{name}.step")
+        cq.exporters.export(solid, str(files[-1]))
+    out, report = tmp_path / "drilled.step", tmp_path / "r.json"
+    code, _, err = run(capsys, "split", files[0], files[1], "-o", out, "--op", "cut", "--with", files[2],
+                       "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())["boolean"]
+    assert data["volume"] == pytest.approx(1000 - 80 * math.pi + 128 / 3, rel=1e-6)
+    assert len(data["steps"]) == 2 and data["valid"]
+    assert surfprep.read(out).shape.ShapeType().name == "TopAbs_SOLID"
+    code, _, err = run(capsys, "split", files[0], files[1], "-o", tmp_path / "out.step", "--with", files[2])
+    assert code != 0 and "--with needs --op" in err
