@@ -232,28 +232,44 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
               eps: float, tol3d: float | None) -> tuple[set[int], set[int]]:
     """The cuts that divide nothing: open, crossing no other cut, with an end inside the
-    face (on no loop, at no other cut's end) -- a curve that stops inside the face. Both
-    ends inside: *dangling*; one on the boundary: a *spur* (its boundary end splits the
-    loop's edge there, so the edge and the spur share that vertex). Both become internal
-    edges of the region they lie in."""
+    face (on no loop, at no other cut's end) -- a curve that stops inside the face -- and,
+    taken away, those they leave so in turn (a path of cuts joined end to end inside the
+    face that stops inside it: a fin's foot made of two curves). Both ends off the
+    boundary: *dangling*; one on it: a *spur* (its boundary end splits the loop's edge
+    there, so the edge and the spur share that vertex). All become internal edges of the
+    region they lie in."""
     ends = []
     for cut in cuts:
         line = cut.samples()
         ends.append((line[0], line[-1]))
-    dangling, spurs = set(), set()
+    candidates, on_loop = [], {}
     for c, cut in enumerate(cuts):
         first, last = ends[c]
         if np.linalg.norm(first - last) <= eps or len(params[c]) > 2:
             continue                                   # closed, or crossing another cut
-        on_loop = [locate_on_loops(loops, point, eps, near_in_space(face, loops, cut, end, tol3d)) is not None
-                   for end, point in ((0, first), (1, last))]
-        if all(on_loop):
-            continue                                   # boundary to boundary: it divides
-        inner = [p for p, on in zip((first, last), on_loop) if not on]
-        if any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends) if d != c
-               for p in inner for q in pair):
-            continue                                   # joined to another cut inside
-        (spurs if any(on_loop) else dangling).add(c)
+        on_loop[c] = [locate_on_loops(loops, point, eps, near_in_space(face, loops, cut, end, tol3d)) is not None
+                      for end, point in ((0, first), (1, last))]
+        if not all(on_loop[c]):                        # boundary to boundary: it divides
+            candidates.append(c)
+    dangling, spurs = set(), set()
+    removed: set[int] = set()
+    changed = True
+    while changed:
+        changed = False
+        for c in candidates:
+            if c in removed:
+                continue
+            free = False
+            for p, on in zip(ends[c], on_loop[c]):
+                # an end on no loop and at no end of a cut still there (crossing cuts
+                # count: they are split at their crossings, not pruned)
+                if not on and not any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends)
+                                      if d != c and d not in removed for q in pair):
+                    free = True
+            if free:
+                removed.add(c)
+                (spurs if any(on_loop[c]) else dangling).add(c)
+                changed = True
     return dangling, spurs
 
 

@@ -127,10 +127,6 @@ def test_a_triangle_of_three_crossing_cuts_and_a_circle_across_one():
 
 def test_cuts_that_cannot_be_used_are_refused():
     face = TrimmedFace(_plane())
-    # two cuts joined end to end inside the face, the second stopping inside it: a path
-    # that divides nothing and is no single internal edge
-    with pytest.raises(InvalidGeometryError, match="neither on the face's boundary nor on another cut"):
-        split_face(face, [_line((0.0, 0.5), (0.4, 0.5)), _line((0.4, 0.5), (0.6, 0.7))])
     with pytest.raises(InvalidGeometryError, match="same boundary point"):
         split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
 
@@ -168,6 +164,16 @@ def test_a_cut_that_stops_inside_the_face_becomes_an_internal_edge():
     (spurred,) = split_face(TrimmedFace(_plane()), [_line((0.0, 0.5), (0.5, 0.5))])
     assert len(spurred.internal) == 1 and len(spurred.loops[0].edges) == 5
     np.testing.assert_allclose(_area(spurred), 1.0, atol=1e-12)
+    # a path of two cuts joined inside the face, the second stopping inside it (a fin's
+    # foot of two curves): both internal edges, the boundary split where the path starts
+    first, second = _line((0.0, 0.5), (0.4, 0.5)), _line((0.4, 0.5), (0.6, 0.7))
+    (path,) = split_face(TrimmedFace(_plane()), [second, first])
+    assert {e.pcurve for e in path.internal} == {first.pcurve, second.pcurve}
+    assert len(path.loops[0].edges) == 5
+    np.testing.assert_allclose(_area(path), 1.0, atol=1e-12)
+    # the same path closed by a third cut back to the boundary divides the face
+    parts = split_face(TrimmedFace(_plane()), [first, second, _line((0.6, 0.7), (0.6, 1.0))])
+    assert len(parts) == 2 and not any(p.internal for p in parts)
 
 
 def test_cuts_along_the_boundary_divide_nothing():

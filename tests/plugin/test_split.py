@@ -94,6 +94,30 @@ def test_a_fin_on_a_plate_is_an_internal_edge_shared_by_three_faces():
     assert len(plate.internal) == 1 and face_area(out.pieces_a[0], 1e-9) == pytest.approx(4.0, rel=1e-9)
 
 
+def test_a_bent_fin_on_a_plate_leaves_a_path_of_two_internal_edges():
+    """A fin of two faces meeting at a right angle (an L seen from above), standing on the
+    plate inside it: its foot is two curves joined at the corner, both stopping inside the
+    plate -- two internal edges of the plate, each shared with the two pieces of one fin
+    face (two T-junctions of three faces)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+    from OCP.gp import gp_Pnt
+
+    def rectangle(*corners):
+        polygon = BRepBuilderAPI_MakePolygon()
+        for c in corners:
+            polygon.Add(gp_Pnt(*c))
+        polygon.Close()
+        return BRepBuilderAPI_MakeFace(polygon.Wire(), True).Face()
+    legs = [rectangle((-0.5, 0, -0.5), (0, 0, -0.5), (0, 0, 0.5), (-0.5, 0, 0.5)),
+            rectangle((0, 0, -0.5), (0, 0.5, -0.5), (0, 0.5, 0.5), (0, 0, 0.5))]
+    out = split(_sheet("XY"), legs)
+    assert all(f.kept is None for f in out.faces) and out.valid
+    assert [len(f.pieces) for f in out.faces] == [1, 2, 2]
+    plate = out.structure.faces[0]
+    assert len(plate.internal) == 2 and face_area(out.pieces_a[0], 1e-9) == pytest.approx(4.0, rel=1e-9)
+    assert out.structure.edges_by_uses().get(3) == 2 and out.shared_edges.get(3) == 2
+
+
 def test_a_fin_over_the_sheets_border_is_a_spur_in_both_sharing_one_edge():
     """The fin stands over the sheet's border: the curve runs in from the sheet's border
     and stops inside it, and from the fin's border and stops inside the fin -- a spur in
