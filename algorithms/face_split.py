@@ -336,6 +336,19 @@ def _speed(cut: Cut, t: float) -> float:
     return float(np.linalg.norm(cut.pcurve.derivatives(np.array([t]), 1)[0, 1]))
 
 
+#: directions at a vertex closer than this (radians) are told apart by their chords
+_TIE_ANGLE = 1e-3
+
+
+def _near_tie(angles: list[float]) -> bool:
+    """Two of ``angles`` (radians) within :data:`_TIE_ANGLE` of each other, round the circle."""
+    a = np.sort(np.mod(angles, 2 * np.pi))
+    if a.size < 2:
+        return False
+    gaps = np.diff(np.append(a, a[0] + 2 * np.pi))
+    return bool(np.min(gaps) < _TIE_ANGLE)
+
+
 def _direction(pcurve: NurbsCurve, t: float, sign: float) -> NDArray:
     """Unit direction of a pcurve at ``t`` run forwards (``sign`` 1) or backwards (-1); a
     short chord where the derivative vanishes."""
@@ -372,28 +385,41 @@ class _Graph:
         self.boundary.append(boundary)
         return len(self.points) - 1
 
-    def _add(self, origin: int, target: int, edges: list[TrimEdge], out: NDArray, into: NDArray) -> None:
+    def _add(self, origin: int, target: int, edges: list[TrimEdge], out: NDArray, into: NDArray,
+             far_out: NDArray, far_into: NDArray) -> None:
+        """A half-edge leaving ``origin`` along ``out`` and arriving at ``target`` along
+        ``into``; ``far_out`` / ``far_into``: the chords to / from a point a sixteenth of
+        the way along it, which order half-edges whose tangents coincide (a curve leaving
+        a pole along the pole's edge in the parameters)."""
         self.half.append({"origin": origin, "target": target, "edges": edges,
-                          "angle": float(np.arctan2(out[1], out[0])), "into": into})
+                          "angle": float(np.arctan2(out[1], out[0])), "into": into,
+                          "far_angle": float(np.arctan2(far_out[1], far_out[0])), "far_into": far_into})
 
     def cut_segment(self, c: int, cut: Cut, a: float, b: float) -> None:
         pa, pb = cut.pcurve.evaluate(np.array([a, b]))
         va = self.vertex(pa, cut_point_at(cut, self.face, a))
         vb = self.vertex(pb, cut_point_at(cut, self.face, b))
+        near_a, near_b = cut.pcurve.evaluate(np.array([a + (b - a) / 16, b - (b - a) / 16]))
         for origin, target, forward in ((va, vb, True), (vb, va, False)):
             start, stop = (a, b) if forward else (b, a)
             sign = 1.0 if forward else -1.0
             edge = TrimEdge(cut.curve3d, cut.pcurve, a, b, not forward, 0.0)
+            far_out, far_into = (near_a - pa, pb - near_b) if forward else (near_b - pb, pa - near_a)
             self._add(origin, target, [("cut", c, edge)],
-                      _direction(cut.pcurve, start, sign), _direction(cut.pcurve, stop, sign))
+                      _direction(cut.pcurve, start, sign), _direction(cut.pcurve, stop, sign), far_out, far_into)
+        self.half[-2]["twin"], self.half[-1]["twin"] = len(self.half) - 1, len(self.half) - 2
 
     def run(self, pieces: list[TrimEdge], start: _Mark, stop: _Mark) -> None:
         first, last = pieces[0], pieces[-1]
         t_first = first.t1 if first.reversed else first.t0
         t_last = last.t0 if last.reversed else last.t1
+        ends = [p.pcurve.evaluate(np.array([t, t + (u - t) / 16]))
+                for p, t, u in ((first, t_first, first.t0 if first.reversed else first.t1),
+                                (last, t_last, last.t1 if last.reversed else last.t0))]
         self._add(start.vertex, stop.vertex, [("run", max(start.gap, stop.gap), p) for p in pieces],
                   _direction(first.pcurve, t_first, -1.0 if first.reversed else 1.0),
-                  _direction(last.pcurve, t_last, -1.0 if last.reversed else 1.0))
+                  _direction(last.pcurve, t_last, -1.0 if last.reversed else 1.0),
+                  ends[0][1] - ends[0][0], ends[1][0] - ends[1][1])
 
     def check_ends(self) -> None:
         """Every vertex inside the face must join at least two cut segments."""
@@ -420,10 +446,16 @@ class _Graph:
                 used.add(k)
                 h = self.half[k]
                 cycle.extend(self._edges(h))
-                back = float(np.arctan2(-h["into"][1], -h["into"][0]))
                 candidates = outgoing.get(h["target"], [])
+                back = float(np.arctan2(-h["into"][1], -h["into"][0]))
+                angles = [self.half[j]["angle"] for j in candidates]
+                # (the way back along a cut is its twin's way out: no tie)
+                if _near_tie([back, *(a for j, a in zip(candidates, angles) if j != h.get("twin"))]):
+                    back = float(np.arctan2(-h["far_into"][1], -h["far_into"][0]))
+                    angles = [self.half[j]["far_angle"] for j in candidates]
                 # the first outgoing half-edge clockwise from the way back: the face stays on the left
-                k = min(candidates, key=lambda j: ((back - self.half[j]["angle"]) % (2 * np.pi)) or 2 * np.pi)
+                k = candidates[min(range(len(candidates)),
+                                   key=lambda i: ((back - angles[i]) % (2 * np.pi)) or 2 * np.pi)]
             cycles.append(cycle)
         return cycles
 

@@ -215,3 +215,30 @@ def test_a_cut_partly_along_the_boundary_keeps_its_part_across():
     ends = [np.array(e.uv_ends()) for e in lower.loops[0].edges]
     on_side = sorted(tuple(np.round(np.sort(uv[:, 1]), 9)) for uv in ends if np.allclose(uv[:, 0], 0.0))
     assert on_side == [(0.0, 0.2), (0.2, 0.6)]
+
+
+def test_a_cut_leaving_a_pole_along_the_pole_edge_still_divides_the_face():
+    """A triangle (the side v = 1 collapsed to its apex) cut from the apex to the base by
+    a curve whose pcurve leaves the pole along the pole's edge in (u, v) -- as an
+    intersection curve from a pole does (occt_k1_catia_debis.stp's face 21 at mid-height):
+    the tangents there coincide, the chords a little farther tell them apart, and the face
+    comes out in two, not in one with the cut run both ways."""
+    apex = np.array([0.5, 1.0, 0.0])
+    surface = NurbsSurface(np.array([[(0, 0, 0), apex], [(1, 0, 0), apex]], float),
+                           [0, 0, 1, 1], [0, 0, 1, 1], 1, 1)
+
+    def side(a, b, degenerated=False):
+        pcurve = NurbsCurve(np.array([a, b], float), [0, 0, 1, 1], 1)
+        if degenerated:
+            return TrimEdge(None, pcurve, 0.0, 1.0, degenerated=True)
+        points = surface.evaluate(np.array([a[0], b[0]]), np.array([a[1], b[1]]))
+        return TrimEdge(NurbsCurve(points, [0, 0, 1, 1], 1), pcurve, 0.0, 1.0)
+    loop = TrimLoop((side((0, 0), (1, 0)), side((1, 0), (1, 1)), side((1, 1), (0, 1), True), side((0, 1), (0, 0))))
+    pcurve = NurbsCurve(np.array([(0.9, 1.0), (0.3, 1.0), (0.3, 0.0)]), [0, 0, 0, 1, 1, 1], 2)
+    parts = split_face(TrimmedFace(surface, (loop,)), [Cut(pcurve)])
+    assert len(parts) == 2
+    areas = sorted(_area(p) for p in parts)
+    assert sum(areas) == pytest.approx(1.0, abs=1e-9) and areas[0] > 0.2
+    for p in parts:
+        cut_uses = [e for e in p.loops[0].edges if e.pcurve is pcurve]
+        assert len(cut_uses) == 1                      # the cut bounds each region once

@@ -341,6 +341,8 @@ def test_a_real_solid_cut_at_mid_height(data_dir):
     out = split(model, plane, tool=True)
     assert out.valid and all(f.kept is None for f in out.faces)
     assert out.assembled == "structure" and count_free_edges(out.shape) == 0
+    # face 21 (a pcurve leaving its pole along the pole's edge) in two, as the Splitter has it
+    assert next(len(f.pieces) for f in out.faces if f.index == 21) == 2
     from surfprep.plugin.occ.faces import trimmed_face_to_occ
     from surfprep.plugin.occ.shapes import sew
     sewn, _ = sew([trimmed_face_to_occ(f) for f in out.structure.faces], out.sew_tol)
