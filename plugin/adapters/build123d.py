@@ -200,7 +200,7 @@ def split(a: ShapeLike, b: ShapeLike | None = None, *, report: Literal[True],
 def split(a: ShapeLike, b: ShapeLike | None = None, *, report: bool = False,
           **options: Any
           ) -> bd.Compound | tuple[bd.Compound, SplitResult]:
-    """The faces of ``a`` and ``b`` cut along their intersection curves, sewn.
+    """The faces of ``a`` and ``b`` cut along their intersection curves, sharing the cut edges.
 
     Parameters
     ----------
@@ -215,7 +215,8 @@ def split(a: ShapeLike, b: ShapeLike | None = None, *, report: bool = False,
     Returns
     -------
     build123d.Compound
-        The pieces and the uncut faces, sewn (non-manifold where surfaces cross:
+        The pieces and the uncut faces in one shell built from their shared edges
+        (non-manifold where surfaces cross:
         four pieces share each intersection edge).
 
     Examples

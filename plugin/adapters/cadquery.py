@@ -205,7 +205,7 @@ def split(a: ShapeLike, b: ShapeLike | None = None, *, report: Literal[True],
 def split(a: ShapeLike, b: ShapeLike | None = None, *, report: bool = False,
           **options: Any
           ) -> cq.Compound | tuple[cq.Compound, SplitResult]:
-    """The faces of ``a`` and ``b`` cut along their intersection curves, sewn.
+    """The faces of ``a`` and ``b`` cut along their intersection curves, sharing the cut edges.
 
     Parameters
     ----------
@@ -219,7 +219,8 @@ def split(a: ShapeLike, b: ShapeLike | None = None, *, report: bool = False,
     Returns
     -------
     cq.Compound
-        The pieces and the uncut faces, sewn (non-manifold where surfaces cross:
+        The pieces and the uncut faces in one shell built from their shared edges
+        (non-manifold where surfaces cross:
         four pieces share each intersection edge).
 
     Examples
@@ -406,7 +407,7 @@ def _workplane_split_faces(self: cq.Workplane, other: ShapeLike | None = None,
     Returns
     -------
     cq.Workplane
-        A new Workplane on the ``cq.Compound`` of the sewn pieces.
+        A new Workplane on the ``cq.Compound`` of the pieces (their shared edges one edge each).
     """
     return self.newObject([split(self, other, report=False, **options)])
 
