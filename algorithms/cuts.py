@@ -219,51 +219,79 @@ def parts_along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps
     it, or no longer than twice that distance, counts as across (a curve crossing the
     boundary, steeply or at a shallow angle), a gap of two or fewer between
     stretches near it as near (a chord of the sampled loops), and a change between the
-    two is found to 1e-12 of the range by bisection."""
+    two is found to 1e-12 of the range by bisection. A short stretch near the boundary
+    inside the cut is a tangential touch (a cylinder's circle inscribed in a square
+    face): the cut is split at the point nearest the boundary, so each piece runs from
+    the boundary to the boundary (the touch is a vertex of the face's loop)."""
     region = FaceRegion(TrimmedFace(face.surface, tuple(loops), 0, face.reversed))
     t0, t1 = cut.range
     t = np.linspace(t0, t1, CUT_SAMPLES)
+    limit = tol3d if tol3d is not None else eps
 
-    def near(ts: NDArray) -> NDArray:
+    def distance(ts: NDArray) -> NDArray:
         if tol3d is not None:
             points = (cut.curve3d.evaluate(ts) if cut.curve3d is not None
                       else face.surface.evaluate(*cut.pcurve.evaluate(ts).T))
-            return region.edge_distance(points) <= tol3d
+            return region.edge_distance(points)
         index = region.loop_index()
         uv = cut.pcurve.evaluate(ts)
         if index is not None:
-            return index.uv_tree.distance(uv) <= eps
+            return index.uv_tree.distance(uv)
         u0, u1, v0, v1 = face.surface.domain
-        return np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])),
-                      axis=0) <= eps
-    on = near(t)
+        return np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])), axis=0)
+    on = distance(t) <= limit
     points = (cut.curve3d.evaluate(t) if cut.curve3d is not None else face.surface.evaluate(*cut.pcurve.evaluate(t).T)
               ) if tol3d is not None else cut.pcurve.evaluate(t)
-    shortest = 2.0 * (tol3d if tol3d is not None else eps)
+    touches = []
     for value in (True, False):                   # short stretches of either kind count with their neighbours
         edges = np.diff(np.concatenate([[0], (on != value).astype(np.int8), [0]]))
         for lo, hi in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
-            if hi - lo <= 2 and (not value or (lo > 0 and hi < on.size)):
+            short = hi - lo <= 2 and (not value or (lo > 0 and hi < on.size))
+            shallow = (value is False and hi - lo < on.size
+                       and np.linalg.norm(points[hi - 1] - points[lo]) <= 2.0 * limit)
+            if short or shallow:
                 on[lo:hi] = value
-            elif (value is False and hi - lo < on.size
-                  and np.linalg.norm(points[hi - 1] - points[lo]) <= shortest):
-                on[lo:hi] = value                 # near it over a tolerance or two: a shallow crossing
-    if not on.any():
+                if value is False and lo > 0 and hi < on.size:
+                    touches.append(_nearest_boundary(distance, t[lo - 1], t[hi]))
+    if not on.any() and not touches:
         return [], [cut]
     if on.all():
         return [cut], []
-    # the parameters where the kind changes, refined by bisection
-    change = [t0]
+    # the parameters where the kind changes, refined by bisection, and the touches
+    change = [t0, *touches]
     for k in np.flatnonzero(on[1:] != on[:-1]):
         lo, hi, first = t[k], t[k + 1], bool(on[k])
         while hi - lo > 1e-12 * max(abs(t1 - t0), 1.0):
             mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if bool(near(np.array([mid]))[0]) == first else (lo, mid)
+            lo, hi = (mid, hi) if bool(distance(np.array([mid]))[0] <= limit) == first else (lo, mid)
         change.append(0.5 * (lo + hi))
-    change.append(t1)
+    change = sorted(change) + [t1]
     along, across = [], []
-    for k, (a, b) in enumerate(itertools.pairwise(change)):
+    for a, b in itertools.pairwise(change):
+        if b - a <= 1e-12 * max(abs(t1 - t0), 1.0):
+            continue
         piece = Cut(cut.pcurve.restrict(a, b), None if cut.curve3d is None else cut.curve3d.restrict(a, b))
-        kind = bool(on[np.searchsorted(t, 0.5 * (a + b))])
+        kind = bool(on[min(np.searchsorted(t, 0.5 * (a + b)), on.size - 1)])
         (along if kind else across).append(piece)
     return along, across
+
+
+def _nearest_boundary(distance, lo: float, hi: float) -> float:
+    """The parameter in ``[lo, hi]`` where ``distance`` (to the boundary) is least:
+    golden-section search to 1e-13 of the bracket... of its width."""
+    ratio = 0.5 * (np.sqrt(5.0) - 1.0)
+    width = hi - lo
+    a, b = lo + (1 - ratio) * width, lo + ratio * width
+    fa, fb = distance(np.array([a, b]))
+    while hi - lo > 1e-13 * max(width, 1e-300):
+        if fa < fb:
+            hi, b, fb = b, a, fa
+            a = lo + (1 - ratio) * (hi - lo)
+            fa = float(distance(np.array([a]))[0])
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + ratio * (hi - lo)
+            fb = float(distance(np.array([b]))[0])
+    return 0.5 * (lo + hi)
+
+

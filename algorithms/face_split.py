@@ -178,7 +178,8 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
                 graph.vertex(point, cut_point_at(cuts[i], face, s), cut_point_at(cuts[j], face, t))
                 params[i].append(s)
                 params[j].append(t)
-    dangling, spurs = _dangling(face, loops, cuts, params, eps, tol3d)
+    joined = _t_junctions(face, cuts, params, graph, eps, tol3d)
+    dangling, spurs = _dangling(face, loops, cuts, params, eps, tol3d, joined)
     marks: list[_Mark] = []
     for c, cut in enumerate(cuts):
         line = cut.samples()
@@ -198,12 +199,7 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
             marks.append(mark)
             mark.vertex = graph.vertex(point, curve3d_points(e, face.surface, np.array([t]))[0],
                                        _cut_point(cut, face, end), boundary=True)
-    seen = {}
-    for m in marks:
-        key = (m.loop, round(m.along / max(eps, 1e-15)))
-        if key in seen:
-            raise InvalidGeometryError(f"cuts {seen[key]} and {m.cut} end at the same boundary point")
-        seen[key] = m.cut
+    marks = _one_mark_per_point(marks, graph, loops)
     # the cut segments between consecutive split parameters, both ways
     for c, cut in enumerate(cuts):
         if c in dangling or c in spurs:
@@ -229,8 +225,65 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
     return _with_internal(face, _regions(face, cycles), [cuts[c] for c in sorted(dangling | spurs)])
 
 
+def _one_mark_per_point(marks: list[_Mark], graph: _Graph, loops: list[TrimLoop]) -> list[_Mark]:
+    """The marks with those at one point of a loop (cuts meeting at the boundary: the
+    pieces of a curve touching it, curves of three faces meeting at a corner) merged
+    into the first: the others' cut ends are made its vertex, and the loop is split
+    there once."""
+    out: list[_Mark] = []
+    for m in sorted(marks, key=lambda m: (m.loop, m.along)):
+        same = next((k for k in out if k.loop == m.loop and
+                     (k.vertex == m.vertex or abs(k.along - m.along) <= 1e-9
+                      or abs(abs(k.along - m.along) - len(loops[m.loop].edges)) <= 1e-9)), None)
+        if same is None:
+            out.append(m)
+        else:
+            graph.join(m.vertex, same.vertex)
+    return out
+
+
+def _near_point(edge: TrimEdge, face: TrimmedFace, point: NDArray, tol3d: float | None):
+    """A test that a point found on ``edge`` lies within ``tol3d`` of ``point`` in space."""
+    if tol3d is None:
+        return lambda best: False
+    return lambda best: float(np.linalg.norm(
+        curve3d_points(edge, face.surface, np.array([best[2]]))[0] - point)) <= tol3d
+
+
+def _t_junctions(face: TrimmedFace, cuts: list[Cut], params: list[list[float]], graph: _Graph,
+                 eps: float, tol3d: float | None) -> set[tuple[int, int]]:
+    """Cuts that end on another cut's inside (a T: where a cylinder touches a box's face
+    along a line, the line ends on the circle where the box's next face cuts the
+    cylinder): the other cut is split there (``params``) and both meet at one vertex.
+    Returns the ``(cut, end)`` that end so."""
+    joined: set[tuple[int, int]] = set()
+    for j, cut in enumerate(cuts):
+        line = cut.samples()
+        if np.linalg.norm(line[0] - line[-1]) <= eps:
+            continue
+        for end, point in ((0, line[0]), (1, line[-1])):
+            for i, other in enumerate(cuts):
+                if i == j:
+                    continue
+                edge = TrimEdge(other.curve3d, other.pcurve, *other.range)
+                where = locate_on_loops([TrimLoop((edge,))], point, eps,
+                                        _near_point(edge, face, cut_point_at(cut, face, cut.range[end]), tol3d))
+                if where is None:
+                    continue
+                s = where[2]
+                at = other.pcurve.evaluate(np.array([s]))[0]
+                if min(np.linalg.norm(at - q) for q in other.pcurve.evaluate(np.array(other.range))) <= eps:
+                    continue                                  # at the other's end: an ordinary joint
+                params[i].append(s)
+                graph.join(graph.vertex(at, cut_point_at(other, face, s)), graph.vertex(point))
+                joined.add((j, end))
+                break
+    return joined
+
+
 def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params: list[list[float]],
-              eps: float, tol3d: float | None) -> tuple[set[int], set[int]]:
+              eps: float, tol3d: float | None, joined: set[tuple[int, int]] = frozenset()
+              ) -> tuple[set[int], set[int]]:
     """The cuts that divide nothing: open, crossing no other cut, with an end inside the
     face (on no loop, at no other cut's end) -- a curve that stops inside the face -- and,
     taken away, those they leave so in turn (a path of cuts joined end to end inside the
@@ -260,10 +313,10 @@ def _dangling(face: TrimmedFace, loops: list[TrimLoop], cuts: list[Cut], params:
             if c in removed:
                 continue
             free = False
-            for p, on in zip(ends[c], on_loop[c]):
-                # an end on no loop and at no end of a cut still there (crossing cuts
-                # count: they are split at their crossings, not pruned)
-                if not on and not any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends)
+            for end, (p, on) in enumerate(zip(ends[c], on_loop[c])):
+                # an end on no loop, on no other cut's inside and at no end of a cut still
+                # there (crossing cuts count: they are split at their crossings, not pruned)
+                if not on and (c, end) not in joined and not any(np.linalg.norm(p - q) <= eps for d, pair in enumerate(ends)
                                       if d != c and d not in removed for q in pair):
                     free = True
             if free:
@@ -373,10 +426,19 @@ class _Graph:
         self.space: list[list[NDArray]] = []     # the 3D points that meet there
         self.boundary: list[bool] = []
         self.half: list[dict] = []               # origin, target, edges, angle out, direction in
+        self.same: dict[int, int] = {}           # vertex -> the vertex it was joined to
+
+    def join(self, k: int, into: int) -> None:
+        """Vertex ``k`` is vertex ``into`` from now on (half-edges added later use it)."""
+        if k != into:
+            self.same[k] = into
+            self.space[into].extend(self.space[k])
+            self.boundary[into] = self.boundary[into] or self.boundary[k]
 
     def vertex(self, point: NDArray, *space: NDArray, boundary: bool = False) -> int:
         for k, q in enumerate(self.points):
             if np.linalg.norm(q - point) <= self.eps:
+                k = self.same.get(k, k)
                 self.space[k].extend(space)
                 self.boundary[k] = self.boundary[k] or boundary
                 return k

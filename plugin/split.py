@@ -604,18 +604,29 @@ def _selected(cut: SplitResult, operation: str) -> BooleanResult:
     model_a, model_b = cut.operands
     sew_tol = cut.sew_tol
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
+    _all_cut(cut, operation)
     shell_a, shell_b = cut.faces_of(0), cut.faces_of(1)
-    # one piece classified per region (pieces joined by edges the other operand does not
-    # use lie on one side of it: 002 §1), its state given to the region
+    # every piece classified, and the pieces of one region (joined by edges the other
+    # operand does not use: 002 §1) must agree -- else a curve where they cross the other
+    # solid is missing (a tangential contact the intersection did not find)
     structure = cut.structure
-    regions = structure.regions()
-    chosen = [region[0] for region in regions]
-    found = piece_states([structure.faces[k] for k in chosen],
-                         [shell_b if structure.origins[k][0] == "a" else shell_a for k in chosen], tol=sew_tol)
-    states = [""] * len(structure.faces)
-    for region, state in zip(regions, found):
-        for k in region:
-            states[k] = state
+    states = piece_states(structure.faces,
+                          [shell_b if o[0] == "a" else shell_a for o in structure.origins], tol=sew_tol)
+    for region in structure.regions():
+        # a piece whose inner point lies on the other solid's boundary but which shares
+        # its region with pieces inside or outside it only touches it there (a ball
+        # resting on a box's face, at the point in the middle): it is where they are
+        found = sorted({states[k] for k in region} - {"shared", "opposite"})
+        if len(found) == 1:
+            for k in region:
+                states[k] = found[0]
+        elif len(found) > 1:
+            names = cut.names()
+            raise OpenCascadeError(
+                f"{operation}: the pieces of one region of {structure.origins[region[0]][0]} lie "
+                f"{' and '.join(found)} the other solid ({', '.join(str(names[k] or k) for k in region[:4])}"
+                f"{'...' if len(region) > 4 else ''}): a curve where it crosses or touches the other "
+                "solid is missing; no result rather than a wrong one")
     n_a = len(cut.pieces_a)
     keep_a, keep_b = OPERATIONS[operation]
     chosen_a = [k for k, s in enumerate(states[:n_a]) if s in keep_a]
@@ -629,6 +640,18 @@ def _selected(cut: SplitResult, operation: str) -> BooleanResult:
         shape = solids[0] if len(solids) == 1 else compound(solids)
     return BooleanResult(shape, operation, cut, (len(chosen_a), len(chosen_b)), bool(solids),
                          is_valid(shape), named)
+
+
+def _all_cut(cut: SplitResult, operation: str) -> None:
+    """Refuse a selection when a face could not be cut: its pieces' sides are then not
+    what the selection would keep (a face kept whole is inside and outside at once)."""
+    refused = [f for f in cut.faces if f.kept is not None]
+    if refused:
+        f = refused[0]
+        raise OpenCascadeError(f"{operation}: face {f.operand}{f.index} could not be cut along its "
+                               f"{f.cuts} curve(s) ({f.kept})" + (f" nor {len(refused) - 1} other face(s)"
+                                                                  if len(refused) > 1 else "")
+                               + "; no result rather than a wrong one")
 
 
 def _assembled(cut: SplitResult, chosen: list[int], turned: list[int]) -> tuple[Any, tuple]:
@@ -693,6 +716,7 @@ def _trimmed(cut: SplitResult, keep: str) -> BooleanResult:
     from ..errors import InvalidGeometryError
     if keep not in ("front", "back"):
         raise InvalidGeometryError(f"keep must be 'front' or 'back', got {keep!r}")
+    _all_cut(cut, f"trim-{keep}")
     sew_tol = cut.sew_tol
     faces_a = cut.structure.faces[:len(cut.pieces_a)]
     points = np.array([interior_point(face)[1] for face in faces_a]).reshape(-1, 3)

@@ -125,10 +125,39 @@ def test_a_triangle_of_three_crossing_cuts_and_a_circle_across_one():
     np.testing.assert_allclose(sum(circle), np.pi * 0.04, rtol=1e-5)
 
 
-def test_cuts_that_cannot_be_used_are_refused():
-    face = TrimmedFace(_plane())
-    with pytest.raises(InvalidGeometryError, match="same boundary point"):
-        split_face(face, [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
+def test_cuts_meeting_at_one_boundary_point_share_its_vertex():
+    """Two curves from one point of the boundary (a V; the pieces of a curve touching the
+    boundary, curves of three faces meeting at a corner): the loop is split there once
+    and both cuts start at that vertex -- three regions."""
+    parts = split_face(TrimmedFace(_plane()), [_line((0.5, 0.0), (0.2, 1.0)), _line((0.5, 0.0), (0.8, 1.0))])
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.3, 0.35, 0.35], atol=1e-12)
+    for p in parts:
+        _closed(p)
+
+
+def test_a_closed_cut_touching_the_boundary_is_cut_where_it_touches():
+    """A circle inscribed in the square (a cylinder's section in a box's face it touches):
+    it touches each side at its middle, so the face is the disc and four corners."""
+    circle = _circle((0.5, 0.5), 0.5)
+    curve3d = NurbsCurve(np.column_stack([circle.pcurve.control_points, np.zeros(9)]), circle.pcurve.knots, 2,
+                         circle.pcurve.weights)
+    parts = split_face(TrimmedFace(_plane()), [Cut(circle.pcurve, curve3d)], tol3d=1e-9)
+    assert len(parts) == 5
+    areas = sorted(_area(p) for p in parts)
+    np.testing.assert_allclose(areas[-1], np.pi / 4, rtol=1e-6)
+    np.testing.assert_allclose(areas[:4], [(1 - np.pi / 4) / 4] * 4, rtol=1e-5)
+    assert all(len(p.loops) == 1 for p in parts)       # no island touching its hole
+
+
+def test_a_cut_ending_on_another_cut_splits_it_there():
+    """A T: one cut from the boundary ends on the inside of another running across the
+    face: the other is split there and the face comes out in three."""
+    across = _line((0.0, 0.5), (1.0, 0.5))
+    stem = _line((0.4, 0.5), (0.4, 1.0))
+    parts = split_face(TrimmedFace(_plane()), [across, stem])
+    np.testing.assert_allclose(sorted(_area(p) for p in parts), [0.2, 0.3, 0.5], atol=1e-12)
+    for p in parts:
+        _closed(p)
 
 
 def test_cuts_joined_end_to_end_inside_the_face_make_one_closed_chain():
@@ -242,3 +271,13 @@ def test_a_cut_leaving_a_pole_along_the_pole_edge_still_divides_the_face():
     for p in parts:
         cut_uses = [e for e in p.loops[0].edges if e.pcurve is pcurve]
         assert len(cut_uses) == 1                      # the cut bounds each region once
+
+
+def test_a_cut_crossing_another_and_stopping_inside_is_refused():
+    """A cut that crosses another and then stops inside the face: the stub past the
+    crossing bounds nothing, and it is not pruned (only cuts crossing none are): refused
+    with the point named, not a wrong region."""
+    across = _line((0.5, 0.0), (0.5, 1.0))
+    stub = _line((0.2, 0.5), (1.0, 0.5))
+    with pytest.raises(InvalidGeometryError, match=r"a cut ends at \[0.2, 0.5\], neither on the face's boundary"):
+        split_face(TrimmedFace(_plane()), [across, stub])

@@ -353,6 +353,35 @@ def test_a_real_solid_cut_at_mid_height(data_dir):
         assert sum(face_area(p, 1e-9) for p in f.pieces) == pytest.approx(whole, rel=1e-5)
 
 
+def test_a_ball_resting_on_a_box_touches_it_at_one_point():
+    """The ball touches the box's top in its middle -- the point a piece is classified by:
+    that face's point is on the ball, its region's other pieces outside it, so it is
+    outside too. Fuse = both volumes, common = 0."""
+    from surfprep.plugin.split import boolean
+    box, ball = cq.Workplane().box(10, 10, 10), cq.Workplane().sphere(5).translate((0, 0, 10))
+    fused = boolean(box, ball, "fuse")
+    assert fused.valid and fused.volume == pytest.approx(1000 + 4 / 3 * math.pi * 125, rel=1e-6)
+    assert boolean(box, ball, "common").volume == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_boolean_whose_curves_miss_a_tangential_contact_refuses_rather_than_answers():
+    """A cylinder r = 5 through a 10 mm cube touches four of its faces along lines; the
+    intersection finds two of them (the two at the cylinder's seam and opposite it, not
+    the two between: tangential contact is the intersection's hardest case). The
+    circles inscribed in the end faces are cut where they touch the sides and the lines
+    split the circles where they end on them, but the box's region then holds pieces
+    inside and outside the cylinder: the Boolean says so instead of giving a volume
+    (it gave 0 and 1000 for fuse and common)."""
+    from surfprep.errors import OpenCascadeError
+    from surfprep.plugin.split import boolean
+    cylinder = cq.Workplane("YZ").circle(5).extrude(20).translate((-10, 0, 0))
+    out = split(cq.Workplane().box(10, 10, 10), cylinder)
+    assert all(f.kept is None for f in out.faces)
+    assert [len(f.pieces) for f in out.faces if f.operand == "a" and f.cuts == 1][:2] == [5, 5]
+    with pytest.raises(OpenCascadeError, match="curve where it crosses or touches the other solid is missing"):
+        boolean(cq.Workplane().box(10, 10, 10), cylinder, "common")
+
+
 def test_booleans_of_n_solids_pairwise():
     """Three boxes fused (each step's result fused with the next; the third touches the
     first over part of a face and overlaps the second): 2200 exactly. A cube minus two
