@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from . import basis_kernels
+from .jit import compiled as worth_compiling
 
 __all__ = [
     "basis_derivatives",
@@ -29,8 +30,8 @@ __all__ = [
     "distinct_knots",
     "find_span",
     "frozen_array",
-    "owned_array",
     "greville_abscissae",
+    "owned_array",
     "span_range",
     "validate_knots",
 ]
@@ -194,7 +195,7 @@ def basis_derivatives(knots: NDArray, degree: int, t: ArrayLike, order: int,
     t = np.asarray(t, dtype=float).reshape(-1)
     if span is None:
         span = find_span(knots, p, t)
-    if compiled and basis_kernels.AVAILABLE:                  # same recurrences, compiled
+    if compiled and worth_compiling(t.size * (p + 1) * (int(order) + 1)):   # same recurrences, compiled
         return basis_kernels.basis_derivatives_compiled(knots, p, t, span,
                                                         max(int(order), 0)), span
     return _basis_derivatives_numpy(knots, p, t, order, span), span

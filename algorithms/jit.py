@@ -19,15 +19,30 @@ a :class:`LazyKernel` as the dispatcher it stands for.
 from __future__ import annotations
 
 import importlib.util
+import sys
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-__all__ = ["AVAILABLE", "LazyKernel", "jit"]
+__all__ = ["AVAILABLE", "COMPILE_FROM", "LazyKernel", "compiled", "jit"]
 
 #: True when numba is installed and :func:`jit` compiles (found without importing it)
 AVAILABLE = importlib.util.find_spec("numba") is not None
 
 F = TypeVar("F", bound=Callable)
+
+#: the size of a call (the elements its numpy form handles: points, control points,
+#: boxes) from which a compiled kernel is used before numba is loaded: below it the
+#: numpy form is quicker than importing numba and loading the kernel (~0.4 s once)
+COMPILE_FROM = 200_000
+
+
+def compiled(work: int) -> bool:
+    """Whether a call of size ``work`` takes the compiled kernel or its numpy form: the
+    kernel when numba is available and either already loaded in this process (its
+    price paid) or the call is large (``work >= COMPILE_FROM``). A one-shot command on
+    a small model then never imports numba; once one large call has loaded it, every
+    call is compiled."""
+    return AVAILABLE and (work >= COMPILE_FROM or "numba" in sys.modules)
 
 
 class LazyKernel:

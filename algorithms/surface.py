@@ -23,7 +23,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidGeometryError
 from . import basis_kernels
-from .basis import basis_derivatives, check_offset, check_weights, find_span, frozen_array, owned_array, validate_knots
+from .basis import (
+    basis_derivatives,
+    check_offset,
+    check_weights,
+    find_span,
+    frozen_array,
+    owned_array,
+    validate_knots,
+)
+from .jit import compiled
 from .rational import surface_derivatives_from_homogeneous
 
 __all__ = ["NurbsSurface"]
@@ -168,7 +177,7 @@ class NurbsSurface:
         su = find_span(self.knots_u, p, u)
         sv = find_span(self.knots_v, q, v)
         net = self.homogeneous_net
-        if basis_kernels.AVAILABLE:           # the same sums, compiled (no per-call overhead)
+        if compiled(u.size * (p + 1) * (q + 1) * (order + 1)):   # the same sums, compiled
             out = basis_kernels.surface_derivatives_compiled(
                 self.knots_u, self.knots_v, p, q, net, u, v, su, sv, order,
                 self.weights is not None)

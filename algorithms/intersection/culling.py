@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
+from ..jit import compiled
 from ..surface import NurbsSurface
 from . import tessellation_kernels, vectors
 
@@ -215,7 +216,7 @@ def candidate_pairs(boxes_a: ArrayLike, boxes_b: ArrayLike, *, pad: float = 0.0)
         raise InvalidGeometryError(f"pad must be finite and >= 0, got {pad!r}")
     a = _check_boxes(boxes_a, "boxes_a")
     b = _check_boxes(boxes_b, "boxes_b")
-    if tessellation_kernels.AVAILABLE:          # the same pairs: a tree on b, a search per box
+    if compiled(8 * (a.shape[0] + b.shape[0])):  # the same pairs: a tree on b, a search per box
         return tessellation_kernels.query_pairs(build_tree(b), a, float(pad))
     return tree_pairs(build_tree(a), build_tree(b), pad=float(pad))
 
@@ -330,7 +331,7 @@ def span_patches(surface: NurbsSurface, span_u: ArrayLike, span_v: ArrayLike) ->
     net = pw[rows[:, :, None], cols[:, None, :]]                      # (k, p+1, q+1, d+1)
     ku = surface.knots_u[iu[:, None] - p + np.arange(2 * p + 2)]
     kv = surface.knots_v[iv[:, None] - q + np.arange(2 * q + 2)]
-    if tessellation_kernels.AVAILABLE:          # the same de Boor triangles, compiled
+    if compiled(net.size):                      # the same de Boor triangles, compiled
         net = tessellation_kernels.blossom_spans(np.ascontiguousarray(net, dtype=float),
                                                  np.ascontiguousarray(ku, dtype=float), p)
         net = tessellation_kernels.blossom_spans(np.ascontiguousarray(np.swapaxes(net, 1, 2)),
@@ -363,7 +364,7 @@ class RegionPatches:
         a, b, c, d = self.bounds[region].T
         s0, s1 = (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a)
         t0, t1 = (rects[:, 2] - c) / (d - c), (rects[:, 3] - c) / (d - c)
-        if tessellation_kernels.AVAILABLE and self.coeffs.shape[-1] == 4:
+        if compiled(rects.shape[0] * self.coeffs[0].size) and self.coeffs.shape[-1] == 4:
             return tessellation_kernels.restricted_boxes(self.coeffs, region, s0, s1, t0, t1)
         coeffs = _blossom_restrict(self.coeffs[region], s0, s1)
         coeffs = _blossom_restrict(np.swapaxes(coeffs, 1, 2), t0, t1)
@@ -431,7 +432,7 @@ def subpatch_boxes(surface: NurbsSurface, rects: ArrayLike) -> NDArray:
     key, inverse = np.unique(iu * (surface.knots_v.size + 1) + iv, return_inverse=True)
     pairs_u, pairs_v = np.divmod(key, surface.knots_v.size + 1)
     coeffs = span_patches(surface, pairs_u, pairs_v)
-    if tessellation_kernels.AVAILABLE and coeffs.shape[-1] == 4:   # the blossoms below, compiled
+    if compiled(rects.shape[0] * coeffs[0].size) and coeffs.shape[-1] == 4:   # the blossoms below, compiled
         return tessellation_kernels.restricted_boxes(
             coeffs, inverse.ravel(), (rects[:, 0] - a) / (b - a), (rects[:, 1] - a) / (b - a),
             (rects[:, 2] - c) / (d - c), (rects[:, 3] - c) / (d - c))

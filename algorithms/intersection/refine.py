@@ -53,6 +53,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
+from ..jit import compiled
 from ..measure import normals
 from ..surface import NurbsSurface
 from ..tolerance import check_tolerance
@@ -275,7 +276,7 @@ def refine_points(surface_a: NurbsSurface, surface_b: NurbsSurface, uv_a: ArrayL
     anchor = None if anchors is None else np.asarray(anchors, dtype=float)
     if anchor is not None and anchor.shape != (n, 3):
         raise InvalidGeometryError(f"anchors must have shape ({n}, 3), got {anchor.shape}")
-    if refine_kernels.AVAILABLE:
+    if compiled(n * 64):                        # Newton steps with two surfaces' derivatives each
         start_a, start_b = ua.copy(), ub.copy()
         img_a, img_b, nrm_a, nrm_b, iterations, singular, fallback = \
             refine_kernels.refine_compiled(surface_a, surface_b, ua, ub, anchor, tol, max_iter,

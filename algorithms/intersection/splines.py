@@ -30,7 +30,7 @@ from ..basis import basis_derivatives, find_span
 from ..basis_kernels import ders_one
 from ..curve import NurbsCurve
 from ..fitting import averaged_knots, knots_from_breakpoints, seam_tangent, solve_banded_rows
-from ..jit import AVAILABLE, jit
+from ..jit import compiled, jit
 from .interpolants import interpolate_samples
 
 __all__ = ["SplineSet", "interpolate_many"]
@@ -87,7 +87,7 @@ class SplineSet:
         """Derivatives ``(m, order + 1, d)`` of curves ``index (m,)`` at ``t (m,)``."""
         index = np.asarray(index, dtype=np.int64).reshape(-1)
         t = np.asarray(t, dtype=float).reshape(-1)
-        if AVAILABLE:
+        if compiled(t.size * 16):
             return _evaluate_many(self.knots, self.knot_start, self.control, self.control_start,
                                   self.degree, index, t, int(order))
         out = np.zeros((t.size, order + 1, self.control.shape[1]))

@@ -57,6 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError, InvalidToleranceError
 from ..basis import find_span
+from ..jit import compiled
 from ..surface import NurbsSurface
 from . import tessellation_kernels
 from .culling import (
@@ -149,7 +150,8 @@ def _chord_errors(surface: NurbsSurface, rects: NDArray
     s = np.linspace(0.0, 1.0, _SAMPLES)
     u = (1 - s) * rects[:, :1] + s * rects[:, 1:2]                  # (k, n)
     v = (1 - s) * rects[:, 2:3] + s * rects[:, 3:4]
-    if tessellation_kernels.AVAILABLE:          # basis functions once per grid line
+    fast = compiled(u.size * _SAMPLES * (surface.degree_u + 1) * (surface.degree_v + 1))
+    if fast:                                    # basis functions once per grid line
         su = find_span(surface.knots_u, surface.degree_u, u.ravel()).reshape(u.shape)
         sv = find_span(surface.knots_v, surface.degree_v, v.ravel()).reshape(v.shape)
         grid = tessellation_kernels.grid_points(
@@ -157,7 +159,7 @@ def _chord_errors(surface: NurbsSurface, rects: NDArray
             surface.homogeneous_net, u, v, su, sv, surface.weights is not None)
     else:
         grid = surface.evaluate(u[:, :, None], v[:, None, :])      # (k, n, n, 3)
-    if tessellation_kernels.AVAILABLE:          # the formulas below, compiled
+    if fast:                                    # the formulas below, compiled
         return tessellation_kernels.chord_errors_from_grid(grid, s)
     corners = grid[:, [0, -1, -1, 0], [0, 0, -1, -1]]               # (k, 4, 3)
     w0, w1 = _interpolation_weights(s)
@@ -218,7 +220,7 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         return np.ones(rects.shape[0], bool)
     boxes = subpatch_boxes(surface, rects) if patches is None else patches.boxes(rects, region)
     if isinstance(keep, BoxTree):
-        if tessellation_kernels.AVAILABLE:
+        if compiled(8 * boxes.shape[0]):
             return tessellation_kernels.any_overlap(keep, boxes, pad)
         pairs = tree_pairs(build_tree(boxes), keep, pad=pad)
         mask = np.zeros(rects.shape[0], bool)
@@ -231,7 +233,7 @@ def _near(surface: NurbsSurface, rects: NDArray, region: NDArray,
         if keep.tree is None:
             object.__setattr__(keep, "tree", build_tree(keep.boxes))
         return _near(surface, rects, region, keep.tree, pad, patches)
-    if tessellation_kernels.AVAILABLE:          # each rectangle against its region's boxes
+    if compiled(int(counts.sum())):              # each rectangle against its region's boxes
         return tessellation_kernels.any_overlap_in_range(boxes, lo, hi, keep.boxes, pad)
     rect = np.repeat(np.arange(rects.shape[0]), counts)
     other = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(rect.size)

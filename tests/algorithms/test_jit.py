@@ -1,8 +1,9 @@
 """Kernels compiled on first call (:mod:`surfprep.algorithms.jit`).
 
 numba is imported when a kernel is first called, not when the geometry package
-is imported; a kernel calling another inside compiled code sees it typed as the
-dispatcher it stands for.
+is imported, and a small call takes the numpy form rather than pay numba's loading
+(``jit.compiled``); a kernel calling another inside compiled code sees it typed as
+the dispatcher it stands for.
 """
 
 from __future__ import annotations
@@ -28,18 +29,36 @@ s = alg.NurbsSurface(control_points=np.random.default_rng(1).random((5, 6, 3)),
 s.derivatives_grid(np.linspace(0, 1, 30), np.linspace(0, 1, 20), 2)
 parametrization_quality(s)
 before = [m for m in ("numba", "scipy") if m in sys.modules]
-s.derivatives([0.2, 0.7], [0.1, 0.9], 1)           # scattered points: the compiled kernel
+small = s.derivatives([0.2, 0.7], [0.1, 0.9], 1)   # a few scattered points: numpy, no numba
+middle = [m for m in ("numba", "scipy") if m in sys.modules]
+rng = np.random.default_rng(2)
+u, v = rng.random(20000), rng.random(20000)
+large = s.derivatives(u, v, 1)                      # many: the compiled kernel, numba loaded
 after = [m for m in ("numba", "scipy") if m in sys.modules]
-print(json.dumps({"before": before, "after": after}))
+again = s.derivatives([0.2, 0.7], [0.1, 0.9], 1)    # small again: compiled, its price paid
+print(json.dumps({"before": before, "middle": middle, "after": after,
+                  "same": float(np.max(np.abs(small - again)))}))
 """
 
 
-def test_numba_is_imported_by_the_first_kernel_call_not_before():
+def test_numba_is_imported_by_the_first_large_kernel_call_not_before():
     done = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True,
                           timeout=300, check=True)
     found = json.loads(done.stdout.strip().splitlines()[-1])
     assert found["before"] == []                   # grids and the figure: numpy alone
+    assert found["middle"] == []                   # a small scattered call: numpy too
     assert "numba" in found["after"]
+    assert found["same"] < 1e-12                   # the two forms agree
+
+
+def test_a_call_takes_the_compiled_form_when_large_or_when_numba_is_loaded(monkeypatch):
+    monkeypatch.setattr(jit, "AVAILABLE", True)
+    monkeypatch.delitem(sys.modules, "numba", raising=False)
+    assert not jit.compiled(jit.COMPILE_FROM - 1) and jit.compiled(jit.COMPILE_FROM)
+    monkeypatch.setitem(sys.modules, "numba", object())
+    assert jit.compiled(1)
+    monkeypatch.setattr(jit, "AVAILABLE", False)
+    assert not jit.compiled(10 * jit.COMPILE_FROM)
 
 
 def test_a_lazy_kernel_wraps_its_function_and_compiles_on_demand():
