@@ -92,6 +92,7 @@ class GridResult:
         return {"blocks": net["blocks"], "interfaces": net["interfaces"], "worst": worst,
                 "snap": net["snap"], "kink_deg": net["kink_deg"],
                 "interface_rounds": net["interface_rounds"],
+                "dims_changed": [{**d, "face": self.faces[d["block"]]} for d in net["dims_changed"]],
                 "skipped": [{"face": k, "reason": r} for k, r in self.skipped],
                 "time_s": self.time_s}
 

@@ -79,6 +79,10 @@ class NetworkGrid:
     failed : tuple of (int, str)
         Surfaces that could not be gridded (a degenerate surface...), with the reason;
         the others are gridded without them.
+    dims_changed : tuple of (int, str, int)
+        With ``dims`` (NI != NJ): ``(block, "i" | "j", count)`` for each direction that
+        got the other count, because a shared edge links it to a direction of the
+        other kind.
     """
 
     blocks: tuple[SurfaceGrid, ...]
@@ -90,6 +94,7 @@ class NetworkGrid:
     indices: tuple[int, ...] = ()
     failed: tuple[tuple[int, str], ...] = ()
     time_s: float = field(default=0.0, compare=False)
+    dims_changed: tuple[tuple[int, str, int], ...] = ()
 
     def report(self) -> dict:
         return {"blocks": [b.report() for b in self.blocks],
@@ -98,6 +103,7 @@ class NetworkGrid:
                                 "kink_deg": k, "crease_deg": c}
                                for f, (k, c) in zip(self.interfaces, self.interface_angles, strict=True)],
                 "snap": self.snap, "kink_deg": self.kink, "interface_rounds": self.interface_rounds,
+                "dims_changed": [{"block": b, "direction": d, "nodes": n} for b, d, n in self.dims_changed],
                 "time_s": self.time_s}
 
 
@@ -180,18 +186,16 @@ def _counts(surfaces, interfaces, dims, size, skip: set[int] = frozenset()) -> d
     for f in interfaces:
         classes.union((f.block, _direction(f.side)), (f.other, _direction(f.other_side)))
     if dims is not None:
+        # a set of linked directions holding i's and j's (a face split into blocks round
+        # a centre, faces of a box) takes the larger count: no side gets fewer nodes than
+        # asked (NetworkGrid.dims_changed names the directions that got more)
         ni, nj = dims
-        counts = {}
+        counts: dict = {}
         for key in classes.parent:
             if key[0] in skip:
                 continue
             root = classes.find(key)
-            want = ni if key[1] == 0 else nj
-            if counts.setdefault(root, want) != want:
-                raise InvalidGeometryError(
-                    f"dims {tuple(dims)} cannot match the network: block {key[0]}'s "
-                    f"{'i' if key[1] == 0 else 'j'} direction meets another block's "
-                    "other direction along a shared edge (give size instead)")
+            counts[root] = max(counts.get(root, 0), ni if key[1] == 0 else nj)
         return {key: counts[classes.find(key)] for key in classes.parent if key[0] not in skip}
     longest: dict = {}
     for b, region in enumerate(surfaces):
@@ -239,7 +243,9 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     gap : float
         Largest distance between two sides called one edge (model units).
     dims : (int, int), optional
-        Nodes along i and j of every block; must be consistent across shared edges.
+        Nodes along i and j of every block. Where shared edges link an i direction to a
+        j direction (a face split into blocks round a centre, the faces of a box), the
+        linked directions all take the larger of the two (``dims_changed`` lists them).
     size : float, optional
         Target cell size; default the median over the blocks of their longest side
         over :data:`~.structured.DEFAULT_CELLS`.
@@ -318,7 +324,9 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
         blocks, rounds = _slide_interfaces(surfaces, blocks, interfaces, tol=tol,
                                            max_sweeps=max_sweeps, budget=budget)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
-    return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())))
+    changed = () if dims is None else tuple(
+        (index[b], "ij"[d], counts[b, d]) for (b, d) in sorted(counts) if b in index and counts[b, d] != dims[d])
+    return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())), dims_changed=changed)
 
 
 def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...]:

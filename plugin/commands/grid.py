@@ -38,7 +38,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Plot3D as Fortran unformatted (default formatted text)")
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--dims", type=int, nargs=2, metavar=("NI", "NJ"),
-                      help="exactly NI x NJ nodes per face (i along the face's u)")
+                      help="NI x NJ nodes per face (i along the face's u); where shared edges link "
+                           "an i direction to a j direction (faces split into blocks) those take the "
+                           "larger, and a note says so")
     size.add_argument("--size", type=float, metavar="H",
                       help="target cell size in mm (default: the median face's longest side / 40)")
     parser.add_argument("--first-spacing", type=float, metavar="D", dest="first",
@@ -147,6 +149,10 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     for face, reason in result.skipped:
         console.print(f"face {face}: not gridded: {reason}")
     net = result.network
+    if net.dims_changed:
+        console.note(f"{len(net.dims_changed)} block direction(s) got {max(n for *_, n in net.dims_changed)} "
+                     "nodes, not the --dims asked: shared edges link them to directions of the other kind "
+                     "(faces split into blocks, faces meeting i to j)")
     console.print(f"{len(net.blocks)} block(s), {len(net.interfaces)} shared edge(s) point-matched "
                   f"(largest snap {net.snap:.2g} mm, kink {net.kink:.1f} deg) in {elapsed:.2f} s, "
                   f"written to {written}")

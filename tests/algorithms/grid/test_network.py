@@ -86,12 +86,23 @@ def test_node_counts_follow_the_shared_edges():
     assert dims[0][1] == dims[2][1] and dims[1][1] == dims[3][1]        # j counts across the u cut
 
 
-def test_dims_that_cannot_match_are_refused():
+def test_dims_linking_i_to_j_take_the_larger_count_and_say_so():
+    """Quarter 1 turned (its i along the other's j): the shared edge links block 0's i
+    (asked 9) to block 1's j (asked 5): both get 9 (block 1 is 9 x 9), the edge is
+    still point-matched, and the direction that got more is named."""
     quarters = _quarters()
     turned = NurbsSurface(np.transpose(quarters[1].control_points, (1, 0, 2)), quarters[1].knots_v,
                           quarters[1].knots_u, quarters[1].degree_v, quarters[1].degree_u)
-    with pytest.raises(InvalidGeometryError, match="cannot match"):
-        grid_network([quarters[0], turned], gap=1e-9, dims=(9, 5))
+    net = grid_network([quarters[0], turned], gap=1e-9, dims=(9, 5))
+    assert [b.dims for b in net.blocks] == [(9, 5), (9, 9)]
+    assert net.dims_changed == ((1, "j", 9),)
+    assert net.report()["dims_changed"] == [{"block": 1, "direction": "j", "nodes": 9}]
+    (f,) = net.interfaces
+    a = side_nodes(net.blocks[f.block].points, f.side)
+    b = side_nodes(net.blocks[f.other].points, f.other_side)
+    assert np.array_equal(a[::-1] if f.reversed else a, b)
+    same = grid_network(_quarters(), gap=1e-9, dims=(9, 5))      # consistent: as asked
+    assert all(b.dims == (9, 5) for b in same.blocks) and same.dims_changed == ()
     with pytest.raises(InvalidGeometryError, match="not both"):
         grid_network(quarters, gap=1e-9, dims=(5, 5), size=0.1)
 

@@ -98,3 +98,17 @@ def test_a_held_curve_on_no_face_is_refused(tmp_path, capsys):
     surfprep.write(stray, curves)
     code, _, err = run(capsys, "grid", FUSELAGE, "-o", tmp_path / "f.xyz", "--hold", curves)
     assert code == 2 and "held curve 0 runs across no gridded face" in err
+
+
+def test_dims_on_faces_split_into_blocks_take_the_larger_count_with_a_note(tmp_path, capsys):
+    """The Mars capsule's n-sided faces are split into blocks round a centre, whose i and
+    j directions meet along the spokes: --dims 11 21 used to be refused; now those
+    directions get 21 and the report and a note say which."""
+    out, report = tmp_path / "g.xyz", tmp_path / "g.json"
+    code, _, err = run(capsys, "grid", SAMPLES / "overture_marscapsule_proe.igs", "-o", out,
+                       "--dims", "11", "21", "--json", report)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["dims_changed"] and all(d["nodes"] == 21 and d["direction"] == "i" for d in data["dims_changed"])
+    assert all(b["dims"][0] in (11, 21) and b["dims"][1] == 21 for b in data["blocks"])
+    assert "not the --dims asked" in err
