@@ -105,9 +105,10 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     and four between it and the loop (its O-grid remapped to an H-grid). A face with
     one hole: blocks round it, one per corner of its outer loop
     (:func:`..healing.decompose.decompose_ring`, spokes from the corners, or four cut
-    points when it has at most two, to the hole). Faces with more
-    holes and loops the split refuses (a spoke leaving a very non-convex outline, a
-    cusp) get the reason.
+    points when it has at most two, to the hole). A face with more holes is cut by
+    straight lines in ``(u, v)`` between them into parts of one hole each
+    (:func:`.holes.separate_holes`), each part gridded so. Loops the split refuses (a
+    spoke leaving a very non-convex outline, a cusp) get the reason.
 
     Parameters
     ----------
@@ -119,7 +120,7 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     -------
     list of Region, or str
     """
-    from ...errors import DegenerateGeometryError
+    from ...errors import DegenerateGeometryError, InvalidGeometryError
     from ..healing.decompose import (
         NotDecomposableError,
         decompose_face,
@@ -130,6 +131,19 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     region = face_region(face)
     if not isinstance(region, str):
         return [region]
+    if len(face.loops) > 2:
+        from .holes import separate_holes
+        try:
+            parts = separate_holes(face)
+        except (NotDecomposableError, DegenerateGeometryError, InvalidGeometryError) as exc:
+            return f"it has {len(face.loops) - 1} holes: not cut into parts of one hole ({exc})"
+        out = []
+        for part in parts:
+            found = face_regions(part, gap_tol=gap_tol)
+            if isinstance(found, str):
+                return f"it has {len(face.loops) - 1} holes: a part of it is not gridded ({found})"
+            out.extend(found)
+        return out
     if len(face.loops) == 2:
         try:
             ring = decompose_ring(face.surface, *ring_edges(face, gap_tol=gap_tol))
