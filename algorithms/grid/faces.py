@@ -93,7 +93,7 @@ def face_region(face: TrimmedFace) -> Region | str:
     return reason
 
 
-def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
+def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[Region] | str:
     """The four-sided regions blocks cover on a face, or why there are none.
 
     A face :func:`face_region` grids is one region. A face bounded by one loop of
@@ -107,8 +107,10 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     (:func:`..healing.decompose.decompose_ring`, spokes from the corners, or four cut
     points when it has at most two, to the hole). A face with more holes is cut by
     straight lines in ``(u, v)`` between them into parts of one hole each
-    (:func:`.holes.separate_holes`), each part gridded so. Loops the split refuses (a
-    spoke leaving a very non-convex outline, a cusp) get the reason.
+    (:func:`.parts.separate_holes`), each part gridded so. A loop the split refuses (a
+    spoke leaving a very non-convex outline) is cut from its most reflex corner
+    (:func:`.parts.split_at_reflex`) and its parts gridded so, up to
+    :data:`MAX_REFLEX_CUTS` cuts deep; what is still refused (a cusp) gets the reason.
 
     Parameters
     ----------
@@ -132,14 +134,14 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     if not isinstance(region, str):
         return [region]
     if len(face.loops) > 2:
-        from .holes import separate_holes
+        from .parts import separate_holes
         try:
             parts = separate_holes(face)
         except (NotDecomposableError, DegenerateGeometryError, InvalidGeometryError) as exc:
             return f"it has {len(face.loops) - 1} holes: not cut into parts of one hole ({exc})"
         out = []
         for part in parts:
-            found = face_regions(part, gap_tol=gap_tol)
+            found = face_regions(part, gap_tol=gap_tol, _depth=_depth)
             if isinstance(found, str):
                 return f"it has {len(face.loops) - 1} holes: a part of it is not gridded ({found})"
             out.extend(found)
@@ -156,8 +158,47 @@ def face_regions(face: TrimmedFace, *, gap_tol: float) -> list[Region] | str:
     try:
         split = decompose_face(face, gap_tol=gap_tol, layout="butterfly")
     except (NotDecomposableError, DegenerateGeometryError) as exc:
-        return f"not split into four-sided blocks: {exc}"
+        return _reflex_parts(face, gap_tol, f"not split into four-sided blocks: {exc}", _depth)
     if split is None:
         return region
     return [Region.from_runs(face.surface, [(pc, *pc.domain) for pc in quad],
                              clockwise=bool(face.reversed)) for quad in split.quads_pcurves]
+
+
+#: how many times over a face is cut at reflex corners before it is refused
+MAX_REFLEX_CUTS = 8
+
+
+def _reflex_parts(face: TrimmedFace, gap_tol: float, reason: str, depth: int) -> list[Region] | str:
+    """The regions of ``face`` cut at its most reflex corner (:func:`.parts.split_at_reflex`),
+    or ``reason`` when it has none or a part is still refused ``MAX_REFLEX_CUTS`` deep."""
+    from ...errors import SurfprepError
+    from .parts import split_at_reflex
+    if depth >= MAX_REFLEX_CUTS:
+        return reason
+    try:
+        parts = split_at_reflex(face)
+    except SurfprepError:
+        parts = None
+    if not parts:
+        return reason
+    out = []
+    for part in parts:
+        found = face_regions(part, gap_tol=gap_tol, _depth=depth + 1)
+        if isinstance(found, str):
+            return reason
+        out.extend(found)
+    if depth == 0 and not all(_unfolded(region) for region in out):
+        return reason + " (cut at its reflex corners, a block's start grid folds)"
+    return out
+
+
+def _unfolded(region: Region) -> bool:
+    """A coarse start grid (9 x 9, no smoothing) of ``region`` has no folded cell: the
+    blocks a reflex cut makes are kept only when they grid."""
+    from ...errors import SurfprepError
+    from .structured import grid_region
+    try:
+        return grid_region(region, dims=(9, 9), smooth="none").quality.folded_cells == 0
+    except SurfprepError:
+        return False

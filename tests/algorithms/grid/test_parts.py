@@ -1,4 +1,4 @@
-"""Faces with two or more holes cut into parts of one hole each, then gridded."""
+"""Faces cut into parts the block layouts take (holes apart, reflex corners), then gridded."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import pytest
 
 from surfprep import NurbsCurve, NurbsSurface, TrimEdge, TrimLoop, TrimmedFace
 from surfprep.algorithms.grid.faces import face_regions
-from surfprep.algorithms.grid.holes import separate_holes
 from surfprep.algorithms.grid.network import grid_network
+from surfprep.algorithms.grid.parts import separate_holes, split_at_reflex
 from surfprep.algorithms.healing.loop_sides import NotDecomposableError
 
 SIDE = 4.0                                      # the plane (u, v) -> (4u, 4v, 0)
@@ -93,3 +93,42 @@ def test_holes_no_straight_cut_separates_are_refused_with_the_reason():
     with pytest.raises(NotDecomposableError, match="no straight cut"):
         separate_holes(face)
     assert "not cut into parts of one hole" in face_regions(face, gap_tol=1e-6)
+
+
+def _outline(*corners) -> TrimLoop:
+    """A loop of straight edges through ``corners`` (counter-clockwise)."""
+    return TrimLoop(tuple(_edge(corners[k], corners[(k + 1) % len(corners)]) for k in range(len(corners))))
+
+
+def test_an_l_is_cut_at_its_reflex_corner_into_two_rectangles():
+    face = TrimmedFace(_plane(), (_outline((0, 0), (1, 0), (1, 0.4), (0.4, 0.4), (0.4, 1), (0, 1)),))
+    parts = split_at_reflex(face)
+    assert parts is not None and len(parts) == 2
+    areas = sorted(abs(_loop_area(p)) for p in parts)
+    # the bisector of the corner's inner angle (45 degrees) runs to the corner (0, 0)
+    assert sum(areas) == pytest.approx(0.64, abs=1e-9) and areas[0] == pytest.approx(0.32, abs=1e-9)
+    assert split_at_reflex(_plate()) is None                   # a square: no reflex corner
+
+
+@pytest.mark.parametrize(("corners", "blocks"), [
+    ([(0, 0), (1, 0), (1, 1), (0.7, 1), (0.7, 0.3), (0.3, 0.3), (0.3, 1), (0, 1)], 3),          # a U
+    ([(0, 0), (1, 0), (1, 1), (0.8, 1), (0.8, 0.3), (0.6, 0.3), (0.6, 1), (0.4, 1), (0.4, 0.3),
+      (0.2, 0.3), (0.2, 1), (0, 1)], 18),                                                       # a comb
+])
+def test_very_non_convex_outlines_are_gridded_after_reflex_cuts(corners, blocks):
+    """The star round a centre leaves these outlines (refused before); cut at reflex
+    corners they are tiled exactly, no fold."""
+    face = TrimmedFace(_plane(), (_outline(*corners),))
+    regions = face_regions(face, gap_tol=1e-6)
+    assert not isinstance(regions, str) and len(regions) == blocks
+    net = grid_network(regions, gap=1e-6, size=0.1)
+    assert sum(b.quality.folded_cells for b in net.blocks) == 0
+    x, y = (SIDE * np.array(corners, float)).T
+    exact = 0.5 * abs(float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
+    assert sum(_cells_area(b.points) for b in net.blocks) == pytest.approx(exact, rel=1e-9)
+
+
+def _loop_area(face: TrimmedFace) -> float:
+    from surfprep.algorithms.trimmed import loop_uv
+    uv = loop_uv(face.loops[0])
+    return 0.5 * float(np.sum(uv[:, 0] * np.roll(uv[:, 1], -1) - np.roll(uv[:, 0], -1) * uv[:, 1]))

@@ -1,17 +1,26 @@
-"""A face with two or more holes cut into parts of one hole each, for block layouts.
+"""A face cut by straight lines in its parameters into parts the block layouts take.
 
 Structured blocks cover a face with at most one hole (one block per outer corner
-round it, :func:`..healing.decompose.decompose_ring`). A face with more holes is
-cut first: the holes' centres (in the face's ``(u, v)``) are split into two groups
-across the widest gap along their principal axis, and a straight cut in ``(u, v)``
-perpendicular to that axis, halfway across the gap, runs from the outer loop to the
-outer loop between them (:func:`~..face_split.split_face`); each part is cut again
-until none has more than one hole. A cut that would cross a hole, or leave the
-groups on one side, is turned (up to 50 degrees either way) or moved along the
-gap, or put in the next widest gap, or across the other axis; when none fits the
-face is refused with the reason. The cut's 3D curve is the
-straight line's image on the surface, interpolated on the pcurve's own parameter,
-so the parts' blocks meet along it.
+round it, :func:`..healing.decompose.decompose_ring`) whose outline is not too far
+from convex (blocks round a centre joined by straight spokes,
+:func:`..healing.decompose.decompose_face`). Two cuts bring other faces there, both
+through :func:`~..face_split.split_face`, the parts' blocks meeting along the cut:
+
+* :func:`separate_holes`: a face with more holes is cut between them: the holes'
+  centres (in the face's ``(u, v)``) are split into two groups across the widest
+  gap along their principal axis, and a straight cut perpendicular to that axis,
+  halfway across the gap, runs from the outer loop to the outer loop between them;
+  each part is cut again until none has more than one hole. A cut that would cross
+  a hole, or leave the groups on one side, is turned (up to 50 degrees either way)
+  or moved along the gap, or put in the next widest gap, or across the other axis;
+  when none fits the face is refused with the reason.
+* :func:`split_at_reflex`: a face of one loop is cut from its most reflex corner
+  (the loop turning against its run by more than :data:`REFLEX_ANGLE`) along the
+  bisector of the corner's inner angle to the loop beyond (an L is cut into two
+  rectangles, a U into three parts by two cuts).
+
+A cut's 3D curve is the straight line's image on the surface, interpolated on the
+pcurve's own parameter.
 """
 
 from __future__ import annotations
@@ -22,10 +31,13 @@ from numpy.typing import NDArray
 from ..cuts import Cut, locate_on_loops
 from ..face_split import split_face
 from ..fitting import interpolate_curve
-from ..healing.loop_sides import NotDecomposableError, uv_segment
+from ..healing.loop_sides import NotDecomposableError, end_tangent, restricted_curve, uv_segment
 from ..trimmed import TrimEdge, TrimLoop, TrimmedFace, loop_uv
 
-__all__ = ["separate_holes"]
+__all__ = ["REFLEX_ANGLE", "separate_holes", "split_at_reflex"]
+
+#: a corner is reflex when the loop turns against its run by more than this (radians)
+REFLEX_ANGLE = np.radians(20.0)
 
 #: points of a cut's image on the surface interpolated into its 3D curve
 _CUT_SAMPLES = 33
@@ -72,6 +84,53 @@ def separate_holes(face: TrimmedFace) -> list[TrimmedFace]:
                     return [piece for part in parts for piece in separate_holes(_restricted(part))]
     raise NotDecomposableError(f"{len(holes)} holes: no straight cut between them runs from the outline "
                                "to the outline clear of every hole")
+
+
+def split_at_reflex(face: TrimmedFace) -> list[TrimmedFace] | None:
+    """``face`` (one loop) cut in two from its most reflex corner along the bisector of
+    the corner's inner angle to the loop beyond it (the module doc); None when no corner
+    is reflex or the cut finds no loop ahead."""
+    if len(face.loops) != 1:
+        return None
+    loop = face.loops[0]
+    edges = [e for e in loop.edges if not e.degenerated]
+    if len(edges) < 2:
+        return None
+    outline = loop_uv(loop)
+    orientation = 1.0 if _signed_area(outline) > 0 else -1.0
+    best, corner = -REFLEX_ANGLE, None
+    for k, (before, after) in enumerate(zip(edges[-1:] + edges[:-1], edges)):
+        t_in, t_out = _uv_tangent(before, 1), _uv_tangent(after, 0)
+        turn = orientation * np.arctan2(t_in[0] * t_out[1] - t_in[1] * t_out[0], t_in @ t_out)
+        if turn < best:
+            best, corner = turn, (k, t_in, t_out, after)
+    if corner is None:
+        return None
+    _, t_in, t_out, after = corner
+    start = after.pcurve.evaluate(np.array([after.t1 if after.reversed else after.t0]))[0]
+    inward = -(-t_in / np.linalg.norm(t_in) + t_out / np.linalg.norm(t_out))
+    if np.linalg.norm(inward) < 1e-12:
+        return None
+    inward /= np.linalg.norm(inward)
+    span = float(np.ptp(outline, axis=0).max())
+    ends = _chord(outline, start + 1e-6 * span * inward, inward)
+    if ends is None or np.linalg.norm(ends[1] - start) < 1e-3 * span:
+        return None
+    end = _on_loop(loop, ends[1])
+    parts = split_face(face, [_straight_cut(face, start, end)])
+    return [_restricted(part) for part in parts] if len(parts) > 1 else None
+
+
+def _uv_tangent(edge: TrimEdge, end: int) -> NDArray:
+    """The loop's direction in ``(u, v)`` at the edge's start (0) or end (1), along the
+    loop (the edge's pcurve turned round where the loop runs it backwards)."""
+    pcurve = restricted_curve(edge.pcurve, edge.t0, edge.t1)
+    return -end_tangent(pcurve, 1 - end) if edge.reversed else end_tangent(pcurve, end)
+
+
+def _signed_area(uv: NDArray) -> float:
+    x, y = uv[:, 0], uv[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
 def _separating(outline, holes, centres, first, second, middle, axis, turn
