@@ -44,8 +44,8 @@ from OCP.ShapeFix import ShapeFix_Shape
 from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
-from ..atomic_files import new_file_mode
 from ..algorithms.trimmed import TrimmedFace
+from ..atomic_files import new_file_mode
 from ..errors import ConversionError, InputFileError, NoFacesError, OpenCascadeError, OutputFileError
 from ..inputs import ShapeLike
 from . import isolation
@@ -64,6 +64,7 @@ __all__ = [
     "TranslationWarning",
     "as_model",
     "bounding_box",
+    "named_model",
     "read",
     "sniff_format",
     "staged_write",
@@ -479,3 +480,14 @@ def to_shape(obj: ShapeLike) -> TopoDS_Shape:
     raise ConversionError(
         f"cannot write a {type(obj).__name__}: expected a CadModel, TopoDS_Shape, "
         "cadquery/build123d object, NurbsSurface, NurbsCurve or a list of them")
+
+
+def named_model(shape, faces, names) -> CadModel:
+    """A CadModel of ``shape`` whose faces are named as ``faces`` (the same faces, in
+    any orientation or location) are by ``names``."""
+    table = FaceNames()
+    for face, name in zip(faces, names):
+        if name is not None:
+            table.add(face, name)
+    out = all_faces(shape)
+    return CadModel(shape, out, tuple(table.get(f) for f in out), (None,) * len(out))

@@ -50,6 +50,7 @@ if TYPE_CHECKING:
     from .algorithms.reparam import ReparametrizationResult
     from .algorithms.trimmed import TrimEdge, TrimLoop, TrimmedFace
     from .algorithms.volume import NurbsVolume
+    from .plugin.booleans import BooleanResult
     from .plugin.convert import to_nurbs, to_occ
     from .plugin.grid import GridResult, grid
     from .plugin.heal import HealResult, heal
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
     from .plugin.occ.faces import make_face
     from .plugin.prepare import PrepareResult, prepare
     from .plugin.reparam import ReparametrizeResult, reparametrize
-    from .plugin.split import BooleanResult, SplitResult, boolean, boolean_all, split, trim
+    from .plugin.split import SplitResult, boolean, boolean_all, split, trim
     from .plugin.volume_boundary import (
         BoundarySolid,
         ComposedVolumes,
@@ -169,7 +170,7 @@ _LAZY_EXPORTS = {
     "boolean": "surfprep.plugin.split",
     "boolean_all": "surfprep.plugin.split",
     "trim": "surfprep.plugin.split",
-    "BooleanResult": "surfprep.plugin.split",
+    "BooleanResult": "surfprep.plugin.booleans",
     "NurbsVolume": "surfprep.algorithms.volume",
     "compose": "surfprep.algorithms.composition",
     "Composition": "surfprep.algorithms.composition",

@@ -27,11 +27,12 @@ from ..split import split as _split_verb
 from . import as_compound, reparametrize_any, reparametrized_shape
 
 if TYPE_CHECKING:
+    from ..booleans import BooleanResult
     from ..heal import HealResult
     from ..intersect import IntersectionResult
     from ..prepare import PrepareResult
     from ..reparam import ReparametrizeResult
-    from ..split import BooleanResult, SplitResult
+    from ..split import SplitResult
     from . import ModelReparametrizeResult
 
 __all__ = ["boolean", "heal", "intersect", "prepare", "reparametrize", "split"]
