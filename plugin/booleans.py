@@ -45,7 +45,7 @@ class BooleanResult:
     Attributes
     ----------
     shape : TopoDS_Shape
-        The kept pieces sewn (a solid when they close).
+        The kept pieces built sharing the split's edges (a solid when they close).
     operation : str
     split : SplitResult
     kept : (int, int)

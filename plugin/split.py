@@ -61,7 +61,8 @@ class SplitResult:
     Attributes
     ----------
     shape : TopoDS_Shape
-        The faces sewn (a compound or shell; non-manifold where surfaces cross).
+        The faces in one shell built from the edges they share (non-manifold where
+        surfaces cross), or sewn when built so a face was invalid (``assembled``).
     faces : tuple of SplitFace
         One per face that had a curve.
     curves : IntersectionResult
@@ -444,7 +445,7 @@ def boolean(a: Any, b: Any, operation: str, *, tol: float | None = None, method:
     (coincident faces) count once: where the normals agree (coplanar faces of two
     overlapping boxes) ``a``'s piece is kept by fuse and common; where they are opposed
     (two solids touching) fuse and common drop both and cut keeps ``a``'s. The kept
-    pieces are sewn into the result.
+    pieces are built into the result sharing the split's edges.
 
     Raises
     ------
@@ -518,7 +519,7 @@ def trim(a: Any, b: Any, *, keep: str = "front", tol: float | None = None,
     -------
     BooleanResult
         ``operation`` ``"trim-front"`` / ``"trim-back"``, ``kept`` (pieces of a, 0), the
-        kept pieces sewn (closed only if they close).
+        kept pieces in a shell (a solid only if they close).
 
     Raises
     ------
