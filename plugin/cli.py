@@ -72,6 +72,19 @@ def _version() -> str:
         return __version__
 
 
+class _VersionAction(argparse.Action):
+    """``--version``: the version looked up when asked (``importlib.metadata`` costs a
+    twentieth of a second, which every other call need not pay)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0,
+                         help=help or "show the version and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"{parser.prog} {_version()}")         # stdout, as argparse's own version action
+        parser.exit()
+
+
 def _common_options(defaults: bool) -> argparse.ArgumentParser:
     """--debug/--progress, accepted before and after the subcommand name."""
     default = (lambda value: value) if defaults else (lambda value: argparse.SUPPRESS)
@@ -95,7 +108,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog=PROG, description=DESCRIPTION, epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
         parents=[_common_options(defaults=True)])
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND")
     for command in COMMANDS:
         cmd_parser = sub.add_parser(
