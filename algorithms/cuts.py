@@ -228,20 +228,27 @@ def parts_along_boundary(face: TrimmedFace, loops: list[TrimLoop], cut: Cut, eps
     t = np.linspace(t0, t1, CUT_SAMPLES)
     limit = tol3d if tol3d is not None else eps
 
-    def distance(ts: NDArray) -> NDArray:
+    def points_at(ts: NDArray) -> NDArray:
+        """The cut's points in space (with ``tol3d``) or in the parameters."""
+        if tol3d is None:
+            return cut.pcurve.evaluate(ts)
+        return (cut.curve3d.evaluate(ts) if cut.curve3d is not None
+                else face.surface.evaluate(*cut.pcurve.evaluate(ts).T))
+
+    def distance_of(points: NDArray) -> NDArray:
         if tol3d is not None:
-            points = (cut.curve3d.evaluate(ts) if cut.curve3d is not None
-                      else face.surface.evaluate(*cut.pcurve.evaluate(ts).T))
             return region.edge_distance(points)
         index = region.loop_index()
-        uv = cut.pcurve.evaluate(ts)
         if index is not None:
-            return index.uv_tree.distance(uv)
+            return index.uv_tree.distance(points)
         u0, u1, v0, v1 = face.surface.domain
-        return np.min(np.abs(np.stack([uv[:, 0] - u0, uv[:, 0] - u1, uv[:, 1] - v0, uv[:, 1] - v1])), axis=0)
-    on = distance(t) <= limit
-    points = (cut.curve3d.evaluate(t) if cut.curve3d is not None else face.surface.evaluate(*cut.pcurve.evaluate(t).T)
-              ) if tol3d is not None else cut.pcurve.evaluate(t)
+        return np.min(np.abs(np.stack([points[:, 0] - u0, points[:, 0] - u1, points[:, 1] - v0,
+                                       points[:, 1] - v1])), axis=0)
+
+    def distance(ts: NDArray) -> NDArray:
+        return distance_of(points_at(ts))
+    points = points_at(t)
+    on = distance_of(points) <= limit
     touches = []
     for value in (True, False):                   # short stretches of either kind count with their neighbours
         edges = np.diff(np.concatenate([[0], (on != value).astype(np.int8), [0]]))

@@ -111,8 +111,6 @@ def _solid_of(model, tol: float):
     return shape
 
 
-
-
 def select_pieces(cut: SplitResult, operation: str, *, keep: str = "front") -> BooleanResult:
     """:meth:`SplitResult.select`: the pieces of ``cut`` a Boolean (``"fuse"``, ``"cut"``,
     ``"common"``) or a trim (``"trim"``, ``keep`` ``"front"`` or ``"back"``) keeps.
@@ -137,7 +135,7 @@ def select_pieces(cut: SplitResult, operation: str, *, keep: str = "front") -> B
 
 
 def _selected(cut: SplitResult, operation: str) -> BooleanResult:
-    """:meth:`SplitResult.select` of a Boolean (the docstring of :func:`boolean`)."""
+    """:meth:`SplitResult.select` of a Boolean (the docstring of :func:`.split.boolean`)."""
     model_a, model_b = cut.operands
     sew_tol = cut.sew_tol
     _solid_of(model_a, sew_tol), _solid_of(model_b, sew_tol)          # both must close
@@ -194,7 +192,7 @@ def _all_cut(cut: SplitResult, operation: str) -> None:
 def _assembled(cut: SplitResult, chosen: list[int], turned: list[int]) -> tuple[Any, tuple]:
     """The faces ``chosen`` (indices into ``cut.structure.faces``; those in ``turned``
     turned over) in a shell per connected component (a compound of them when more
-    than one), built from the structure as :func:`split` builds its
+    than one), built from the structure as :func:`.split.split` builds its
     shape; when the split itself had to be sewn, or a face built so is invalid, the
     split's faces sewn (OpenCascade's manifold sewing loses the seam halves of a cap
     cut across a sphere's seam: every edge came out degenerated, so non-manifold).
@@ -214,9 +212,8 @@ def _assembled(cut: SplitResult, chosen: list[int], turned: list[int]) -> tuple[
     return shape, tuple(zip(faces, (names[k] for k in chosen)))
 
 
-
 def _trimmed(cut: SplitResult, keep: str) -> BooleanResult:
-    """:meth:`SplitResult.select` of ``"trim"`` (the docstring of :func:`trim`)."""
+    """:meth:`SplitResult.select` of ``"trim"`` (the docstring of :func:`.split.trim`)."""
     from ..errors import InvalidGeometryError
     if keep not in ("front", "back"):
         raise InvalidGeometryError(f"keep must be 'front' or 'back', got {keep!r}")

@@ -398,7 +398,8 @@ def split(a: Any, b: Any = None, *, tol: float | None = None, method: str = "aut
             continue
         done.append(SplitFace(operand, k, len(face_cuts), tuple(pieces[(operand, k)]), refused.get((operand, k))))
     done.sort(key=lambda f: (f.operand, f.index))
-    valid = all(is_valid(p) for f in done for p in f.pieces)
+    # built from the structure, every face has passed BRepCheck already (built.valid)
+    valid = assembled == "structure" or all(is_valid(p) for f in done for p in f.pieces)
     n_a = sum(1 for _, (operand, _) in listed if operand == "a")
     return SplitResult(shape, tuple(done), curves, count_free_edges(shape), _edge_uses(shape), valid,
                        time.perf_counter() - started, tuple(faces[:n_a]), tuple(faces[n_a:]),

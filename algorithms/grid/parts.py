@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from ..cuts import Cut, locate_on_loops
 from ..face_split import split_face
 from ..fitting import interpolate_curve
-from ..healing.loop_sides import NotDecomposableError, end_tangent, restricted_curve, uv_segment
+from ..healing.loop_sides import NotDecomposableError, end_tangent, restricted_curve, signed_area, uv_segment
 from ..trimmed import TrimEdge, TrimLoop, TrimmedFace, loop_uv
 
 __all__ = ["REFLEX_ANGLE", "separate_holes", "split_at_reflex"]
@@ -97,7 +97,7 @@ def split_at_reflex(face: TrimmedFace) -> list[TrimmedFace] | None:
     if len(edges) < 2:
         return None
     outline = loop_uv(loop)
-    orientation = 1.0 if _signed_area(outline) > 0 else -1.0
+    orientation = 1.0 if signed_area(outline) > 0 else -1.0
     best, corner = -REFLEX_ANGLE, None
     for k, (before, after) in enumerate(zip(edges[-1:] + edges[:-1], edges)):
         t_in, t_out = _uv_tangent(before, 1), _uv_tangent(after, 0)
@@ -126,11 +126,6 @@ def _uv_tangent(edge: TrimEdge, end: int) -> NDArray:
     loop (the edge's pcurve turned round where the loop runs it backwards)."""
     pcurve = restricted_curve(edge.pcurve, edge.t0, edge.t1)
     return -end_tangent(pcurve, 1 - end) if edge.reversed else end_tangent(pcurve, end)
-
-
-def _signed_area(uv: NDArray) -> float:
-    x, y = uv[:, 0], uv[:, 1]
-    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
 
 
 def _separating(outline, holes, centres, first, second, middle, axis, turn
