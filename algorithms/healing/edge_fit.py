@@ -1,0 +1,285 @@
+"""A face's surface moved onto its neighbours' edges: gaps closed in the geometry where
+the face is not replaced by an approximant (001 §8's joins for faces that keep their
+surface).
+
+Two trimmed faces of a real model often meet along edges that lie a little apart
+(1e-4 to 1e-1 mm): each face's trimming curve lies on its own surface, the surfaces miss
+each other along it. Sewing hides such a gap behind a raised edge tolerance. Closing it
+in the geometry means changing a surface so that its trimming curve, mapped through it,
+runs along the common edge. :func:`fit_to_edges` does that with the least change: the
+displacement is a B-spline on the surface's own knots (refined where the edges need
+it), with control-point displacements ``d_ij``
+
+.. math::
+
+    S'(u, v) = S(u, v) + \\sum_{ij} R_{ij}(u, v)\\, d_{ij},
+
+``R_ij`` the surface's (rational) basis functions, so the weights and the
+parametrization stay and every pcurve of the face stays valid. The ``d_ij`` are the
+minimum-norm least-squares solution of ``S'(uv_k) = target_k`` at the samples of the
+edges, so only control points whose support meets an edge move, and since the
+``R_ij`` are non-negative and sum to one, ``max |d_ij|`` bounds how far any point of
+the surface moved (:attr:`EdgeFit.moved`). Knots are inserted (exactly, [PT] A5.4)
+in the spans where a sample misses its target (in both directions: across an edge the
+band the displacement decays over narrows; more the more it misses) until every sample
+is within ``tol``.
+
+References
+----------
+001 §8, [PT] A5.4 (see ``surfprep.algorithms`` References).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import sparse
+from scipy.sparse import linalg as splinalg
+
+from ...errors import InvalidGeometryError
+from ..basis import basis_functions, find_span
+from ..surface import NurbsSurface
+
+__all__ = ["MAX_FIT_CONTROL", "MAX_FIT_ROUNDS", "MIN_SPAN_SAMPLES", "EdgeFit", "EdgeTarget", "fit_to_edges"]
+
+#: rounds of knot insertion at most
+MAX_FIT_ROUNDS = 24
+#: control points of the refined surface at most
+MAX_FIT_CONTROL = 40_000
+#: weight of the displacement's membrane energy against the samples' (relative to the
+#: largest diagonal entry of ``A^T A``) ...
+_SMOOTH = 1e-6
+#: ... and the length, as a fraction of the net's larger side, over which it decays
+_DECAY = 1.0 / 3.0
+#: corrections of the regularized solution by what the samples still miss
+_SWEEPS = 3
+#: a span is split only when it holds at least this many samples
+MIN_SPAN_SAMPLES = 12
+#: the displacement's degree at least (the surface's degree raised to it when lower)
+_MIN_DEGREE = 3
+#: a span is split into this many parts at most in one round
+_MAX_SPLIT = 8
+
+
+@dataclass(frozen=True)
+class EdgeTarget:
+    """Where one edge of a face must lie: samples of its pcurve and the points they go to.
+
+    Attributes
+    ----------
+    uv : (m, 2) float
+        Parameters on the surface, in order along the edge (m >= 2).
+    points : (m, 3) float
+        The targets; the surface's own points along an edge the face holds.
+    """
+
+    uv: NDArray
+    points: NDArray
+
+    def __post_init__(self) -> None:
+        uv = np.asarray(self.uv, dtype=float)
+        points = np.asarray(self.points, dtype=float)
+        if uv.ndim != 2 or uv.shape[1] != 2 or uv.shape[0] < 2:
+            raise InvalidGeometryError(f"uv must have shape (m, 2) with m >= 2, got {uv.shape}")
+        if points.shape != (uv.shape[0], 3):
+            raise InvalidGeometryError(
+                f"points must have shape ({uv.shape[0]}, 3) like uv, got {points.shape}")
+        if not (np.all(np.isfinite(uv)) and np.all(np.isfinite(points))):
+            raise InvalidGeometryError("edge targets contain NaN or infinite values")
+        object.__setattr__(self, "uv", uv)
+        object.__setattr__(self, "points", points)
+
+
+@dataclass(frozen=True)
+class EdgeFit:
+    """Result of :func:`fit_to_edges`.
+
+    Attributes
+    ----------
+    surface : NurbsSurface
+        The moved surface (the input's degree raised to at least 3, its knots plus those
+        inserted; the same weights where none is raised).
+    residual : float
+        Largest distance between the moved surface and a target, over all samples.
+    moved : float
+        Largest control-point displacement: no point of the surface moved farther.
+    inserted : int
+        Knots inserted.
+    converged : bool
+        ``residual <= tol``.
+    """
+
+    surface: NurbsSurface
+    residual: float
+    moved: float
+    inserted: int
+    converged: bool
+
+
+def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: float,
+                 max_rounds: int = MAX_FIT_ROUNDS, max_control: int = MAX_FIT_CONTROL
+                 ) -> EdgeFit:
+    """Move ``surface`` the least so that its points at the targets' ``uv`` are the
+    targets' points (the module doc).
+
+    Parameters
+    ----------
+    surface : NurbsSurface (d = 3)
+    targets : sequence of EdgeTarget
+        One per edge of the face: where it must go, or (points on the surface) where it
+        must stay.
+    tol : float
+        Largest distance left at a sample, model units.
+    max_rounds : int
+        Rounds of knot insertion at most.
+    max_control : int
+        Control points of the refined surface at most; refinement stops before it
+        would exceed them.
+
+    Returns
+    -------
+    EdgeFit
+
+    Raises
+    ------
+    InvalidGeometryError
+        No target, a surface that is not 3D, or ``tol`` not a positive number.
+
+    Examples
+    --------
+    A flat bicubic patch whose edge ``v = 0`` must rise by 1e-3:
+
+    >>> import numpy as np
+    >>> from surfprep.algorithms.fitting import interpolate_surface
+    >>> x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5), indexing="ij")
+    >>> flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1))
+    >>> u = np.linspace(0, 1, 50)
+    >>> edge = EdgeTarget(np.stack([u, 0 * u], axis=1), np.stack([u, 0 * u, 0 * u + 1e-3], axis=1))
+    >>> fit = fit_to_edges(flat, [edge], tol=1e-9)
+    >>> fit.converged, round(fit.moved, 6)
+    (True, 0.001)
+    >>> 0 < float(fit.surface.evaluate(0.5, 1.0)[2]) < 1e-3   # the far edge moved less
+    True
+    """
+    if surface.dimension != 3:
+        raise InvalidGeometryError(f"fit_to_edges needs a 3D surface, got d={surface.dimension}")
+    if not targets:
+        raise InvalidGeometryError("fit_to_edges needs at least one edge target")
+    if not (np.isfinite(tol) and tol > 0):
+        raise InvalidGeometryError(f"tol must be a positive length, got {tol!r}")
+    uv = np.concatenate([t.uv for t in targets])
+    points = np.concatenate([t.points for t in targets])
+    u0, u1, v0, v1 = surface.domain
+    uv = np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
+    inserted = 0
+    # a direction of degree below 3 raised to 3 first (exactly): a displacement in a
+    # bilinear net only refines towards the targets' kinks at the vertices linearly
+    s = surface.elevate_degree(max(0, _MIN_DEGREE - surface.degree_u),
+                               max(0, _MIN_DEGREE - surface.degree_v))
+    for round_ in range(max_rounds + 1):
+        matrix = _collocation(s, uv)
+        offset = points - s.evaluate(uv[:, 0], uv[:, 1])
+        d = _smooth_solve(matrix, offset, s.n_control)
+        left = np.linalg.norm(matrix @ d - offset, axis=1)
+        if left.max() <= tol or round_ == max_rounds:
+            break
+        refined = _refined(s, uv, left, tol, max_control)
+        if refined is None:
+            break
+        s, count = refined
+        inserted += count
+    net = s.control_points + d.reshape(s.control_points.shape)
+    moved = s.construct_fast(net, s.knots_u, s.knots_v, s.degree_u, s.degree_v, s.weights)
+    residual = float(np.max(np.linalg.norm(moved.evaluate(uv[:, 0], uv[:, 1]) - points, axis=1)))
+    return EdgeFit(moved, residual, float(np.max(np.linalg.norm(d, axis=1), initial=0.0)),
+                   inserted, residual <= tol)
+
+
+def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:
+    """``R_ij(uv_k)``: the (m, n_u n_v) sparse matrix, columns the flat net indices."""
+    p, q = s.degree_u, s.degree_v
+    nu, nv = s.n_control
+    span_u, bu = basis_functions(s.knots_u, p, uv[:, 0])
+    span_v, bv = basis_functions(s.knots_v, q, uv[:, 1])
+    iu = span_u[:, None] - p + np.arange(p + 1)                          # (m, p+1)
+    iv = span_v[:, None] - q + np.arange(q + 1)                          # (m, q+1)
+    values = bu[:, :, None] * bv[:, None, :]                             # (m, p+1, q+1)
+    if s.weights is not None:
+        values = values * s.weights[iu[:, :, None], iv[:, None, :]]
+        values /= values.sum(axis=(1, 2), keepdims=True)
+    flat = (iu[:, :, None] * nv + iv[:, None, :]).reshape(uv.shape[0], -1)
+    rows = np.repeat(np.arange(uv.shape[0]), flat.shape[1])
+    return sparse.csr_matrix((values.reshape(-1), (rows, flat.reshape(-1))),
+                             shape=(uv.shape[0], nu * nv))
+
+
+def _second_differences(n: int) -> sparse.csr_matrix:
+    """``(n - 2, n)``: rows ``x[i] - 2 x[i+1] + x[i+2]`` (zero rows when n < 3)."""
+    if n < 3:
+        return sparse.csr_matrix((0, n))
+    return sparse.diags([1.0, -2.0, 1.0], [0, 1, 2], shape=(n - 2, n), format="csr")
+
+
+def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, shape: tuple[int, int]) -> NDArray:
+    """Control-point displacements ``d`` (n_u n_v, 3) minimizing
+
+    ``|A d - offset|^2 + mu (|D_u d|^2 + |D_v d|^2) + eps |d|^2``:
+
+    the samples met, the displacement a discrete screened membrane on the net (first
+    differences), which decays away from the edges over about a third of the net
+    (``eps / mu``) and, by the maximum principle, nowhere exceeds what the samples ask;
+    ``mu`` is small against ``A``'s scale, so the samples dominate, and ``_SWEEPS``
+    steps of iterated Tikhonov regularization (the same factorization applied to what
+    the samples still miss) take out the pull the membrane keeps on them."""
+    nu, nv = shape
+    first_u = sparse.diags([-1.0, 1.0], [0, 1], shape=(max(nu - 1, 0), nu), format="csr")
+    first_v = sparse.diags([-1.0, 1.0], [0, 1], shape=(max(nv - 1, 0), nv), format="csr")
+    membrane = [sparse.kron(first_u, sparse.identity(nv)), sparse.kron(sparse.identity(nu), first_v)]
+    gram = (matrix.T @ matrix).tocsc()
+    scale = float(gram.diagonal().max())
+    energy = sum((m.T @ m for m in membrane), sparse.csc_matrix((nu * nv, nu * nv)))
+    decay = (_DECAY * max(nu, nv)) ** 2
+    system = _SMOOTH * scale * (energy + sparse.identity(nu * nv) / decay) + gram
+    solve = splinalg.splu(system.tocsc()).solve
+    d = solve(np.asarray(matrix.T @ offset))
+    for _ in range(_SWEEPS):            # iterated Tikhonov: the membrane's pull on the samples undone
+        d += solve(np.asarray(matrix.T @ (offset - matrix @ d)))
+    return d
+
+
+def _refined(s: NurbsSurface, uv: NDArray, miss: NDArray, tol: float, max_control: int
+             ) -> tuple[NurbsSurface, int] | None:
+    """``s`` with each span (in u and in v) holding a sample that misses its target by
+    more than ``tol`` split into ``k`` equal parts, ``k = (miss / tol)^(1/4)`` (the
+    error of a cubic falls as the fourth power of the span) between 2 and
+    ``_MAX_SPLIT``, where the span holds at least ``MIN_SPAN_SAMPLES`` samples (finer
+    spans than the samples resolve would wave between them); None when nothing can be
+    inserted or the net would exceed ``max_control`` control points."""
+    new = []
+    missed = miss > tol
+    for knots, degree, k in ((s.knots_u, s.degree_u, 0), (s.knots_v, s.degree_v, 1)):
+        span = find_span(knots, degree, uv[:, k])
+        held = np.bincount(span, minlength=knots.size)
+        worst = np.zeros(knots.size)
+        np.maximum.at(worst, span[missed], miss[missed])
+        chosen = np.flatnonzero((worst > tol) & (held >= MIN_SPAN_SAMPLES)
+                                & (np.append(np.diff(knots), 0.0) > 0))
+        parts = np.clip(np.ceil((worst[chosen] / tol) ** 0.25), 2, _MAX_SPLIT).astype(int)
+        values = np.concatenate([knots[c] + (knots[c + 1] - knots[c]) * np.arange(1, n) / n
+                                 for c, n in zip(chosen, parts)] or [np.zeros(0)])
+        # strictly inside their spans (a span too short to split in floating point is not)
+        inside = np.concatenate([np.full(n - 1, c) for c, n in zip(chosen, parts)] or [np.zeros(0, int)])
+        keep = (values > knots[inside]) & (values < knots[inside + 1])
+        new.append(np.unique(values[keep]))
+    nu, nv = s.n_control
+    if not (new[0].size or new[1].size) or (nu + new[0].size) * (nv + new[1].size) > max_control:
+        return None
+    out = s
+    if new[0].size:
+        out = out.refine(np.sort(new[0]), "u")
+    if new[1].size:
+        out = out.refine(np.sort(new[1]), "v")
+    return out, int(new[0].size + new[1].size)

@@ -1,0 +1,106 @@
+"""Where a face's sides go when its surface is moved onto its neighbours' edges: the
+samples of a common curve mapped onto the face (:func:`on_surface`), their ends kept
+at the face's corners (:func:`pinned_ends`, :func:`spread_ends`), and how wavy an
+edge's image is (:func:`roughness`); the targets of
+:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges` as
+:mod:`surfprep.plugin.heal.close_gaps` builds them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ...errors import SurfprepError
+from ..fitting import approximate_curve
+from ..projection import project_to_surface
+from ..surface import NurbsSurface
+
+__all__ = ["along_iso", "on_surface", "pinned_ends", "roughness", "spread_ends"]
+
+#: a pcurve whose samples lie within this share of the domain of one of its sides runs
+#: along that side (its samples then slide along the iso-curve), and the Gauss-Newton
+#: steps taken there
+ON_BORDER = 1e-9
+ISO_STEPS = 6
+#: samples closer than this share of a pcurve's extent to its end have piled up there
+PILED = 1e-12
+#: share of a pcurve's parameter over which the shift of an end back to its corner fades
+END_FADE = 0.25
+#: knot spans of the smooth curve an image is compared with (:func:`roughness`)
+SMOOTH_SPANS = 8
+
+
+def on_surface(surface: NurbsSurface, points: NDArray, guess: NDArray) -> NDArray:
+    """Parameters on ``surface`` for ``points`` (m, 3) near the pcurve samples ``guess``
+    (m, 2): their closest points, or, for a pcurve along the domain's border (an
+    untrimmed face's side), their closest points on that border's iso-curve
+    (:func:`along_iso`; projected onto the surface, feet near a corner would pile up at
+    the corner). Returns (m, 2) float."""
+    u0, u1, v0, v1 = surface.domain
+    for k, (lo, hi) in enumerate(((u0, u1), (v0, v1))):
+        for end in (lo, hi):
+            if np.all(np.abs(guess[:, k] - end) <= ON_BORDER * (hi - lo)):
+                return along_iso(surface, points, guess, k, end)
+    return project_to_surface(surface, points, guess=guess).uv
+
+
+def spread_ends(uv: NDArray, s: NDArray) -> NDArray:
+    """``uv`` (m, 2) with the samples that piled up at an end (a common curve reaching
+    past the surface's corner projects onto the corner) spread evenly in ``s`` (m,) up
+    to the first that did not: one target per parameter."""
+    uv = uv.copy()
+    scale = float(np.ptp(uv, axis=0).max()) or 1.0
+    for order in (slice(None), slice(None, None, -1)):
+        w, t = uv[order], s[order]
+        moved = np.flatnonzero(np.linalg.norm(w - w[0], axis=1) > PILED * scale)
+        if moved.size and moved[0] > 1:
+            k = moved[0]
+            w[1:k] = w[0] + np.outer((t[1:k] - t[0]) / (t[k] - t[0]), w[k] - w[0])
+    return uv
+
+
+def along_iso(surface: NurbsSurface, points: NDArray, guess: NDArray, k: int, value: float
+               ) -> NDArray:
+    """Closest points of ``points`` (m, 3) on the iso-curve ``uv[k] = value`` by
+    Gauss-Newton steps in the other parameter from ``guess`` (m, 2) (beyond the domain:
+    along the tangent at its end, so the result may leave the domain there). Returns
+    (m, 2) float."""
+    free = 1 - k
+    lo, hi = surface.domain[2 * free], surface.domain[2 * free + 1]
+    uv = guess.copy()
+    uv[:, k] = value
+    for _ in range(ISO_STEPS):
+        at = uv.copy()
+        at[:, free] = np.clip(at[:, free], lo, hi)
+        d = surface.derivatives(at[:, 0], at[:, 1], 1)
+        tangent = d[:, 1, 0] if free == 0 else d[:, 0, 1]
+        step = np.einsum("ij,ij->i", points - d[:, 0, 0], tangent) / np.maximum(
+            np.einsum("ij,ij->i", tangent, tangent), 1e-300)
+        # beyond an end the foot is extrapolated along the end's tangent (clamped, the
+        # feet would pile up at the corner); :func:`pinned_ends` brings the ends back
+        uv[:, free] = at[:, free] + step
+    return uv
+
+
+def pinned_ends(uv: NDArray, old: NDArray, s: NDArray) -> NDArray:
+    """``uv`` (m, 2) with its ends put back where the old pcurve ``old`` (m, 2) ended, the
+    shift faded out over ``END_FADE`` of the parameter ``s`` (m,) at each end by the C1
+    cubic ``(1 - x)^2 (1 + 2x)``: the face's corners keep their parameters (the other
+    edges there end at them; a pole's point projects to any parameter along it), the
+    surface moves them to the vertices."""
+    def fade(x: NDArray) -> NDArray:
+        x = np.clip(x / END_FADE, 0.0, 1.0)
+        return ((1.0 - x) ** 2 * (1.0 + 2.0 * x))[:, None]      # 1 at the end, C1 to 0
+    return uv + fade(s - s[0]) * (old[0] - uv[0]) + fade(s[-1] - s) * (old[-1] - uv[-1])
+
+
+def roughness(points: NDArray, s: NDArray) -> float:
+    """How far ``points`` (m, 3) along an edge at ``s`` (m,) lie from their least-squares
+    cubic with ``SMOOTH_SPANS`` spans: the waves of a pcurve approximated coarsely by an
+    exporter (0 when there are too few points to fit)."""
+    try:
+        smooth = approximate_curve(points, SMOOTH_SPANS + 3, parameters=s)
+    except SurfprepError:
+        return 0.0
+    return float(np.max(np.linalg.norm(smooth.evaluate(s) - points, axis=1)))

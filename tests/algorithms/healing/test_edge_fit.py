@@ -1,0 +1,117 @@
+"""Surfaces moved onto target edges (algorithms/healing/edge_fit.py): checked densely
+along the edges, away from them, and against exact answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.algorithms.healing.edge_fit import EdgeTarget, fit_to_edges
+from surfprep.algorithms.surface import NurbsSurface
+from surfprep.errors import InvalidGeometryError
+
+
+def _graph(n=8):
+    x, y = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
+    return interpolate_surface(np.stack([x, y, 0.2 * np.sin(3 * x) * np.cos(2 * y)], axis=-1))
+
+
+def _circle(surface, n, amplitude=1e-3):
+    a = np.linspace(0, 2 * np.pi, n)
+    uv = np.stack([0.5 + 0.3 * np.cos(a), 0.5 + 0.3 * np.sin(a)], axis=1)
+    points = surface.evaluate(uv[:, 0], uv[:, 1])
+    points[:, 2] += amplitude * np.exp(np.sin(5 * a))        # not in any spline space
+    return uv, points
+
+
+def test_a_constant_lift_of_a_boundary_edge_is_exact_and_fades_away_from_it():
+    x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5), indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1))
+    u = np.linspace(0, 1, 50)
+    edge = EdgeTarget(np.stack([u, 0 * u], axis=1), np.stack([u, 0 * u, 0 * u + 1e-3], axis=1))
+    fit = fit_to_edges(flat, [edge], tol=1e-9)
+    assert fit.converged and fit.inserted == 0
+    dense = np.linspace(0, 1, 1001)
+    on_edge = fit.surface.evaluate(dense, 0 * dense)
+    assert np.max(np.abs(on_edge[:, 2] - 1e-3)) <= 1e-9
+    assert np.max(np.abs(on_edge[:, :2] - np.stack([dense, 0 * dense], axis=1))) <= 1e-12
+    # the membrane decays away from the edge and never exceeds the lift asked for
+    g = np.linspace(0, 1, 41)
+    lift = fit.surface.evaluate_grid(g, g)[..., 2]
+    assert lift.max() <= 1e-3 + 1e-12 and lift.min() >= -1e-12
+    assert np.all(np.diff(lift, axis=1) <= 1e-15)          # falling with v
+    assert fit.moved == pytest.approx(1e-3, rel=1e-9)
+
+
+def test_a_wavy_interior_edge_is_met_densely_between_the_samples():
+    s = _graph()
+    uv, points = _circle(s, 1600)
+    v = np.linspace(0, 1, 100)
+    held_uv = np.stack([0 * v, v], axis=1)
+    held = EdgeTarget(held_uv, s.evaluate(held_uv[:, 0], held_uv[:, 1]))
+    fit = fit_to_edges(s, [EdgeTarget(uv, points), held], tol=1e-6)
+    assert fit.converged and fit.inserted > 0
+    check_uv, check = _circle(s, 20001)                  # 12x denser than the fit
+    miss = np.linalg.norm(fit.surface.evaluate(check_uv[:, 0], check_uv[:, 1]) - check, axis=1)
+    assert miss.max() <= 2e-6
+    vv = np.linspace(0, 1, 2001)
+    still = fit.surface.evaluate(0 * vv, vv) - s.evaluate(0 * vv, vv)
+    assert np.max(np.linalg.norm(still, axis=1)) <= 2e-6
+    # the displacement is of the size the targets ask (their offsets reach 2.7e-3)
+    g = np.linspace(0, 1, 101)
+    moved = np.linalg.norm(fit.surface.evaluate_grid(g, g) - s.evaluate_grid(g, g), axis=-1)
+    assert moved.max() <= 2.5 * 2.72e-3
+    assert fit.moved >= moved.max() - 1e-12             # the control points bound it
+
+
+def test_samples_too_sparse_for_the_tolerance_are_reported_not_converged():
+    s = _graph()
+    uv, points = _circle(s, 40)
+    fit = fit_to_edges(s, [EdgeTarget(uv, points)], tol=1e-9)
+    assert not fit.converged
+    miss = np.linalg.norm(fit.surface.evaluate(uv[:, 0], uv[:, 1]) - points, axis=1)
+    assert fit.residual == pytest.approx(miss.max(), rel=1e-12)
+
+
+def test_a_rational_cylinder_keeps_its_weights_and_moves_radially():
+    w = np.sqrt(0.5)
+    arc = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    cp = np.stack([np.concatenate([np.repeat(arc[:, :1], 1, 1), arc[:, 1:], np.full((3, 1), z)], 1)
+                   for z in (0.0, 1.0)], axis=1)                                    # (3, 2, 3)
+    weights = np.array([[1.0, 1.0], [w, w], [1.0, 1.0]])
+    cyl = NurbsSurface(cp, [0, 0, 0, 1, 1, 1], [0, 0, 1, 1], 2, 1, weights)
+    u = np.linspace(0, 1, 200)
+    edge_uv = np.stack([u, np.full_like(u, 1.0)], axis=1)                          # the top
+    on = cyl.evaluate(edge_uv[:, 0], edge_uv[:, 1])
+    assert np.allclose(np.hypot(on[:, 0], on[:, 1]), 1.0)
+    radial = np.stack([on[:, 0], on[:, 1], 0 * u], axis=1)
+    fit = fit_to_edges(cyl, [EdgeTarget(edge_uv, on + 1e-3 * radial)], tol=1e-7)
+    assert fit.converged
+    assert fit.surface.weights is not None
+    out = fit.surface.evaluate(np.linspace(0, 1, 999), np.ones(999))
+    assert np.max(np.abs(np.hypot(out[:, 0], out[:, 1]) - 1.001)) <= 1e-7
+    bottom = fit.surface.evaluate(np.linspace(0, 1, 99), np.zeros(99))
+    assert np.max(np.abs(np.hypot(bottom[:, 0], bottom[:, 1]) - 1.0)) <= 1e-3  # decayed
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda s: ([], 1e-6), "at least one"),
+    (lambda s: ([EdgeTarget(np.zeros((5, 2)), np.zeros((5, 3)))], 0.0), "positive"),
+    (lambda s: ([EdgeTarget(np.zeros((5, 2)), np.zeros((5, 3)))], float("nan")), "positive"),
+])
+def test_bad_arguments_are_refused(make, match):
+    targets, tol = make(None)
+    with pytest.raises(InvalidGeometryError, match=match):
+        fit_to_edges(_graph(), targets, tol=tol)
+
+
+@pytest.mark.parametrize("uv, points, match", [
+    (np.zeros((1, 2)), np.zeros((1, 3)), "m >= 2"),
+    (np.zeros((5, 3)), np.zeros((5, 3)), r"\(m, 2\)"),
+    (np.zeros((5, 2)), np.zeros((4, 3)), r"\(5, 3\)"),
+    (np.full((5, 2), np.nan), np.zeros((5, 3)), "NaN"),
+])
+def test_bad_targets_are_refused(uv, points, match):
+    with pytest.raises(InvalidGeometryError, match=match):
+        EdgeTarget(uv, points)
