@@ -60,7 +60,17 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    or directed patches;
    untouched faces keep their names (a replaced face passes its name to its
    approximant; holes are named ``heal_hole_<k>``, their sub-patches
-   ``heal_hole_<k>_<n>``).
+   ``heal_hole_<k>_<n>``);
+6. shared edges whose faces still lie farther apart than ``TIGHT_FACTOR`` x size
+   (sewing closed them by raising the edge's tolerance: faces kept as they were, gaps
+   the file hid in its tolerances) are closed in the geometry (:mod:`.close_gaps`):
+   the B-spline faces along them are moved the least, by at most ``tol`` (default
+   ``gap_tol``), onto one common curve per edge, their pcurves re-projected, analytic
+   faces kept exact; the report's ``closed_gaps`` says which faces moved and how far.
+
+Free edges "in the geometry" (``tight_free_edges_before/after``) are measured on the
+faces, each face's pcurves through its surface (:mod:`surfprep.plugin.occ.gaps`), not
+on the edge curves a file carries.
 
 The building blocks are :mod:`surfprep.algorithms.healing`
 (``local_approximant``, ``connect``, ``Continuity``, ``Side``); the approximants
@@ -71,6 +81,7 @@ result types are in :mod:`.result`.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import os
 import time
@@ -99,6 +110,7 @@ from ...errors import ConversionError, InvalidGeometryError, SurfprepError
 from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs
+from .close_gaps import closed_in_geometry
 from .cut import covered_holes_dropped, cut_under_patches
 from .jobs import (
     PatchOrigin,
@@ -239,7 +251,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         Called before each approximant and after the last.
     stage : callable(str), optional
         Called as each stage begins ("reading the faces", "finding gaps, holes and
-        overlaps", "approximants", "joining, sewing and checking").
+        overlaps", "approximants", "joining, sewing and checking", "closing gaps in the
+        geometry").
 
     Returns
     -------
@@ -258,7 +271,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     ...     return interpolate_surface(np.stack([x, y, np.sin(x) * np.cos(y)], axis=-1))
     >>> faces = [surfprep.make_face(patch(0.0, 1.0)), surfprep.make_face(patch(1.001, 2.0))]
     >>> healed = surfprep.heal(faces, gap_tol=0.01, continuity="G1")
-    >>> free = healed.report()["free_edges"]     # sewn at 1e-7 x size: open before, closed after
+    >>> free = healed.report()["free_edges"]     # in the geometry at 1e-7 x size: open, closed
     >>> free["tight_before"], free["tight_after"]
     (8, 6)
     >>> join = healed.report()["shared_edges"][0]   # measured on the surfaces
@@ -354,7 +367,10 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     if result.tight_free_edges_after > result.tight_free_edges_before:
         result, done, snapped = tight_round(
             result, done, snapped, dropped, functools.partial(again, skipped=notes_so_far),
-            before, work=work, model=model, gap_tol=gap_tol)
+            before, model=model, gap_tol=gap_tol)
+    say("closing gaps in the geometry")
+    result = closed_in_geometry(result, size=model.size, allowed=tol if tol is not None else gap_tol)
+    result = dataclasses.replace(result, time_s=time.perf_counter() - start)
     result.extra["replace"] = replace
     result.extra["free_loops"] = [loop.as_dict() for loop in loops]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]

@@ -59,8 +59,10 @@ class HealResult:
     free_edges_before, free_edges_after : int
         Free edges after sewing at ``gap_tol`` (input) and in the result.
     tight_free_edges_before, tight_free_edges_after : int
-        Free edges when the input faces, and the output faces before sewing, are
-        sewn at ``TIGHT_FACTOR`` x size: edges not closed in the geometry.
+        Free edges in the geometry at ``TIGHT_FACTOR`` x size, of the input and of the
+        result sewn at ``gap_tol``: free edges plus, per shared edge whose faces lie
+        farther apart than that (measured on the faces, :mod:`surfprep.plugin.occ.gaps`),
+        one per face.
     valid_before, valid_after : bool
         ``BRepCheck_Analyzer`` on the input shape and on the result.
     max_edge_tolerance : float
@@ -129,4 +131,5 @@ class HealResult:
             "max_edge_tolerance": self.max_edge_tolerance,
             "replace": self.extra.get("replace"),
             "free_loops": self.extra.get("free_loops", []),
+            "closed_gaps": self.extra.get("closed_gaps", {}),
         }

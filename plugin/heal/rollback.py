@@ -27,6 +27,7 @@ from ...algorithms.projection import project_to_surface
 from ...algorithms.trimmed import TrimmedFace
 from ..io import CadModel
 from ..occ.faces import make_face
+from ..occ.gaps import gaps_in_geometry
 from ..occ.shapes import (
     FaceNames,
     all_faces,
@@ -73,23 +74,22 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
     return make_face(surface, reversed=bool(np.dot(n_new, n_old) < 0))
 
 
-def tight_round(result, done, snapped, dropped, again, before: Before, *, work, model,
-                 gap_tol: float):
+def tight_round(result, done, snapped, dropped, again, before: Before, *, model,
+                gap_tol: float):
     """With more free edges in the geometry (sewn at ``TIGHT_FACTOR`` x size) than the
     input had, the approximants along the new ones (:func:`_opened_in_geometry`) taken
     back and the rest joined again (``again``, :func:`no_worse_than_before`, from the
     same drops, so its notes say again what it takes back); kept when that leaves
     fewer, with a note."""
     network = result.network
-    kept_drops = [d for d in dropped if d in set(result.dropped)]
-    blame = _opened_in_geometry(work, done, network, kept_drops, before, model, gap_tol)
+    blame = _opened_in_geometry(result.model.shape, done, network, before, model, gap_tol)
     if not blame:
         return result, done, snapped
     retry, retry_done, retry_snapped = again(without_jobs(done, blame), dropped)
     if retry.tight_free_edges_after >= result.tight_free_edges_after:
         return result, done, snapped
     what = sorted({f"{done[k][0].origin.kind} {done[k][0].origin.index}" for k in blame})
-    note = (f"free edges in the geometry (sewn at {TIGHT_FACTOR:g} x size) "
+    note = (f"free edges in the geometry (measured on the faces at {TIGHT_FACTOR:g} x size) "
             f"{result.tight_free_edges_before} -> {result.tight_free_edges_after} with them, "
             f"{retry.tight_free_edges_after} without: taken back (faces kept as they were): "
             f"{', '.join(what)}")
@@ -325,9 +325,9 @@ class Before:
     @classmethod
     def of(cls, model: CadModel, gap_tol: float) -> Before:
         sewn, _ = sew(list(model.faces), gap_tol)
-        tight, _ = sew(list(model.faces), TIGHT_FACTOR * model.size)
-        return cls(count_free_edges(sewn), count_free_edges(tight), is_valid(model.shape),
-                   boundary_edge_points(sewn, 129), boundary_edge_points(tight, 129))
+        tight = gaps_in_geometry(sewn, TIGHT_FACTOR * model.size, samples=129)
+        return cls(count_free_edges(sewn), tight.free_in_geometry, is_valid(model.shape),
+                   boundary_edge_points(sewn, 129), list(tight.polylines))
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,
@@ -340,7 +340,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
     out_names = tuple(_sewn_name(f, sewing, names, originals + new_faces) for f in out_faces)
     result_model = CadModel(shape, out_faces, out_names, (None,) * len(out_faces),
                             model.length_unit, None, model.file_format)
-    tight_after, _ = sew(originals + new_faces, TIGHT_FACTOR * model.size)   # unsewn output
+
     reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
                                 la.artificial_share, la.converged, la.tol, deviation)
                     for (job, la), deviation in zip(done, deviations))
@@ -349,7 +349,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
         network=network, dropped=tuple(dropped), skipped=tuple(skipped),
         free_edges_before=before.free_edges, free_edges_after=count_free_edges(shape),
         tight_free_edges_before=before.tight_free_edges,
-        tight_free_edges_after=count_free_edges(tight_after),
+        tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * model.size).free_in_geometry,
         valid_before=before.valid, valid_after=is_valid(shape),
         max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
         continuity=continuity, time_s=time.perf_counter() - start,
@@ -374,17 +374,16 @@ def _output_faces(work, done, network, dropped) -> tuple[list, list, FaceNames]:
     return originals, new_faces, names
 
 
-def _opened_in_geometry(work, done, network, dropped, before: Before, model, gap_tol: float
+def _opened_in_geometry(shape, done, network, before: Before, model, gap_tol: float
                         ) -> set[int]:
-    """The approximants (indices of ``done``) along free edges that the result's faces
-    sewn at ``TIGHT_FACTOR`` x size have and the input's have not: gaps the approximants
-    opened in the geometry (a corner off a neighbour's short edge) where sewing at
-    ``gap_tol`` hides them."""
+    """The approximants (indices of ``done``) along free edges in the geometry (at
+    ``TIGHT_FACTOR`` x size, :func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`) that the
+    result ``shape`` has and the input has not: gaps the approximants opened in the
+    geometry (a corner off a neighbour's short edge) where sewing at ``gap_tol`` hides
+    them."""
     if network is None:
         return set()
-    originals, new_faces, _ = _output_faces(work, done, network, dropped)
-    tight, _ = sew(originals + new_faces, TIGHT_FACTOR * model.size)
-    free = boundary_edge_points(tight, 9)
+    free = list(gaps_in_geometry(shape, TIGHT_FACTOR * model.size).polylines)
     if not free:
         return set()
     known = (_polylines_along(before.tight_lines, free, gap_tol) if before.tight_lines

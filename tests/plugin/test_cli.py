@@ -538,4 +538,5 @@ def test_heal_says_its_stages(capsys, tmp_path):
     lines = [ln.strip("\r") for ln in err.splitlines()]
     stages = [ln for ln in lines if ln.startswith("heal: ")]
     assert stages == ["heal: reading the faces", "heal: finding gaps, holes and overlaps",
-                      "heal: approximants", "heal: joining, sewing and checking"]
+                      "heal: approximants", "heal: joining, sewing and checking",
+                      "heal: closing gaps in the geometry"]

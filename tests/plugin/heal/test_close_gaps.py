@@ -1,0 +1,120 @@
+"""Gaps closed in the geometry after sewing (plugin/heal/close_gaps.py): the faces along
+an edge sewing closed by tolerance moved onto one common curve, measured densely on the
+surfaces, the analytic faces and the faces far from the gap untouched."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from OCP.BRep import BRep_Tool
+from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+from OCP.Geom import Geom_Plane
+from OCP.gp import gp_Dir, gp_Pnt
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+from OCP.TopExp import TopExp
+from OCP.TopoDS import TopoDS
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+
+from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.plugin.heal.close_gaps import close_gaps
+from surfprep.plugin.occ.faces import make_face
+from surfprep.plugin.occ.shapes import all_faces, is_valid, max_edge_tolerance, sew
+
+TIGHT = 1e-7
+
+
+def _patch(x0, x1, dz=0.0, n=6):
+    x, y = np.meshgrid(np.linspace(x0, x1, n), np.linspace(0, 1, n), indexing="ij")
+    return interpolate_surface(np.stack([x, y, 0.1 * np.sin(2 * x) * np.cos(y) + dz * (x >= 1.0 - 1e-12)],
+                                        axis=-1))
+
+
+def _shared(shape):
+    """(edge, face a, face b) of every edge two faces share."""
+    edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
+    TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
+    out = []
+    for k in range(1, edge_faces.Extent() + 1):
+        faces = list(edge_faces.FindFromIndex(k))
+        if len(faces) == 2:
+            out.append((TopoDS.Edge_s(edge_faces.FindKey(k)), TopoDS.Face_s(faces[0]),
+                        TopoDS.Face_s(faces[1])))
+    return out
+
+
+def _images(edge, face, n=2001):
+    curve, surface = BRepAdaptor_Curve2d(edge, face), BRepAdaptor_Surface(face)
+    t = np.linspace(curve.FirstParameter(), curve.LastParameter(), n)
+    return np.array([surface.Value(*curve.Value(x).Coord()).Coord() for x in t])
+
+
+def _gap(edge, a, b):
+    """Largest distance between the two faces' points along the edge, at equal parameters."""
+    return float(np.max(np.linalg.norm(_images(edge, a) - _images(edge, b), axis=1)))
+
+
+def test_two_patches_a_step_apart_meet_in_the_geometry_after_closing():
+    # the second patch lies 2e-4 higher: sewing at 1e-3 joins them by raising the edge's
+    # tolerance; closing moves both onto one curve and the edge tolerance falls with it
+    patches = [_patch(0.0, 1.0), _patch(1.0, 2.0, dz=2e-4)]
+    shape, _ = sew([make_face(p) for p in patches], 1e-3)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)
+    assert max_edge_tolerance(shape) >= 1e-4
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 0)
+    assert len(closed.moved) == 2 and all(m["moved"] <= 2e-4 for m in closed.moved)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT                        # measured on 2001 points
+    assert BRep_Tool.Tolerance_s(edge) <= TIGHT
+    assert is_valid(shape)
+    # the free edges held: each face's far side is where it was
+    v = np.linspace(0.0, 1.0, 201)
+    for face in all_faces(shape):
+        surface = BRep_Tool.Surface_s(face)
+        left = surface.Value(0.5, 0.5).X() < 1.0
+        patch, u = (patches[0], 0.0) if left else (patches[1], 1.0)
+        new = np.array([surface.Value(u, x).Coord() for x in v])
+        assert np.max(np.linalg.norm(new - patch.evaluate(np.full_like(v, u), v), axis=1)) <= TIGHT
+
+
+def test_an_analytic_plane_stays_and_the_b_spline_comes_to_it():
+    plane = Geom_Plane(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))
+    flat = BRepBuilderAPI_MakeFace(plane, -1.0, 0.0, 0.0, 1.0, 1e-7).Face()   # x in [-1, 0]
+    x, y = np.meshgrid(np.linspace(0, 1, 6), np.linspace(0, 1, 6), indexing="ij")
+    lifted = interpolate_surface(np.stack([x, y, 3e-4 * (1 - x) + 0.05 * x ** 2], axis=-1))
+    shape, _ = sew([flat, make_face(lifted)], 1e-3)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) == pytest.approx(3e-4, rel=1e-6)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert closed.open_after == 0 and len(closed.moved) == 1
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT
+    planes = [f for f in all_faces(shape) if isinstance(BRep_Tool.Surface_s(f), Geom_Plane)]
+    assert len(planes) == 1                                  # still a plane, z = 0
+    s = BRepAdaptor_Surface(planes[0])
+    assert s.Value(-0.5, 0.5).Z() == 0.0
+    assert is_valid(shape)
+
+
+def test_a_gap_no_b_spline_can_close_is_left_with_a_note():
+    flat = [BRepBuilderAPI_MakeFace(Geom_Plane(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1)), x0, x0 + 1.0,
+                                    0.0, 1.0, 1e-7).Face() for x0, z in ((0.0, 0.0), (1.0, 2e-4))]
+    shape, _ = sew(flat, 1e-3)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 1)
+    assert closed.moved == ()
+    assert any("cannot move" in n for n in closed.notes)
+    assert is_valid(shape)
+
+
+def test_a_face_that_would_move_too_far_is_kept():
+    faces = [make_face(_patch(0.0, 1.0)), make_face(_patch(1.0, 2.0, dz=2e-4))]
+    shape, _ = sew(faces, 1e-3)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-5)
+    assert closed.open_after == 1 and closed.moved == ()
+    assert sum("would move" in n for n in closed.notes) == 2
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)   # nothing changed
+    assert is_valid(shape)
