@@ -43,6 +43,7 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineSurface
+from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
@@ -51,15 +52,17 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
+from ...algorithms.curve import NurbsCurve
 from ...algorithms.fitting import interpolate_curve
 from ...algorithms.healing.edge_fit import EdgeFit, EdgeTarget, fit_to_edges
 from ...algorithms.healing.edge_targets import on_surface, pinned_ends, roughness, spread_ends
 from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
+from ..occ.edges import EXACT_2D, converts_exactly
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
-from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_from_occ, surface_to_occ
+from ..occ.geom import curve2d_to_occ, curve_from_occ, curve_to_occ, surface_from_occ, surface_to_occ
 from ..occ.shapes import is_valid, max_edge_tolerance
 from .result import HealResult
 from .rollback import TIGHT_FACTOR
@@ -136,6 +139,8 @@ class _Edge:
     seam: bool = False
     degenerated: bool = False
     gap: float = 0.0
+    curves: dict = field(default_factory=dict)      # (i, reverse) -> NurbsCurve or None
+    surfaces: dict = field(default_factory=dict)    # face -> NurbsSurface or None (shared)
 
 
 @dataclass
@@ -157,7 +162,9 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
     TopExp.MapShapes_s(shape, TopAbs_VERTEX, vertices)
     edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
-    edges = [_read_edge(edge_faces, k, faces, vertices) for k in range(1, edge_faces.Extent() + 1)]
+    shared: dict = {}                   # the faces' surfaces, read once
+    edges = [_read_edge(edge_faces, k, faces, vertices, shared)
+             for k in range(1, edge_faces.Extent() + 1)]
     probe = np.linspace(0.0, 1.0, PROBE_SAMPLES)
     for e in edges:
         if len(e.faces) >= 2:
@@ -243,7 +250,7 @@ def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> Close
 
 
 # ------------------------------------------------------------------ reading
-def _read_edge(edge_faces, k: int, faces, vertices) -> _Edge:
+def _read_edge(edge_faces, k: int, faces, vertices, shared: dict) -> _Edge:
     edge = TopoDS.Edge_s(edge_faces.FindKey(k))
     indices, ranges = [], []
     for f in edge_faces.FindFromIndex(k):
@@ -254,7 +261,8 @@ def _read_edge(edge_faces, k: int, faces, vertices) -> _Edge:
     first = vertices.FindIndex(TopExp.FirstVertex_s(edge))
     last = vertices.FindIndex(TopExp.LastVertex_s(edge))
     seam = len(indices) == 1 and BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces.FindKey(indices[0])))
-    return _Edge(edge, indices, ranges, first, last, seam, BRep_Tool.Degenerated_s(edge))
+    return _Edge(edge, indices, ranges, first, last, seam, BRep_Tool.Degenerated_s(edge),
+                 surfaces=shared)
 
 
 def _edges_by_face(edges: list[_Edge]) -> dict[int, list[_Edge]]:
@@ -272,16 +280,46 @@ def _pcurve(e: _Edge, i: int, faces, reverse: bool = False):
 
 
 def _uv(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
-    """The pcurve of ``e`` on its ``i``-th face at ``s`` in [0, 1] of its range."""
-    curve = _pcurve(e, i, faces, reverse)
+    """The pcurve of ``e`` on its ``i``-th face at ``s`` in [0, 1] of its range
+    (evaluated as a NURBS curve when it converts with its parameter, B-splines and lines,
+    else point by point)."""
     a, b = e.ranges[i]
-    return np.array([curve.Value(t).Coord() for t in a + s * (b - a)])
+    t = a + s * (b - a)
+    key = (i, reverse)
+    if key not in e.curves:
+        curve = _pcurve(e, i, faces, reverse)
+        e.curves[key] = curve
+        if converts_exactly(curve, EXACT_2D, Geom2d_TrimmedCurve):
+            try:
+                e.curves[key] = curve_from_occ(curve, (min(a, b), max(a, b)))
+            except SurfprepError:
+                pass
+    curve = e.curves[key]
+    if isinstance(curve, NurbsCurve):
+        lo, hi = curve.domain
+        return curve.evaluate(np.clip(t, lo, hi))
+    return np.array([curve.Value(x).Coord() for x in t])
 
 
 def _occ_images(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
-    """``S_F(pc_F(t))`` by OpenCascade (any surface), (len(s), 3)."""
-    surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(e.faces[i])))
-    return np.array([surface.Value(u, v).Coord() for u, v in _uv(e, i, faces, s, reverse)])
+    """``S_F(pc_F(t))`` for any surface, (len(s), 3): a B-spline surface evaluated as a
+    NURBS surface where the parameters lie in its domain, others by OpenCascade."""
+    f = e.faces[i]
+    if f not in e.surfaces:
+        surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f)))
+        e.surfaces[f] = (surface, None)
+        if isinstance(surface, Geom_BSplineSurface):
+            try:
+                e.surfaces[f] = (surface, surface_from_occ(surface))
+            except SurfprepError:
+                pass
+    surface, nurbs = e.surfaces[f]
+    uv = _uv(e, i, faces, s, reverse)
+    if nurbs is not None:
+        u0, u1, v0, v1 = nurbs.domain
+        if np.all((uv[:, 0] >= u0) & (uv[:, 0] <= u1) & (uv[:, 1] >= v0) & (uv[:, 1] <= v1)):
+            return nurbs.evaluate(uv[:, 0], uv[:, 1])
+    return np.array([surface.Value(u, v).Coord() for u, v in uv])
 
 
 def _same_surface(faces, f: int, edges: list[_Edge]) -> NurbsSurface | None:
@@ -546,7 +584,7 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
             a, b = float(common.t[0]), float(common.t[-1])
             builder.Range(e.edge, a, b, True)
             now = replace(e, ranges=[BRep_Tool.Range_s(e.edge, TopoDS.Face_s(faces.FindKey(f)))
-                                     for f in e.faces])
+                                     for f in e.faces], curves={}, surfaces={})
             on_curve = curve.evaluate(a + check * (b - a))
             deviation = max(float(np.max(np.linalg.norm(_occ_images(now, i, faces, check, side) - on_curve,
                                                         axis=1)))

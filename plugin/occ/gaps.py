@@ -35,8 +35,10 @@ __all__ = ["PROBE_SAMPLES", "SIDE_SAMPLES", "GeometricGaps", "gaps_in_geometry"]
 PROBE_SAMPLES = 33
 #: ... and per face where the distance to the other face's points is measured otherwise
 SIDE_SAMPLES = 129
-#: Gauss-Newton steps from the nearest sample to the closest point
+#: Gauss-Newton steps from the nearest sample to the closest point, for this many of a
+#: side's points farthest from the other side's polyline
 _NEWTON_STEPS = 3
+_REFINED = 8
 
 
 @dataclass(frozen=True)
@@ -153,6 +155,23 @@ def _gap(edge: TopoDS_Edge, faces: list, tight: float) -> float:
         for j, other in enumerate(sides):
             if i == j:
                 continue
-            nearest = cKDTree(dense[j]).query(pts)[1]
-            worst = max(worst, max(other.distance(q, s[n]) for q, n in zip(pts, nearest)))
+            # the distance to the other side's polyline (above the true one by at most a
+            # chord's sagitta) ranks the points; the farthest are measured exactly
+            near, nearest = _to_polyline(pts, dense[j])
+            for n in np.argsort(near)[::-1][:_REFINED]:
+                worst = max(worst, other.distance(pts[n], s[nearest[n]]))
     return worst
+
+
+def _to_polyline(points: NDArray, line: NDArray) -> tuple[NDArray, NDArray]:
+    """Distance from each of ``points`` (m, 3) to the polyline ``line`` (n, 3) and the
+    index of its nearest vertex."""
+    nearest = cKDTree(line).query(points)[1]
+    best = np.linalg.norm(points - line[nearest], axis=1)
+    for shift in (-1, 0):                 # the segments before and after the vertex
+        a = np.clip(nearest + shift, 0, len(line) - 2)
+        d = line[a + 1] - line[a]
+        t = np.clip(np.einsum("ij,ij->i", points - line[a], d)
+                    / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(points - line[a] - t[:, None] * d, axis=1))
+    return best, nearest
