@@ -88,6 +88,9 @@ _STILL = 1e-3
 #: weight of an image's waves (:func:`~surfprep.algorithms.healing.edge_targets.roughness`)
 #: against its distance from the other faces in choosing the common curve
 _ROUGHNESS_WEIGHT = 2.0
+#: an edge measured wider than this times its gap before (or ``tight``) after the move
+#: takes its moved faces back
+_WIDER = 1.05
 #: passes of close_gaps at most (closed_in_geometry)
 _PASSES = 3
 #: smallest edge tolerance set
@@ -187,25 +190,31 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
             break
         fits, commons, positions, failed = _fit_round(moving, surfaces, edges, of_face, faces,
                                                      tight, allowed, notes)
-        if not failed:
-            journal = _Journal()
-            try:
-                after = _apply(fits, commons, edges, of_face, faces, vertices, positions, journal,
-                               surfaces)
-                failed = _invalid(fits, of_face, faces)
-            except Exception as exc:
-                if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
-                    raise
-                _undo(journal, shape)
-                notes.append(f"moving faces onto common edges failed ({exc}): put back as they were")
-                fits = {}
-                break
-            if not failed:
-                break
+        fixed |= failed             # kept; the faces that fit move (their gaps to these narrow)
+        if not fits:
+            continue
+        journal = _Journal()
+        try:
+            after = _apply(fits, commons, edges, of_face, faces, vertices, positions, journal,
+                           surfaces)
+            # a face whose edge ends farther from its neighbour than before (its surface
+            # waving between the fit's samples) is not moved either
+            bad = _invalid(fits, of_face, faces) | {
+                f for e in edges if after.get(id(e), 0.0) > _WIDER * max(e.gap, tight)
+                for f in e.faces if f in fits}
+        except Exception as exc:
+            if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
+                raise
             _undo(journal, shape)
-            notes.append(f"faces {sorted(f - 1 for f in failed)} fail BRepCheck once moved onto "
-                         "their neighbours' edges: kept as they are")
-        fixed |= failed             # the others fitted again with these where they are
+            notes.append(f"moving faces onto common edges failed ({exc}): put back as they were")
+            fits = {}
+            break
+        if not bad:
+            break
+        _undo(journal, shape)
+        notes.append(f"faces {sorted(f - 1 for f in bad)} fail BRepCheck, or leave an edge wider "
+                     "than it was, once moved onto their neighbours' edges: kept as they are")
+        fixed |= bad                # the others fitted again with these where they are
         fits = {}
     if not fits:
         return _unchanged(open_, largest, notes, f"{len(open_)} edges between faces that cannot "
