@@ -90,7 +90,7 @@ _STILL = 1e-3
 _ROUGHNESS_WEIGHT = 2.0
 #: an edge measured wider than this times its gap before (or ``tight``) after the move
 #: takes its moved faces back
-_WIDER = 1.05
+_WIDER = 2.0
 #: passes of close_gaps at most (closed_in_geometry)
 _PASSES = 3
 #: smallest edge tolerance set
@@ -190,9 +190,10 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
             break
         fits, commons, positions, failed = _fit_round(moving, surfaces, edges, of_face, faces,
                                                      tight, allowed, notes)
-        fixed |= failed             # kept; the faces that fit move (their gaps to these narrow)
-        if not fits:
-            continue
+        fixed |= failed
+        if failed and _round < _ROUNDS - 1 or not fits:
+            continue                # the others fitted again with these where they are
+        # (in the last round the faces that fit move, their gaps to the others narrowed)
         journal = _Journal()
         try:
             after = _apply(fits, commons, edges, of_face, faces, vertices, positions, journal,
