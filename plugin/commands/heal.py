@@ -97,6 +97,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="which loops of free edges to fill: holes, whose surroundings "
                              "continue across them (default), also open boundaries such as "
                              "a sheet's edge or a pipe's end (all), or none")
+    parser.add_argument("--no-close-gaps", action="store_false", dest="close_gaps",
+                        help="leave the edges sewing closed by raising their tolerance as they "
+                             "are (by default the B-spline faces along them are moved onto "
+                             "one common curve per edge: the gaps close in the geometry)")
     parser.add_argument("--job-time-limit", type=seconds_argument,
                         default=DEFAULT_JOB_TIME_LIMIT, metavar="S", dest="job_time_limit",
                         help="stop an approximant that takes longer than S seconds to build, "
@@ -163,7 +167,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         result = heal(model, tol=args.tol, continuity=args.continuity, gap_tol=args.gap_tol,
                       patches=args.patches, overlap=args.overlap,
                       split_faces=args.split_faces, replace=args.replace,
-                      meshes=args.meshes, fill=args.fill, progress=progress,
+                      meshes=args.meshes, fill=args.fill, close_gaps=args.close_gaps,
+                      progress=progress,
                       stage=lambda what: console.stage(f"heal: {what}"))
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
               "repaired": repaired_report(model)}

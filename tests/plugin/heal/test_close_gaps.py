@@ -118,3 +118,24 @@ def test_a_face_that_would_move_too_far_is_kept():
     [(edge, a, b)] = _shared(shape)
     assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)   # nothing changed
     assert is_valid(shape)
+
+
+@pytest.mark.slow
+def test_heal_closes_the_capsules_gaps_unless_told_not_to():
+    """The bundled Mars capsule: sewing closes its 10 open edges (up to 0.047 apart) by
+    raising their tolerance to 0.049; heal moves the six B-spline faces along them onto
+    common curves (largest edge tolerance 4.1e-6, each face within gap_tol of where it
+    was); --no-close-gaps / close_gaps=False leaves them as sewing does."""
+    import surfprep
+    from helpers.paths import SAMPLES
+
+    path = SAMPLES / "overture_marscapsule_proe.igs"
+    closed = surfprep.heal(path)
+    report = closed.report()["closed_gaps"]
+    assert report["open_edges_before"] == 10 and report["open_edges_after"] == 0
+    assert all(m["moved"] <= closed.gap_tol for m in report["faces_moved"])
+    assert closed.max_edge_tolerance < 1e-5 and closed.valid_after
+    kept = surfprep.heal(path, close_gaps=False)
+    assert kept.report()["closed_gaps"] == {}
+    assert kept.max_edge_tolerance > 0.04
+    assert kept.tight_free_edges_after > closed.tight_free_edges_after
