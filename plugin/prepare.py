@@ -100,7 +100,8 @@ class PrepareResult:
     stages : tuple of StageReport
         One per stage of :data:`STAGES`, in order.
     face_status : tuple of str
-        Per face of :attr:`model`: ``"untouched"``, ``"healed"`` (an approximant or a
+        Per face of :attr:`model`: ``"untouched"``, ``"healed"`` (an approximant, a face
+        moved onto its neighbours' edges, or a
         filled hole) or ``"reparametrized"``.
     curves : IntersectionResult or None
         The intersect stage's curves.
@@ -289,9 +290,12 @@ def _heal(model: CadModel, continuity: str, tol: float | None, tick):
                "valid": f"{report['valid']['before']} -> {report['valid']['after']}",
                "worst_deviation": max((p["deviation_from_input"] for p in report["patches"]),
                                       default=0.0)}
-    if not report["patches"] and result.model.n_faces == model.n_faces:
+    moved = [m["face"] for m in report.get("closed_gaps", {}).get("faces_moved", [])]
+    summary["faces_moved"] = len(moved)
+    if not report["patches"] and not moved and result.model.n_faces == model.n_faces:
         summary["note"] = "nothing to heal"
     healed = _new_faces(model, result.model)
+    healed[[k for k in moved if k < healed.size]] = True     # moved onto common edges
     return summary, report, (result.model, healed)
 
 

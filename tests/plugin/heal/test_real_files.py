@@ -40,7 +40,9 @@ def test_microstation_gaps_fewer_geometric_free_edges(data_dir):
     hole and kept open only because its patch landed on faces)."""
     path = data_dir / "occt_k1geo_microstation.stp"
     r = surfprep.heal(path)
-    assert r.tight_free_edges_after <= 11 < r.tight_free_edges_before
+    # measured on the faces (not the file's edge curves) the input has 55 free edges in
+    # the geometry; faces moved onto common curves close all but 7 of the 22 open edges
+    assert r.tight_free_edges_after <= 16 < r.tight_free_edges_before == 55
     assert r.free_edges_after <= r.free_edges_before
     assert r.valid_after
     assert len(r.joins) >= 5 and all(j.max_gap < 1e-9 for j in r.joins)
