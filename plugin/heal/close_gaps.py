@@ -314,16 +314,7 @@ def _uv(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
 def _occ_images(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
     """``S_F(pc_F(t))`` for any surface, (len(s), 3): a B-spline surface evaluated as a
     NURBS surface where the parameters lie in its domain, others by OpenCascade."""
-    f = e.faces[i]
-    if f not in e.surfaces:
-        surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f)))
-        e.surfaces[f] = (surface, None)
-        if isinstance(surface, Geom_BSplineSurface):
-            try:
-                e.surfaces[f] = (surface, surface_from_occ(surface))
-            except SurfprepError:
-                pass
-    surface, nurbs = e.surfaces[f]
+    surface, nurbs = _face_surface(e, e.faces[i], faces)
     uv = _uv(e, i, faces, s, reverse)
     if nurbs is not None:
         u0, u1, v0, v1 = nurbs.domain
@@ -332,16 +323,26 @@ def _occ_images(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> N
     return np.array([surface.Value(u, v).Coord() for u, v in uv])
 
 
+def _face_surface(e: _Edge, f: int, faces):
+    """Face ``f``'s surface and, for a B-spline, its :class:`NurbsSurface` (else None),
+    converted once (the cache is shared by all edges of the shape)."""
+    if f not in e.surfaces:
+        surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f)))
+        e.surfaces[f] = (surface, None)
+        if isinstance(surface, Geom_BSplineSurface):
+            try:
+                e.surfaces[f] = (surface, surface_from_occ(surface))
+            except SurfprepError:
+                pass
+    return e.surfaces[f]
+
+
 def _same_surface(faces, f: int, edges: list[_Edge]) -> NurbsSurface | None:
     """Face ``f``'s B-spline surface as a :class:`NurbsSurface` in the same parameters
     (checked at its pcurves' ends and middles), or None for a surface that is not a
     B-spline or does not convert exactly."""
-    surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f)))
-    if not isinstance(surface, Geom_BSplineSurface):
-        return None
-    try:
-        nurbs = surface_from_occ(surface)
-    except SurfprepError:
+    surface, nurbs = _face_surface(next(e for e in edges if f in e.faces), f, faces)
+    if nurbs is None:
         return None
     uv = np.concatenate([_uv(e, e.faces.index(f), faces, np.array([0.0, 0.5, 1.0]))
                          for e in edges if f in e.faces])

@@ -5,7 +5,7 @@ The approximants are joined and snapped (:func:`connect`,
 faces at ``gap_tol``, checked, and measured against the input faces
 (:func:`no_worse_than_before`); approximants and duplicate drops that leave more free
 edges at ``gap_tol`` than the input had are taken back and the rest joined again, and
-then those that leave more free edges in the geometry (the faces sewn at
+then those that leave more free edges in the geometry (measured on the faces at
 ``TIGHT_FACTOR`` x size) than the input had (:func:`tight_round`).
 """
 
@@ -76,7 +76,7 @@ def _oriented_face(surface, reference: TrimmedFace | None) -> TopoDS_Face:
 
 def tight_round(result, done, snapped, dropped, again, before: Before, *, model,
                 gap_tol: float):
-    """With more free edges in the geometry (sewn at ``TIGHT_FACTOR`` x size) than the
+    """With more free edges in the geometry (at ``TIGHT_FACTOR`` x size) than the
     input had, the approximants along the new ones (:func:`_opened_in_geometry`) taken
     back and the rest joined again (``again``, :func:`no_worse_than_before`, from the
     same drops, so its notes say again what it takes back); kept when that leaves
@@ -313,7 +313,8 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
 
 @dataclass(frozen=True)
 class Before:
-    """The input's figures: free edges sewn at ``gap_tol`` and at ``TIGHT_FACTOR`` x size,
+    """The input's figures: free edges sewn at ``gap_tol``, in the geometry at
+    ``TIGHT_FACTOR`` x size (:func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`),
     validity."""
 
     free_edges: int
