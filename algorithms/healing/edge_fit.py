@@ -62,6 +62,10 @@ MIN_SPAN_SAMPLES = 12
 _MIN_DEGREE = 3
 #: a span is split into this many parts at most in one round
 _MAX_SPLIT = 8
+#: a sample lies on a side of the domain within this share of its width
+_ON_SIDE = 1e-9
+#: samples at an end of a target its slope there is measured on
+_SLOPE_SAMPLES = 5
 
 
 @dataclass(frozen=True)
@@ -179,6 +183,7 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
     # bilinear net only refines towards the targets' kinks at the vertices linearly
     s = surface.elevate_degree(max(0, _MIN_DEGREE - surface.degree_u),
                                max(0, _MIN_DEGREE - surface.degree_v))
+    s, inserted = _with_kinks(s, targets, tol)
     for round_ in range(max_rounds + 1):
         matrix = _collocation(s, uv)
         offset = points - s.evaluate(uv[:, 0], uv[:, 1])
@@ -196,6 +201,68 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
     residual = float(np.max(np.linalg.norm(moved.evaluate(uv[:, 0], uv[:, 1]) - points, axis=1)))
     return EdgeFit(moved, residual, float(np.max(np.linalg.norm(d, axis=1), initial=0.0)),
                    inserted, residual <= tol)
+
+
+def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
+                ) -> tuple[NurbsSurface, int]:
+    """``s`` with a knot of full multiplicity (the degree) where two targets along the
+    same side of the domain meet and the displacement they ask for turns there, and
+    the count inserted.
+
+    Two edges of a face along one side of its domain (a side split by a vertex) lie
+    next to two different neighbours, whose edges meet at the vertex at a slight angle:
+    the displacement ``target - S`` along that side is continuous there but its slope
+    jumps. A smooth spline only follows a kink by knots graded towards it, and being a
+    tensor product it pays for each of those knots with a whole knot line (the Mars
+    capsule's faces grew from 7 x 4 to 105 x 139 control points); a knot of multiplicity
+    ``degree`` at the vertex lets the displacement turn there exactly (the surface is
+    then C0 along that iso-line, its tangent planes turning by the neighbours' angle,
+    ``|jump| / |S_t|``, a few 1e-4 rad). Inserted only where the jump times the knot
+    span holding the vertex exceeds ``tol`` (a smooth spline meets smaller kinks)."""
+    ends: dict[tuple[int, int, float], list[float]] = {}
+    domain = s.domain
+    for t in targets:
+        if t.uv.shape[0] < _SLOPE_SAMPLES:
+            continue
+        offset = t.points - s.evaluate(t.uv[:, 0], t.uv[:, 1])
+        for k in (0, 1):                         # the target runs along parameter k ...
+            other = 1 - k
+            lo, hi = domain[2 * other], domain[2 * other + 1]
+            width = hi - lo
+            side = next((j for j, value in enumerate((lo, hi))
+                         if np.all(np.abs(t.uv[:, other] - value) <= _ON_SIDE * width)), None)
+            if side is None:                     # ... on a side other = lo or hi
+                continue
+            for end in (slice(0, _SLOPE_SAMPLES), slice(-1, -_SLOPE_SAMPLES - 1, -1)):
+                at = float(t.uv[end, k][0])
+                step = t.uv[end, k] - at
+                if not abs(step[-1]) > 0.0:
+                    continue
+                # d offset / d param at the end: a parabola through the end's samples
+                slope = np.polyfit(step / step[-1], offset[end], 2)[1] / step[-1]
+                moves = float(np.max(np.linalg.norm(offset, axis=1)))
+                ends.setdefault((k, side, round(at, 12)), []).append((slope, moves))
+    new: tuple[dict[float, int], dict[float, int]] = ({}, {})
+    for (k, _, at), meeting in ends.items():
+        knots, degree = (s.knots_u, s.degree_u) if k == 0 else (s.knots_v, s.degree_v)
+        if len(meeting) < 2 or not knots[degree] < at < knots[-degree - 1]:
+            continue
+        if max(moves for _, moves in meeting) <= tol:
+            continue
+        span = int(find_span(knots, degree, np.array([at]))[0])
+        jump = max(float(np.linalg.norm(a - b)) for a, _ in meeting for b, _ in meeting)
+        # a kink: multiplicity degree; a vertex the targets fade to: a break point
+        wanted = degree if jump * (knots[span + 1] - knots[span]) > tol else 1
+        new[k][at] = max(new[k].get(at, 0), wanted)
+    inserted = 0
+    for k, direction in ((0, "u"), (1, "v")):
+        for at, wanted in sorted(new[k].items()):
+            knots = s.knots_u if k == 0 else s.knots_v
+            have = int(np.count_nonzero(np.abs(knots - at) <= _ON_SIDE * (knots[-1] - knots[0])))
+            if have < wanted:
+                s = s.insert_knot(at, direction, wanted - have)
+                inserted += wanted - have
+    return s, inserted
 
 
 def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:

@@ -65,6 +65,48 @@ def test_a_wavy_interior_edge_is_met_densely_between_the_samples():
     assert fit.moved >= moved.max() - 1e-12             # the control points bound it
 
 
+def _tent_side(kink):
+    """A flat bicubic patch whose side u = 0 is split at v = 0.5 into two edges lifted
+    by ``1e-3 (1 - |v - 0.5| / 0.5)`` (kink) or ``1e-3 v^2`` (smooth)."""
+    x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5), indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1))
+
+    def lift(v):
+        return 1e-3 * (1 - np.abs(v - 0.5) / 0.5) if kink else 1e-3 * v ** 2
+
+    targets = []
+    for a, b in ((0.0, 0.5), (0.5, 1.0)):
+        v = np.linspace(a, b, 300)
+        targets.append(EdgeTarget(np.stack([0 * v, v], axis=1), np.stack([0 * v, v, lift(v)], axis=1)))
+    return flat, targets, lift
+
+
+def test_a_kink_where_two_edges_of_a_side_meet_is_one_knot_line_not_many():
+    """The displacement turns at the vertex between two edges of one side: a knot of
+    full multiplicity there meets it exactly (the Mars capsule's faces grew from 7 x 4
+    to 105 x 139 control points by knots graded towards such kinks)."""
+    flat, targets, lift = _tent_side(kink=True)
+    fit = fit_to_edges(flat, targets, tol=1e-8)
+    assert fit.converged
+    knots, counts = np.unique(fit.surface.knots_v, return_counts=True)
+    assert counts[np.isclose(knots, 0.5)].tolist() == [3]
+    assert fit.surface.n_control[1] <= 10, fit.surface.n_control
+    v = np.linspace(0, 1, 4001)                                 # 7x denser than the fit
+    miss = fit.surface.evaluate(0 * v, v) - np.stack([0 * v, v, lift(v)], axis=1)
+    assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
+
+
+def test_a_smooth_side_split_by_a_vertex_keeps_its_continuity():
+    flat, targets, lift = _tent_side(kink=False)
+    fit = fit_to_edges(flat, targets, tol=1e-8)
+    assert fit.converged
+    _, counts = np.unique(fit.surface.knots_v, return_counts=True)
+    assert counts[1:-1].max(initial=0) < fit.surface.degree_v      # no C0 knot line
+    v = np.linspace(0, 1, 4001)
+    miss = fit.surface.evaluate(0 * v, v) - np.stack([0 * v, v, lift(v)], axis=1)
+    assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
+
+
 def test_samples_too_sparse_for_the_tolerance_are_reported_not_converged():
     s = _graph()
     uv, points = _circle(s, 40)
