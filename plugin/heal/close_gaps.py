@@ -34,6 +34,7 @@ what fails is put back as it was.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -184,12 +185,13 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
     of_face = _edges_by_face(edges)
     fixed: set[int] = set()
     fits: dict = {}
+    done: dict = {}                     # fits by face and targets: a later round asks most again
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         if not moving:
             break
         fits, commons, positions, failed = _fit_round(moving, surfaces, edges, of_face, faces,
-                                                     tight, allowed, notes)
+                                                     tight, allowed, notes, done)
         fixed |= failed
         if failed and _round < _ROUNDS - 1 or not fits:
             continue                # the others fitted again with these where they are
@@ -372,10 +374,11 @@ class _Common:
 
 
 def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
-               tight: float, allowed: float, notes: list[str]):
+               tight: float, allowed: float, notes: list[str], done: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed: ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position},
-    failed faces)``."""
+    failed faces)``. ``done`` holds the fits of earlier rounds by face and targets (a
+    face whose neighbours all stayed as they were gets the same targets again)."""
     moving_set = set(moving)
     # even samples and Chebyshev-Lobatto points: dense at the vertices too, where two
     # edges' targets meet in a kink the fit resolves only with short knot spans (each
@@ -413,13 +416,19 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         if offset <= _STILL * tight:        # its edges are on it already: the surface stays
             fits[f] = (EdgeFit(surfaces[f], offset, 0.0, 0, True), 0.0)
             continue
-        try:
-            fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
-        except SurfprepError as exc:
-            failed.add(f)
-            notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({exc}); kept as it is")
-            continue
-        moved = _moved(surfaces[f], fit.surface, faces, f)
+        key = (f, _digest(targets))
+        if key in done:
+            fit, moved = done[key]
+        else:
+            try:
+                fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
+            except SurfprepError as exc:
+                failed.add(f)
+                notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({exc}); "
+                             "kept as it is")
+                continue
+            moved = _moved(surfaces[f], fit.surface, faces, f)
+            done[key] = fit, moved
         if fit.converged and moved <= allowed:
             fits[f] = (fit, moved)
             continue
@@ -428,6 +437,15 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
                else f"its fit leaves {fit.residual:.3g} > {_FIT_SHARE * tight:.3g}")
         notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({why}); kept as it is")
     return fits, commons, position, failed
+
+
+def _digest(targets: list[EdgeTarget]) -> bytes:
+    """A fingerprint of ``targets`` (their samples' bytes)."""
+    h = hashlib.blake2b(digest_size=16)
+    for t in targets:
+        h.update(t.uv.tobytes())
+        h.update(t.points.tobytes())
+    return h.digest()
 
 
 def _common(e: _Edge, s: NDArray, images, position, moving: set[int], surfaces, faces,
