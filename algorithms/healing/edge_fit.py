@@ -62,6 +62,10 @@ MIN_SPAN_SAMPLES = 12
 _MIN_DEGREE = 3
 #: a span is split into this many parts at most in one round
 _MAX_SPLIT = 8
+#: refinement stops when the largest miss has fallen by less than this share ...
+_PROGRESS = 0.1
+#: ... over this many rounds
+_STALLED = 8
 #: a sample lies on a side of the domain within this share of its width
 _ON_SIDE = 1e-9
 #: samples at an end of a target its slope there is measured on
@@ -184,14 +188,23 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
     s = surface.elevate_degree(max(0, _MIN_DEGREE - surface.degree_u),
                                max(0, _MIN_DEGREE - surface.degree_v))
     s, inserted = _with_kinks(s, targets, tol)
+    # a target along a side of the domain is the side's row of control points: knots
+    # along it meet it, splitting the spans across it only adds knot lines (degree 7
+    # nets of ICEM files were split down to spans of 1e-8 at their sides)
+    splits = np.concatenate([np.repeat([[_on_side(t.uv, k, s.domain) is None for k in (0, 1)]],
+                                       t.uv.shape[0], axis=0) for t in targets])
+    worst: list[float] = []
     for round_ in range(max_rounds + 1):
         matrix = _collocation(s, uv)
         offset = points - s.evaluate(uv[:, 0], uv[:, 1])
         d = _smooth_solve(matrix, offset, s.n_control)
         left = np.linalg.norm(matrix @ d - offset, axis=1)
-        if left.max() <= tol or round_ == max_rounds:
+        worst.append(float(left.max()))
+        if worst[-1] <= tol or round_ == max_rounds:
             break
-        refined = _refined(s, uv, left, tol, max_control)
+        if len(worst) > _STALLED and worst[-1] > (1.0 - _PROGRESS) * worst[-1 - _STALLED]:
+            break                       # knots no longer help (the misses lie where none can go)
+        refined = _refined(s, uv, splits, left, tol, max_control)
         if refined is None:
             break
         s, count = refined
@@ -226,12 +239,8 @@ def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
             continue
         offset = t.points - s.evaluate(t.uv[:, 0], t.uv[:, 1])
         for k in (0, 1):                         # the target runs along parameter k ...
-            other = 1 - k
-            lo, hi = domain[2 * other], domain[2 * other + 1]
-            width = hi - lo
-            side = next((j for j, value in enumerate((lo, hi))
-                         if np.all(np.abs(t.uv[:, other] - value) <= _ON_SIDE * width)), None)
-            if side is None:                     # ... on a side other = lo or hi
+            side = _on_side(t.uv, 1 - k, domain)
+            if side is None:                     # ... on a side of the domain
                 continue
             for end in (slice(0, _SLOPE_SAMPLES), slice(-1, -_SLOPE_SAMPLES - 1, -1)):
                 at = float(t.uv[end, k][0])
@@ -263,6 +272,14 @@ def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
                 s = s.insert_knot(at, direction, wanted - have)
                 inserted += wanted - have
     return s, inserted
+
+
+def _on_side(uv: NDArray, k: int, domain: tuple[float, float, float, float]) -> int | None:
+    """0 or 1 when all of ``uv`` (m, 2) lie on the side ``k = lo`` or ``k = hi`` of
+    ``domain`` (k = 0 for u), else None."""
+    lo, hi = domain[2 * k], domain[2 * k + 1]
+    return next((j for j, value in enumerate((lo, hi))
+                 if np.all(np.abs(uv[:, k] - value) <= _ON_SIDE * (hi - lo))), None)
 
 
 def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:
@@ -317,17 +334,18 @@ def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, shape: tuple[int, 
     return d
 
 
-def _refined(s: NurbsSurface, uv: NDArray, miss: NDArray, tol: float, max_control: int
-             ) -> tuple[NurbsSurface, int] | None:
+def _refined(s: NurbsSurface, uv: NDArray, splits: NDArray, miss: NDArray, tol: float,
+             max_control: int) -> tuple[NurbsSurface, int] | None:
     """``s`` with each span (in u and in v) holding a sample that misses its target by
     more than ``tol`` split into ``k`` equal parts, ``k = (miss / tol)^(1/4)`` (the
     error of a cubic falls as the fourth power of the span) between 2 and
     ``_MAX_SPLIT``, where the span holds at least ``MIN_SPAN_SAMPLES`` samples (finer
-    spans than the samples resolve would wave between them); None when nothing can be
+    spans than the samples resolve would wave between them); ``splits`` (m, 2) bool
+    says in which directions a sample's miss splits its spans. None when nothing can be
     inserted or the net would exceed ``max_control`` control points."""
     new = []
-    missed = miss > tol
     for knots, degree, k in ((s.knots_u, s.degree_u, 0), (s.knots_v, s.degree_v, 1)):
+        missed = (miss > tol) & splits[:, k]
         span = find_span(knots, degree, uv[:, k])
         held = np.bincount(span, minlength=knots.size)
         worst = np.zeros(knots.size)

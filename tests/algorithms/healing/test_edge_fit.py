@@ -107,6 +107,25 @@ def test_a_smooth_side_split_by_a_vertex_keeps_its_continuity():
     assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
 
 
+def test_a_wavy_side_is_met_by_knots_along_it_only():
+    """A side of the domain is its row of control points: knots across it would only
+    add knot lines (ICEM's degree 7 nets were split to spans of 1e-8 at their sides)."""
+    x, y = np.meshgrid(np.linspace(0, 1, 8), np.linspace(0, 1, 8), indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1), degree_u=7, degree_v=7)
+    v = np.linspace(0, 1, 2000)
+
+    def lift(v):
+        return 1e-3 * np.sin(7 * v) * np.exp(v)
+
+    edge = EdgeTarget(np.stack([0 * v, v], axis=1), np.stack([0 * v, v, lift(v)], axis=1))
+    fit = fit_to_edges(flat, [edge], tol=1e-8)
+    assert fit.converged and fit.inserted > 0
+    assert np.array_equal(fit.surface.knots_u, flat.knots_u)
+    dense = np.linspace(0, 1, 20001)
+    miss = fit.surface.evaluate(0 * dense, dense) - np.stack([0 * dense, dense, lift(dense)], axis=1)
+    assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
+
+
 def test_samples_too_sparse_for_the_tolerance_are_reported_not_converged():
     s = _graph()
     uv, points = _circle(s, 40)
