@@ -574,6 +574,8 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
     its faces' points are; its tolerance is set to 1.1 times that distance)."""
     builder = BRep_Builder()
     by_id = {id(e): e for e in edges}
+    # the faces' surfaces as they are now (the fixed ones' as read, the moved ones' put)
+    fresh = {f: pair for f, pair in (edges[0].surfaces if edges else {}).items() if f not in fits}
     for f, (fit, _) in fits.items():
         face = TopoDS.Face_s(faces.FindKey(f))
         location = TopLoc_Location()
@@ -594,8 +596,9 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
                         (float(common.t[0]), float(common.t[-1]))))
         journal.faces.append((face, raw, location, BRep_Tool.Tolerance_s(face), old))
         if fit.surface is not surfaces[f]:          # else only its pcurves change
-            builder.UpdateFace(face, surface_to_occ(fit.surface), TopLoc_Location(),
-                               BRep_Tool.Tolerance_s(face))
+            put = surface_to_occ(fit.surface)
+            builder.UpdateFace(face, put, TopLoc_Location(), BRep_Tool.Tolerance_s(face))
+            fresh[f] = (put, fit.surface)
         _put_pcurves(builder, face, new)
     check = np.linspace(0.0, 1.0, CHECK_SAMPLES)
     after = {}
@@ -613,7 +616,7 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
             a, b = float(common.t[0]), float(common.t[-1])
             builder.Range(e.edge, a, b, True)
             now = replace(e, ranges=[BRep_Tool.Range_s(e.edge, TopoDS.Face_s(faces.FindKey(f)))
-                                     for f in e.faces], curves={}, surfaces={})
+                                     for f in e.faces], curves={}, surfaces=fresh)
             on_curve = curve.evaluate(a + check * (b - a))
             deviation = max(float(np.max(np.linalg.norm(_occ_images(now, i, faces, check, side) - on_curve,
                                                         axis=1)))
