@@ -185,7 +185,7 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
     of_face = _edges_by_face(edges)
     fixed: set[int] = set()
     fits: dict = {}
-    done: dict = {}                     # fits by face and targets: a later round asks most again
+    done: dict = {}                     # common curves and fits: a later round asks most again
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         if not moving:
@@ -377,8 +377,9 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
                tight: float, allowed: float, notes: list[str], done: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed: ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position},
-    failed faces)``. ``done`` holds the fits of earlier rounds by face and targets (a
-    face whose neighbours all stayed as they were gets the same targets again)."""
+    failed faces)``. ``done`` holds the common curves and fits of earlier rounds, by
+    edge, the faces that move and the vertices, and by face and targets (a face whose
+    neighbours all stayed as they were gets the same targets again)."""
     moving_set = set(moving)
     # even samples and Chebyshev-Lobatto points: dense at the vertices too, where two
     # edges' targets meet in a kink the fit resolves only with short knot spans (each
@@ -399,8 +400,15 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         for i in range(len(e.faces)):
             images[id(e), i] = image(e, i, s)
     position = _vertex_positions(edges, moving_set, images, image)
-    commons = {key: _common(e, s, images, position, moving_set, surfaces, faces, tight)
-               for key, e in touched.items()}
+    commons = {}
+    for key, e in touched.items():
+        # the same when its faces move or stay as in an earlier round and its vertices
+        # are where they were
+        seen = ("common", key, tuple(f in moving_set for f in e.faces),
+                position[e.first].tobytes(), position[e.last].tobytes())
+        if seen not in done:
+            done[seen] = _common(e, s, images, position, moving_set, surfaces, faces, tight)
+        commons[key] = done[seen]
     fits, failed = {}, set()
     for f in moving:
         targets = []
@@ -416,7 +424,7 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         if offset <= _STILL * tight:        # its edges are on it already: the surface stays
             fits[f] = (EdgeFit(surfaces[f], offset, 0.0, 0, True), 0.0)
             continue
-        key = (f, _digest(targets))
+        key = ("fit", f, _digest(targets))
         if key in done:
             fit, moved = done[key]
         else:
