@@ -105,8 +105,9 @@ def test_healed_faces_are_told_apart():
     """The Mars capsule: the faces the healing replaced or moved onto their neighbours'
     edges are 'healed' (its approximants are taken back: they opened gaps in the
     geometry; six faces are moved to close the gaps sewing covered by tolerance), the
-    others are the input's own, and the copies of faces the file holds twice are gone."""
-    result = prepare(CAPSULE, intersect=False, reparam=False)  # moved faces hold many knots
+    others are the input's own (reparametrized or untouched), and the copies of faces
+    the file holds twice are gone."""
+    result = prepare(CAPSULE, intersect=False)
     heal = result.stage("heal")
     assert heal.status == "done"
     changed = heal.summary["patches"] + heal.summary["faces_moved"]
