@@ -68,6 +68,8 @@ _PROGRESS = 0.1
 _STALLED = 8
 #: a sample lies on a side of the domain within this share of its width
 _ON_SIDE = 1e-9
+#: samples on either side of a miss among which a kink inside a target is looked for
+_KINK_WINDOW = 8
 #: samples at an end of a target its slope there is measured on
 _SLOPE_SAMPLES = 5
 
@@ -204,11 +206,12 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
             break
         if len(worst) > _STALLED and worst[-1] > (1.0 - _PROGRESS) * worst[-1 - _STALLED]:
             break                       # knots no longer help (the misses lie where none can go)
-        refined = _refined(s, uv, splits, left, tol, max_control)
-        if refined is None:
+        kinked = _with_inner_kinks(s, targets, uv, left, tol)
+        refined = _refined(kinked[0], uv, splits, left, tol, max_control)
+        if refined is None and not kinked[1]:
             break
-        s, count = refined
-        inserted += count
+        s, count = refined if refined is not None else kinked
+        inserted += count + (kinked[1] if refined is not None else 0)
     net = s.control_points + d.reshape(s.control_points.shape)
     moved = s.construct_fast(net, s.knots_u, s.knots_v, s.degree_u, s.degree_v, s.weights)
     residual = float(np.max(np.linalg.norm(moved.evaluate(uv[:, 0], uv[:, 1]) - points, axis=1)))
@@ -272,6 +275,87 @@ def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
                 s = s.insert_knot(at, direction, wanted - have)
                 inserted += wanted - have
     return s, inserted
+
+
+def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArray,
+                      miss: NDArray, tol: float) -> tuple[NurbsSurface, int]:
+    """``s`` with a knot of full multiplicity where a target along a side of the domain
+    turns between two of its samples, and the count inserted.
+
+    The common curve of an edge is often a neighbour's boundary, which turns where the
+    neighbour's pcurve or surface has a knot of full multiplicity: the displacement has
+    a kink inside the edge. Refinement splits the spans around it until they hold too
+    few samples (``MIN_SPAN_SAMPLES``), and stalls; so where the samples missing by more
+    than ``tol`` lie in such a span along their side, the kink is located between them
+    (the crossing of the lines fitted to the offsets on either side, the split of the
+    window that fits them best) and a knot put there."""
+    domain = s.domain
+    start = 0
+    new: tuple[list[float], list[float]] = ([], [])
+    for t in targets:
+        m = t.uv.shape[0]
+        here = slice(start, start + m)
+        start += m
+        along = next((k for k in (0, 1) if _on_side(t.uv, 1 - k, domain) is not None), None)
+        missed = np.flatnonzero(miss[here] > tol)
+        if along is None or missed.size == 0:
+            continue
+        knots, degree = (s.knots_u, s.degree_u) if along == 0 else (s.knots_v, s.degree_v)
+        span_all = find_span(knots, degree, uv[:, along])
+        held = np.bincount(span_all, minlength=knots.size)
+        span = span_all[here]
+        for c in np.unique(span[missed]):
+            if held[c] >= MIN_SPAN_SAMPLES:
+                continue                        # refinement can still split it
+            in_span = missed[span[missed] == c]
+            j = int(in_span[np.argmax(miss[here][in_span])])
+            at = _kink(t, s, along, j, tol)
+            if at is not None and knots[degree] < at < knots[-degree - 1]:
+                new[along].append(at)
+    inserted = 0
+    for k, direction in ((0, "u"), (1, "v")):
+        for at in sorted(set(new[k])):
+            knots, degree = (s.knots_u, s.degree_u) if k == 0 else (s.knots_v, s.degree_v)
+            have = int(np.count_nonzero(np.abs(knots - at) <= _ON_SIDE * (knots[-1] - knots[0])))
+            if have < degree:
+                s = s.insert_knot(at, direction, degree - have)
+                inserted += degree - have
+    return s, inserted
+
+
+def _kink(t: EdgeTarget, s: NurbsSurface, k: int, j: int, tol: float) -> float | None:
+    """Where the offset ``target - S`` of ``t`` (m samples along parameter ``k``) turns
+    near its sample ``j``: of the splits of the ``2 _KINK_WINDOW + 1`` samples around
+    ``j`` into two runs of at least 3, the one whose two fitted lines leave the least,
+    and the parameter where those lines come closest; None when the window is too
+    short, the lines' slopes differ by less than ``tol`` over it, or they come
+    closest outside the gap between the runs' facing samples."""
+    lo, hi = max(0, j - _KINK_WINDOW), min(t.uv.shape[0], j + _KINK_WINDOW + 1)
+    if hi - lo < 6:
+        return None
+    x = t.uv[lo:hi, k]
+    y = t.points[lo:hi] - s.evaluate(t.uv[lo:hi, 0], t.uv[lo:hi, 1])
+    scale = float(np.max(np.abs(x - x[0]))) or 1.0
+    x = (x - x[0]) / scale
+    best = None
+    for c in range(3, x.size - 2):
+        lines, left = [], 0.0
+        for part in (slice(0, c), slice(c, x.size)):
+            coef, res, *_ = np.polyfit(x[part], y[part], 1, full=True)
+            lines.append(coef)
+            left += float(np.sum(res))
+        if best is None or left < best[0]:
+            best = (left, c, lines)
+    _, c, ((b1, a1), (b2, a2)) = best
+    db, da = b1 - b2, a1 - a2
+    # a turn the samples resolve: the two lines part by more than tol across the window
+    if float(np.linalg.norm(db)) * float(np.ptp(x)) <= tol:
+        return None
+    cross = -float(da @ db) / float(db @ db)
+    lo_x, hi_x = sorted((x[c - 1], x[c]))
+    if not lo_x <= cross <= hi_x:       # the lines meet beyond the runs: the turn lies
+        return None                     # outside the window
+    return float(t.uv[lo, k] + scale * cross)
 
 
 def _on_side(uv: NDArray, k: int, domain: tuple[float, float, float, float]) -> int | None:

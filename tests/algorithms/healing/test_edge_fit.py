@@ -107,6 +107,28 @@ def test_a_smooth_side_split_by_a_vertex_keeps_its_continuity():
     assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
 
 
+def test_a_kink_inside_one_edge_is_located_between_its_samples():
+    """A neighbour's boundary turns inside an edge (at its own knot): refinement alone
+    stalls when the spans around the turn hold too few samples; the turn is found
+    between two samples and a knot line put there."""
+    x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5), indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1))
+    kink = 0.3719
+
+    def lift(v):
+        return 1e-3 * np.where(v < kink, v / kink, (1 - v) / (1 - kink))
+
+    v = np.linspace(0, 1, 300)
+    edge = EdgeTarget(np.stack([0 * v, v], axis=1), np.stack([0 * v, v, lift(v)], axis=1))
+    fit = fit_to_edges(flat, [edge], tol=1e-8)
+    assert fit.converged
+    knots, counts = np.unique(fit.surface.knots_v, return_counts=True)
+    assert np.any((np.abs(knots - kink) < 1e-6) & (counts == 3))
+    dense = np.linspace(0, 1, 20001)
+    miss = fit.surface.evaluate(0 * dense, dense) - np.stack([0 * dense, dense, lift(dense)], axis=1)
+    assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
+
+
 def test_a_wavy_side_is_met_by_knots_along_it_only():
     """A side of the domain is its row of control points: knots across it would only
     add knot lines (ICEM's degree 7 nets were split to spans of 1e-8 at their sides)."""
