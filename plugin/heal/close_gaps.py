@@ -198,13 +198,11 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
         # (in the last round the faces that fit move, their gaps to the others narrowed)
         journal = _Journal()
         try:
-            after = _apply(fits, commons, edges, of_face, faces, vertices, positions, journal,
-                           surfaces)
+            after, apart = _apply(fits, commons, edges, of_face, faces, vertices, positions,
+                                  journal, surfaces)
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
-            bad = _invalid(fits, of_face, faces) | {
-                f for e in edges if after.get(id(e), 0.0) > _WIDER * max(e.gap, tight)
-                for f in e.faces if f in fits}
+            bad = _invalid(fits, of_face, faces) | _widening(edges, fits, after, apart, tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
                 raise
@@ -511,7 +509,7 @@ def _common(e: _Edge, s: NDArray, images, position, moving: set[int], surfaces, 
                 common.uv[f, side] = guess
                 common.goals[f, side] = to_vertices(images[id(e), i])
                 continue
-            uv = pinned_ends(spread_ends(on_surface(surfaces[f], points, guess), s), guess, s)
+            uv = pinned_ends(spread_ends(on_surface(surfaces[f], points, guess, s), s), guess, s)
             u0, u1, v0, v1 = surfaces[f].domain
             common.uv[f, side] = np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)],
                                           axis=1)
@@ -574,12 +572,13 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
 
 # ------------------------------------------------------------------ applying
 def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, positions,
-           journal: _Journal, surfaces) -> dict[int, float]:
+           journal: _Journal, surfaces) -> tuple[dict[int, float], dict[tuple[int, int], float]]:
     """Put the moved surfaces, their pcurves (the common curves' projections), the
     common curves and the vertices into the shape, recording in ``journal`` what they
     replace; returns per edge touched twice the largest distance, on ``CHECK_SAMPLES``
     points, between its curve and its faces' surfaces (a bound on how far apart two of
-    its faces' points are; its tolerance is set to 1.1 times that distance)."""
+    its faces' points are; its tolerance is set to 1.1 times that distance), and that
+    distance per edge and face."""
     builder = BRep_Builder()
     by_id = {id(e): e for e in edges}
     # the faces' surfaces as they are now (the fixed ones' as read, the moved ones' put)
@@ -609,7 +608,8 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
             fresh[f] = (put, fit.surface)
         _put_pcurves(builder, face, new)
     check = np.linspace(0.0, 1.0, CHECK_SAMPLES)
-    after = {}
+    after: dict[int, float] = {}
+    apart: dict[tuple[int, int], float] = {}
     fixer = ShapeFix_ShapeTolerance()
     for key, common in commons.items():
         e = by_id[key]
@@ -626,9 +626,12 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
             now = replace(e, ranges=[BRep_Tool.Range_s(e.edge, TopoDS.Face_s(faces.FindKey(f)))
                                      for f in e.faces], curves={}, surfaces=fresh)
             on_curve = curve.evaluate(a + check * (b - a))
-            deviation = max(float(np.max(np.linalg.norm(_occ_images(now, i, faces, check, side) - on_curve,
-                                                        axis=1)))
-                            for i in range(len(e.faces)) for side in ((False, True) if e.seam else (False,)))
+            for i, f in enumerate(e.faces):
+                for side in ((False, True) if e.seam else (False,)):
+                    off = float(np.max(np.linalg.norm(_occ_images(now, i, faces, check, side)
+                                                      - on_curve, axis=1)))
+                    apart[key, f] = max(apart.get((key, f), 0.0), off)
+                    deviation = max(deviation, off)
         after[key] = 2.0 * deviation
         fixer.SetTolerance(e.edge, max(1.1 * deviation, _MIN_TOLERANCE), TopAbs_EDGE)
     for v, p in positions.items():
@@ -639,7 +642,24 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
     # the vertices hold every curve's end there, on the fixed faces' edges too
     for g in _around(fits, of_face):
         BRepLib.UpdateTolerances_s(faces.FindKey(g), False)
-    return after
+    return after, apart
+
+
+def _widening(edges: list[_Edge], fits, after: dict[int, float],
+              apart: dict[tuple[int, int], float], tight: float) -> set[int]:
+    """The moving faces to blame for the edges that end wider than ``_WIDER`` times
+    their gap (or ``tight``): those lying alone far enough from the edge's curve to
+    widen it, else all its moving faces (a closed edge next to one waving face keeps
+    its other, well-fitted face moving)."""
+    blamed: set[int] = set()
+    for e in edges:
+        limit = _WIDER * max(e.gap, tight)
+        if after.get(id(e), 0.0) <= limit:
+            continue
+        moving = [f for f in e.faces if f in fits]
+        alone = {f for f in moving if 2.0 * apart.get((id(e), f), 0.0) > limit}
+        blamed |= alone or set(moving)
+    return blamed
 
 
 def _invalid(fits, of_face, faces) -> set[int]:
