@@ -16,7 +16,7 @@ from ..fitting import approximate_curve
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
 
-__all__ = ["along_iso", "on_surface", "pinned_ends", "roughness", "spread_ends"]
+__all__ = ["along_iso", "monotone", "on_surface", "pinned_ends", "roughness", "spread_ends"]
 
 #: a pcurve whose samples lie within this share of the domain of one of its sides runs
 #: along that side (its samples then slide along the iso-curve), and the Gauss-Newton
@@ -31,18 +31,45 @@ END_FADE = 0.25
 SMOOTH_SPANS = 8
 
 
-def on_surface(surface: NurbsSurface, points: NDArray, guess: NDArray) -> NDArray:
+def on_surface(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArray) -> NDArray:
     """Parameters on ``surface`` for ``points`` (m, 3) near the pcurve samples ``guess``
-    (m, 2): their closest points, or, for a pcurve along the domain's border (an
-    untrimmed face's side), their closest points on that border's iso-curve
-    (:func:`along_iso`; projected onto the surface, feet near a corner would pile up at
-    the corner). Returns (m, 2) float."""
+    (m, 2) at ``s`` (m,) along the edge: their closest points, or, for a pcurve along
+    the domain's border (an untrimmed face's side), their closest points on that
+    border's iso-curve (:func:`along_iso`; projected onto the surface, feet near a
+    corner would pile up at the corner), kept in order (:func:`monotone`). Returns
+    (m, 2) float."""
     u0, u1, v0, v1 = surface.domain
     for k, (lo, hi) in enumerate(((u0, u1), (v0, v1))):
         for end in (lo, hi):
             if np.all(np.abs(guess[:, k] - end) <= ON_BORDER * (hi - lo)):
-                return along_iso(surface, points, guess, k, end)
+                return monotone(along_iso(surface, points, guess, k, end), 1 - k, s)
     return project_to_surface(surface, points, guess=guess).uv
+
+
+def monotone(uv: NDArray, k: int, s: NDArray) -> NDArray:
+    """``uv`` (m, 2) with parameter ``k`` made strictly monotone in ``s`` (m,), the
+    samples' parameter along the edge: a sample that steps back or stays (a common
+    curve passing over a crease of the surface, or round a sharp bend, projects back
+    and forth or piles up on it) gets the parameter interpolated linearly in ``s``
+    between the nearest samples before and after it that keep the order (samples at
+    one ``s`` share it). Two targets at one parameter ask for two points there, which
+    no surface meets. Returns (m, 2) float."""
+    x = uv[:, k]
+    sign = np.sign(x[-1] - x[0])
+    first = np.concatenate([[True], np.diff(s) > PILED * max(float(np.ptp(s)), 1.0)])
+    if sign == 0 or np.count_nonzero(first) < 3:
+        return uv
+    y = sign * x[first]
+    before = np.maximum.accumulate(np.concatenate([[-np.inf], y[:-1]]))
+    after = np.minimum.accumulate(np.concatenate([y[1:], [np.inf]])[::-1])[::-1]
+    kept = (y > before) & (y < after)
+    kept[[0, -1]] = True
+    if kept.all():
+        return uv
+    t = s[first]
+    out = uv.copy()
+    out[:, k] = sign * np.interp(s, t[kept], y[kept])
+    return out
 
 
 def spread_ends(uv: NDArray, s: NDArray) -> NDArray:

@@ -9,6 +9,7 @@ from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.healing.edge_targets import (
     END_FADE,
     along_iso,
+    monotone,
     on_surface,
     pinned_ends,
     roughness,
@@ -35,7 +36,7 @@ def test_points_beside_a_side_slide_along_it_and_past_its_end():
     uv = along_iso(plane, points, guess, 0, 0.0)
     assert np.all(uv[:, 0] == 0.0)
     assert np.allclose(uv[:, 1], 1.1 * v, atol=1e-12)                    # past v = 1 too
-    assert np.array_equal(on_surface(plane, points, guess), uv)          # a border pcurve
+    assert np.array_equal(on_surface(plane, points, guess, v), uv)       # a border pcurve
 
 
 def test_points_inside_go_to_their_closest_points():
@@ -44,8 +45,34 @@ def test_points_inside_go_to_their_closest_points():
     guess = np.stack([0.5 + 0.3 * np.cos(a), 0.5 + 0.3 * np.sin(a)], axis=1)
     on = bump.evaluate(guess[:, 0], guess[:, 1])
     normal = bump.normals(guess[:, 0], guess[:, 1])
-    uv = on_surface(bump, on + 1e-3 * normal, guess + 1e-3)
+    uv = on_surface(bump, on + 1e-3 * normal, guess + 1e-3, a / (2 * np.pi))
     assert np.max(np.abs(uv - guess)) <= 1e-8
+
+
+def test_a_side_projected_back_and_forth_over_a_crease_is_put_in_order():
+    """A common curve passing over a crease of the face projects onto the crease from a
+    whole stretch (a pile) and steps back beside it: two targets at one parameter ask
+    for two points there. The stretch gets parameters linear in s between the samples
+    that keep the order; samples at one s (the even and Chebyshev samples share 0.5)
+    keep one parameter; an ordered side is unchanged."""
+    s = np.union1d(np.linspace(0, 1, 21), 0.5 - 0.5 * np.cos(np.linspace(0, np.pi, 21)))
+    uv = np.stack([0 * s, s ** 2], axis=1)
+    assert np.array_equal(monotone(uv, 1, s), uv)
+    bad = uv.copy()
+    pile = (s > 0.3) & (s < 0.45)
+    bad[pile, 1] = 0.3 ** 2                                  # piled on the crease
+    back = np.flatnonzero(s >= 0.45)[0]
+    bad[back, 1] = 0.29 ** 2                                 # and one stepping back
+    out = monotone(bad, 1, s)
+    assert np.all(np.diff(out[:, 1])[np.diff(s) > 1e-12] > 0)
+    kept = ~pile & (np.arange(s.size) != back)
+    assert np.array_equal(out[kept], bad[kept])
+    lo, hi = np.flatnonzero(kept & (s <= 0.3))[-1], np.flatnonzero(kept & (s > 0.45))[0]
+    inside = slice(lo + 1, hi)
+    expected = bad[lo, 1] + (s[inside] - s[lo]) / (s[hi] - s[lo]) * (bad[hi, 1] - bad[lo, 1])
+    assert np.allclose(out[inside, 1], expected, atol=1e-15)
+    twins = np.flatnonzero(np.diff(s) <= 1e-12)
+    assert twins.size and np.allclose(out[twins], out[twins + 1], rtol=0, atol=1e-15)
 
 
 def test_piled_ends_are_spread_and_ends_pinned_smoothly():
