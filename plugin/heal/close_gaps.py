@@ -498,8 +498,12 @@ def _common(e: _Edge, s: NDArray, images, position, moving: set[int], surfaces, 
         score, ref, base, feet = best
         mean = base if score <= _FIT_SHARE * tight else np.mean([base, *feet], axis=0)
     a, b = e.ranges[ref]
-    points = to_vertices(mean)
-    common = _Common(a + s * (b - a), points, _even(s))
+    t, even = a + s * (b - a), _even(s)
+    # the targets are the edge's curve (the cubic through the even samples) at every
+    # sample: points mixing feet and images can wave between the even samples, and a
+    # face fitted to them would lie off its edge there
+    points = _through(t, to_vertices(mean), even).evaluate(t)
+    common = _Common(t, points, even)
     for i, f in enumerate(e.faces):
         if f not in moving:
             continue
