@@ -266,15 +266,7 @@ def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
         # a kink: multiplicity degree; a vertex the targets fade to: a break point
         wanted = degree if jump * (knots[span + 1] - knots[span]) > tol else 1
         new[k][at] = max(new[k].get(at, 0), wanted)
-    inserted = 0
-    for k, direction in ((0, "u"), (1, "v")):
-        for at, wanted in sorted(new[k].items()):
-            knots = s.knots_u if k == 0 else s.knots_v
-            have = int(np.count_nonzero(np.abs(knots - at) <= _ON_SIDE * (knots[-1] - knots[0])))
-            if have < wanted:
-                s = s.insert_knot(at, direction, wanted - have)
-                inserted += wanted - have
-    return s, inserted
+    return _with_knots(s, new)
 
 
 def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArray,
@@ -291,7 +283,7 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
     window that fits them best) and a knot put there."""
     domain = s.domain
     start = 0
-    new: tuple[list[float], list[float]] = ([], [])
+    new: tuple[dict[float, int], dict[float, int]] = ({}, {})
     for t in targets:
         m = t.uv.shape[0]
         here = slice(start, start + m)
@@ -311,16 +303,8 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
             j = int(in_span[np.argmax(miss[here][in_span])])
             at = _kink(t, s, along, j, tol)
             if at is not None and knots[degree] < at < knots[-degree - 1]:
-                new[along].append(at)
-    inserted = 0
-    for k, direction in ((0, "u"), (1, "v")):
-        for at in sorted(set(new[k])):
-            knots, degree = (s.knots_u, s.degree_u) if k == 0 else (s.knots_v, s.degree_v)
-            have = int(np.count_nonzero(np.abs(knots - at) <= _ON_SIDE * (knots[-1] - knots[0])))
-            if have < degree:
-                s = s.insert_knot(at, direction, degree - have)
-                inserted += degree - have
-    return s, inserted
+                new[along][at] = degree
+    return _with_knots(s, new)
 
 
 def _kink(t: EdgeTarget, s: NurbsSurface, k: int, j: int, tol: float) -> float | None:
@@ -356,6 +340,22 @@ def _kink(t: EdgeTarget, s: NurbsSurface, k: int, j: int, tol: float) -> float |
     if not lo_x <= cross <= hi_x:       # the lines meet beyond the runs: the turn lies
         return None                     # outside the window
     return float(t.uv[lo, k] + scale * cross)
+
+
+def _with_knots(s: NurbsSurface, new: tuple[dict[float, int], dict[float, int]]
+                ) -> tuple[NurbsSurface, int]:
+    """``s`` with each knot ``new[k]`` (k = 0 for u) raised to its multiplicity there
+    (knots within ``_ON_SIDE`` of the domain width counted as one), and the count
+    inserted."""
+    inserted = 0
+    for k, direction in ((0, "u"), (1, "v")):
+        for at, wanted in sorted(new[k].items()):
+            knots = s.knots_u if k == 0 else s.knots_v
+            have = int(np.count_nonzero(np.abs(knots - at) <= _ON_SIDE * (knots[-1] - knots[0])))
+            if have < wanted:
+                s = s.insert_knot(at, direction, wanted - have)
+                inserted += wanted - have
+    return s, inserted
 
 
 def _on_side(uv: NDArray, k: int, domain: tuple[float, float, float, float]) -> int | None:
