@@ -293,9 +293,8 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
         if along is None or missed.size == 0:
             continue
         knots, degree = (s.knots_u, s.degree_u) if along == 0 else (s.knots_v, s.degree_v)
-        span_all = find_span(knots, degree, uv[:, along])
-        held = np.bincount(span_all, minlength=knots.size)
-        span = span_all[here]
+        held = _held(knots, degree, uv[:, along])
+        span = find_span(knots, degree, uv[here, along])
         for c in np.unique(span[missed]):
             if held[c] >= MIN_SPAN_SAMPLES:
                 continue                        # refinement can still split it
@@ -309,27 +308,36 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
 
 def _kink(t: EdgeTarget, s: NurbsSurface, k: int, j: int, tol: float) -> float | None:
     """Where the offset ``target - S`` of ``t`` (m samples along parameter ``k``) turns
-    near its sample ``j``: of the splits of the ``2 _KINK_WINDOW + 1`` samples around
-    ``j`` into two runs of at least 3, the one whose two fitted lines leave the least,
+    near its sample ``j``: of the splits of the ``2 _KINK_WINDOW + 1`` distinct
+    parameters around ``j`` into two runs of at least 3, the one whose two fitted lines leave the least,
     and the parameter where those lines come closest; None when the window is too
     short, the lines' slopes differ by less than ``tol`` over it, or they come
     closest outside the gap between the runs' facing samples."""
-    lo, hi = max(0, j - _KINK_WINDOW), min(t.uv.shape[0], j + _KINK_WINDOW + 1)
+    # the distinct parameters (samples piled at one resolve nothing), in order
+    param, first = np.unique(t.uv[:, k], return_index=True)
+    at = int(np.searchsorted(param, t.uv[j, k]))
+    lo, hi = max(0, at - _KINK_WINDOW), min(param.size, at + _KINK_WINDOW + 1)
     if hi - lo < 6:
         return None
-    x = t.uv[lo:hi, k]
-    y = t.points[lo:hi] - s.evaluate(t.uv[lo:hi, 0], t.uv[lo:hi, 1])
-    scale = float(np.max(np.abs(x - x[0]))) or 1.0
-    x = (x - x[0]) / scale
+    chosen = first[lo:hi]
+    x0 = param[lo]
+    y = t.points[chosen] - s.evaluate(t.uv[chosen, 0], t.uv[chosen, 1])
+    scale = float(param[hi - 1] - x0) or 1.0
+    x = (param[lo:hi] - x0) / scale
     best = None
     for c in range(3, x.size - 2):
         lines, left = [], 0.0
         for part in (slice(0, c), slice(c, x.size)):
-            coef, res, *_ = np.polyfit(x[part], y[part], 1, full=True)
-            lines.append(coef)
-            left += float(np.sum(res))
-        if best is None or left < best[0]:
-            best = (left, c, lines)
+            line = _line(x[part], y[part])
+            if line is None:
+                break
+            lines.append(line[:2])
+            left += line[2]
+        else:
+            if best is None or left < best[0]:
+                best = (left, c, lines)
+    if best is None:
+        return None
     _, c, ((b1, a1), (b2, a2)) = best
     db, da = b1 - b2, a1 - a2
     # a turn the samples resolve: the two lines part by more than tol across the window
@@ -339,7 +347,7 @@ def _kink(t: EdgeTarget, s: NurbsSurface, k: int, j: int, tol: float) -> float |
     lo_x, hi_x = sorted((x[c - 1], x[c]))
     if not lo_x <= cross <= hi_x:       # the lines meet beyond the runs: the turn lies
         return None                     # outside the window
-    return float(t.uv[lo, k] + scale * cross)
+    return float(x0 + scale * cross)
 
 
 def _with_knots(s: NurbsSurface, new: tuple[dict[float, int], dict[float, int]]
@@ -356,6 +364,25 @@ def _with_knots(s: NurbsSurface, new: tuple[dict[float, int], dict[float, int]]
                 s = s.insert_knot(at, direction, wanted - have)
                 inserted += wanted - have
     return s, inserted
+
+
+def _held(knots: NDArray, degree: int, t: NDArray) -> NDArray:
+    """Per knot span, how many distinct parameters of ``t`` (m,) it holds (samples
+    piled at one parameter resolve nothing between them)."""
+    return np.bincount(find_span(knots, degree, np.unique(t)), minlength=knots.size)
+
+
+def _line(x: NDArray, y: NDArray) -> tuple[NDArray, NDArray, float] | None:
+    """The least-squares line ``y = a + b x`` through (n,) ``x`` and (n, 3) ``y``:
+    ``(b, a, squared residual)``, or None when ``x`` holds one value (samples piled
+    at one parameter)."""
+    dx = x - x.mean()
+    sxx = float(dx @ dx)
+    if not sxx > 0.0:
+        return None
+    b = dx @ (y - y.mean(axis=0)) / sxx
+    a = y.mean(axis=0) - b * x.mean()
+    return b, a, float(np.sum((a + np.outer(x, b) - y) ** 2))
 
 
 def _on_side(uv: NDArray, k: int, domain: tuple[float, float, float, float]) -> int | None:
@@ -423,7 +450,7 @@ def _refined(s: NurbsSurface, uv: NDArray, splits: NDArray, miss: NDArray, tol: 
     """``s`` with each span (in u and in v) holding a sample that misses its target by
     more than ``tol`` split into ``k`` equal parts, ``k = (miss / tol)^(1/4)`` (the
     error of a cubic falls as the fourth power of the span) between 2 and
-    ``_MAX_SPLIT``, where the span holds at least ``MIN_SPAN_SAMPLES`` samples (finer
+    ``_MAX_SPLIT``, where the span holds at least ``MIN_SPAN_SAMPLES`` distinct samples (finer
     spans than the samples resolve would wave between them); ``splits`` (m, 2) bool
     says in which directions a sample's miss splits its spans. None when nothing can be
     inserted or the net would exceed ``max_control`` control points."""
@@ -431,7 +458,7 @@ def _refined(s: NurbsSurface, uv: NDArray, splits: NDArray, miss: NDArray, tol: 
     for knots, degree, k in ((s.knots_u, s.degree_u, 0), (s.knots_v, s.degree_v, 1)):
         missed = (miss > tol) & splits[:, k]
         span = find_span(knots, degree, uv[:, k])
-        held = np.bincount(span, minlength=knots.size)
+        held = _held(knots, degree, uv[:, k])
         worst = np.zeros(knots.size)
         np.maximum.at(worst, span[missed], miss[missed])
         chosen = np.flatnonzero((worst > tol) & (held >= MIN_SPAN_SAMPLES)

@@ -129,6 +129,24 @@ def test_a_kink_inside_one_edge_is_located_between_its_samples():
     assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
 
 
+def test_samples_piled_at_one_parameter_beside_a_kink_are_no_line():
+    """A window round a miss holding samples piled at one parameter (an edge's end
+    reaching past a corner) is not fitted by a line there (a zero-length run crashed
+    the least squares)."""
+    x, y = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 5), indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1))
+    kink = 0.3719
+    v = np.sort(np.concatenate([np.linspace(0, 1, 300), np.full(12, 0.372)]))
+    lift = 1e-3 * np.where(v < kink, v / kink, (1 - v) / (1 - kink))
+    edge = EdgeTarget(np.stack([0 * v, v], axis=1), np.stack([0 * v, v, lift], axis=1))
+    fit = fit_to_edges(flat, [edge], tol=1e-8)
+    assert fit.converged
+    dense = np.linspace(0, 1, 20001)
+    lifted = 1e-3 * np.where(dense < kink, dense / kink, (1 - dense) / (1 - kink))
+    miss = fit.surface.evaluate(0 * dense, dense) - np.stack([0 * dense, dense, lifted], axis=1)
+    assert np.max(np.linalg.norm(miss, axis=1)) <= 1e-8
+
+
 def test_a_wavy_side_is_met_by_knots_along_it_only():
     """A side of the domain is its row of control points: knots across it would only
     add knot lines (ICEM's degree 7 nets were split to spans of 1e-8 at their sides)."""
