@@ -428,10 +428,12 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         else:
             try:
                 fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
-            except SurfprepError as exc:
+            except (SurfprepError, np.linalg.LinAlgError, RuntimeError) as exc:
+                # (a least-squares or factorization failure of scipy/numpy on this
+                # face's system is this face's failure, not the model's)
                 failed.add(f)
-                notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({exc}); "
-                             "kept as it is")
+                notes.append(f"face {f - 1}: not moved onto its neighbours' edges "
+                             f"({type(exc).__name__}: {exc}); kept as it is")
                 continue
             moved = _moved(surfaces[f], fit.surface, faces, f)
             done[key] = fit, moved
