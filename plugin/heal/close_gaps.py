@@ -78,8 +78,9 @@ FIT_SAMPLES = 513
 #: ... and where the result is measured (the edges' tolerances)
 CHECK_SAMPLES = 1025
 #: rounds of fitting, faces whose fit failed or that fail BRepCheck once moved fixed for
-#: the next
-_ROUNDS = 4
+#: the next (fits and common curves are remembered, so a round costs what changed; a
+#: last round that still fails puts everything back: asmo needs 5)
+_ROUNDS = 8
 #: a face moves when its fit leaves at most this share of the tight tolerance (two faces
 #: then meet within it)
 _FIT_SHARE = 0.4
