@@ -423,6 +423,12 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         if offset <= _STILL * tight:        # its edges are on it already: the surface stays
             fits[f] = (EdgeFit(surfaces[f], offset, 0.0, 0, True), 0.0)
             continue
+        if offset > allowed + _FIT_SHARE * tight:
+            # a point of its edges would move farther than allowed: no fit can pass
+            failed.add(f)
+            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (its edges lie "
+                         f"up to {offset:.3g} from them > {allowed:.3g}); kept as it is")
+            continue
         key = ("fit", f, _digest(targets))
         if key in done:
             fit, moved = done[key]
