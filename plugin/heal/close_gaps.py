@@ -157,10 +157,11 @@ class _Journal:
     vertices: list = field(default_factory=list)   # (vertex, point, tol)
 
 
-def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
+def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = None) -> ClosedGaps:
     """Close in the geometry the gaps of ``shape`` (a sewn shell, solid or compound)
     wider than ``tight``, moving B-spline faces by at most ``allowed`` (the module doc).
-    ``shape`` is changed in place."""
+    ``shape`` is changed in place. ``fitted`` keeps the fits by face, surface and
+    targets across calls on the same shape (the passes of :func:`closed_in_geometry`)."""
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     vertices = TopTools_IndexedMapOfShape()
@@ -186,13 +187,14 @@ def close_gaps(shape, *, tight: float, allowed: float) -> ClosedGaps:
     of_face = _edges_by_face(edges)
     fixed: set[int] = set()
     fits: dict = {}
-    done: dict = {}                     # common curves and fits: a later round asks most again
+    done: dict = {}                     # common curves: a later round asks most again
+    fitted = {} if fitted is None else fitted
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         if not moving:
             break
         fits, commons, positions, failed = _fit_round(moving, surfaces, edges, of_face, faces,
-                                                     tight, allowed, notes, done)
+                                                     tight, allowed, notes, done, fitted)
         fixed |= failed
         if failed and _round < _ROUNDS - 1 or not fits:
             continue                # the others fitted again with these where they are
@@ -238,8 +240,10 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     largest edge tolerance; ``extra["closed_gaps"]`` says what moved. Passes are repeated (at most ``_PASSES``) while one moves a face and leaves
     an edge open: faces kept in one pass meet neighbours that have moved in the next."""
     passes = []
+    fitted: dict = {}                   # a face kept in one pass meets mostly the same targets
     for _ in range(_PASSES):
-        closed = close_gaps(result.model.shape, tight=TIGHT_FACTOR * size, allowed=allowed)
+        closed = close_gaps(result.model.shape, tight=TIGHT_FACTOR * size, allowed=allowed,
+                            fitted=fitted)
         passes.append(closed)
         if not closed.moved or closed.open_after == 0:
             break
@@ -373,12 +377,12 @@ class _Common:
 
 
 def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
-               tight: float, allowed: float, notes: list[str], done: dict):
+               tight: float, allowed: float, notes: list[str], done: dict, fitted: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed: ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position},
-    failed faces)``. ``done`` holds the common curves and fits of earlier rounds, by
-    edge, the faces that move and the vertices, and by face and targets (a face whose
-    neighbours all stayed as they were gets the same targets again)."""
+    failed faces)``. ``done`` holds the common curves of earlier rounds, by edge, the
+    faces that move and the vertices; ``fitted`` the fits, by face, surface and targets
+    (a face whose neighbours all stayed as they were gets the same targets again)."""
     moving_set = set(moving)
     # even samples and Chebyshev-Lobatto points: dense at the vertices too, where two
     # edges' targets meet in a kink the fit resolves only with short knot spans (each
@@ -426,12 +430,13 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
         if offset > allowed + _FIT_SHARE * tight:
             # a point of its edges would move farther than allowed: no fit can pass
             failed.add(f)
-            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (its edges lie "
-                         f"up to {offset:.3g} from them > {allowed:.3g}); kept as it is")
+            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (it would move "
+                         f"at least {offset:.3g} > {allowed:.3g}: its edges lie that far from "
+                         "them); kept as it is")
             continue
-        key = ("fit", f, _digest(targets))
-        if key in done:
-            fit, moved = done[key]
+        key = (f, _digest(targets, surfaces[f]))
+        if key in fitted:
+            fit, moved = fitted[key]
         else:
             try:
                 fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
@@ -443,7 +448,7 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
                              f"({type(exc).__name__}: {exc}); kept as it is")
                 continue
             moved = _moved(surfaces[f], fit.surface, faces, f)
-            done[key] = fit, moved
+            fitted[key] = fit, moved
         if fit.converged and moved <= allowed:
             fits[f] = (fit, moved)
             continue
@@ -454,9 +459,12 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
     return fits, commons, position, failed
 
 
-def _digest(targets: list[EdgeTarget]) -> bytes:
-    """A fingerprint of ``targets`` (their samples' bytes)."""
+def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
+    """A fingerprint of ``targets`` and ``surface`` (their arrays' bytes)."""
     h = hashlib.blake2b(digest_size=16)
+    for array in (surface.control_points, surface.knots_u, surface.knots_v, surface.weights):
+        if array is not None:
+            h.update(np.ascontiguousarray(array).tobytes())
     for t in targets:
         h.update(t.uv.tobytes())
         h.update(t.points.tobytes())
