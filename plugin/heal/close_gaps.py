@@ -43,30 +43,35 @@ from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.BRepTools import BRepTools
-from OCP.Geom import Geom_BSplineSurface
-from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_ShapeTolerance
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
+from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_VERTEX
 from OCP.TopExp import TopExp
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from ...algorithms.curve import NurbsCurve
 from ...algorithms.fitting import interpolate_curve
 from ...algorithms.healing.edge_fit import EdgeFit, EdgeTarget, fit_to_edges
 from ...algorithms.healing.edge_targets import on_surface, pinned_ends, roughness, spread_ends
 from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
-from ..occ.edges import EXACT_2D, converts_exactly
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
-from ..occ.geom import curve2d_to_occ, curve_from_occ, curve_to_occ, surface_from_occ, surface_to_occ
+from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
 from ..occ.shapes import is_valid, max_edge_tolerance
 from .result import HealResult
 from .rollback import TIGHT_FACTOR
+from .shared_edges import (
+    SharedEdge,
+    edges_by_face,
+    images_on_face,
+    pcurve,
+    pcurve_points,
+    read_edge,
+    same_surface,
+)
 
 __all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "close_gaps", "closed_in_geometry"]
 
@@ -133,22 +138,6 @@ class ClosedGaps:
 
 
 @dataclass
-class _Edge:
-    """One edge of the shape with its faces' images on ``s`` in [0, 1]."""
-
-    edge: object
-    faces: list[int]                    # indices in the face map (a seam's face once)
-    ranges: list[tuple[float, float]]   # per face, the pcurve's range
-    first: int                          # vertex indices at s = 0 and s = 1
-    last: int
-    seam: bool = False
-    degenerated: bool = False
-    gap: float = 0.0
-    curves: dict = field(default_factory=dict)      # (i, reverse) -> NurbsCurve or None
-    surfaces: dict = field(default_factory=dict)    # face -> NurbsSurface or None (shared)
-
-
-@dataclass
 class _Journal:
     """What was changed, to put it back."""
 
@@ -169,12 +158,12 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
     shared: dict = {}                   # the faces' surfaces, read once
-    edges = [_read_edge(edge_faces, k, faces, vertices, shared)
+    edges = [read_edge(edge_faces, k, faces, vertices, shared)
              for k in range(1, edge_faces.Extent() + 1)]
     probe = np.linspace(0.0, 1.0, PROBE_SAMPLES)
     for e in edges:
         if len(e.faces) >= 2:
-            images = [_occ_images(e, i, faces, probe) for i in range(len(e.faces))]
+            images = [images_on_face(e, i, faces, probe) for i in range(len(e.faces))]
             e.gap = max(float(np.max(np.linalg.norm(a - b, axis=1)))
                         for a in images for b in images)
     open_ = [e for e in edges if e.gap > tight]
@@ -183,8 +172,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     largest = max(e.gap for e in open_)
     notes: list[str] = []
     candidates = sorted({f for e in open_ for f in e.faces})
-    surfaces = {f: s for f in candidates if (s := _same_surface(faces, f, edges)) is not None}
-    of_face = _edges_by_face(edges)
+    surfaces = {f: s for f in candidates if (s := same_surface(faces, f, edges)) is not None}
+    of_face = edges_by_face(edges)
     fixed: set[int] = set()
     fits: dict = {}
     done: dict = {}                     # common curves: a later round asks most again
@@ -264,104 +253,6 @@ def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> Close
     return ClosedGaps(len(open_), len(open_), largest, largest, (), (*notes, why))
 
 
-# ------------------------------------------------------------------ reading
-def _read_edge(edge_faces, k: int, faces, vertices, shared: dict) -> _Edge:
-    edge = TopoDS.Edge_s(edge_faces.FindKey(k))
-    indices, ranges = [], []
-    for f in edge_faces.FindFromIndex(k):
-        i = faces.FindIndex(f)
-        if i not in indices:
-            indices.append(i)
-            ranges.append(BRep_Tool.Range_s(edge, TopoDS.Face_s(f)))
-    first = vertices.FindIndex(TopExp.FirstVertex_s(edge))
-    last = vertices.FindIndex(TopExp.LastVertex_s(edge))
-    seam = len(indices) == 1 and BRep_Tool.IsClosed_s(edge, TopoDS.Face_s(faces.FindKey(indices[0])))
-    return _Edge(edge, indices, ranges, first, last, seam, BRep_Tool.Degenerated_s(edge),
-                 surfaces=shared)
-
-
-def _edges_by_face(edges: list[_Edge]) -> dict[int, list[_Edge]]:
-    out: dict[int, list[_Edge]] = {}
-    for e in edges:
-        for f in e.faces:
-            out.setdefault(f, []).append(e)
-    return out
-
-
-def _pcurve(e: _Edge, i: int, faces, reverse: bool = False):
-    face = TopoDS.Face_s(faces.FindKey(e.faces[i]))
-    edge = e.edge.Oriented(TopAbs_REVERSED if reverse else TopAbs_FORWARD)
-    return BRep_Tool.CurveOnSurface_s(TopoDS.Edge_s(edge), face, 0.0, 0.0)
-
-
-def _uv(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
-    """The pcurve of ``e`` on its ``i``-th face at ``s`` in [0, 1] of its range
-    (evaluated as a NURBS curve when it converts with its parameter, B-splines and lines,
-    else point by point)."""
-    a, b = e.ranges[i]
-    t = a + s * (b - a)
-    key = (i, reverse)
-    if key not in e.curves:
-        curve = _pcurve(e, i, faces, reverse)
-        e.curves[key] = curve
-        if converts_exactly(curve, EXACT_2D, Geom2d_TrimmedCurve):
-            try:
-                e.curves[key] = curve_from_occ(curve, (min(a, b), max(a, b)))
-            except SurfprepError:
-                pass
-    curve = e.curves[key]
-    if isinstance(curve, NurbsCurve):
-        lo, hi = curve.domain
-        return curve.evaluate(np.clip(t, lo, hi))
-    return np.array([curve.Value(x).Coord() for x in t])
-
-
-def _occ_images(e: _Edge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
-    """``S_F(pc_F(t))`` for any surface, (len(s), 3): a B-spline surface evaluated as a
-    NURBS surface where the parameters lie in its domain, others by OpenCascade."""
-    surface, nurbs = _face_surface(e, e.faces[i], faces)
-    uv = _uv(e, i, faces, s, reverse)
-    if nurbs is not None:
-        u0, u1, v0, v1 = nurbs.domain
-        if np.all((uv[:, 0] >= u0) & (uv[:, 0] <= u1) & (uv[:, 1] >= v0) & (uv[:, 1] <= v1)):
-            return nurbs.evaluate(uv[:, 0], uv[:, 1])
-    return np.array([surface.Value(u, v).Coord() for u, v in uv])
-
-
-def _face_surface(e: _Edge, f: int, faces):
-    """Face ``f``'s surface and, for a B-spline, its :class:`NurbsSurface` (else None),
-    converted once (the cache is shared by all edges of the shape)."""
-    if f not in e.surfaces:
-        surface = BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f)))
-        e.surfaces[f] = (surface, None)
-        if isinstance(surface, Geom_BSplineSurface):
-            try:
-                e.surfaces[f] = (surface, surface_from_occ(surface))
-            except SurfprepError:
-                pass
-    return e.surfaces[f]
-
-
-def _same_surface(faces, f: int, edges: list[_Edge]) -> NurbsSurface | None:
-    """Face ``f``'s B-spline surface as a :class:`NurbsSurface` in the same parameters
-    (checked at its pcurves' ends and middles), or None for a surface that is not a
-    B-spline or does not convert exactly."""
-    surface, nurbs = _face_surface(next(e for e in edges if f in e.faces), f, faces)
-    if nurbs is None:
-        return None
-    uv = np.concatenate([_uv(e, e.faces.index(f), faces, np.array([0.0, 0.5, 1.0]))
-                         for e in edges if f in e.faces])
-    u0, u1, v0, v1 = nurbs.domain
-    inside = ((uv[:, 0] >= u0 - 1e-9 * (u1 - u0)) & (uv[:, 0] <= u1 + 1e-9 * (u1 - u0))
-              & (uv[:, 1] >= v0 - 1e-9 * (v1 - v0)) & (uv[:, 1] <= v1 + 1e-9 * (v1 - v0)))
-    if not inside.all():
-        return None
-    ours = nurbs.evaluate(uv[:, 0], uv[:, 1])
-    theirs = np.array([surface.Value(u, v).Coord() for u, v in uv])
-    scale = float(np.ptp(nurbs.control_points.reshape(-1, 3), axis=0).max()) or 1.0
-    return nurbs if np.max(np.abs(ours - theirs)) <= 1e-9 * scale else None
-
-
 # ------------------------------------------------------------------ fitting
 @dataclass
 class _Common:
@@ -376,7 +267,7 @@ class _Common:
     goals: dict = field(default_factory=dict)     # (face, seam side) -> (m, 3), else points
 
 
-def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
+def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, faces,
                tight: float, allowed: float, notes: list[str], done: dict, fitted: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed: ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position},
@@ -392,12 +283,12 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
     touched = {id(e): e for f in moving for e in of_face[f]}
     images: dict[tuple[int, int], NDArray] = {}
 
-    def image(e: _Edge, i: int, at: NDArray, reverse: bool = False) -> NDArray:
+    def image(e: SharedEdge, i: int, at: NDArray, reverse: bool = False) -> NDArray:
         f = e.faces[i]
         if f in moving_set:
-            uv = _uv(e, i, faces, at, reverse)
+            uv = pcurve_points(e, i, faces, at, reverse)
             return surfaces[f].evaluate(uv[:, 0], uv[:, 1])
-        return _occ_images(e, i, faces, at, reverse)
+        return images_on_face(e, i, faces, at, reverse)
 
     for e in touched.values():
         for i in range(len(e.faces)):
@@ -420,7 +311,7 @@ def _fit_round(moving: list[int], surfaces, edges: list[_Edge], of_face, faces,
             for side in ((False, True) if e.seam else (False,)):
                 uv = common.uv.get((f, side))
                 if uv is None:          # a pole: the old pcurve, every point to the vertex
-                    uv = _uv(e, e.faces.index(f), faces, s, side)
+                    uv = pcurve_points(e, e.faces.index(f), faces, s, side)
                 targets.append(EdgeTarget(uv, common.goals.get((f, side), common.points)))
         offset = max(float(np.max(np.linalg.norm(
             surfaces[f].evaluate(t.uv[:, 0], t.uv[:, 1]) - t.points, axis=1))) for t in targets)
@@ -471,7 +362,7 @@ def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
     return h.digest()
 
 
-def _common(e: _Edge, s: NDArray, images, position, moving: set[int], surfaces, faces,
+def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfaces, faces,
             tight: float) -> _Common:
     """The common curve of ``e`` (the module doc), its ends pulled onto the vertices.
     An edge open at ``tight``: a fixed face's image if it has one, else the image of the
@@ -525,7 +416,7 @@ def _common(e: _Edge, s: NDArray, images, position, moving: set[int], surfaces, 
         if f not in moving:
             continue
         for side in ((False, True) if e.seam else (False,)):
-            guess = _uv(e, i, faces, s, side)
+            guess = pcurve_points(e, i, faces, s, side)
             if closed:          # each face keeps its own side, its ends at the vertices
                 common.uv[f, side] = guess
                 common.goals[f, side] = to_vertices(images[id(e), i])
@@ -548,17 +439,17 @@ def _through(t: NDArray, points: NDArray, even: NDArray):
     return interpolate_curve(points[even], parameters=t[even])
 
 
-def _feet(e: _Edge, i: int, points: NDArray, images, surfaces, faces, s: NDArray) -> NDArray:
+def _feet(e: SharedEdge, i: int, points: NDArray, images, surfaces, faces, s: NDArray) -> NDArray:
     """Closest points of moving face ``e.faces[i]``'s surface to ``points`` (started from
     its pcurve at the same parameters); where one lands farther than twice the edge's
     gap (a wrong local minimum), the face's own point there."""
-    foot = project_to_surface(surfaces[e.faces[i]], points, guess=_uv(e, i, faces, s)).points
+    foot = project_to_surface(surfaces[e.faces[i]], points, guess=pcurve_points(e, i, faces, s)).points
     far = np.linalg.norm(foot - points, axis=1) > 2.0 * e.gap + 1e-12
     foot[far] = images[id(e), i][far]
     return foot
 
 
-def _vertex_positions(edges: list[_Edge], moving: set[int], images, image) -> dict[int, NDArray]:
+def _vertex_positions(edges: list[SharedEdge], moving: set[int], images, image) -> dict[int, NDArray]:
     """Per vertex of an edge of a moving face: the mean of its faces' corners there (of
     the fixed faces' if any)."""
     wanted = {v for e in edges if any(f in moving for f in e.faces) for v in (e.first, e.last)}
@@ -592,7 +483,7 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
 
 
 # ------------------------------------------------------------------ applying
-def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, positions,
+def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, positions,
            journal: _Journal, surfaces) -> tuple[dict[int, float], dict[tuple[int, int], float]]:
     """Put the moved surfaces, their pcurves (the common curves' projections), the
     common curves and the vertices into the shape, recording in ``journal`` what they
@@ -612,7 +503,7 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
         for e in of_face[f]:
             i = e.faces.index(f)
             tol = BRep_Tool.Tolerance_s(e.edge)
-            old.append((e, _pcurve(e, i, faces), _pcurve(e, i, faces, True) if e.seam else None, tol,
+            old.append((e, pcurve(e, i, faces), pcurve(e, i, faces, True) if e.seam else None, tol,
                         BRep_Tool.Range_s(e.edge, face)))
             common = commons[id(e)]
             if (f, False) not in common.uv:           # a pole keeps its pcurve
@@ -649,7 +540,7 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
             on_curve = curve.evaluate(a + check * (b - a))
             for i, f in enumerate(e.faces):
                 for side in ((False, True) if e.seam else (False,)):
-                    off = float(np.max(np.linalg.norm(_occ_images(now, i, faces, check, side)
+                    off = float(np.max(np.linalg.norm(images_on_face(now, i, faces, check, side)
                                                       - on_curve, axis=1)))
                     apart[key, f] = max(apart.get((key, f), 0.0), off)
                     deviation = max(deviation, off)
@@ -666,7 +557,7 @@ def _apply(fits, commons, edges: list[_Edge], of_face, faces, vertices, position
     return after, apart
 
 
-def _widening(edges: list[_Edge], fits, after: dict[int, float],
+def _widening(edges: list[SharedEdge], fits, after: dict[int, float],
               apart: dict[tuple[int, int], float], tight: float) -> set[int]:
     """The moving faces to blame for the edges that end wider than ``_WIDER`` times
     their gap (or ``tight``): those lying alone far enough from the edge's curve to
