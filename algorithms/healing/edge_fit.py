@@ -234,8 +234,10 @@ def _with_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], tol: float
     ``degree`` at the vertex lets the displacement turn there exactly (the surface is
     then C0 along that iso-line, its tangent planes turning by the neighbours' angle,
     ``|jump| / |S_t|``, a few 1e-4 rad). Inserted only where the jump times the knot
-    span holding the vertex exceeds ``tol`` (a smooth spline meets smaller kinks)."""
-    ends: dict[tuple[int, int, float], list[float]] = {}
+    span holding the vertex exceeds ``tol`` (a smooth spline meets smaller kinks); a
+    vertex the displacement only fades to (its slopes level there) gets a simple knot,
+    a break point for the fades on either side."""
+    ends: dict[tuple[int, int, float], list[tuple[NDArray, float]]] = {}
     domain = s.domain
     for t in targets:
         if t.uv.shape[0] < _SLOPE_SAMPLES:
