@@ -206,12 +206,14 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
             break
         if len(worst) > _STALLED and worst[-1] > (1.0 - _PROGRESS) * worst[-1 - _STALLED]:
             break                       # knots no longer help (the misses lie where none can go)
-        kinked = _with_inner_kinks(s, targets, uv, left, tol)
-        refined = _refined(kinked[0], uv, splits, left, tol, max_control)
-        if refined is None and not kinked[1]:
+        s, count = _with_inner_kinks(s, targets, uv, left, tol)
+        refined = _refined(s, uv, splits, left, tol, max_control)
+        if refined is None and not count:
             break
-        s, count = refined if refined is not None else kinked
-        inserted += count + (kinked[1] if refined is not None else 0)
+        if refined is not None:
+            s, more = refined
+            count += more
+        inserted += count
     net = s.control_points + d.reshape(s.control_points.shape)
     moved = s.construct_fast(net, s.knots_u, s.knots_v, s.degree_u, s.degree_v, s.weights)
     residual = float(np.max(np.linalg.norm(moved.evaluate(uv[:, 0], uv[:, 1]) - points, axis=1)))
@@ -286,6 +288,7 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
     domain = s.domain
     start = 0
     new: tuple[dict[float, int], dict[float, int]] = ({}, {})
+    held: dict[int, NDArray] = {}       # per direction, distinct parameters per span
     for t in targets:
         m = t.uv.shape[0]
         here = slice(start, start + m)
@@ -295,10 +298,11 @@ def _with_inner_kinks(s: NurbsSurface, targets: Sequence[EdgeTarget], uv: NDArra
         if along is None or missed.size == 0:
             continue
         knots, degree = (s.knots_u, s.degree_u) if along == 0 else (s.knots_v, s.degree_v)
-        held = _held(knots, degree, uv[:, along])
+        if along not in held:
+            held[along] = _held(knots, degree, uv[:, along])
         span = find_span(knots, degree, uv[here, along])
         for c in np.unique(span[missed]):
-            if held[c] >= MIN_SPAN_SAMPLES:
+            if held[along][c] >= MIN_SPAN_SAMPLES:
                 continue                        # refinement can still split it
             in_span = missed[span[missed] == c]
             j = int(in_span[np.argmax(miss[here][in_span])])

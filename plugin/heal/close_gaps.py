@@ -51,6 +51,7 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
+from ...algorithms.curve import NurbsCurve
 from ...algorithms.fitting import interpolate_curve
 from ...algorithms.healing.edge_fit import EdgeFit, EdgeTarget, fit_to_edges
 from ...algorithms.healing.edge_targets import on_surface, pinned_ends, roughness, spread_ends
@@ -263,6 +264,7 @@ class _Common:
     t: NDArray
     points: NDArray
     even: NDArray                                 # indices of the evenly spaced samples
+    curve: NurbsCurve | None = None               # C: the cubic through the even samples
     uv: dict = field(default_factory=dict)        # (face, seam side) -> (m, 2)
     goals: dict = field(default_factory=dict)     # (face, seam side) -> (m, 3), else points
 
@@ -298,7 +300,7 @@ def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, fa
     for key, e in touched.items():
         # the same when its faces move or stay as in an earlier round and its vertices
         # are where they were
-        seen = ("common", key, tuple(f in moving_set for f in e.faces),
+        seen = (key, tuple(f in moving_set for f in e.faces),
                 position[e.first].tobytes(), position[e.last].tobytes())
         if seen not in done:
             done[seen] = _common(e, s, images, position, moving_set, surfaces, faces, tight)
@@ -410,8 +412,8 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfa
     # the targets are the edge's curve (the cubic through the even samples) at every
     # sample: points mixing feet and images can wave between the even samples, and a
     # face fitted to them would lie off its edge there
-    points = _through(t, to_vertices(mean), even).evaluate(t)
-    common = _Common(t, points, even)
+    curve = _through(t, to_vertices(mean), even)
+    common = _Common(t, curve.evaluate(t), even, curve)
     for i, f in enumerate(e.faces):
         if f not in moving:
             continue
@@ -421,7 +423,7 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfa
                 common.uv[f, side] = guess
                 common.goals[f, side] = to_vertices(images[id(e), i])
                 continue
-            uv = pinned_ends(spread_ends(on_surface(surfaces[f], points, guess, s), s), guess, s)
+            uv = pinned_ends(spread_ends(on_surface(surfaces[f], common.points, guess, s), s), guess, s)
             u0, u1, v0, v1 = surfaces[f].domain
             common.uv[f, side] = np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)],
                                           axis=1)
@@ -531,7 +533,7 @@ def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, pos
                               location, t0, t1, BRep_Tool.Tolerance_s(e.edge)))
         deviation = 0.0
         if not e.degenerated:
-            curve = _through(common.t, common.points, common.even)
+            curve = common.curve
             builder.UpdateEdge(e.edge, curve_to_occ(curve), TopLoc_Location(), BRep_Tool.Tolerance_s(e.edge))
             a, b = float(common.t[0]), float(common.t[-1])
             builder.Range(e.edge, a, b, True)
