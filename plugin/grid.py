@@ -194,7 +194,8 @@ def _assign_held(surfaces: list, curves: list, gap: float) -> dict[int, list]:
 
 def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | None = None,
          size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
-         smooth: str = "elliptic", tol: float = 1e-4, gap: float | None = None,
+         smooth: str = "elliptic", orthogonal: bool = True, tol: float = 1e-4,
+         gap: float | None = None,
          whole_surfaces: bool = False, hold=(), max_sweeps: int = 2000, progress=None) -> GridResult:
     """Structured grids on the four-sided faces of a model (or on surfaces), one block each.
 
@@ -211,6 +212,9 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
     spacing : Spacing or (Spacing, Spacing), optional
         Node distribution along i and j (default uniform in arc length).
     smooth : {"elliptic", "none"}
+    orthogonal : bool
+        With elliptic smoothing, grid lines leave every face side at 90 degrees
+        (blended to the face's own corner angles).
     tol : float
         Elliptic residual to stop at (fraction of a cell).
     gap : float, optional
@@ -290,7 +294,8 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
                                    else "nothing to grid")
     held = _assign_held(surfaces, list(hold), gap)
     network = grid_network(surfaces, gap=gap, dims=dims, size=size, spacing=spacing,
-                           smooth=smooth, tol=tol, max_sweeps=max_sweeps, hold=held,
+                           smooth=smooth, orthogonal=orthogonal, tol=tol, max_sweeps=max_sweeps,
+                           hold=held,
                            progress=progress)
     skipped += [(kept[b], why) for b, why in network.failed]
     return GridResult(network, tuple(kept[b] for b in network.indices),

@@ -85,6 +85,7 @@ References
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,6 +94,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from .elliptic_kernels import sweep
+from .orthogonal import BoundaryControl
 
 __all__ = ["EllipticResult", "corner_jacobians", "refine"]
 
@@ -105,6 +107,9 @@ _MIN_RELAXATION = 0.05
 #: over the last STALL_WINDOW evaluations
 STALL_FACTOR = 0.9
 STALL_WINDOW = 25
+#: with boundary orthogonality, the sides' sources are moved only when the grid has
+#: nearly settled on the current ones (residual below this, in cells)
+ORTHOGONAL_BELOW = 0.05
 
 
 @dataclass(frozen=True)
@@ -195,6 +200,13 @@ def _pole_terms(points: NDArray, short: float) -> tuple[NDArray | None, NDArray 
     return out[0], out[1]
 
 
+def _short(points: NDArray) -> float:
+    """A length below which a side of the grid ``points`` (ni, nj, 3) is collapsed (a pole)."""
+    sides = (points[:, 0], points[:, -1], points[0, :], points[-1, :])
+    legs = np.concatenate([np.linalg.norm(np.diff(side, axis=0), axis=1) for side in sides])
+    return 1e-9 * float(legs.max(initial=0.0))
+
+
 def _controls(points: NDArray) -> tuple[NDArray, NDArray]:
     """``P, Q`` on the interior nodes of the start grid ``points`` (ni, nj, 3).
 
@@ -203,9 +215,7 @@ def _controls(points: NDArray) -> tuple[NDArray, NDArray]:
     (ni-2, nj-2) arrays.
     """
     ni, nj = points.shape[:2]
-    sides = (points[:, 0], points[:, -1], points[0, :], points[-1, :])
-    legs = np.concatenate([np.linalg.norm(np.diff(side, axis=0), axis=1) for side in sides])
-    short = (1e-9 * float(legs.max(initial=0.0))) ** 2
+    short = _short(points) ** 2
     p0, p1, q0, q1 = _side_terms(points, short)
     eta = np.linspace(0.0, 1.0, nj)[1:-1]
     xi = np.linspace(0.0, 1.0, ni)[1:-1]
@@ -250,8 +260,8 @@ def _folded(s: NDArray, t: NDArray, sign: float, floor: NDArray) -> bool:
     return bool(np.any(sign * corner_jacobians(s, t) <= floor))
 
 
-def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, tol: float,
-                  max_sweeps: int) -> NDArray:
+def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool,
+                  heights: Mapping[str, float] | None, tol: float, max_sweeps: int) -> NDArray:
     """Interior ``(s, t)`` from the solution on a grid of about half the nodes."""
     from scipy.ndimage import map_coordinates
     ni, nj = st.shape[:2]
@@ -259,7 +269,8 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, tol: float,
     fi, fj = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
     gi, gj = np.meshgrid(fi, fj, indexing="ij")
     coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
-    solved = refine(surface, coarse, control=control, tol=tol, max_sweeps=max_sweeps).parameters
+    solved = refine(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
+                    tol=tol, max_sweeps=max_sweeps).parameters
     # back on the fine index positions
     bi, bj = np.meshgrid(np.arange(ni) * (ci - 1) / (ni - 1), np.arange(nj) * (cj - 1) / (nj - 1),
                          indexing="ij")
@@ -270,7 +281,8 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, tol: float,
 
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
-           tol: float = 1e-4, max_sweeps: int = 2000,
+           orthogonal: bool = False, heights: Mapping[str, float] | None = None, tol: float = 1e-4,
+           max_sweeps: int = 2000,
            relaxation: float | None = None, warm: bool = False) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
 
@@ -283,6 +295,15 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     control : bool
         Thomas--Middlecoff control functions (keep the side distributions), or
         ``P = Q = 0`` (Winslow's harmonic lines on the surface).
+    orthogonal : bool
+        Also make the lines leave every side at 90 degrees (blended to the face's
+        own angle next to its corners, left free at sharp bends of a side and next
+        to a pole): Steger--Sorenson sources iterated with the grid
+        (:mod:`.orthogonal`). The grid has converged only when every side is
+        within :data:`.orthogonal.ANGLE_TOL` degrees of its wanted angle.
+    heights : dict, optional
+        With ``orthogonal``, side (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``) to the
+        height its first cells are held at (model units).
     tol : float
         Stop when no node would move more than ``tol`` times its cell size.
     max_sweeps : int
@@ -311,8 +332,12 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     start_jac = sign * corner_jacobians(st[..., 0], st[..., 1])
     if np.any(start_jac <= 0.0):
         raise InvalidGeometryError("the start grid has folded or degenerate cells in the parameters")
+    sides = None
+    if orthogonal:                       # the first-cell heights of the start grid are held
+        start_points = surface.evaluate(st[..., 0], st[..., 1])
+        sides = BoundaryControl.start(start_points, heights=heights, short=_short(start_points))
     if max(ni, nj) > COARSEN_ABOVE and not warm:
-        st = _coarse_start(surface, st, control, tol, max_sweeps)
+        st = _coarse_start(surface, st, control, orthogonal, heights, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
             st = _check_grid(surface, parameters)          # the coarse start folded: plain start
     floor = np.zeros_like(start_jac)
@@ -322,20 +347,25 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     P, Q = np.zeros((ni, nj)), np.zeros((ni, nj))
     if control:
         P[1:-1, 1:-1], Q[1:-1, 1:-1] = _controls(surface.evaluate(s, t))
+    base = P.copy(), Q.copy()
     box = surface.domain
     residuals: list[float] = []
     refused = sweeps = 0
     best = (math.inf, s, t)
+    misfit = math.inf if sides is not None else 0.0
     while sweeps < max_sweeps:
         d = surface.derivatives(s, t, 1)
         x, rs, rt = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
+        if sides is not None and (not residuals or residuals[-1] < ORTHOGONAL_BELOW):
+            sides, dP, dQ, misfit = sides.update(x)
+            P, Q = base[0] + dP, base[1] + dQ
         saved = s.copy(), t.copy()
         residual = sweep(s, t, x, rs, rt, P, Q, omega, box)
         sweeps += 1
         residuals.append(residual)
         if residual < best[0]:
             best = (residual, *saved)
-        if residual < tol:
+        if residual < tol and misfit <= 1.0:
             s, t = saved                 # converged on the exact nodes: keep them
             break
         if _stalled(residuals):
@@ -350,7 +380,7 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
             omega *= 0.5
             if omega < _MIN_RELAXATION:
                 break
-    converged = bool(residuals and residuals[-1] < tol)
+    converged = bool(residuals and residuals[-1] < tol and misfit <= 1.0)
     if not converged and residuals:
         s, t = best[1], best[2]
         residuals.append(best[0])        # the history ends with the residual of the grid returned

@@ -233,8 +233,9 @@ def _side_parameters(grid: SurfaceGrid, side: str) -> NDArray:
 
 def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tuple[int, int] | None = None,
                  size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
-                 smooth: str = "elliptic", tol: float = 1e-4, max_sweeps: int = 2000,
-                 hold: dict[int, list] | None = None, progress=None) -> NetworkGrid:
+                 smooth: str = "elliptic", orthogonal: bool = True, tol: float = 1e-4,
+                 max_sweeps: int = 2000, hold: dict[int, list] | None = None,
+                 progress=None) -> NetworkGrid:
     """Point-matched grids over a network of four-sided surfaces (see the module doc).
 
     Parameters
@@ -249,7 +250,7 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     size : float, optional
         Target cell size; default the median over the blocks of their longest side
         over :data:`~.structured.DEFAULT_CELLS`.
-    spacing, smooth, tol, max_sweeps
+    spacing, smooth, orthogonal, tol, max_sweeps
         As in :func:`~.structured.grid_surface` (default spacing: uniform in arc length).
     hold : dict, optional
         Surface index to the curves held as grid lines on it (see
@@ -302,7 +303,8 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
                     fractions = _side_parameters(blocks[a], side_a)
                     given[side] = _transfer(surfaces[a], side_a, fractions, surface, side, reverse)
             blocks.append(grid_region(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
-                                      smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
+                                      smooth=smooth, orthogonal=orthogonal, tol=tol,
+                                      max_sweeps=max_sweeps, sides=given,
                                       hold=(hold or {}).get(b, ()), hold_tol=gap))
         except SurfprepError as exc:
             failed[b] = str(exc)

@@ -141,6 +141,10 @@ class SurfaceGrid:
         The algebraic start grid (to show what the refinement changed).
     side_params : dict of str to (n,) float
         The normalized side parameters (:class:`Side`) of each side's nodes.
+    orthogonal : str or None
+        With ``orthogonal=True``: None when the lines leave the sides at right angles
+        (:func:`.elliptic.refine`), else why the grid without that control is kept
+        (the controlled iteration did not converge).
     """
 
     points: NDArray
@@ -157,6 +161,7 @@ class SurfaceGrid:
     start_points: NDArray | None = field(default=None, repr=False, compare=False)
     start_parameters: NDArray | None = field(default=None, repr=False, compare=False)
     side_params: dict = field(default_factory=dict, repr=False, compare=False)
+    orthogonal: str | None = None
 
     @property
     def dims(self) -> tuple[int, int]:
@@ -318,9 +323,9 @@ def _refine_pieces(surface: NurbsSurface, st: NDArray, pieces: list[tuple[int, i
 
 def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
                  spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                 control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
-                 sides: dict[str, NDArray] | None = None, hold: Sequence = (),
-                 hold_tol: float | None = None) -> SurfaceGrid:
+                 control: bool = True, orthogonal: bool = True, tol: float = 1e-4,
+                 max_sweeps: int = 2000, sides: dict[str, NDArray] | None = None,
+                 hold: Sequence = (), hold_tol: float | None = None) -> SurfaceGrid:
     """A structured grid on a surface's whole parameter rectangle (003: redistribution, TFI, elliptic).
 
     :func:`grid_region` on :meth:`Region.rectangle`; the parameters and their meaning
@@ -339,15 +344,15 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
     if not isinstance(surface, NurbsSurface) or surface.dimension != 3:
         raise InvalidGeometryError("grid_surface needs a 3D NurbsSurface")
     return grid_region(Region.rectangle(surface), dims=dims, size=size, spacing=spacing, smooth=smooth,
-                       control=control, tol=tol, max_sweeps=max_sweeps, sides=sides, hold=hold,
-                       hold_tol=hold_tol)
+                       control=control, orthogonal=orthogonal, tol=tol, max_sweeps=max_sweeps,
+                       sides=sides, hold=hold, hold_tol=hold_tol)
 
 
 def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: float | None = None,
                 spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                control: bool = True, tol: float = 1e-4, max_sweeps: int = 2000,
-                sides: dict[str, NDArray] | None = None, hold: Sequence = (),
-                hold_tol: float | None = None) -> SurfaceGrid:
+                control: bool = True, orthogonal: bool = True, tol: float = 1e-4,
+                max_sweeps: int = 2000, sides: dict[str, NDArray] | None = None,
+                hold: Sequence = (), hold_tol: float | None = None) -> SurfaceGrid:
     """A structured grid on a four-sided region of a surface (003: redistribution, TFI, elliptic).
 
     Parameters
@@ -366,6 +371,10 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         Elliptic refinement on the surface metric (default), or the algebraic grid.
     control, tol, max_sweeps
         Passed to :func:`.elliptic.refine`.
+    orthogonal : bool
+        Grid lines leave the sides at 90 degrees (:func:`.elliptic.refine`; default);
+        where that iteration does not converge, the grid without it is kept and
+        ``SurfaceGrid.orthogonal`` says so.
     sides : dict, optional
         Nodes of some sides given, instead of by the law: side name (``"j0"``,
         ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side's normalized
@@ -448,10 +457,17 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
     start_params = st
     result = None
     points, quality = start_points, start_quality
-    kept_start = None
+    kept_start = dropped = None
     if smooth == "elliptic":
-        result = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
-                                max_sweeps=max_sweeps)
+        result = _refine_pieces(surface, st, pieces, axis, control=control, orthogonal=orthogonal,
+                                tol=tol, max_sweeps=max_sweeps)
+        if orthogonal and not result.converged:
+            plain = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
+                                   max_sweeps=max_sweeps)
+            if plain.converged:
+                dropped = (f"the sides' orthogonality was not reached (residual "
+                           f"{result.residuals[-1]:.3g}); the grid without it is kept")
+                result = plain
         refined_points, refined = measured(result.parameters)
         worse = refined.folded_cells > start_quality.folded_cells or (
             not result.converged and refined.max_skewness > start_quality.max_skewness)
@@ -469,4 +485,4 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                        collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started, start_points=start_points,
-                       start_parameters=start_params, side_params=dict(fractions))
+                       start_parameters=start_params, side_params=dict(fractions), orthogonal=dropped)

@@ -54,6 +54,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--smooth", choices=("elliptic", "none"), default="elliptic",
                         help="elliptic refinement on the surface metric (default) or the "
                              "algebraic (TFI) grid")
+    parser.add_argument("--no-orthogonal", action="store_false", dest="orthogonal",
+                        help="do not force the grid lines to leave the face sides at 90 degrees "
+                             "(by default they do, blended to the faces' own corner angles)")
     parser.add_argument("--whole-surfaces", action="store_true", dest="whole_surfaces",
                         help="grid the whole surface of a trimmed face (its trims ignored) "
                              "instead of leaving the face out")
@@ -110,7 +113,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     model = read_model(args.file, console, strict=args.strict)
     start = time.perf_counter()
     result = grid(model, faces=args.faces, dims=tuple(args.dims) if args.dims else None, size=args.size,
-                  spacing=spacing, smooth=args.smooth, gap=args.gap, whole_surfaces=args.whole_surfaces,
+                  spacing=spacing, smooth=args.smooth, orthogonal=args.orthogonal, gap=args.gap,
+                  whole_surfaces=args.whole_surfaces,
                   hold=held,
                   progress=lambda done, total: console.progress(done, total, "face"))
     elapsed = time.perf_counter() - start

@@ -1,0 +1,300 @@
+r"""Boundary orthogonality control of the elliptic system: sources iterated with the grid (Steger--Sorenson).
+
+The elliptic system of :mod:`.elliptic`,
+
+.. math::
+
+    g_{22} (r_{\xi\xi} + P r_\xi) - 2 g_{12} r_{\xi\eta} + g_{11} (r_{\eta\eta} + Q r_\eta)
+        = 2 H g \, n,
+
+is given sources near every side of the grid that make its lines leave the
+side at a wanted angle -- 90 degrees, blended to the face's own angle next to
+its corners ([SS]_, [S]_) -- and, where asked, with a given first-cell height.
+As in Sorenson's GRAPE the sources of a side are ``p(xi) exp(-a eta)`` (``eta``
+the index distance from the side, ``a`` = :data:`DECAY`) and their side values
+``p`` are iterated with the grid; what moves them here is the miss measured on
+the grid itself, not a one-sided estimate of ``r_etaeta`` (which on a curved
+side confuses a chord with a derivative and asks for sources an exact
+orthogonal grid does not need). At a node of the side ``eta = 0``, with
+``r_xi`` along the side and ``r_1 - r_0`` the first line across it:
+
+* the angle: a source ``P`` moves the first row along ``r_xi``; for a miss that
+  is smooth along the side the 1-D problem across it,
+  ``g11 d_etaeta = -g22 c exp(-a eta) |r_xi|``, ``d(0) = 0``, gives the first
+  row's move ``d_1 = (g22 / g11) |r_xi| c (1 - e^{-a}) / a^2``, so the step of
+  ``c`` that turns the line by ``d cos`` is
+  ``d cos |r_xi| / (h (1 - e^{-a}) / a^2)`` (:func:`source_steps`);
+* the height: likewise a source ``Q`` moves the first row across the side by
+  ``h c (1 - e^{-a}) / a^2``.
+
+The steps are under-relaxed (:data:`RELAXATION`), bounded (:data:`BOUND`), and
+each node's step gain grows while its steps keep their sign and is cut when it
+flips (:func:`_adapted`): a miss local to a few nodes moves the row less per
+unit of source than a smooth one. Nodes at a sharp bend of a side or next to a
+pole are left free. The grid has converged when every side is within
+:data:`ANGLE_TOL` of its wanted angle outside the corners' blend.
+
+References
+----------
+.. [SS] J. L. Steger, R. L. Sorenson, "Automatic mesh-point clustering near a
+   boundary in grid generation with elliptic partial differential equations",
+   J. Comput. Phys. 33 (1979) 405-410.
+.. [S] R. L. Sorenson, "A computer program to generate two-dimensional grids about
+   airfoils and other shapes by the use of Poisson's equation", NASA TM-81198 (1980).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["BoundaryControl", "side_targets", "source_steps", "spread"]
+
+#: decay of a side's sources into the grid, per node of index distance
+DECAY = 0.35
+#: fraction of the way a side's correction moves toward what it lacks, per update
+RELAXATION = 0.5
+#: largest correction of a source (dimensionless, per index unit)
+BOUND = 2.0
+#: per-node gain changes (:func:`_adapted`)
+GAIN_UP, GAIN_DOWN, GAIN_MIN, GAIN_MAX = 1.25, 0.5, 0.25, 16.0
+#: a side is as wanted when its lines leave it within this many degrees of the wanted angle
+ANGLE_TOL = 0.5
+#: ... and, where held, its first cells are within this fraction of their height
+HEIGHT_TOL = 0.01
+#: a side bending by more than this many degrees at a node is left free there (:func:`side_targets`)
+BEND = 8.0
+#: the wanted angle blends from the face's corner angle to 90 degrees over this
+#: fraction of a side (at least three nodes)
+CORNER_BLEND = 0.1
+
+
+def _unit(v: NDArray) -> NDArray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(n > 0.0, n, 1.0)
+
+
+def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """First-cell heights, wanted angles and freedom along the side ``j = 0`` of a grid.
+
+    Parameters
+    ----------
+    points : (ni, nj, 3) float
+        The start grid (its first-cell heights are the ones held).
+
+    Returns
+    -------
+    heights : (ni,) float
+        ``|r_1 - r_0|`` of the start grid at every node of the side.
+    cosines : (ni,) float
+        Cosine of the wanted angle between the side and the lines leaving it: 0
+        (90 degrees), blended linearly to the grid's own angle at the two corners
+        over :data:`CORNER_BLEND` of the side (a corner's angle is the face's; no
+        source can change it).
+    free : (ni,) float in [0, 1]
+        How far each node is left to the system: 1 at a bend of the side sharper
+        than :data:`BEND` (orthogonal lines would fan out of a convex bend and cross
+        in a concave one) and next to a pole (a collapsed neighbouring side, where
+        the lines fan out), fading to 0 over the same length as the corners' blend.
+    counted : (ni,) bool
+        The nodes that must meet their wanted angle for the grid to have converged:
+        those outside the corners' blend and the free nodes' reach (there the
+        sides' wishes meet and may not all be met).
+    """
+    ni = points.shape[0]
+    heights = np.linalg.norm(points[:, 1] - points[:, 0], axis=-1)
+    side = points[:, 0]
+    legs = np.diff(side, axis=0)
+    lengths = np.linalg.norm(legs, axis=-1)
+    m = max(3.0, CORNER_BLEND * (ni - 1))
+    k = np.arange(ni, dtype=float)
+    centres = []                                   # nodes the system is left to
+    corner = []
+    for end, i, along in ((0, 0, legs[0]), (1, ni - 1, legs[-1])):
+        across = points[i, 1] - points[i, 0]
+        a, c = np.linalg.norm(along), np.linalg.norm(across)
+        if a > 0.0 and c > 0.0:
+            corner.append(float(np.dot(along, across) / (a * c)))
+        else:
+            corner.append(0.0)
+            centres.append(i)
+    ok = (lengths[1:] > 0.0) & (lengths[:-1] > 0.0)
+    turn = np.einsum("ij,ij->i", legs[1:], legs[:-1]) / np.where(ok, lengths[1:] * lengths[:-1], 1.0)
+    bends = 1 + np.flatnonzero(ok & (turn < math.cos(math.radians(BEND))))
+    centres.extend(bends.tolist())
+    wa = np.clip(1.0 - k / m, 0.0, 1.0)
+    wb = np.clip(1.0 - (ni - 1 - k) / m, 0.0, 1.0)
+    free = np.zeros(ni)
+    for c in centres:
+        free = np.maximum(free, np.clip(1.0 - np.abs(k - c) / m, 0.0, 1.0))
+    counted = (wa == 0.0) & (wb == 0.0) & (free == 0.0)
+    return heights, corner[0] * wa + corner[1] * wb, free, counted
+
+
+def source_steps(points: NDArray, heights: NDArray | None, cosines: NDArray, free: NDArray,
+                 counted: NDArray) -> tuple[NDArray, NDArray, float]:
+    """Changes of ``P``, ``Q`` at the first interior row that would put it where the side wants it.
+
+    Parameters
+    ----------
+    points : (ni, nj, 3) float, nj >= 2
+        The current grid.
+    heights, cosines, free, counted : (ni,)
+        From :func:`side_targets`; ``heights`` None where they are not held. A
+        node's step is ``(1 - free)`` of the step to its wanted angle (a free node
+        asks nothing).
+
+    Returns
+    -------
+    dP, dQ : (ni - 2,) float
+        At the side's inner nodes (0 where the side or the line has no length: a pole).
+    misfit : float
+        The side's worst miss at its ``counted`` nodes: angle off in units of
+        :data:`ANGLE_TOL`, or height off in units of :data:`HEIGHT_TOL` (relative),
+        whichever is larger; at most 1 when the side is as wanted.
+    """
+    r0, r1 = points[:, 0], points[:, 1]
+    along = 0.5 * (r0[2:] - r0[:-2])
+    across = r1[1:-1] - r0[1:-1]
+    a = np.linalg.norm(along, axis=-1)
+    h = np.linalg.norm(across, axis=-1)
+    ok = (a > 0.0) & (h > 0.0)
+    a, h = np.where(ok, a, 1.0), np.where(ok, h, 1.0)
+    cos = np.einsum("ij,ij->i", along, across) / (a * h)
+    held = 1.0 - free[1:-1]
+    wanted = held * cosines[1:-1] + free[1:-1] * cos
+    # a correction c spread as c exp(-DECAY k) moves the first row, for errors smooth along
+    # the side, by c (1 - exp(-DECAY)) / DECAY^2 times (g22 / g11) |r_xi| along it and h across
+    response = (1.0 - np.exp(-DECAY)) / DECAY ** 2
+    dP = (wanted - cos) * a / (h * response)
+    off = np.degrees(np.abs(np.arccos(np.clip(cos, -1.0, 1.0))
+                            - np.arccos(np.clip(wanted, -1.0, 1.0)))) / ANGLE_TOL
+    if heights is None:
+        dQ = np.zeros_like(h)
+    else:
+        dQ = held * (heights[1:-1] - h) / (h * response)
+        off = np.maximum(off, held * np.abs(heights[1:-1] - h)
+                         / (np.maximum(heights[1:-1], 1e-300) * HEIGHT_TOL))
+    misfit = float(np.max(np.where(ok & counted[1:-1], off, 0.0), initial=0.0))
+    return np.where(ok, dP, 0.0), np.where(ok, dQ, 0.0), misfit
+
+
+def spread(corrections: NDArray, length: int, decay: float = DECAY) -> NDArray:
+    """A side's corrections (n,) carried ``length`` nodes into the grid: (n, length), weight ``exp(-decay k)``."""
+    return corrections[:, None] * np.exp(-decay * np.arange(length, dtype=float))[None, :]
+
+
+def _adapted(gain: NDArray, step: NDArray, last: NDArray) -> NDArray:
+    """Per-node step gains, Rprop-like: grown where a node's steps keep their sign, cut where it flips.
+
+    The steps of :func:`source_steps` assume an error smooth along the side; an
+    error local to a few nodes moves the first row less per unit of source (down
+    to about a tenth), so its steps keep their sign and its gain grows until it is
+    corrected at the pace of the smooth errors.
+    """
+    same = step * last
+    return np.clip(np.where(same > 0.0, gain * GAIN_UP, np.where(same < 0.0, gain * GAIN_DOWN, gain)),
+                   GAIN_MIN, GAIN_MAX)
+
+
+#: the four sides as views of the grid with the side at j = 0: (transpose, flip j), and whether
+#: the side's "P" is the grid's P (True) or its Q
+_SIDES = {"j0": (False, False), "j1": (False, True), "i0": (True, False), "i1": (True, True)}
+
+
+def _view(a: NDArray, side: str) -> NDArray:
+    transpose, flip = _SIDES[side]
+    if transpose:
+        a = np.swapaxes(a, 0, 1)
+    return a[:, ::-1] if flip else a
+
+
+@dataclass(frozen=True)
+class BoundaryControl:
+    """The corrections of ``P``, ``Q`` held for the four sides of a grid as it is refined.
+
+    Built on the start grid, whose first-cell heights it holds (:meth:`start`);
+    :meth:`update` moves each side's corrections by a relaxed step toward what the
+    current grid lacks and returns the corrections spread over the grid, to add to
+    the base control functions.
+
+    Attributes
+    ----------
+    sides : tuple of str
+        The controlled sides (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``).
+    targets : dict
+        Side to its ``(heights or None, cosines, free, counted)`` (:func:`side_targets`).
+    corrections : dict
+        Side to its state ``(along, across, gain_along, gain_across, last_along,
+        last_across)``, each ``(n - 2,)`` at the side's inner nodes, in the side's
+        own orientation: the corrections, their step gains (:func:`_adapted`) and
+        the last steps.
+    """
+
+    sides: tuple[str, ...]
+    targets: dict
+    corrections: dict
+
+    @classmethod
+    def start(cls, points: NDArray, *, heights: Mapping[str, float] | None = None,
+              short: float = 0.0) -> BoundaryControl:
+        """Targets from the start grid ``points`` (ni, nj, 3), at least 3 x 3.
+
+        ``heights`` maps sides to the height of their first cells, held across the
+        whole side (model units); the other sides only get the angle (their first
+        cells take the height the system gives them). Sides shorter than ``short`` in total (collapsed: a
+        pole) are not controlled.
+        """
+        targets, corrections, kept = {}, {}, []
+        heights = dict(heights or {})
+        for side in _SIDES:
+            p = _view(points, side)
+            if float(np.linalg.norm(np.diff(p[:, 0], axis=0), axis=-1).sum()) <= short:
+                continue
+            held, cosines, free, counted = side_targets(p)
+            if side in heights:
+                held = np.full_like(held, float(heights[side]))
+            targets[side] = (held if side in heights else None, cosines, free, counted)
+            zero, one = np.zeros(p.shape[0] - 2), np.ones(p.shape[0] - 2)
+            corrections[side] = (zero, zero, one, one, zero, zero)
+            kept.append(side)
+        return cls(tuple(kept), targets, corrections)
+
+    def update(self, points: NDArray) -> tuple[BoundaryControl, NDArray, NDArray, float]:
+        """One relaxed step of every side's corrections on the current grid ``points`` (ni, nj, 3).
+
+        Returns
+        -------
+        control : BoundaryControl
+            With the new corrections.
+        dP, dQ : (ni, nj) float
+            The corrections spread over the grid (to add to the base ``P``, ``Q``).
+        misfit : float
+            The worst side's miss before this step (:func:`source_steps`; at most 1
+            when every side is as wanted).
+        """
+        dP, dQ = np.zeros(points.shape[:2]), np.zeros(points.shape[:2])
+        misfit = 0.0
+        corrections = {}
+        for side in self.sides:
+            p = _view(points, side)
+            step_a, step_b, miss = source_steps(p, *self.targets[side])
+            misfit = max(misfit, miss)
+            ca, cb, ga, gb, pa, pb = self.corrections[side]
+            ga, gb = _adapted(ga, step_a, pa), _adapted(gb, step_b, pb)
+            na = np.clip(ca + RELAXATION * ga * step_a, -BOUND, BOUND)
+            nb = np.clip(cb + RELAXATION * gb * step_b, -BOUND, BOUND)
+            corrections[side] = (na, nb, ga, gb, step_a, step_b)
+            transpose, flip = _SIDES[side]
+            sign_b = -1.0 if flip else 1.0         # Q r_eta is even in eta: Q flips with it
+            va, vb = _view(dQ if transpose else dP, side), _view(dP if transpose else dQ, side)
+            va[1:-1] += spread(na, p.shape[1])
+            vb[1:-1] += sign_b * spread(nb, p.shape[1])
+        for a in (dP, dQ):
+            a[[0, -1], :] = 0.0
+            a[:, [0, -1]] = 0.0
+        return BoundaryControl(self.sides, self.targets, corrections), dP, dQ, misfit

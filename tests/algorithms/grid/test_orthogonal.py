@@ -1,0 +1,121 @@
+"""Boundary orthogonality (Steger--Sorenson sources), measured on the grids' own nodes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.grid_cases import pole_patch, warped_cylinder
+from helpers.paths import SAMPLES
+
+from surfprep.algorithms.grid import Spacing, grid_surface
+from surfprep.algorithms.grid.orthogonal import CORNER_BLEND, BoundaryControl, source_steps
+from surfprep.algorithms.surface import NurbsSurface
+
+LINEAR = [0.0, 0.0, 1.0, 1.0]
+
+
+def _trapezoid() -> NurbsSurface:
+    """The plane trapezoid (0,0) (4,0) (3,2) (1,2): its Winslow lines leave the slanted
+    sides and the top at angles up to ~10 degrees off 90."""
+    net = np.array([[[0, 0, 0], [1, 2, 0]], [[4, 0, 0], [3, 2, 0]]], float)
+    return NurbsSurface(net, LINEAR, LINEAR, 1, 1)
+
+
+def _bent() -> NurbsSurface:
+    """A plane sheet whose bottom side bends by 53 degrees in its middle (a roof line)."""
+    net = np.array([[[0, 0, 0], [0, 2, 0]], [[1, 0.5, 0], [1, 2, 0]], [[2, 0, 0], [2, 2, 0]]], float)
+    return NurbsSurface(net, [0, 0, 0.5, 1, 1], LINEAR, 1, 1)
+
+
+def _side_angles(points: np.ndarray) -> list[np.ndarray]:
+    """Angles (degrees) between each side and the lines leaving it, at the side's inner nodes,
+    outside the corners' blend (i0, i1, j0, j1)."""
+    out = []
+    for view in (np.swapaxes(points, 0, 1), np.swapaxes(points, 0, 1)[:, ::-1], points, points[:, ::-1]):
+        along = view[2:, 0] - view[:-2, 0]
+        across = view[1:-1, 1] - view[1:-1, 0]
+        cos = np.einsum("ij,ij->i", along, across) / np.linalg.norm(along, axis=1) / np.linalg.norm(across, axis=1)
+        angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
+        m = int(np.ceil(max(3.0, CORNER_BLEND * (view.shape[0] - 1))))
+        out.append(angles[m:-m])
+    return out
+
+
+def test_an_orthogonal_grid_asks_for_nothing():
+    x, y = np.meshgrid(np.linspace(0, 2, 9), np.linspace(0, 1, 7), indexing="ij")
+    points = np.stack([x, y, np.zeros_like(x)], axis=-1)
+    control = BoundaryControl.start(points, heights={"i0": 0.25, "j1": 1 / 6})
+    assert control.sides == ("j0", "j1", "i0", "i1")
+    _, dP, dQ, misfit = control.update(points)
+    assert misfit < 1e-9 and np.abs(dP).max() < 1e-9 and np.abs(dQ).max() < 1e-9
+    sheared = points.copy()
+    sheared[:, 1:-1, 0] += 0.05                          # the first rows lean
+    steps_p, _, miss = source_steps(sheared, *control.targets["j0"])
+    assert miss > 1.0 and np.all(steps_p[2:-2] < 0.0)    # P pulls the lines back
+
+
+def test_lines_leave_the_sides_of_a_trapezoid_at_right_angles():
+    plain = grid_surface(_trapezoid(), dims=(41, 31), orthogonal=False)
+    square = grid_surface(_trapezoid(), dims=(41, 31))
+    before = max(np.abs(a - 90).max() for a in _side_angles(plain.points))
+    after = max(np.abs(a - 90).max() for a in _side_angles(square.points))
+    assert before > 5.0
+    assert after < 0.5
+    assert square.elliptic.converged and square.quality.folded_cells == 0 and square.orthogonal is None
+    assert np.abs(square.points[..., 2]).max() == 0.0
+    # the sides' nodes are where the arc-length law put them
+    np.testing.assert_array_equal(square.points[:, 0], plain.points[:, 0])
+    np.testing.assert_array_equal(square.points[0, :], plain.points[0, :])
+
+
+def test_a_stretched_grid_whose_sides_cannot_be_met_keeps_the_grid_without_it():
+    """A first spacing of 0.005 clusters the lines at the bottom within the corners' blend
+    of the slanted sides: their wish is not met, and the converged plain grid is kept, said."""
+    spacing = (Spacing(), Spacing(first=0.005))
+    square = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing)
+    plain = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing, orthogonal=False)
+    assert square.orthogonal is not None and "not reached" in square.orthogonal
+    np.testing.assert_array_equal(square.points, plain.points)
+    assert plain.orthogonal is None and square.elliptic.converged
+
+
+def test_an_orthogonal_grid_on_a_developable_surface_is_left_as_it_is():
+    surface = warped_cylinder()
+    plain = grid_surface(surface, dims=(25, 21), orthogonal=False, tol=1e-7)
+    square = grid_surface(surface, dims=(25, 21), tol=1e-7)
+    assert np.abs(square.points - plain.points).max() < 1e-4 * np.ptp(plain.points[..., 0])
+    assert square.quality.max_skewness < 1e-3
+
+
+def test_a_bend_of_a_side_is_left_free_and_nothing_folds():
+    grid = grid_surface(_bent(), dims=(41, 31))
+    assert grid.elliptic.converged and grid.quality.folded_cells == 0
+    angles = _side_angles(grid.points)
+    assert np.abs(angles[1] - 90).max() < 0.5 and np.abs(angles[3] - 90).max() < 0.5   # the straight sides
+    bottom = angles[2]
+    m = 4
+    assert np.abs(bottom[:len(bottom) // 2 - m] - 90).max() < 0.5   # away from the bend
+
+
+def test_no_fold_next_to_a_pole():
+    grid = grid_surface(pole_patch(), dims=(21, 21))
+    assert grid.quality.folded_cells == 0 and grid.elliptic.converged
+
+
+def test_a_badly_parametrized_real_face_gets_right_angles_at_its_sides():
+    import surfprep
+    face = surfprep.to_nurbs(surfprep.read(SAMPLES / "occt_catia4_face_L1.igs").faces[0])
+    plain = grid_surface(face.surface, dims=(41, 41), orthogonal=False)
+    square = grid_surface(face.surface, dims=(41, 41))
+    assert max(np.abs(a - 90).max() for a in _side_angles(plain.points)) > 8.0
+    assert max(np.abs(a - 90).max() for a in _side_angles(square.points)) < 0.5
+    assert square.quality.folded_cells == 0
+    assert square.quality.max_skewness <= plain.quality.max_skewness
+
+
+@pytest.mark.parametrize("orthogonal", [False, True])
+def test_refine_keeps_the_boundary(orthogonal):
+    grid = grid_surface(_trapezoid(), dims=(21, 15), orthogonal=orthogonal)
+    start = grid.start_parameters
+    for side in (np.s_[:, 0], np.s_[:, -1], np.s_[0, :], np.s_[-1, :]):
+        np.testing.assert_array_equal(grid.parameters[side], start[side])
