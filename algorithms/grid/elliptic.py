@@ -131,6 +131,10 @@ class EllipticResult:
         Blocks of sweeps taken back because they would have folded a cell.
     sweeps : int
         SOR sweeps on the finest grid.
+    sides_misfit : float
+        With ``orthogonal``: the worst side's miss of its wanted angle (and height)
+        on the grid returned, in units of the tolerances of :mod:`.orthogonal` (at
+        most 1: met); 0 without.
     """
 
     parameters: NDArray
@@ -138,6 +142,7 @@ class EllipticResult:
     converged: bool
     refused: int
     sweeps: int
+    sides_misfit: float = 0.0
 
 
 def corner_jacobians(s: NDArray, t: NDArray) -> NDArray:
@@ -243,11 +248,12 @@ def _check_grid(surface: NurbsSurface, parameters: NDArray) -> NDArray:
     return st
 
 
-def _stalled(residuals: list[float]) -> bool:
-    """No progress over the last :data:`STALL_WINDOW` evaluations."""
-    if len(residuals) <= STALL_WINDOW:
+def _stalled(scores: list[float]) -> bool:
+    """No progress over the last :data:`STALL_WINDOW` evaluations (``scores``: residuals, or
+    with the sides' control the larger of residual / tol and the sides' misfit)."""
+    if len(scores) <= STALL_WINDOW:
         return False
-    return min(residuals[-STALL_WINDOW:]) > STALL_FACTOR * min(residuals[:-STALL_WINDOW])
+    return min(scores[-STALL_WINDOW:]) > STALL_FACTOR * min(scores[:-STALL_WINDOW])
 
 
 def _orientation(s: NDArray, t: NDArray) -> float:
@@ -350,27 +356,30 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     base = P.copy(), Q.copy()
     box = surface.domain
     residuals: list[float] = []
+    scores: list[float] = []             # how far from converged: residual / tol, or the sides' misfit
     refused = sweeps = 0
-    best = (math.inf, s, t)
+    best = (math.inf, math.inf, math.inf, s, t)    # (score, residual, misfit, s, t)
     misfit = math.inf if sides is not None else 0.0
     while sweeps < max_sweeps:
         d = surface.derivatives(s, t, 1)
         x, rs, rt = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
-        if sides is not None and (not residuals or residuals[-1] < ORTHOGONAL_BELOW):
-            sides, dP, dQ, misfit = sides.update(x)
-            P, Q = base[0] + dP, base[1] + dQ
+        if sides is not None:
+            moved, dP, dQ, misfit = sides.update(x)
+            # the sources move while a side misses, once the grid has nearly settled on them
+            if misfit > 1.0 and residuals and residuals[-1] < ORTHOGONAL_BELOW:
+                sides, P, Q = moved, base[0] + dP, base[1] + dQ
         saved = s.copy(), t.copy()
         residual = sweep(s, t, x, rs, rt, P, Q, omega, box)
         sweeps += 1
         residuals.append(residual)
-        if residual < best[0]:
-            best = (residual, *saved)
+        scores.append(max(residual / tol, misfit))
+        if scores[-1] < best[0]:
+            best = (scores[-1], residual, misfit, *saved)
         if residual < tol and misfit <= 1.0:
             s, t = saved                 # converged on the exact nodes: keep them
             break
-        if _stalled(residuals):
-            s, t = best[1], best[2]      # not converging: the iterate nearest to a solution
-            break
+        if _stalled(scores):
+            break                        # not converging: the iterate nearest to a solution is returned
         for _ in range(SWEEPS_PER_EVALUATION - 1):
             sweep(s, t, x, rs, rt, P, Q, omega, box)
             sweeps += 1
@@ -382,7 +391,9 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
                 break
     converged = bool(residuals and residuals[-1] < tol and misfit <= 1.0)
     if not converged and residuals:
-        s, t = best[1], best[2]
-        residuals.append(best[0])        # the history ends with the residual of the grid returned
+        s, t = best[3], best[4]
+        residuals.append(best[1])        # the history ends with the residual of the grid returned
+        misfit = best[2]
     out = np.stack([s, t], axis=-1)
-    return EllipticResult(out, tuple(residuals), converged, refused, sweeps)
+    return EllipticResult(out, tuple(residuals), converged, refused, sweeps,
+                          misfit if sides is not None else 0.0)

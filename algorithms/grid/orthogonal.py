@@ -58,7 +58,8 @@ __all__ = ["BoundaryControl", "side_targets", "source_steps", "spread"]
 DECAY = 0.35
 #: fraction of the way a side's correction moves toward what it lacks, per update
 RELAXATION = 0.5
-#: largest correction of a source (dimensionless, per index unit)
+#: largest correction of a source (dimensionless, per index unit; P's times the first
+#: cells' aspect ratio, :func:`source_steps`)
 BOUND = 2.0
 #: per-node gain changes (:func:`_adapted`)
 GAIN_UP, GAIN_DOWN, GAIN_MIN, GAIN_MAX = 1.25, 0.5, 0.25, 16.0
@@ -69,8 +70,9 @@ HEIGHT_TOL = 0.01
 #: a side bending by more than this many degrees at a node is left free there (:func:`side_targets`)
 BEND = 8.0
 #: the wanted angle blends from the face's corner angle to 90 degrees over this
-#: fraction of a side (at least three nodes)
+#: fraction of a side's length, or BLEND_NODES nodes, whichever reaches farther
 CORNER_BLEND = 0.1
+BLEND_NODES = 3.0
 
 
 def _unit(v: NDArray) -> NDArray:
@@ -93,8 +95,10 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     cosines : (ni,) float
         Cosine of the wanted angle between the side and the lines leaving it: 0
         (90 degrees), blended linearly to the grid's own angle at the two corners
-        over :data:`CORNER_BLEND` of the side (a corner's angle is the face's; no
-        source can change it).
+        over :data:`CORNER_BLEND` of the side's length or :data:`BLEND_NODES` nodes,
+        whichever reaches farther (a corner's angle is the face's; no source can
+        change it; on a side whose nodes crowd into a corner the blend still spans
+        a length).
     free : (ni,) float in [0, 1]
         How far each node is left to the system: 1 at a bend of the side sharper
         than :data:`BEND` (orthogonal lines would fan out of a convex bend and cross
@@ -110,11 +114,19 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     side = points[:, 0]
     legs = np.diff(side, axis=0)
     lengths = np.linalg.norm(legs, axis=-1)
-    m = max(3.0, CORNER_BLEND * (ni - 1))
     k = np.arange(ni, dtype=float)
+    along_side = np.concatenate([[0.0], np.cumsum(lengths)])
+    along_side /= along_side[-1]
+
+    def near(c: int) -> NDArray:
+        """1 at node c, fading to 0 over CORNER_BLEND of the side's length or BLEND_NODES nodes."""
+        by_nodes = 1.0 - np.abs(k - c) / BLEND_NODES
+        by_length = 1.0 - np.abs(along_side - along_side[c]) / CORNER_BLEND
+        return np.clip(np.maximum(by_nodes, by_length), 0.0, 1.0)
+
     centres = []                                   # nodes the system is left to
     corner = []
-    for end, i, along in ((0, 0, legs[0]), (1, ni - 1, legs[-1])):
+    for i, along in ((0, legs[0]), (ni - 1, legs[-1])):
         across = points[i, 1] - points[i, 0]
         a, c = np.linalg.norm(along), np.linalg.norm(across)
         if a > 0.0 and c > 0.0:
@@ -126,17 +138,16 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     turn = np.einsum("ij,ij->i", legs[1:], legs[:-1]) / np.where(ok, lengths[1:] * lengths[:-1], 1.0)
     bends = 1 + np.flatnonzero(ok & (turn < math.cos(math.radians(BEND))))
     centres.extend(bends.tolist())
-    wa = np.clip(1.0 - k / m, 0.0, 1.0)
-    wb = np.clip(1.0 - (ni - 1 - k) / m, 0.0, 1.0)
+    wa, wb = near(0), near(ni - 1)
     free = np.zeros(ni)
     for c in centres:
-        free = np.maximum(free, np.clip(1.0 - np.abs(k - c) / m, 0.0, 1.0))
+        free = np.maximum(free, near(c))
     counted = (wa == 0.0) & (wb == 0.0) & (free == 0.0)
     return heights, corner[0] * wa + corner[1] * wb, free, counted
 
 
 def source_steps(points: NDArray, heights: NDArray | None, cosines: NDArray, free: NDArray,
-                 counted: NDArray) -> tuple[NDArray, NDArray, float]:
+                 counted: NDArray) -> tuple[NDArray, NDArray, float, NDArray]:
     """Changes of ``P``, ``Q`` at the first interior row that would put it where the side wants it.
 
     Parameters
@@ -156,6 +167,10 @@ def source_steps(points: NDArray, heights: NDArray | None, cosines: NDArray, fre
         The side's worst miss at its ``counted`` nodes: angle off in units of
         :data:`ANGLE_TOL`, or height off in units of :data:`HEIGHT_TOL` (relative),
         whichever is larger; at most 1 when the side is as wanted.
+    aspect : (ni - 2,) float
+        ``max(1, |r_xi| / h)`` of the first cells: a ``P`` moves a first row that is
+        ``aspect`` times flatter than wide that much less, so its bound is that much
+        larger.
     """
     r0, r1 = points[:, 0], points[:, 1]
     along = 0.5 * (r0[2:] - r0[:-2])
@@ -180,7 +195,8 @@ def source_steps(points: NDArray, heights: NDArray | None, cosines: NDArray, fre
         off = np.maximum(off, held * np.abs(heights[1:-1] - h)
                          / (np.maximum(heights[1:-1], 1e-300) * HEIGHT_TOL))
     misfit = float(np.max(np.where(ok & counted[1:-1], off, 0.0), initial=0.0))
-    return np.where(ok, dP, 0.0), np.where(ok, dQ, 0.0), misfit
+    aspect = np.where(ok, np.maximum(a / h, 1.0), 1.0)
+    return np.where(ok, dP, 0.0), np.where(ok, dQ, 0.0), misfit, aspect
 
 
 def spread(corrections: NDArray, length: int, decay: float = DECAY) -> NDArray:
@@ -282,11 +298,11 @@ class BoundaryControl:
         corrections = {}
         for side in self.sides:
             p = _view(points, side)
-            step_a, step_b, miss = source_steps(p, *self.targets[side])
+            step_a, step_b, miss, aspect = source_steps(p, *self.targets[side])
             misfit = max(misfit, miss)
             ca, cb, ga, gb, pa, pb = self.corrections[side]
             ga, gb = _adapted(ga, step_a, pa), _adapted(gb, step_b, pb)
-            na = np.clip(ca + RELAXATION * ga * step_a, -BOUND, BOUND)
+            na = np.clip(ca + RELAXATION * ga * step_a, -BOUND * aspect, BOUND * aspect)
             nb = np.clip(cb + RELAXATION * gb * step_b, -BOUND, BOUND)
             corrections[side] = (na, nb, ga, gb, step_a, step_b)
             transpose, flip = _SIDES[side]

@@ -8,7 +8,7 @@ from helpers.grid_cases import pole_patch, warped_cylinder
 from helpers.paths import SAMPLES
 
 from surfprep.algorithms.grid import Spacing, grid_surface
-from surfprep.algorithms.grid.orthogonal import CORNER_BLEND, BoundaryControl, source_steps
+from surfprep.algorithms.grid.orthogonal import BLEND_NODES, CORNER_BLEND, BoundaryControl, source_steps
 from surfprep.algorithms.surface import NurbsSurface
 
 LINEAR = [0.0, 0.0, 1.0, 1.0]
@@ -36,8 +36,12 @@ def _side_angles(points: np.ndarray) -> list[np.ndarray]:
         across = view[1:-1, 1] - view[1:-1, 0]
         cos = np.einsum("ij,ij->i", along, across) / np.linalg.norm(along, axis=1) / np.linalg.norm(across, axis=1)
         angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
-        m = int(np.ceil(max(3.0, CORNER_BLEND * (view.shape[0] - 1))))
-        out.append(angles[m:-m])
+        run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(view[:, 0], axis=0), axis=1))])
+        run = run[1:-1] / run[-1]
+        k = np.arange(1, view.shape[0] - 1)
+        inside = (run > CORNER_BLEND) & (run < 1 - CORNER_BLEND) & (k >= BLEND_NODES) \
+            & (k <= view.shape[0] - 1 - BLEND_NODES)
+        out.append(angles[inside])
     return out
 
 
@@ -50,7 +54,7 @@ def test_an_orthogonal_grid_asks_for_nothing():
     assert misfit < 1e-9 and np.abs(dP).max() < 1e-9 and np.abs(dQ).max() < 1e-9
     sheared = points.copy()
     sheared[:, 1:-1, 0] += 0.05                          # the first rows lean
-    steps_p, _, miss = source_steps(sheared, *control.targets["j0"])
+    steps_p, _, miss, _ = source_steps(sheared, *control.targets["j0"])
     assert miss > 1.0 and np.all(steps_p[2:-2] < 0.0)    # P pulls the lines back
 
 
@@ -68,15 +72,22 @@ def test_lines_leave_the_sides_of_a_trapezoid_at_right_angles():
     np.testing.assert_array_equal(square.points[0, :], plain.points[0, :])
 
 
-def test_a_stretched_grid_whose_sides_cannot_be_met_keeps_the_grid_without_it():
-    """A first spacing of 0.005 clusters the lines at the bottom within the corners' blend
-    of the slanted sides: their wish is not met, and the converged plain grid is kept, said."""
-    spacing = (Spacing(), Spacing(first=0.005))
-    square = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing)
+@pytest.mark.parametrize("first", [0.01, 0.002])
+def test_a_first_spacing_asked_for_is_held_off_the_side(first):
+    """The tanh law puts the first node of the slanted sides ``first`` from the bottom; the
+    algebraic grid's first cells between them are lower (the trapezoid is 2 high, its slanted
+    sides 2.24 long): the controlled grid holds ``first`` across the whole side."""
+    spacing = (Spacing(), Spacing(first=first))
     plain = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing, orthogonal=False)
-    assert square.orthogonal is not None and "not reached" in square.orthogonal
-    np.testing.assert_array_equal(square.points, plain.points)
-    assert plain.orthogonal is None and square.elliptic.converged
+    grid = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing)
+    assert grid.orthogonal is None and grid.elliptic.converged and grid.quality.folded_cells == 0
+
+    def heights(points):
+        return np.linalg.norm(points[:, 1] - points[:, 0], axis=-1)[4:-4] / first - 1.0
+
+    assert np.abs(heights(plain.points)).max() > 0.05
+    assert np.abs(heights(grid.points)).max() < 0.015
+    assert max(np.abs(a - 90).max() for a in _side_angles(grid.points)) < 0.5
 
 
 def test_an_orthogonal_grid_on_a_developable_surface_is_left_as_it_is():
@@ -119,3 +130,15 @@ def test_refine_keeps_the_boundary(orthogonal):
     start = grid.start_parameters
     for side in (np.s_[:, 0], np.s_[:, -1], np.s_[0, :], np.s_[-1, :]):
         np.testing.assert_array_equal(grid.parameters[side], start[side])
+
+
+def test_a_run_that_does_not_reach_the_sides_keeps_the_plain_grid_and_says_so():
+    """100 sweeps converge the plain grid of the trapezoid but not its sides' sources: the
+    plain grid is returned, the block's report says why."""
+    square = grid_surface(_trapezoid(), dims=(41, 31), max_sweeps=100)
+    plain = grid_surface(_trapezoid(), dims=(41, 31), max_sweeps=100, orthogonal=False)
+    assert square.orthogonal is not None and "not reached" in square.orthogonal
+    np.testing.assert_array_equal(square.points, plain.points)
+    assert square.report()["elliptic"]["orthogonal_dropped"] == square.orthogonal
+    full = grid_surface(_trapezoid(), dims=(41, 31))
+    assert full.orthogonal is None and full.report()["elliptic"]["sides_misfit"] <= 1.0
