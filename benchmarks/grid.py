@@ -18,7 +18,8 @@ Tools:
 
 * **ours none / ours elliptic**: ``grid_surface(face.surface, dims=..., smooth=...)``
   (arc-length side nodes, distribution mesh; then elliptic refinement on the
-  surface metric). Time: in-process, warm (numba compiled), the call alone (median of
+  surface metric, by default with the lines leaving the sides at right angles;
+  "sides free": ``orthogonal=False``, Thomas--Middlecoff control only). Time: in-process, warm (numba compiled), the call alone (median of
   ``--repeat`` calls, default 3);
   "whole call": a fresh ``python`` process that reads the file and grids the
   face (elliptic), as a user's one-shot script runs (numba's on-disk cache
@@ -44,7 +45,10 @@ the NurbsSurface's normals: Gmsh's nodes are projected onto the surface
 surface by construction) and its node table is turned to our i/j orientation by
 matching the four corners (the boundary nodes of the two tools are then compared
 as a check: both space them uniformly in arc length). Columns: orthogonality
-(min/max angle between grid lines at the nodes, degrees), max equiangle
+(min/max angle between grid lines at the nodes, degrees), the sides' orthogonality
+(largest angle off 90 degrees between a side and the lines leaving it, away from
+the corners: farther than three nodes and ``0.1 (1 + 3 |cos(corner angle)|)`` of
+the side), max equiangle
 skewness, min scaled Jacobian, folded cells, max growth ratio, max node
 distance to the surface (Gmsh), time; on the smoothed Gmsh rows the ratios ours
 elliptic / that row for time and max skewness (below 1: ours faster / less skewed).
@@ -189,8 +193,39 @@ def cold_ours(case: dict, dims, folder: Path) -> float:
     return time.perf_counter() - start
 
 
-def row(label, tool, q, dist, seconds, whole, note="", ratio=("", "", "")) -> str:
-    return (f"| {label} | {tool} | {q.min_angle:.1f} | {q.max_angle:.1f} | {q.max_skewness:.3f} | "
+def side_angle_off(points: np.ndarray) -> float:
+    """Largest angle (degrees) off 90 between a side and the lines leaving it (one-sided across
+    the side, central along it), away from the corners, whose angles are the face's: farther
+    than three nodes and than ``0.1 (1 + 3 |cos(corner angle)|)`` of the side's length (the
+    blend of ``surfprep.algorithms.grid.orthogonal``). A collapsed side (a pole) is left out."""
+    worst = 0.0
+    views = (points, points[:, ::-1], np.swapaxes(points, 0, 1), np.swapaxes(points, 0, 1)[:, ::-1])
+    longest = max(float(np.linalg.norm(np.diff(v[:, 0], axis=0), axis=1).sum()) for v in views)
+    for view in views:
+        side = view[:, 0]
+        run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(side, axis=0), axis=1))])
+        if run[-1] <= 1e-9 * longest:
+            continue
+        with np.errstate(invalid="ignore", divide="ignore"):
+            along, across = side[2:] - side[:-2], view[1:-1, 1] - side[1:-1]
+            cos = np.einsum("ij,ij->i", along, across) / np.linalg.norm(along, axis=1) \
+                / np.linalg.norm(across, axis=1)
+            ends = [abs(float(np.dot(leg, view[i, 1] - view[i, 0]) / np.linalg.norm(leg)
+                              / np.linalg.norm(view[i, 1] - view[i, 0])))
+                    for i, leg in ((0, side[1] - side[0]), (-1, side[-1] - side[-2]))]
+        ends = np.nan_to_num(ends)
+        s = run[1:-1] / run[-1]
+        k = np.arange(1, view.shape[0] - 1)
+        inside = (s > 0.1 * (1 + 3 * ends[0])) & (1 - s > 0.1 * (1 + 3 * ends[1])) & (k >= 3) \
+            & (k <= view.shape[0] - 4) & np.isfinite(cos)
+        if inside.any():
+            worst = max(worst, float(np.abs(np.degrees(np.arccos(np.clip(cos[inside], -1, 1))) - 90).max()))
+    return worst
+
+
+def row(label, tool, q, dist, seconds, whole, note="", ratio=("", "", ""), side=None) -> str:
+    side = "" if side is None else f"{side:.1f}"
+    return (f"| {label} | {tool} | {q.min_angle:.1f} | {q.max_angle:.1f} | {side} | {q.max_skewness:.3f} | "
             f"{q.min_scaled_jacobian:.3f} | {q.folded_cells} | {q.max_growth_ratio:.2f} | {dist} | "
             f"{seconds:.3f} | {whole} | {ratio[0]} | {ratio[1]} | {ratio[2]} | {note} |")
 
@@ -223,24 +258,30 @@ def main() -> None:
                 dims = (n, n)
                 tag = f"{name} {n}x{n}"
                 ours, seconds = {}, {}
-                for smooth in ("none", "elliptic"):
-                    runs = [grid_surface(surface, dims=dims, smooth=smooth) for _ in range(args.repeat)]
+                for smooth, orthogonal in (("none", True), ("plain", False), ("elliptic", True)):
+                    runs = [grid_surface(surface, dims=dims, smooth="none" if smooth == "none" else "elliptic",
+                                         orthogonal=orthogonal) for _ in range(args.repeat)]
                     ours[smooth], seconds[smooth] = runs[0], float(np.median([r.time_s for r in runs]))
                 ell = ours["elliptic"]
                 whole_ours = cold_ours(case, dims, folder)
-                e = ell.elliptic
-                rows.append(row(tag, "ours none", ours["none"].quality, "on", seconds["none"], ""))
-                rows.append(row(tag, "ours elliptic", ell.quality, "on", seconds["elliptic"],
-                                f"{whole_ours:.2f}",
-                                f"{'converged' if e.converged else 'NOT converged'}, {e.sweeps} "
-                                f"sweeps, residual {e.residuals[-1]:.2g}"))
+                rows.append(row(tag, "ours none", ours["none"].quality, "on", seconds["none"], "",
+                                side=side_angle_off(ours["none"].points)))
+                for kind, label in (("plain", "ours elliptic, sides free"), ("elliptic", "ours elliptic")):
+                    e = ours[kind].elliptic
+                    note = (f"{'converged' if e.converged else 'NOT converged'}, {e.sweeps} sweeps, "
+                            f"residual {e.residuals[-1]:.2g}")
+                    if ours[kind].orthogonal:
+                        note += f"; {ours[kind].orthogonal}"
+                    rows.append(row(tag, label, ours[kind].quality, "on", seconds[kind],
+                                    f"{whole_ours:.2f}" if kind == "elliptic" else "", note,
+                                    side=side_angle_off(ours[kind].points)))
                 tfi = None
                 for tool, smoothing in GMSH:
                     raw, meta = run_gmsh(case, dims, smoothing, ell.collapsed_sides, folder,
                                          args.repeat)
                     if raw is None:
                         rows.append(f"| {tag} | {tool} | failed: {meta.get('error')} "
-                                    f"{' '.join(meta.get('log', []))} |" + " |" * 13)
+                                    f"{' '.join(meta.get('log', []))} |" + " |" * 14)
                         continue
                     points, corner_miss = orient(raw, ell.points)
                     q, dist = measure(surface, points)
@@ -262,7 +303,8 @@ def main() -> None:
                                  f"{ell.quality.max_skewness / q.max_skewness:.2f}"
                                  if q.max_skewness > 1e-3 else "both ~0")
                     rows.append(row(tag, tool, q, f"{dist:.1e}", meta["generate_s"],
-                                    f"{meta['wall_s']:.2f}", ", ".join(note), ratio))
+                                    f"{meta['wall_s']:.2f}", ", ".join(note), ratio,
+                                    side=side_angle_off(points)))
                     if smoothing == "none":
                         checks.append(
                             f"{tag}: Gmsh surface {meta['tag']} of {meta['n_surfaces']} "
@@ -279,10 +321,10 @@ def main() -> None:
         f"time; times in s: 'time (call)' the median of {args.repeat} in-process runs (grid_surface / "
         "Gmsh's generate(2)), 'whole call' one fresh process (read + grid + save)")
     say()
-    say("| face, nodes | tool | min angle | max angle | max skew | min scaled Jac | folded | "
+    say("| face, nodes | tool | min angle | max angle | sides off 90 | max skew | min scaled Jac | folded | "
         "max growth | max dist to surface | time (call) | whole call | time ratio ours ell / this "
         "(call) | (whole call) | skew ratio ours ell / this | notes |")
-    say("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    say("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for line in rows:
         say(line)
     say()

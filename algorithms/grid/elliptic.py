@@ -85,7 +85,7 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,7 +94,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from .elliptic_kernels import sweep
-from .orthogonal import BoundaryControl
+from .orthogonal import SIDE_NAMES, BoundaryControl
 
 __all__ = ["EllipticResult", "corner_jacobians", "refine"]
 
@@ -266,7 +266,7 @@ def _folded(s: NDArray, t: NDArray, sign: float, floor: NDArray) -> bool:
     return bool(np.any(sign * corner_jacobians(s, t) <= floor))
 
 
-def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool,
+def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool | Collection[str],
                   heights: Mapping[str, float] | None, tol: float, max_sweeps: int) -> NDArray:
     """Interior ``(s, t)`` from the solution on a grid of about half the nodes."""
     from scipy.ndimage import map_coordinates
@@ -287,7 +287,7 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
 
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
-           orthogonal: bool = False, heights: Mapping[str, float] | None = None, tol: float = 1e-4,
+           orthogonal: bool | Collection[str] = False, heights: Mapping[str, float] | None = None, tol: float = 1e-4,
            max_sweeps: int = 2000,
            relaxation: float | None = None, warm: bool = False) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
@@ -301,8 +301,8 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     control : bool
         Thomas--Middlecoff control functions (keep the side distributions), or
         ``P = Q = 0`` (Winslow's harmonic lines on the surface).
-    orthogonal : bool
-        Also make the lines leave every side at 90 degrees (blended to the face's
+    orthogonal : bool or collection of {"i0", "i1", "j0", "j1"}
+        Also make the lines leave every side (or the sides named) at 90 degrees (blended to the face's
         own angle next to its corners, left free at sharp bends of a side and next
         to a pole): Steger--Sorenson sources iterated with the grid
         (:mod:`.orthogonal`). The grid has converged only when every side is
@@ -341,7 +341,9 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     sides = None
     if orthogonal:                       # the first-cell heights of the start grid are held
         start_points = surface.evaluate(st[..., 0], st[..., 1])
-        sides = BoundaryControl.start(start_points, heights=heights, short=_short(start_points))
+        chosen = SIDE_NAMES if orthogonal is True else tuple(orthogonal)
+        sides = BoundaryControl.start(start_points, sides=chosen, heights=heights,
+                                      short=_short(start_points))
     if max(ni, nj) > COARSEN_ABOVE and not warm:
         st = _coarse_start(surface, st, control, orthogonal, heights, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):

@@ -303,8 +303,11 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
                     fractions = _side_parameters(blocks[a], side_a)
                     given[side] = _transfer(surfaces[a], side_a, fractions, surface, side, reverse)
             blocks.append(grid_region(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
-                                      smooth=smooth, orthogonal=orthogonal, tol=tol,
-                                      max_sweeps=max_sweeps, sides=given,
+                                      smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
+                                      # square to the network's open sides, not across its
+                                      # interfaces (there the lines are made to run on smoothly)
+                                      orthogonal=orthogonal and tuple(
+                                          side for side in SIDES if (b, side) not in partner),
                                       hold=(hold or {}).get(b, ()), hold_tol=gap))
         except SurfprepError as exc:
             failed[b] = str(exc)
@@ -324,7 +327,8 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     if smooth == "elliptic" and interfaces:
         budget = time.perf_counter() - started          # sliding may at most double the work
         blocks, rounds = _slide_interfaces(surfaces, blocks, interfaces, tol=tol,
-                                           max_sweeps=max_sweeps, budget=budget)
+                                           max_sweeps=max_sweeps, budget=budget,
+                                           orthogonal=orthogonal)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
     changed = () if dims is None else tuple(
         (index[b], "ij"[d], counts[b, d]) for (b, d) in sorted(counts) if b in index and counts[b, d] != dims[d])
@@ -361,7 +365,8 @@ def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
 
 
 def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfaces: list[Interface], *,
-                      tol: float, max_sweeps: int, budget: float = math.inf) -> tuple[list[SurfaceGrid], int]:
+                      tol: float, max_sweeps: int, budget: float = math.inf,
+                      orthogonal: bool = False) -> tuple[list[SurfaceGrid], int]:
     """Let the nodes of every interface slide along it until the grid lines cross it
     smoothly: each round moves them by the Winslow stencil of both blocks together
     (:func:`_edge_moves`), gives both blocks the new side nodes and refines the
@@ -378,6 +383,9 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     # creases do not slide, nor do blocks that kept their algebraic grid or hold curves
     # (refined piece by piece between them)
     still = {k for k, b in enumerate(blocks) if b.kept_start is not None or b.held}
+    # the sides the lines leave at right angles: those that are no interface (of any kind)
+    shared = {(f.block, f.side) for f in interfaces} | {(f.other, f.other_side) for f in interfaces}
+    open_sides = [tuple(side for side in SIDES if (k, side) not in shared) for k in range(len(blocks))]
     interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
                   and f.block not in still and f.other not in still]
     touched: set[int] = set()
@@ -416,7 +424,8 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             break                             # converged, the moves no longer shrink, or out of time
         previous = worst
         for k in changed:
-            result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
+            result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
+                            orthogonal=orthogonal and open_sides[k])
             params[k] = result.parameters.copy()
             points = surfaces[k].surface.evaluate(params[k][..., 0], params[k][..., 1])
             grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result,

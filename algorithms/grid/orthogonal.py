@@ -46,13 +46,15 @@ References
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["BoundaryControl", "side_targets", "source_steps", "spread"]
+from ...errors import InvalidGeometryError
+
+__all__ = ["SIDE_NAMES", "BoundaryControl", "side_targets", "source_steps", "spread"]
 
 #: decay of a side's sources into the grid, per node of index distance
 DECAY = 0.35
@@ -73,6 +75,8 @@ BEND = 8.0
 #: fraction of a side's length, or BLEND_NODES nodes, whichever reaches farther
 CORNER_BLEND = 0.1
 BLEND_NODES = 3.0
+#: ... that fraction times ``1 + CORNER_STRETCH |cos(corner angle)|``
+CORNER_STRETCH = 3.0
 
 
 def _unit(v: NDArray) -> NDArray:
@@ -95,10 +99,11 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     cosines : (ni,) float
         Cosine of the wanted angle between the side and the lines leaving it: 0
         (90 degrees), blended linearly to the grid's own angle at the two corners
-        over :data:`CORNER_BLEND` of the side's length or :data:`BLEND_NODES` nodes,
-        whichever reaches farther (a corner's angle is the face's; no source can
-        change it; on a side whose nodes crowd into a corner the blend still spans
-        a length).
+        over ``CORNER_BLEND (1 + CORNER_STRETCH |cos(corner angle)|)`` of the side's
+        length or :data:`BLEND_NODES` nodes, whichever reaches farther (a corner's
+        angle is the face's; no source can change it, and the farther it is from
+        square the longer the lines take to turn; on a side whose nodes crowd into
+        a corner the blend still spans a length).
     free : (ni,) float in [0, 1]
         How far each node is left to the system: 1 at a bend of the side sharper
         than :data:`BEND` (orthogonal lines would fan out of a convex bend and cross
@@ -118,10 +123,10 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     along_side = np.concatenate([[0.0], np.cumsum(lengths)])
     along_side /= along_side[-1]
 
-    def near(c: int) -> NDArray:
-        """1 at node c, fading to 0 over CORNER_BLEND of the side's length or BLEND_NODES nodes."""
+    def near(c: int, reach: float = CORNER_BLEND) -> NDArray:
+        """1 at node c, fading to 0 over ``reach`` of the side's length or BLEND_NODES nodes."""
         by_nodes = 1.0 - np.abs(k - c) / BLEND_NODES
-        by_length = 1.0 - np.abs(along_side - along_side[c]) / CORNER_BLEND
+        by_length = 1.0 - np.abs(along_side - along_side[c]) / reach
         return np.clip(np.maximum(by_nodes, by_length), 0.0, 1.0)
 
     centres = []                                   # nodes the system is left to
@@ -138,7 +143,9 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     turn = np.einsum("ij,ij->i", legs[1:], legs[:-1]) / np.where(ok, lengths[1:] * lengths[:-1], 1.0)
     bends = 1 + np.flatnonzero(ok & (turn < math.cos(math.radians(BEND))))
     centres.extend(bends.tolist())
-    wa, wb = near(0), near(ni - 1)
+    # a corner far from square turns the lines over a longer stretch of the side
+    wa, wb = (near(i, CORNER_BLEND * (1.0 + CORNER_STRETCH * abs(c))) for i, c in ((0, corner[0]),
+                                                                                   (ni - 1, corner[1])))
     free = np.zeros(ni)
     for c in centres:
         free = np.maximum(free, near(c))
@@ -220,6 +227,8 @@ def _adapted(gain: NDArray, step: NDArray, last: NDArray) -> NDArray:
 #: the four sides as views of the grid with the side at j = 0: (transpose, flip j), and whether
 #: the side's "P" is the grid's P (True) or its Q
 _SIDES = {"j0": (False, False), "j1": (False, True), "i0": (True, False), "i1": (True, True)}
+#: the four sides' names
+SIDE_NAMES = tuple(_SIDES)
 
 
 def _view(a: NDArray, side: str) -> NDArray:
@@ -256,9 +265,9 @@ class BoundaryControl:
     corrections: dict
 
     @classmethod
-    def start(cls, points: NDArray, *, heights: Mapping[str, float] | None = None,
-              short: float = 0.0) -> BoundaryControl:
-        """Targets from the start grid ``points`` (ni, nj, 3), at least 3 x 3.
+    def start(cls, points: NDArray, *, sides: Collection[str] = ("j0", "j1", "i0", "i1"),
+              heights: Mapping[str, float] | None = None, short: float = 0.0) -> BoundaryControl:
+        """Targets of the ``sides`` named from the start grid ``points`` (ni, nj, 3), at least 3 x 3.
 
         ``heights`` maps sides to the height of their first cells, held across the
         whole side (model units); the other sides only get the angle (their first
@@ -267,7 +276,12 @@ class BoundaryControl:
         """
         targets, corrections, kept = {}, {}, []
         heights = dict(heights or {})
+        unknown = set(sides) - set(_SIDES)
+        if unknown:
+            raise InvalidGeometryError(f"unknown side(s) {sorted(unknown)}; expected {', '.join(_SIDES)}")
         for side in _SIDES:
+            if side not in sides:
+                continue
             p = _view(points, side)
             if float(np.linalg.norm(np.diff(p[:, 0], axis=0), axis=-1).sum()) <= short:
                 continue

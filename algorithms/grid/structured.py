@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -336,7 +336,7 @@ def _refine_pieces(surface: NurbsSurface, st: NDArray, pieces: list[tuple[int, i
 
 def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, size: float | None = None,
                  spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                 control: bool = True, orthogonal: bool = True, tol: float = 1e-4,
+                 control: bool = True, orthogonal: bool | Collection[str] = True, tol: float = 1e-4,
                  max_sweeps: int = 2000, sides: dict[str, NDArray] | None = None,
                  hold: Sequence = (), hold_tol: float | None = None) -> SurfaceGrid:
     """A structured grid on a surface's whole parameter rectangle (003: redistribution, TFI, elliptic).
@@ -363,7 +363,7 @@ def grid_surface(surface: NurbsSurface, *, dims: tuple[int, int] | None = None, 
 
 def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: float | None = None,
                 spacing: Spacing | tuple[Spacing, Spacing] = Spacing(), smooth: str = "elliptic",
-                control: bool = True, orthogonal: bool = True, tol: float = 1e-4,
+                control: bool = True, orthogonal: bool | Collection[str] = True, tol: float = 1e-4,
                 max_sweeps: int = 2000, sides: dict[str, NDArray] | None = None,
                 hold: Sequence = (), hold_tol: float | None = None) -> SurfaceGrid:
     """A structured grid on a four-sided region of a surface (003: redistribution, TFI, elliptic).
@@ -384,8 +384,9 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         Elliptic refinement on the surface metric (default), or the algebraic grid.
     control, tol, max_sweeps
         Passed to :func:`.elliptic.refine`.
-    orthogonal : bool
-        Grid lines leave the sides at 90 degrees (:func:`.elliptic.refine`; default),
+    orthogonal : bool or collection of {"i0", "i1", "j0", "j1"}
+        Grid lines leave the sides (all four, or those named) at 90 degrees
+        (:func:`.elliptic.refine`; default),
         and the first cells off a side whose first (or last) spacing is given are that
         high all along it; where that iteration does not converge, the grid without it
         is kept and ``SurfaceGrid.orthogonal`` says so.

@@ -8,7 +8,9 @@
   unrolled uniform grid (an orthogonal grid exists, and the solver must find it);
 * :func:`pole_patch`: a planar patch with the side ``u = 0`` collapsed to a point;
 * :func:`crowded_plane`: a plane whose parameters crowd into one corner (a
-  chord-length mismatch in the hundreds): the parameter grid there is useless.
+  chord-length mismatch in the hundreds): the parameter grid there is useless;
+* :func:`side_angles`: the angles at which a grid's lines leave its four sides,
+  measured on the nodes, away from the corners.
 """
 
 from __future__ import annotations
@@ -19,7 +21,44 @@ from surfprep import NurbsSurface
 
 from .surfaces import HALF, K_HALF, W_HALF
 
-__all__ = ["crowded_plane", "pole_patch", "unrolled_cylinder_grid", "warped_cylinder", "warped_plane"]
+__all__ = ["crowded_plane", "pole_patch", "side_angles", "unrolled_cylinder_grid", "warped_cylinder",
+           "warped_plane"]
+
+
+def side_angles(points: np.ndarray, blend: float = 0.1, stretch: float = 3.0, nodes: int = 3) -> list[np.ndarray]:
+    """Angles (degrees) between each side of a grid (i0, i1, j0, j1) and the lines leaving it.
+
+    Measured on the nodes: the side's direction by central differences, the line's by
+    the first cell across (one-sided), at the side's inner nodes away from its corners,
+    whose angles are the face's: farther than ``nodes`` nodes and than
+    ``blend (1 + stretch |cos(corner angle)|)`` of the side's length from each corner
+    (the reach :mod:`surfprep.algorithms.grid.orthogonal` documents for its blend).
+    A collapsed side (a pole) gives an empty array.
+    """
+    out = []
+    longest = max(float(np.linalg.norm(np.diff(side, axis=0), axis=1).sum())
+                  for side in (points[:, 0], points[:, -1], points[0], points[-1]))
+    for view in (np.swapaxes(points, 0, 1), np.swapaxes(points, 0, 1)[:, ::-1], points, points[:, ::-1]):
+        side = view[:, 0]
+        run = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(side, axis=0), axis=1))])
+        if run[-1] <= 1e-9 * longest:
+            out.append(np.zeros(0))
+            continue
+        along, across = side[2:] - side[:-2], view[1:-1, 1] - side[1:-1]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cos = np.einsum("ij,ij->i", along, across) / np.linalg.norm(along, axis=1) \
+                / np.linalg.norm(across, axis=1)
+            corners = []
+            for i, leg in ((0, side[1] - side[0]), (-1, side[-1] - side[-2])):
+                line = view[i, 1] - view[i, 0]
+                corners.append(abs(float(np.dot(leg, line) / np.linalg.norm(leg) / np.linalg.norm(line))))
+        s = run[1:-1] / run[-1]
+        k = np.arange(1, view.shape[0] - 1)
+        corners = np.nan_to_num(corners)
+        keep = (s > blend * (1 + stretch * corners[0])) & (1 - s > blend * (1 + stretch * corners[1])) \
+            & (k >= nodes) & (k <= view.shape[0] - 1 - nodes) & np.isfinite(cos)
+        out.append(np.degrees(np.arccos(np.clip(cos[keep], -1, 1))))
+    return out
 
 
 def warped_plane(n: int = 6) -> NurbsSurface:

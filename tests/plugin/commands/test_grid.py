@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 from helpers.cli import run
+from helpers.grid_cases import side_angles
 from helpers.paths import SAMPLES
 
 from surfprep.algorithms.grid.io import read_plot3d
@@ -41,15 +42,6 @@ def test_dims_and_spacing_reach_the_file(tmp_path, capsys):
 def test_the_sides_orthogonality_is_on_by_default_and_can_be_turned_off(tmp_path, capsys):
     """The catia4 surface's plain grid leaves its sides up to 11 degrees off 90; by default the
     lines leave them square (measured here on the written nodes, one-sided across the side)."""
-    def worst_side_angle(block):
-        out = 0.0
-        for view in (block, block[:, ::-1], np.swapaxes(block, 0, 1), np.swapaxes(block, 0, 1)[:, ::-1]):
-            along, across = view[2:, 0] - view[:-2, 0], view[1:-1, 1] - view[1:-1, 0]
-            cos = np.einsum("ij,ij->i", along, across) / np.linalg.norm(along, axis=1) \
-                / np.linalg.norm(across, axis=1)
-            out = max(out, float(np.abs(np.degrees(np.arccos(cos[5:-5])) - 90).max()))
-        return out
-
     angles = {}
     for flag in ((), ("--no-orthogonal",)):
         out, report = tmp_path / f"c{len(flag)}.xyz", tmp_path / f"c{len(flag)}.json"
@@ -59,7 +51,7 @@ def test_the_sides_orthogonality_is_on_by_default_and_can_be_turned_off(tmp_path
         (entry,) = json.loads(report.read_text())["blocks"]
         assert entry["quality"]["folded_cells"] == 0
         (block,) = read_plot3d(out)
-        angles[flag] = worst_side_angle(block)
+        angles[flag] = max(float(np.abs(a - 90).max()) for a in side_angles(block))
         assert (entry["elliptic"]["sides_misfit"] <= 1.0) if not flag else entry["elliptic"]["sides_misfit"] == 0
     assert angles[()] < 0.5
     assert angles[("--no-orthogonal",)] > 8.0
