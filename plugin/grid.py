@@ -110,7 +110,14 @@ class GridResult:
         if fmt == "plot3d":
             return write_plot3d(target, blocks, binary=binary)
         if fmt == "cgns":
-            names = [f"Face{k:0{len(str(max(self.faces)))}d}" for k in self.faces]
+            width = len(str(max(self.faces)))
+            # a face split into several blocks (round a hole, at its corners) names each of them
+            split = {k for k in self.faces if self.faces.count(k) > 1}
+            seen: dict[int, int] = {}
+            names = []
+            for k in self.faces:
+                names.append(f"Face{k:0{width}d}" + (f"_{seen.get(k, 0)}" if k in split else ""))
+                seen[k] = seen.get(k, 0) + 1
             return write_cgns(target, blocks, interfaces=self.network.interfaces, names=names)
         cells = [{"skewness": cell_skewness(b)} for b in blocks]
         if fmt == "vts":

@@ -38,7 +38,7 @@ from ...errors import InvalidGeometryError, SurfprepError
 from ..surface import NurbsSurface
 from .io.blocks import Interface, side_nodes
 from .region import Region
-from .structured import DEFAULT_CELLS, SIDES, Spacing, SurfaceGrid, grid_region
+from .structured import DEFAULT_CELLS, SIDES, SKEW_SLACK, Spacing, SurfaceGrid, corner_skewness, grid_region
 
 __all__ = ["NetworkGrid", "grid_network", "match_sides"]
 
@@ -424,17 +424,44 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             break                             # converged, the moves no longer shrink, or out of time
         previous = worst
         for k in changed:
+            squared = orthogonal and grids[k].orthogonal is None and open_sides[k]
             result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
-                            orthogonal=orthogonal and open_sides[k])
+                            orthogonal=squared)
+            if squared and not result.nearly_converged(tol):      # as grid_region: the plain grid
+                plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
+                if plain.converged or plain.residuals[-1] < result.residuals[-1]:
+                    result = plain
+                    grids[k] = replace(grids[k], orthogonal=(
+                        "the sides' orthogonality was not reached after the shared edges' nodes "
+                        "slid; the grid without it is kept"))
             params[k] = result.parameters.copy()
             points = surfaces[k].surface.evaluate(params[k][..., 0], params[k][..., 1])
             grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result,
                                side_params=dict(side_params[k]))
             touched.add(k)
     for k in touched:
-        g, p = grids[k], params[k]
+        # the parameters its points were evaluated at (params[k] may hold a last round's side
+        # moves that were never refined: the loop stops once they are small)
+        g = grids[k]
+        p = g.elliptic.parameters
         quality = grid_quality(g.points, g.orientation * normals(surfaces[k].surface, p[..., 0], p[..., 1]))
-        grids[k] = replace(g, parameters=p, quality=quality)
+        grids[k] = replace(g, parameters=p.copy(), quality=quality)
+        if orthogonal and g.orthogonal is None and open_sides[k] \
+                and quality.max_skewness > corner_skewness(g.points) + SKEW_SLACK:
+            # as grid_region: squared sides that squeeze a sharp corner's cells are given up
+            plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True)
+            pp = plain.parameters
+            points = surfaces[k].surface.evaluate(pp[..., 0], pp[..., 1])
+            plain_quality = grid_quality(points, g.orientation * normals(surfaces[k].surface, pp[..., 0],
+                                                                         pp[..., 1]))
+            if plain.nearly_converged(tol) and plain_quality.folded_cells <= quality.folded_cells \
+                    and plain_quality.max_skewness < quality.max_skewness - SKEW_SLACK / 2:
+                grids[k] = replace(g, points=points, parameters=pp.copy(), elliptic=plain,
+                                   quality=plain_quality, orthogonal=(
+                                       f"squaring the sides made the worst cell more skewed than the "
+                                       f"face's corners do ({quality.max_skewness:.3g} against "
+                                       f"{plain_quality.max_skewness:.3g} without): the grid without "
+                                       "it is kept"))
     return grids, rounds
 
 

@@ -77,6 +77,9 @@ CORNER_BLEND = 0.1
 BLEND_NODES = 3.0
 #: ... that fraction times ``1 + CORNER_STRETCH |cos(corner angle)|``
 CORNER_STRETCH = 3.0
+#: a corner with ``|cos(angle)|`` above this (sharper than 45 or flatter than 135
+#: degrees) leaves the lines near it free over the same stretch
+SHARP_CORNER = math.cos(math.radians(45.0)) + 1e-9
 
 
 def _unit(v: NDArray) -> NDArray:
@@ -108,7 +111,10 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         How far each node is left to the system: 1 at a bend of the side sharper
         than :data:`BEND` (orthogonal lines would fan out of a convex bend and cross
         in a concave one) and next to a pole (a collapsed neighbouring side, where
-        the lines fan out), fading to 0 over the same length as the corners' blend.
+        the lines fan out), fading to 0 over the same length as the corners' blend;
+        and over the blend of a corner sharper than 45 or flatter than 135 degrees
+        (:data:`SHARP_CORNER`: turning the lines there folds the cells beside it
+        toward the corner's own angle).
     counted : (ni,) bool
         The nodes that must meet their wanted angle for the grid to have converged:
         those outside the corners' blend and the free nodes' reach (there the
@@ -149,6 +155,9 @@ def side_targets(points: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     free = np.zeros(ni)
     for c in centres:
         free = np.maximum(free, near(c))
+    for w, c in ((wa, corner[0]), (wb, corner[1])):
+        if abs(c) > SHARP_CORNER:             # a sharp or flat corner: the lines near it are left free
+            free = np.maximum(free, w)
     counted = (wa == 0.0) & (wb == 0.0) & (free == 0.0)
     return heights, corner[0] * wa + corner[1] * wb, free, counted
 

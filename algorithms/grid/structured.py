@@ -38,7 +38,8 @@ from .quality import GridQuality, grid_quality
 from .region import SIDE_NAMES, Region
 from .tfi import distribution_mesh, transfinite
 
-__all__ = ["DEFAULT_CELLS", "Spacing", "SurfaceGrid", "grid_region", "grid_surface", "side_curves"]
+__all__ = ["DEFAULT_CELLS", "SKEW_SLACK", "Spacing", "SurfaceGrid", "corner_angles", "corner_skewness",
+           "grid_region", "grid_surface", "side_curves"]
 
 #: cells along the longest side when neither ``dims`` nor ``size`` is given
 DEFAULT_CELLS = 40
@@ -46,9 +47,9 @@ DEFAULT_CELLS = 40
 COLLAPSED = 1e-9
 LAWS = ("uniform", "geometric", "tanh", "curvature")
 SIDES = ("j0", "j1", "i0", "i1")
-#: a refinement with the sides' orthogonality whose residual stalls below this many times
-#: the tolerance, its sides met, is kept (:func:`_nearly_converged`)
-NEARLY = 10.0
+#: the sides' orthogonality may leave the worst cell this much more skewed than the face's
+#: corners before the grid without it is tried
+SKEW_SLACK = 0.02
 
 
 @dataclass(frozen=True)
@@ -308,12 +309,11 @@ def _held_start(surface: NurbsSurface, hold: Sequence, fractions: dict[str, NDAr
     return np.transpose(xy, (1, 0, 2))[..., ::-1], pieces, 1
 
 
-def _nearly_converged(result: EllipticResult, tol: float) -> bool:
-    """The sides are as wanted and the residual within :data:`NEARLY` of the tolerance (a face
-    whose parameters hold a band the surface barely moves across can leave the residual
-    hovering just above it)."""
-    return result.converged or (result.sides_misfit <= 1.0 and bool(result.residuals)
-                                and result.residuals[-1] < NEARLY * tol)
+def corner_skewness(points: NDArray) -> float:
+    """The equiangle skewness the face's corners alone impose: ``|angle - 90| / 90`` at the
+    worst corner (None at a collapsed corner is left out)."""
+    angles = [a for a in corner_angles(points) if a is not None]
+    return max((abs(a - 90.0) / 90.0 for a in angles), default=0.0)
 
 
 def _refine_pieces(surface: NurbsSurface, st: NDArray, pieces: list[tuple[int, int]], axis: int,
@@ -479,7 +479,7 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                        if given is not None and name not in collapsed}
         result = _refine_pieces(surface, st, pieces, axis, control=control, orthogonal=orthogonal,
                                 heights=first_cells, tol=tol, max_sweeps=max_sweeps)
-        if orthogonal and not _nearly_converged(result, tol):
+        if orthogonal and not result.nearly_converged(tol):
             plain = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
                                    max_sweeps=max_sweeps)
             if plain.converged or plain.residuals[-1] < result.residuals[-1]:
@@ -488,6 +488,18 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                            "their tolerance); the grid without it is kept")
                 result = plain
         refined_points, refined = measured(result.parameters)
+        if orthogonal and dropped is None and refined.max_skewness > corner_skewness(start_points) + SKEW_SLACK:
+            # the squared sides may squeeze the cells beside a sharp corner further than the
+            # corner itself does: then the grid without them, if its worst cell is better
+            plain = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
+                                   max_sweeps=max_sweeps)
+            plain_points, plain_quality = measured(plain.parameters)
+            if plain.nearly_converged(tol) and plain_quality.folded_cells <= refined.folded_cells \
+                    and plain_quality.max_skewness < refined.max_skewness - SKEW_SLACK / 2:
+                dropped = (f"squaring the sides made the worst cell more skewed than the face's "
+                           f"corners do ({refined.max_skewness:.3g} against "
+                           f"{plain_quality.max_skewness:.3g} without): the grid without it is kept")
+                result, refined_points, refined = plain, plain_points, plain_quality
         worse = refined.folded_cells > start_quality.folded_cells or (
             not result.converged and refined.max_skewness > start_quality.max_skewness)
         if worse:

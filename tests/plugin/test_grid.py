@@ -235,6 +235,20 @@ def test_a_face_with_a_hole_is_gridded_as_four_blocks_round_it():
     assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(0.64 - np.pi * 0.09, rel=2e-3)
 
 
+def test_the_blocks_of_one_face_get_zone_names_of_their_own(tmp_path):
+    """A face gridded as four blocks round its hole: CGNS zones Face0_0 .. Face0_3 (one name
+    for all four was refused by the writer, and the whole file with it)."""
+    h5py = pytest.importorskip("h5py", reason="CGNS output needs h5py")
+    from helpers.heal_cases import plane_with_hole
+    result = surfprep.grid(plane_with_hole(), size=0.04)
+    assert result.faces == (0, 0, 0, 0)
+    path = result.write(tmp_path / "hole.cgns")
+    with h5py.File(path, "r") as f:
+        (base,) = [k for k in f if k not in (" format", " hdf5version", "CGNSLibraryVersion")]
+        zones = sorted(k for k in f[base] if f[base][k].attrs.get("label", b"").startswith(b"Zone_t"))
+    assert zones == ["Face0_0", "Face0_1", "Face0_2", "Face0_3"]
+
+
 def test_a_hexagon_with_a_hole_is_gridded_as_six_blocks_round_it():
     """One block per outer corner: six, spokes from the corners to the hole, every cell
     unfolded and the cells adding up to the hexagon less the disc."""
