@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..algorithms import NurbsSurface
-from ..algorithms.grid.faces import face_regions
+from ..algorithms.grid.faces import face_regions, pole_halves
 from ..algorithms.grid.io import write_cgns, write_plot3d, write_vtm, write_vts
 from ..algorithms.grid.network import NetworkGrid, grid_network
 from ..algorithms.grid.quality import cell_skewness
@@ -266,35 +266,36 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         if k in unreadable or item is None:
             continue
         if isinstance(item, NurbsSurface):
-            region, flip = item, False
             if item.dimension != 3:
                 skipped.append((k, "not a 3D surface"))
                 continue
-        else:
-            flip = bool(item.reversed)
-            if item.surface.dimension != 3:
-                skipped.append((k, "not a 3D surface"))
-                continue
-            regions = face_regions(item, gap_tol=gap)
-            if isinstance(regions, str):
-                if not whole_surfaces:
-                    skipped.append((k, regions))
-                    continue
-                regions = [Region.rectangle(item.surface)]
+            halves = pole_halves(item)          # a sphere's rectangle: a block round each pole
             name = names[k] if k < len(names) else None
-            for n, region in enumerate(regions):
-                if region.is_rectangle:
-                    region = reversed_v(item.surface) if flip else item.surface
-                surfaces.append(region)
+            for n, half in enumerate(halves):
+                surfaces.append(half)
                 kept.append(k)
-                kept_names.append(name if len(regions) == 1 or name is None else f"{name}_{n}")
-                # a loop's region is oriented by the loop's direction
-                flips.append(flip and isinstance(region, NurbsSurface))
+                kept_names.append(name if len(halves) == 1 or name is None else f"{name}_{n}")
+                flips.append(False)
             continue
-        surfaces.append(region)
-        kept.append(k)
-        kept_names.append(names[k] if k < len(names) else None)
-        flips.append(flip)
+        flip = bool(item.reversed)
+        if item.surface.dimension != 3:
+            skipped.append((k, "not a 3D surface"))
+            continue
+        regions = face_regions(item, gap_tol=gap)
+        if isinstance(regions, str):
+            if not whole_surfaces:
+                skipped.append((k, regions))
+                continue
+            regions = [Region.rectangle(h) for h in pole_halves(item.surface)]
+        name = names[k] if k < len(names) else None
+        for n, region in enumerate(regions):
+            if region.is_rectangle:             # the surface's rectangle, or half of it
+                region = reversed_v(region.surface) if flip else region.surface
+            surfaces.append(region)
+            kept.append(k)
+            kept_names.append(name if len(regions) == 1 or name is None else f"{name}_{n}")
+            # a loop's region is oriented by the loop's direction
+            flips.append(flip and isinstance(region, NurbsSurface))
     if not surfaces:
         why = "; ".join(f"face {k}: {r}" for k, r in skipped[:3])
         raise InvalidGeometryError(f"nothing to grid: no four-sided face ({why})" if why

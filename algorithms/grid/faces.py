@@ -15,16 +15,59 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
 from .region import Region
 
-__all__ = ["face_region", "face_regions", "four_sided_reason"]
+__all__ = ["face_region", "face_regions", "four_sided_reason", "pole_halves"]
+
+#: a side shorter than this fraction of the surface's box diagonal is collapsed (a pole)
+POLE = 1e-9
+#: iso-lines sampled between two poles to find the longest (where a two-pole face is split)
+POLE_SPLIT_SAMPLES = 33
 
 #: pcurve samples per edge checked against the rectangle
 SAMPLES = 9
 #: how close to a side of the rectangle a pcurve must run in space, at least (fraction of
 #: the surface's box diagonal; an edge's own tolerance, doubled, where that is larger)
 SIDE_TOL = 1e-7
+
+
+def pole_halves(surface: NurbsSurface) -> list[NurbsSurface]:
+    """The surface, or its two halves when two opposite sides of its rectangle collapse.
+
+    A sphere's rectangle runs from pole to pole: no block can have two collapsed
+    sides, so the rectangle is split along its longest iso-line between the poles
+    (the equator), and each half is one block round one pole, the two sharing the
+    equator.
+
+    Parameters
+    ----------
+    surface : NurbsSurface (3D)
+
+    Returns
+    -------
+    list of NurbsSurface
+        ``[surface]``, or the halves ``[low, high]`` in the direction between the poles.
+    """
+    u0, u1, v0, v1 = surface.domain
+    diag = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
+    t = np.linspace(0.0, 1.0, 65)
+
+    def length(u, v) -> float:
+        p = surface.evaluate(np.broadcast_to(u, t.shape), np.broadcast_to(v, t.shape))
+        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
+    along_u, along_v = u0 + t * (u1 - u0), v0 + t * (v1 - v0)
+    if not diag > 0.0:
+        return [surface]
+    for direction, lo, hi, iso in (("v", v0, v1, lambda v: length(along_u, v)),
+                                   ("u", u0, u1, lambda u: length(u, along_v))):
+        if iso(lo) <= POLE * diag and iso(hi) <= POLE * diag:
+            inner = np.linspace(lo, hi, POLE_SPLIT_SAMPLES)[1:-1]
+            cut = float(inner[int(np.argmax([iso(x) for x in inner]))])
+            return list(surface.split(cut, direction))
+    return [surface]
 
 
 def four_sided_reason(face: TrimmedFace) -> str | None:
@@ -96,7 +139,8 @@ def face_region(face: TrimmedFace) -> Region | str:
 def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[Region] | str:
     """The four-sided regions blocks cover on a face, or why there are none.
 
-    A face :func:`face_region` grids is one region. A face bounded by one loop of
+    A face :func:`face_region` grids is one region (two when its rectangle runs from
+    pole to pole: :func:`pole_halves`). A face bounded by one loop of
     three, five or more corners is split as healing splits it (:func:`..healing.decompose.decompose_face`: the loop's
     corners, quads around a centre joined by straight spokes in ``(u, v)``), one
     region per sub-patch; blocks of neighbouring sub-patches share their spoke; a
@@ -132,7 +176,8 @@ def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[
 
     region = face_region(face)
     if not isinstance(region, str):
-        return [region]
+        halves = pole_halves(face.surface) if region.is_rectangle else [face.surface]
+        return [region] if len(halves) == 1 else [Region.rectangle(h) for h in halves]
     if len(face.loops) > 2:
         from .parts import separate_holes
         try:

@@ -278,3 +278,32 @@ def test_a_spoke_through_a_collapsed_point_is_a_reason_not_a_crash(data_dir):
         if isinstance(regions, str):
             reasons[k] = regions
     assert "surface collapses" in reasons[1]
+
+
+def test_a_sphere_is_gridded_as_two_blocks_round_its_poles():
+    """A sphere's rectangle runs from pole to pole (both of its sides along u collapse: no
+    block can have two): it is split at its longest parallel, the equator, into two blocks
+    round one pole each, sharing the equator and each its seam; every node on the sphere."""
+    from helpers.occ_shapes import sphere
+
+    from surfprep.algorithms.grid.faces import pole_halves
+    ball = sphere(5.0)
+    low, high = pole_halves(ball)
+    assert low.domain[3] == pytest.approx(0.0, abs=1e-12) == high.domain[2]   # at the equator
+    result = surfprep.grid(ball, size=0.5)
+    assert len(result.blocks) == 2 and len(result.network.interfaces) == 3
+    _assert_point_matched(result)
+    assert {(f.block, f.other) for f in result.network.interfaces} == {(0, 0), (1, 1), (0, 1)}
+    nodes = np.concatenate([b.reshape(-1, 3) for b in result.blocks])
+    assert np.abs(np.linalg.norm(nodes, axis=1) - 5.0).max() < 1e-9
+    assert result.report()["worst"]["folded_cells"] == 0
+    # the two blocks cover the sphere: their cells add up to its area
+    assert sum(_cells_area(b) for b in result.blocks) == pytest.approx(4 * np.pi * 25, rel=5e-3)
+
+
+def test_a_surface_with_one_pole_stays_one_block():
+    from helpers.grid_cases import pole_patch
+
+    from surfprep.algorithms.grid.faces import pole_halves
+    patch = pole_patch()
+    assert pole_halves(patch) == [patch]

@@ -131,3 +131,18 @@ def test_dims_on_faces_split_into_blocks_take_the_larger_count_with_a_note(tmp_p
     assert data["dims_changed"] and all(d["nodes"] == 21 and d["direction"] == "i" for d in data["dims_changed"])
     assert all(b["dims"][0] in (11, 21) and b["dims"][1] == 21 for b in data["blocks"])
     assert "not the --dims asked" in err
+
+
+def test_a_ball_read_from_step_is_gridded(tmp_path, capsys):
+    """The face of a solid sphere (was refused: 'sides j0 and j1 are both collapsed'): two
+    blocks round its poles, exit 0."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+
+    import surfprep
+    ball = tmp_path / "ball.step"
+    surfprep.write(BRepPrimAPI_MakeSphere(5.0).Shape(), ball)
+    out, report = tmp_path / "ball.cgns", tmp_path / "ball.json"
+    code, stdout, _ = run(capsys, "grid", ball, "-o", out, "--json", report)
+    assert code == 0, stdout
+    data = json.loads(report.read_text())
+    assert len(data["blocks"]) == 2 and data["worst"]["folded_cells"] == 0 and not data["skipped"]
