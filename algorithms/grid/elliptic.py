@@ -95,6 +95,7 @@ from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
 from .elliptic_kernels import sweep
 from .orthogonal import SIDE_NAMES, BoundaryControl
+from .periodic import Seam, grid_controls
 
 __all__ = ["EllipticResult", "corner_jacobians", "refine"]
 
@@ -276,8 +277,23 @@ def _folded(s: NDArray, t: NDArray, sign: float, floor: NDArray) -> bool:
     return bool(np.any(sign * corner_jacobians(s, t) <= floor))
 
 
+def _inside(seam: Seam | None, s: NDArray, t: NDArray) -> tuple[NDArray, NDArray]:
+    """Parameters to evaluate the surface at: unwrapped ones brought into the domain."""
+    return seam.wrapped(s, t) if seam is not None else (s, t)
+
+
+def _unwrapped(seam: Seam, solved: NDArray, start: NDArray) -> NDArray:
+    """``solved`` (wrapped into the domain) shifted by whole periods back next to ``start``."""
+    out = solved.copy()
+    for k, d in enumerate(seam.shift):
+        if d:
+            out[..., k] += np.round((start[..., k] - solved[..., k]) / abs(d)) * abs(d)
+    return out
+
+
 def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool | Collection[str],
-                  heights: Mapping[str, float] | None, tol: float, max_sweeps: int) -> NDArray:
+                  heights: Mapping[str, float] | None, seam: Seam | None, tol: float,
+                  max_sweeps: int) -> NDArray:
     """Interior ``(s, t)`` from the solution on a grid of about half the nodes."""
     from scipy.ndimage import map_coordinates
     ni, nj = st.shape[:2]
@@ -286,7 +302,9 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
     gi, gj = np.meshgrid(fi, fj, indexing="ij")
     coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
     solved = refine(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
-                    tol=tol, max_sweeps=max_sweeps).parameters
+                    seam=seam, tol=tol, max_sweeps=max_sweeps).parameters
+    if seam is not None:                 # back to unwrapped parameters before interpolating
+        solved = _unwrapped(seam, solved, coarse)
     # back on the fine index positions
     bi, bj = np.meshgrid(np.arange(ni) * (ci - 1) / (ni - 1), np.arange(nj) * (cj - 1) / (nj - 1),
                          indexing="ij")
@@ -297,7 +315,8 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
 
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
-           orthogonal: bool | Collection[str] = False, heights: Mapping[str, float] | None = None, tol: float = 1e-4,
+           orthogonal: bool | Collection[str] = False, heights: Mapping[str, float] | None = None,
+           seam: Seam | None = None, tol: float = 1e-4,
            max_sweeps: int = 2000,
            relaxation: float | None = None, warm: bool = False) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
@@ -320,6 +339,10 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     heights : dict, optional
         With ``orthogonal``, side (``"i0"``, ``"i1"``, ``"j0"``, ``"j1"``) to the
         height its first cells are held at (model units).
+    seam : Seam, optional
+        The grid closes on itself along ``seam.axis`` (:mod:`.periodic`): the two
+        copies of the seam are solved as one line of interior nodes, not held; the
+        parameters returned are wrapped into the domain.
     tol : float
         Stop when no node would move more than ``tol`` times its cell size.
     max_sweeps : int
@@ -350,30 +373,47 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         raise InvalidGeometryError("the start grid has folded or degenerate cells in the parameters")
     sides = None
     if orthogonal:                       # the first-cell heights of the start grid are held
-        start_points = surface.evaluate(st[..., 0], st[..., 1])
-        chosen = SIDE_NAMES if orthogonal is True else tuple(orthogonal)
+        chosen = set(SIDE_NAMES if orthogonal is True else orthogonal)
+        if seam is not None:             # the seam is no side
+            chosen -= {"i0", "i1"} if seam.axis == 0 else {"j0", "j1"}
+        s0, t0 = seam.pad(st[..., 0], st[..., 1]) if seam is not None else (st[..., 0], st[..., 1])
+        start_points = surface.evaluate(*_inside(seam, s0, t0))
         sides = BoundaryControl.start(start_points, sides=chosen, heights=heights,
-                                      short=_short(start_points))
+                                      short=_short(start_points)) if chosen else None
     if max(ni, nj) > COARSEN_ABOVE and not warm:
-        st = _coarse_start(surface, st, control, orthogonal, heights, tol, max_sweeps)
+        st = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
             st = _check_grid(surface, parameters)          # the coarse start folded: plain start
-    floor = np.zeros_like(start_jac)
     n = max(ni, nj)
     omega = relaxation if relaxation is not None else min(1.95, 2.0 / (1.0 + math.sin(math.pi / n)))
     s, t = st[..., 0].copy(), st[..., 1].copy()
-    P, Q = np.zeros((ni, nj)), np.zeros((ni, nj))
-    if control:
-        P[1:-1, 1:-1], Q[1:-1, 1:-1] = _controls(surface.evaluate(s, t))
-    base = P.copy(), Q.copy()
     box = surface.domain
+    if seam is not None:                 # iterate on the grid padded across its seam
+        s, t = seam.pad(s, t)
+        box = seam.box()
+    floor = np.zeros((4, s.shape[0] - 1, s.shape[1] - 1))
+    P, Q = np.zeros(s.shape), np.zeros(s.shape)
+    if control:
+        nodes = surface.evaluate(*_inside(seam, s, t))
+        P[1:-1, 1:-1], Q[1:-1, 1:-1] = _controls(nodes)
+        if seam is not None:             # the family across the seam keeps the start's spacing
+            own = grid_controls(nodes)[1 - seam.axis].mean(axis=seam.axis, keepdims=True)
+            (Q if seam.axis == 0 else P)[1:-1, 1:-1] = own
+    base = P.copy(), Q.copy()
     residuals: list[float] = []
     scores: list[float] = []             # how far from converged: residual / tol, or the sides' misfit
     refused = sweeps = 0
     best = (math.inf, math.inf, math.inf, s, t)    # (score, residual, misfit, s, t)
     misfit = math.inf if sides is not None else 0.0
+
+    def one_sweep() -> float:
+        residual = sweep(s, t, x, rs, rt, P, Q, omega, box)
+        if seam is not None:
+            seam.sync(s, t, x)
+        return residual
+
     while sweeps < max_sweeps:
-        d = surface.derivatives(s, t, 1)
+        d = surface.derivatives(*_inside(seam, s, t), 1)
         x, rs, rt = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
         if sides is not None:
             moved, dP, dQ, misfit = sides.update(x)
@@ -381,7 +421,7 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
             if misfit > 1.0 and residuals and residuals[-1] < ORTHOGONAL_BELOW:
                 sides, P, Q = moved, base[0] + dP, base[1] + dQ
         saved = s.copy(), t.copy()
-        residual = sweep(s, t, x, rs, rt, P, Q, omega, box)
+        residual = one_sweep()
         sweeps += 1
         residuals.append(residual)
         scores.append(max(residual / tol, misfit))
@@ -393,10 +433,10 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         if _stalled(scores):
             break                        # not converging: the iterate nearest to a solution is returned
         for _ in range(SWEEPS_PER_EVALUATION - 1):
-            sweep(s, t, x, rs, rt, P, Q, omega, box)
+            one_sweep()
             sweeps += 1
         if _folded(s, t, sign, floor):
-            s, t = saved
+            s[...], t[...] = saved
             refused += 1
             omega *= 0.5
             if omega < _MIN_RELAXATION:
@@ -406,6 +446,8 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         s, t = best[3], best[4]
         residuals.append(best[1])        # the history ends with the residual of the grid returned
         misfit = best[2]
+    if seam is not None:
+        s, t = seam.wrapped(seam.unpad(s), seam.unpad(t))
     out = np.stack([s, t], axis=-1)
     return EllipticResult(out, tuple(residuals), converged, refused, sweeps,
                           misfit if sides is not None else 0.0)

@@ -387,7 +387,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     shared = {(f.block, f.side) for f in interfaces} | {(f.other, f.other_side) for f in interfaces}
     open_sides = [tuple(side for side in SIDES if (k, side) not in shared) for k in range(len(blocks))]
     interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
-                  and f.block not in still and f.other not in still]
+                  and f.block not in still and f.other not in still and not _on_seam(blocks, f)]
     touched: set[int] = set()
     rounds = 0
     previous = math.inf
@@ -425,10 +425,12 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
         previous = worst
         for k in changed:
             squared = orthogonal and grids[k].orthogonal is None and open_sides[k]
+            seam = grids[k].seam
             result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
-                            orthogonal=squared)
+                            orthogonal=squared, seam=seam)
             if squared and not result.nearly_converged(tol):      # as grid_region: the plain grid
-                plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True)
+                plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
+                               seam=seam)
                 if plain.converged or plain.residuals[-1] < result.residuals[-1]:
                     result = plain
                     grids[k] = replace(grids[k], orthogonal=(
@@ -449,7 +451,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
         if orthogonal and g.orthogonal is None and open_sides[k] \
                 and quality.max_skewness > corner_skewness(g.points) + SKEW_SLACK:
             # as grid_region: squared sides that squeeze a sharp corner's cells are given up
-            plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True)
+            plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True, seam=g.seam)
             pp = plain.parameters
             points = surfaces[k].surface.evaluate(pp[..., 0], pp[..., 1])
             plain_quality = grid_quality(points, g.orientation * normals(surfaces[k].surface, pp[..., 0],
@@ -463,6 +465,13 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
                                        f"{plain_quality.max_skewness:.3g} without): the grid without "
                                        "it is kept"))
     return grids, rounds
+
+
+def _on_seam(blocks: list[SurfaceGrid], f: Interface) -> bool:
+    """The interface is a block's own seam, solved across by its elliptic step (:mod:`.periodic`)."""
+    seam = blocks[f.block].seam
+    return f.block == f.other and seam is not None and {f.side, f.other_side} == (
+        {"i0", "i1"} if seam.axis == 0 else {"j0", "j1"})
 
 
 def _set_side_parameters(params: NDArray, region: Region, side: str, values: NDArray) -> None:

@@ -34,6 +34,7 @@ from ..tensor import Direction
 from . import distribution
 from .elliptic import EllipticResult, corner_jacobians, refine
 from .held import HeldLine, held_line, split_along
+from .periodic import Seam
 from .quality import GridQuality, grid_quality
 from .region import SIDE_NAMES, Region
 from .tfi import distribution_mesh, transfinite
@@ -149,6 +150,9 @@ class SurfaceGrid:
         With ``orthogonal=True``: None when the lines leave the sides at right angles
         (:func:`.elliptic.refine`), else why the grid without that control is kept
         (the controlled iteration did not converge).
+    seam : Seam or None
+        Where the grid closes on itself (:mod:`.periodic`): the two copies of that side
+        were solved as one line, not held.
     """
 
     points: NDArray
@@ -166,6 +170,7 @@ class SurfaceGrid:
     start_parameters: NDArray | None = field(default=None, repr=False, compare=False)
     side_params: dict = field(default_factory=dict, repr=False, compare=False)
     orthogonal: str | None = None
+    seam: Seam | None = field(default=None, repr=False, compare=False)
 
     @property
     def dims(self) -> tuple[int, int]:
@@ -469,6 +474,8 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         return points, grid_quality(points, normals)
 
     start_points, start_quality = measured(st)
+    # a closed face (a cylinder, a torus): its seam is solved across, not held
+    seam = Seam.find(st, start_points, surface.domain, diag) if region.is_rectangle and not hold else None
     start_params = st
     result = None
     points, quality = start_points, start_quality
@@ -478,9 +485,9 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                                                        ("j0", spacing[1].first), ("j1", spacing[1].last))
                        if given is not None and name not in collapsed}
         result = _refine_pieces(surface, st, pieces, axis, control=control, orthogonal=orthogonal,
-                                heights=first_cells, tol=tol, max_sweeps=max_sweeps)
+                                heights=first_cells, seam=seam, tol=tol, max_sweeps=max_sweeps)
         if orthogonal and not result.nearly_converged(tol):
-            plain = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
+            plain = _refine_pieces(surface, st, pieces, axis, control=control, seam=seam, tol=tol,
                                    max_sweeps=max_sweeps)
             if plain.converged or plain.residuals[-1] < result.residuals[-1]:
                 dropped = (f"the sides' orthogonality was not reached (residual "
@@ -491,7 +498,7 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         if orthogonal and dropped is None and refined.max_skewness > corner_skewness(start_points) + SKEW_SLACK:
             # the squared sides may squeeze the cells beside a sharp corner further than the
             # corner itself does: then the grid without them, if its worst cell is better
-            plain = _refine_pieces(surface, st, pieces, axis, control=control, tol=tol,
+            plain = _refine_pieces(surface, st, pieces, axis, control=control, seam=seam, tol=tol,
                                    max_sweeps=max_sweeps)
             plain_points, plain_quality = measured(plain.parameters)
             if plain.nearly_converged(tol) and plain_quality.folded_cells <= refined.folded_cells \
@@ -516,4 +523,5 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                        collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started, start_points=start_points,
-                       start_parameters=start_params, side_params=dict(fractions), orthogonal=dropped)
+                       start_parameters=start_params, side_params=dict(fractions), orthogonal=dropped,
+                       seam=seam)
