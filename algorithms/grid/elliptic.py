@@ -155,6 +155,14 @@ class EllipticResult:
         return self.converged or (self.sides_misfit <= 1.0 and bool(self.residuals)
                                   and self.residuals[-1] < NEARLY * tol)
 
+    def yields_to(self, plain: EllipticResult) -> bool:
+        """This run with the sides' control, not nearly converged, gives way to ``plain`` (the
+        same solve without it): unless ``plain`` is itself much further from converged
+        (a residual :data:`NEARLY` times this one's), its sides missed theirs anyway."""
+        if plain.converged or not self.residuals:
+            return True
+        return bool(plain.residuals) and plain.residuals[-1] < NEARLY * self.residuals[-1]
+
 
 def corner_jacobians(s: NDArray, t: NDArray) -> NDArray:
     """Signed area of the four corner triangles of every cell of a 2-D grid.

@@ -431,7 +431,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             if squared and not result.nearly_converged(tol):      # as grid_region: the plain grid
                 plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
                                seam=seam)
-                if plain.converged or plain.residuals[-1] < result.residuals[-1]:
+                if result.yields_to(plain):
                     result = plain
                     grids[k] = replace(grids[k], orthogonal=(
                         "the sides' orthogonality was not reached after the shared edges' nodes "

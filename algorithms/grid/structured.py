@@ -489,7 +489,7 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         if orthogonal and not result.nearly_converged(tol):
             plain = _refine_pieces(surface, st, pieces, axis, control=control, seam=seam, tol=tol,
                                    max_sweeps=max_sweeps)
-            if plain.converged or plain.residuals[-1] < result.residuals[-1]:
+            if result.yields_to(plain):
                 dropped = (f"the sides' orthogonality was not reached (residual "
                            f"{result.residuals[-1]:.3g}, sides off by {result.sides_misfit:.3g} x "
                            "their tolerance); the grid without it is kept")
