@@ -104,13 +104,8 @@ class Seam:
             out.append(np.ascontiguousarray(np.moveaxis(padded, 0, self.axis)))
         return out[0], out[1]
 
-    def pad_values(self, a: NDArray) -> NDArray:
-        """Node values (ni, nj, ...) padded as :meth:`pad` pads the parameters (no shift)."""
-        b = np.moveaxis(a, self.axis, 0)
-        padded = np.concatenate([b[-2:-1], b], axis=0)
-        return np.ascontiguousarray(np.moveaxis(padded, 0, self.axis))
-
     def unpad(self, a: NDArray) -> NDArray:
+        """A padded array without its ghost line: the grid's own (ni, nj, ...)."""
         b = np.moveaxis(a, self.axis, 0)[1:]
         return np.ascontiguousarray(np.moveaxis(b, 0, self.axis))
 
