@@ -270,8 +270,8 @@ def main() -> None:
                     e = ours[kind].elliptic
                     note = (f"{'converged' if e.converged else 'NOT converged'}, {e.sweeps} sweeps, "
                             f"residual {e.residuals[-1]:.2g}")
-                    if ours[kind].orthogonal:
-                        note += f"; {ours[kind].orthogonal}"
+                    if ours[kind].orthogonal_dropped:
+                        note += f"; {ours[kind].orthogonal_dropped}"
                     rows.append(row(tag, label, ours[kind].quality, "on", seconds[kind],
                                     f"{whole_ours:.2f}" if kind == "elliptic" else "", note,
                                     side=side_angle_off(ours[kind].points)))

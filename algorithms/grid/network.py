@@ -424,7 +424,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             break                             # converged, the moves no longer shrink, or out of time
         previous = worst
         for k in changed:
-            squared = orthogonal and grids[k].orthogonal is None and open_sides[k]
+            squared = orthogonal and grids[k].orthogonal_dropped is None and open_sides[k]
             seam = grids[k].seam
             result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
                             orthogonal=squared, seam=seam)
@@ -433,7 +433,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
                                seam=seam)
                 if result.yields_to(plain):
                     result = plain
-                    grids[k] = replace(grids[k], orthogonal=(
+                    grids[k] = replace(grids[k], orthogonal_dropped=(
                         "the sides' orthogonality was not reached after the shared edges' nodes "
                         "slid; the grid without it is kept"))
             params[k] = result.parameters.copy()
@@ -448,7 +448,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
         p = g.elliptic.parameters
         quality = grid_quality(g.points, g.orientation * normals(surfaces[k].surface, p[..., 0], p[..., 1]))
         grids[k] = replace(g, parameters=p.copy(), quality=quality)
-        if orthogonal and g.orthogonal is None and open_sides[k] \
+        if orthogonal and g.orthogonal_dropped is None and open_sides[k] \
                 and quality.max_skewness > corner_skewness(g.points) + SKEW_SLACK:
             # as grid_region: squared sides that squeeze a sharp corner's cells are given up
             plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True, seam=g.seam)
@@ -459,7 +459,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             if plain.nearly_converged(tol) and plain_quality.folded_cells <= quality.folded_cells \
                     and plain_quality.max_skewness < quality.max_skewness - SKEW_SLACK / 2:
                 grids[k] = replace(g, points=points, parameters=pp.copy(), elliptic=plain,
-                                   quality=plain_quality, orthogonal=(
+                                   quality=plain_quality, orthogonal_dropped=(
                                        f"squaring the sides made the worst cell more skewed than the "
                                        f"face's corners do ({quality.max_skewness:.3g} against "
                                        f"{plain_quality.max_skewness:.3g} without): the grid without "

@@ -146,10 +146,11 @@ class SurfaceGrid:
         The algebraic start grid (to show what the refinement changed).
     side_params : dict of str to (n,) float
         The normalized side parameters (:class:`Side`) of each side's nodes.
-    orthogonal : str or None
+    orthogonal_dropped : str or None
         With ``orthogonal=True``: None when the lines leave the sides at right angles
-        (:func:`.elliptic.refine`), else why the grid without that control is kept
-        (the controlled iteration did not converge).
+        (:func:`.elliptic.refine`), else why the grid without that control is kept (the
+        controlled iteration did not settle, or it skewed the cells by a sharp corner
+        beyond the corner's own skewness).
     seam : Seam or None
         Where the grid closes on itself (:mod:`.periodic`): the two copies of that side
         were solved as one line, not held.
@@ -169,7 +170,7 @@ class SurfaceGrid:
     start_points: NDArray | None = field(default=None, repr=False, compare=False)
     start_parameters: NDArray | None = field(default=None, repr=False, compare=False)
     side_params: dict = field(default_factory=dict, repr=False, compare=False)
-    orthogonal: str | None = None
+    orthogonal_dropped: str | None = None
     seam: Seam | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -188,7 +189,7 @@ class SurfaceGrid:
                                "refused_steps": self.elliptic.refused,
                                "residuals": list(self.elliptic.residuals),
                                "sides_misfit": self.elliptic.sides_misfit,
-                               "kept_start": self.kept_start, "orthogonal_dropped": self.orthogonal}
+                               "kept_start": self.kept_start, "orthogonal_dropped": self.orthogonal_dropped}
         return out
 
 
@@ -394,7 +395,7 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         (:func:`.elliptic.refine`; default),
         and the first cells off a side whose first (or last) spacing is given are that
         high all along it; where that iteration does not converge, the grid without it
-        is kept and ``SurfaceGrid.orthogonal`` says so.
+        is kept and ``SurfaceGrid.orthogonal_dropped`` says so.
     sides : dict, optional
         Nodes of some sides given, instead of by the law: side name (``"j0"``,
         ``"j1"``: ``(ni,)``; ``"i0"``, ``"i1"``: ``(nj,)``) to the side's normalized
@@ -523,5 +524,5 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                        collapsed_sides=tuple(sorted(collapsed)),
                        spacing_error=_spacing_error(points, spacing, collapsed),
                        time_s=time.perf_counter() - started, start_points=start_points,
-                       start_parameters=start_params, side_params=dict(fractions), orthogonal=dropped,
+                       start_parameters=start_params, side_params=dict(fractions), orthogonal_dropped=dropped,
                        seam=seam)

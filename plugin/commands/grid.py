@@ -150,8 +150,8 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                       f"{block.time_s:.2f} s")
         if block.kept_start:
             console.note(f"face {face}: {block.kept_start}")
-        if block.orthogonal:
-            console.note(f"face {face}: {block.orthogonal}")
+        if block.orthogonal_dropped:
+            console.note(f"face {face}: {block.orthogonal_dropped}")
     for face, reason in result.skipped:
         console.print(f"face {face}: not gridded: {reason}")
     net = result.network

@@ -47,7 +47,7 @@ def test_lines_leave_the_sides_of_a_trapezoid_at_right_angles():
     after = max(np.abs(a - 90).max() for a in side_angles(square.points))
     assert before > 5.0
     assert after < 0.5
-    assert square.elliptic.converged and square.quality.folded_cells == 0 and square.orthogonal is None
+    assert square.elliptic.converged and square.quality.folded_cells == 0 and square.orthogonal_dropped is None
     assert np.abs(square.points[..., 2]).max() == 0.0
     # the sides' nodes are where the arc-length law put them
     np.testing.assert_array_equal(square.points[:, 0], plain.points[:, 0])
@@ -62,7 +62,7 @@ def test_a_first_spacing_asked_for_is_held_off_the_side(first):
     spacing = (Spacing(), Spacing(first=first))
     plain = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing, orthogonal=False)
     grid = grid_surface(_trapezoid(), dims=(41, 31), spacing=spacing)
-    assert grid.orthogonal is None and grid.elliptic.converged and grid.quality.folded_cells == 0
+    assert grid.orthogonal_dropped is None and grid.elliptic.converged and grid.quality.folded_cells == 0
 
     def heights(points):
         return np.linalg.norm(points[:, 1] - points[:, 0], axis=-1)[4:-4] / first - 1.0
@@ -119,11 +119,11 @@ def test_a_run_that_does_not_reach_the_sides_keeps_the_plain_grid_and_says_so():
     plain grid is returned, the block's report says why."""
     square = grid_surface(_trapezoid(), dims=(41, 31), max_sweeps=100)
     plain = grid_surface(_trapezoid(), dims=(41, 31), max_sweeps=100, orthogonal=False)
-    assert square.orthogonal is not None and "not reached" in square.orthogonal
+    assert square.orthogonal_dropped is not None and "not reached" in square.orthogonal_dropped
     np.testing.assert_array_equal(square.points, plain.points)
-    assert square.report()["elliptic"]["orthogonal_dropped"] == square.orthogonal
+    assert square.report()["elliptic"]["orthogonal_dropped"] == square.orthogonal_dropped
     full = grid_surface(_trapezoid(), dims=(41, 31))
-    assert full.orthogonal is None and full.report()["elliptic"]["sides_misfit"] <= 1.0
+    assert full.orthogonal_dropped is None and full.report()["elliptic"]["sides_misfit"] <= 1.0
 
 
 def test_a_network_squares_its_open_sides_and_lets_its_interfaces_run_on():
@@ -152,6 +152,6 @@ def test_a_sharp_corner_is_not_squeezed_further_by_the_squared_sides():
     sliver = NurbsSurface(np.array([[[0, 0, 0], [tip, 1, 0]], [[4, 0, 0], [4, 1, 0]]], float), LINEAR, LINEAR, 1, 1)
     grid = grid_surface(sliver, dims=(41, 21))
     plain = grid_surface(sliver, dims=(41, 21), orthogonal=False)
-    assert grid.orthogonal is not None and "more skewed" in grid.orthogonal
+    assert grid.orthogonal_dropped is not None and "more skewed" in grid.orthogonal_dropped
     np.testing.assert_array_equal(grid.points, plain.points)
     assert grid.quality.max_skewness < 75 / 90 + 0.005 and grid.quality.folded_cells == 0   # the corner's own
