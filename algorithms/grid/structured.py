@@ -247,7 +247,10 @@ def _side_fractions(region: Region, lengths: dict[str, float], collapsed: set[st
                                 ("i0", "i1", nj, spacing[1]), ("i1", "i0", nj, spacing[1])):
         if name in collapsed:
             if other in collapsed:
-                raise DegenerateGeometryError(f"sides {name} and {other} are both collapsed")
+                raise DegenerateGeometryError(
+                    f"sides {name} and {other} are both collapsed (a rectangle from pole to pole, as "
+                    "a sphere's): split it between the poles first (faces.pole_halves; surfprep.grid "
+                    "does)")
             continue
         side = region.sides[name]
         dense = side.points(np.linspace(0.0, 1.0, 257)) if law.law == "curvature" else None

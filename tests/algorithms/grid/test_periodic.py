@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from helpers.grid_cases import warped_plane
-from helpers.occ_shapes import cylinder, torus
+from helpers.occ_shapes import cylinder, sphere, torus
 
 import surfprep
 from surfprep.algorithms.grid import grid_surface
 from surfprep.algorithms.grid.periodic import Seam
+from surfprep.errors import DegenerateGeometryError
 
 
 def _turns(points: np.ndarray) -> np.ndarray:
@@ -67,3 +69,8 @@ def test_a_torus_in_a_model_has_smooth_lines_across_both_seams(tmp_path):
     assert len(result.blocks) == 1 and len(report["interfaces"]) == 2
     assert max(i["kink_deg"] for i in report["interfaces"]) < 1.0
     assert report["worst"]["max_skewness"] < 0.06 and report["worst"]["folded_cells"] == 0
+
+
+def test_a_sphere_alone_is_refused_with_the_way_out():
+    with pytest.raises(DegenerateGeometryError, match="pole to pole.*pole_halves"):
+        grid_surface(sphere(2.0), dims=(9, 9))
