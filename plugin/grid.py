@@ -265,28 +265,20 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         item = items[k]
         if k in unreadable or item is None:
             continue
-        if isinstance(item, NurbsSurface):
-            if item.dimension != 3:
-                skipped.append((k, "not a 3D surface"))
-                continue
-            halves = pole_halves(item)          # a sphere's rectangle: a block round each pole
-            name = names[k] if k < len(names) else None
-            for n, half in enumerate(halves):
-                surfaces.append(half)
-                kept.append(k)
-                kept_names.append(name if len(halves) == 1 or name is None else f"{name}_{n}")
-                flips.append(False)
-            continue
-        flip = bool(item.reversed)
-        if item.surface.dimension != 3:
+        surface = item if isinstance(item, NurbsSurface) else item.surface
+        if surface.dimension != 3:
             skipped.append((k, "not a 3D surface"))
             continue
-        regions = face_regions(item, gap_tol=gap)
+        flip = not isinstance(item, NurbsSurface) and bool(item.reversed)
+        # a surface's rectangle (a sphere's: a block round each pole), or the face's regions
+        regions = face_regions(item, gap_tol=gap) if not isinstance(item, NurbsSurface) else None
         if isinstance(regions, str):
             if not whole_surfaces:
                 skipped.append((k, regions))
                 continue
-            regions = [Region.rectangle(h) for h in pole_halves(item.surface)]
+            regions = None
+        if regions is None:
+            regions = [Region.rectangle(h) for h in pole_halves(surface)]
         name = names[k] if k < len(names) else None
         for n, region in enumerate(regions):
             if region.is_rectangle:             # the surface's rectangle, or half of it

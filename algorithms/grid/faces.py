@@ -52,20 +52,21 @@ def pole_halves(surface: NurbsSurface) -> list[NurbsSurface]:
     """
     u0, u1, v0, v1 = surface.domain
     diag = float(np.linalg.norm(np.ptp(surface.bounding_box(), axis=0)))
-    t = np.linspace(0.0, 1.0, 65)
-
-    def length(u, v) -> float:
-        p = surface.evaluate(np.broadcast_to(u, t.shape), np.broadcast_to(v, t.shape))
-        return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
-
-    along_u, along_v = u0 + t * (u1 - u0), v0 + t * (v1 - v0)
     if not diag > 0.0:
         return [surface]
-    for direction, lo, hi, iso in (("v", v0, v1, lambda v: length(along_u, v)),
-                                   ("u", u0, u1, lambda u: length(u, along_v))):
-        if iso(lo) <= POLE * diag and iso(hi) <= POLE * diag:
-            inner = np.linspace(lo, hi, POLE_SPLIT_SAMPLES)[1:-1]
-            cut = float(inner[int(np.argmax([iso(x) for x in inner]))])
+    t = np.linspace(0.0, 1.0, 65)
+    us, vs = u0 + t * (u1 - u0), v0 + t * (v1 - v0)
+    for direction, lo, hi in (("v", v0, v1), ("u", u0, u1)):
+        across = np.linspace(lo, hi, POLE_SPLIT_SAMPLES)
+        # every iso-line between the poles in one evaluation: (lines, 65, 3)
+        if direction == "v":
+            u, v = np.meshgrid(us, across, indexing="xy")
+        else:
+            u, v = np.meshgrid(across, vs, indexing="ij")
+        points = surface.evaluate(u, v)
+        lengths = np.linalg.norm(np.diff(points, axis=1), axis=-1).sum(axis=1)
+        if lengths[0] <= POLE * diag and lengths[-1] <= POLE * diag:
+            cut = float(across[1 + int(np.argmax(lengths[1:-1]))])
             return list(surface.split(cut, direction))
     return [surface]
 

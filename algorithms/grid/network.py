@@ -38,7 +38,15 @@ from ...errors import InvalidGeometryError, SurfprepError
 from ..surface import NurbsSurface
 from .io.blocks import Interface, side_nodes
 from .region import Region
-from .structured import DEFAULT_CELLS, SIDES, SKEW_SLACK, Spacing, SurfaceGrid, corner_skewness, grid_region
+from .structured import (
+    DEFAULT_CELLS,
+    SIDES,
+    Spacing,
+    SurfaceGrid,
+    grid_region,
+    plain_kept,
+    squeezes_corners,
+)
 
 __all__ = ["NetworkGrid", "grid_network", "match_sides"]
 
@@ -448,22 +456,17 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
         p = g.elliptic.parameters
         quality = grid_quality(g.points, g.orientation * normals(surfaces[k].surface, p[..., 0], p[..., 1]))
         grids[k] = replace(g, parameters=p.copy(), quality=quality)
-        if orthogonal and g.orthogonal_dropped is None and open_sides[k] \
-                and quality.max_skewness > corner_skewness(g.points) + SKEW_SLACK:
+        if orthogonal and g.orthogonal_dropped is None and open_sides[k] and squeezes_corners(quality, g.points):
             # as grid_region: squared sides that squeeze a sharp corner's cells are given up
             plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True, seam=g.seam)
             pp = plain.parameters
             points = surfaces[k].surface.evaluate(pp[..., 0], pp[..., 1])
             plain_quality = grid_quality(points, g.orientation * normals(surfaces[k].surface, pp[..., 0],
                                                                          pp[..., 1]))
-            if plain.nearly_converged(tol) and plain_quality.folded_cells <= quality.folded_cells \
-                    and plain_quality.max_skewness < quality.max_skewness - SKEW_SLACK / 2:
+            why = plain_kept(quality, plain, plain_quality, tol)
+            if why is not None:
                 grids[k] = replace(g, points=points, parameters=pp.copy(), elliptic=plain,
-                                   quality=plain_quality, orthogonal_dropped=(
-                                       f"squaring the sides made the worst cell more skewed than the "
-                                       f"face's corners do ({quality.max_skewness:.3g} against "
-                                       f"{plain_quality.max_skewness:.3g} without): the grid without "
-                                       "it is kept"))
+                                   quality=plain_quality, orthogonal_dropped=why)
     return grids, rounds
 
 

@@ -40,7 +40,7 @@ from .region import SIDE_NAMES, Region
 from .tfi import distribution_mesh, transfinite
 
 __all__ = ["DEFAULT_CELLS", "SKEW_SLACK", "Spacing", "SurfaceGrid", "corner_angles", "corner_skewness",
-           "grid_region", "grid_surface", "side_curves"]
+           "grid_region", "grid_surface", "plain_kept", "side_curves", "squeezes_corners"]
 
 #: cells along the longest side when neither ``dims`` nor ``size`` is given
 DEFAULT_CELLS = 40
@@ -325,6 +325,26 @@ def corner_skewness(points: NDArray) -> float:
     return max((abs(a - 90.0) / 90.0 for a in angles), default=0.0)
 
 
+def squeezes_corners(squared: GridQuality, points: NDArray) -> bool:
+    """A grid with squared sides (its quality ``squared``) whose worst cell is more skewed, by
+    :data:`SKEW_SLACK`, than the corners of the block ``points`` impose: squaring the sides may
+    squeeze the cells beside a sharp corner, and the grid without it is to be tried."""
+    return squared.max_skewness > corner_skewness(points) + SKEW_SLACK
+
+
+def plain_kept(squared: GridQuality, plain: EllipticResult, plain_quality: GridQuality,
+               tol: float) -> str | None:
+    """Why the grid without the sides' control (``plain``, its quality) is kept instead of the
+    squared one, or None when it is not: it must have (nearly) converged, fold no more cells and
+    have a worst cell better by half of :data:`SKEW_SLACK`."""
+    if plain.nearly_converged(tol) and plain_quality.folded_cells <= squared.folded_cells \
+            and plain_quality.max_skewness < squared.max_skewness - SKEW_SLACK / 2:
+        return (f"squaring the sides made the worst cell more skewed than the face's corners do "
+                f"({squared.max_skewness:.3g} against {plain_quality.max_skewness:.3g} without): the "
+                "grid without it is kept")
+    return None
+
+
 def _refine_pieces(surface: NurbsSurface, st: NDArray, pieces: list[tuple[int, int]], axis: int,
                    **options) -> EllipticResult:
     """Refine each piece between held lines with its boundary fixed; one result for all."""
@@ -499,17 +519,12 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
                            "their tolerance); the grid without it is kept")
                 result = plain
         refined_points, refined = measured(result.parameters)
-        if orthogonal and dropped is None and refined.max_skewness > corner_skewness(start_points) + SKEW_SLACK:
-            # the squared sides may squeeze the cells beside a sharp corner further than the
-            # corner itself does: then the grid without them, if its worst cell is better
+        if orthogonal and dropped is None and squeezes_corners(refined, start_points):
             plain = _refine_pieces(surface, st, pieces, axis, control=control, seam=seam, tol=tol,
                                    max_sweeps=max_sweeps)
             plain_points, plain_quality = measured(plain.parameters)
-            if plain.nearly_converged(tol) and plain_quality.folded_cells <= refined.folded_cells \
-                    and plain_quality.max_skewness < refined.max_skewness - SKEW_SLACK / 2:
-                dropped = (f"squaring the sides made the worst cell more skewed than the face's "
-                           f"corners do ({refined.max_skewness:.3g} against "
-                           f"{plain_quality.max_skewness:.3g} without): the grid without it is kept")
+            dropped = plain_kept(refined, plain, plain_quality, tol)
+            if dropped is not None:
                 result, refined_points, refined = plain, plain_points, plain_quality
         worse = refined.folded_cells > start_quality.folded_cells or (
             not result.converged and refined.max_skewness > start_quality.max_skewness)
