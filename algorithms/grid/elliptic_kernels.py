@@ -68,6 +68,38 @@ def _reach(s, t, i, j):  # pragma: no cover - compiled
 
 
 @jit
+def _near_line(px, py, ax, ay, bx, by, d):  # pragma: no cover - compiled
+    """The point ``p`` lies closer than ``d`` to the line through ``a`` and ``b`` (or to
+    ``a`` when ``a == b``), tested with squares: no root, no division."""
+    dx = bx - ax
+    dy = by - ay
+    n2 = dx * dx + dy * dy
+    if n2 == 0.0:
+        return (px - ax) ** 2 + (py - ay) ** 2 < d * d
+    cross = (px - ax) * dy - (py - ay) * dx
+    return cross * cross < d * d * n2
+
+
+@jit
+def _may_fold(s, t, i, j, d):  # pragma: no cover - compiled
+    """A line of :func:`_reach` lies closer than ``d`` to node (i, j): only then is the
+    exact distance needed (most steps are far shorter than any of them)."""
+    px = s[i, j]
+    py = t[i, j]
+    for di, dj in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
+        ax = s[i + di, j]
+        ay = t[i + di, j]
+        bx = s[i, j + dj]
+        by = t[i, j + dj]
+        cx = s[i + di, j + dj]
+        cy = t[i + di, j + dj]
+        if _near_line(px, py, ax, ay, bx, by, d) or _near_line(px, py, ax, ay, cx, cy, d) \
+                or _near_line(px, py, bx, by, cx, cy, d):
+            return True
+    return False
+
+
+@jit
 def _sweep_kernel(s, t, x, rs, rt, p, q, omega, u0, u1, v0, v1):  # pragma: no cover - compiled
     ni, nj = s.shape
     worst = 0.0
@@ -113,11 +145,12 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, omega, u0, u1, v0, v1):  # pragma: no c
                 worst = move / size
             # the step stays within LIMIT of the distance to every line whose crossing
             # would fold a corner of the four cells around the node (none can fold)
-            reach = _reach(s, t, i, j)
             step = omega * np.sqrt(ds * ds + dt * dt)
             scale = omega
-            if step > LIMIT * reach:
-                scale = omega * LIMIT * reach / step
+            if _may_fold(s, t, i, j, step / LIMIT):
+                reach = _reach(s, t, i, j)
+                if step > LIMIT * reach:
+                    scale = omega * LIMIT * reach / step
             sn = min(max(s[i, j] + scale * ds, u0), u1)
             tn = min(max(t[i, j] + scale * dt, v0), v1)
             ds = sn - s[i, j]
