@@ -139,6 +139,9 @@ class EllipticResult:
         With ``orthogonal``: the worst side's miss of its wanted angle (and height)
         on the grid returned, in units of the tolerances of :mod:`.orthogonal` (at
         most 1: met); 0 without.
+    control : BoundaryControl or None
+        With ``orthogonal``: the sides' sources that gave the grid returned (to resume
+        from, ``refine(resume=...)``, when the grid is refined again).
     """
 
     parameters: NDArray
@@ -147,6 +150,7 @@ class EllipticResult:
     refused: int
     sweeps: int
     sides_misfit: float = 0.0
+    control: BoundaryControl | None = None
 
     def nearly_converged(self, tol: float) -> bool:
         """Converged, or the sides as wanted and the residual within :data:`NEARLY` times
@@ -301,16 +305,17 @@ def _unwrapped(seam: Seam, solved: NDArray, start: NDArray) -> NDArray:
 
 def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool | Collection[str],
                   heights: Mapping[str, float] | None, seam: Seam | None, tol: float,
-                  max_sweeps: int) -> NDArray:
-    """Interior ``(s, t)`` from the solution on a grid of about half the nodes."""
+                  max_sweeps: int) -> tuple[NDArray, EllipticResult]:
+    """Interior ``(s, t)`` from the solution on a grid of about half the nodes, and that solution."""
     from scipy.ndimage import map_coordinates
     ni, nj = st.shape[:2]
     ci, cj = (ni + 1) // 2, (nj + 1) // 2
     fi, fj = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
     gi, gj = np.meshgrid(fi, fj, indexing="ij")
     coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
-    solved = refine(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
-                    seam=seam, tol=tol, max_sweeps=max_sweeps).parameters
+    result = refine(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
+                    seam=seam, tol=tol, max_sweeps=max_sweeps)
+    solved = result.parameters
     if seam is not None:                 # back to unwrapped parameters before interpolating
         solved = _unwrapped(seam, solved, coarse)
     # back on the fine index positions
@@ -319,14 +324,15 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
     fine = np.stack([map_coordinates(solved[..., k], [bi, bj], order=1) for k in range(2)], axis=-1)
     out = st.copy()
     out[1:-1, 1:-1] = fine[1:-1, 1:-1]
-    return out
+    return out, result
 
 
 def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
            orthogonal: bool | Collection[str] = False, heights: Mapping[str, float] | None = None,
            seam: Seam | None = None, tol: float = 1e-4,
            max_sweeps: int = 2000,
-           relaxation: float | None = None, warm: bool = False) -> EllipticResult:
+           relaxation: float | None = None, warm: bool = False,
+           resume: BoundaryControl | None = None) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
 
     Parameters
@@ -360,6 +366,9 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     warm : bool
         The start is already nearly a solution (a grid refined before, its boundary
         moved a little): iterate on it directly, without the coarse-grid start.
+    resume : BoundaryControl, optional
+        With ``orthogonal``: the sources an earlier refinement of this grid reached
+        (:attr:`EllipticResult.control`), to start from instead of none.
 
     Returns
     -------
@@ -388,10 +397,17 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         start_points = surface.evaluate(*_inside(seam, s0, t0))
         sides = BoundaryControl.start(start_points, sides=chosen, heights=heights,
                                       short=_short(start_points)) if chosen else None
+        if sides is not None and resume is not None:
+            sides = sides.resumed(resume)
     if max(ni, nj) > COARSEN_ABOVE and not warm:
-        st = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps)
+        st, coarse = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
             st = _check_grid(surface, parameters)          # the coarse start folded: plain start
+        elif sides is not None and resume is None and coarse.control is not None:
+            # the sources the coarse grid found, at the fine grid's spacing
+            ratio = 0.5 * ((coarse.parameters.shape[0] - 1) / (ni - 1)
+                           + (coarse.parameters.shape[1] - 1) / (nj - 1))
+            sides, resume = sides.resumed(coarse.control, ratio), coarse.control
     n = max(ni, nj)
     omega = relaxation if relaxation is not None else min(1.95, 2.0 / (1.0 + math.sin(math.pi / n)))
     s, t = st[..., 0].copy(), st[..., 1].copy()
@@ -408,10 +424,13 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
             own = grid_controls(nodes)[1 - seam.axis].mean(axis=seam.axis, keepdims=True)
             (Q if seam.axis == 0 else P)[1:-1, 1:-1] = own
     base = P.copy(), Q.copy()
+    if sides is not None and resume is not None:      # the sources reached before
+        dP, dQ = sides.fields(s.shape)
+        P, Q = base[0] + dP, base[1] + dQ
     residuals: list[float] = []
     scores: list[float] = []             # how far from converged: residual / tol, or the sides' misfit
     refused = sweeps = 0
-    best = (math.inf, math.inf, math.inf, s, t)    # (score, residual, misfit, s, t)
+    best = (math.inf, math.inf, math.inf, s, t, sides)    # (score, residual, misfit, s, t, sources)
     misfit = math.inf if sides is not None else 0.0
 
     def one_sweep() -> float:
@@ -429,12 +448,13 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
             if misfit > 1.0 and residuals and residuals[-1] < ORTHOGONAL_BELOW:
                 sides, P, Q = moved, base[0] + dP, base[1] + dQ
         saved = s.copy(), t.copy()
+        used = sides                     # the sources the grid in `saved` was swept with
         residual = one_sweep()
         sweeps += 1
         residuals.append(residual)
         scores.append(max(residual / tol, misfit))
         if scores[-1] < best[0]:
-            best = (scores[-1], residual, misfit, *saved)
+            best = (scores[-1], residual, misfit, *saved, used)
         if residual < tol and misfit <= 1.0:
             s, t = saved                 # converged on the exact nodes: keep them
             break
@@ -454,8 +474,9 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
         s, t = best[3], best[4]
         residuals.append(best[1])        # the history ends with the residual of the grid returned
         misfit = best[2]
+        sides = best[5]
     if seam is not None:
         s, t = seam.wrapped(seam.unpad(s), seam.unpad(t))
     out = np.stack([s, t], axis=-1)
     return EllipticResult(out, tuple(residuals), converged, refused, sweeps,
-                          misfit if sides is not None else 0.0)
+                          misfit if sides is not None else 0.0, sides)

@@ -383,8 +383,9 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     (:data:`INTERFACE_PROGRESS`), after :data:`INTERFACE_ROUNDS` rounds, or once the
     rounds took ``budget`` seconds (the caller's: as long as gridding the blocks did)."""
     from ..measure import normals
-    from .elliptic import refine
+    from .elliptic import corner_jacobians, refine
     from .quality import grid_quality
+    from .tfi import carried_inward
     params = [b.parameters.copy() for b in blocks]
     side_params = [dict(b.side_params) for b in blocks]
     grids = list(blocks)
@@ -432,10 +433,20 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             break                             # converged, the moves no longer shrink, or out of time
         previous = worst
         for k in changed:
+            # the sides' slide carried into the block (unless that folds a cell): the warm
+            # solve then starts without the slide's long-wave error
+            if grids[k].seam is None:
+                moved = carried_inward(grids[k].parameters, params[k])
+                before = corner_jacobians(grids[k].parameters[..., 0], grids[k].parameters[..., 1])
+                after = corner_jacobians(moved[..., 0], moved[..., 1])
+                if np.all(after * np.sign(before.sum()) > 0):
+                    params[k] = moved
             squared = orthogonal and grids[k].orthogonal_dropped is None and open_sides[k]
             seam = grids[k].seam
+            earlier = grids[k].elliptic
             result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
-                            orthogonal=squared, seam=seam)
+                            orthogonal=squared, seam=seam,
+                            resume=earlier.control if earlier is not None else None)
             if squared and not result.nearly_converged(tol):      # as grid_region: the plain grid
                 plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
                                seam=seam)

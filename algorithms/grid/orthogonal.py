@@ -316,7 +316,6 @@ class BoundaryControl:
             The worst side's miss before this step (:func:`source_steps`; at most 1
             when every side is as wanted).
         """
-        dP, dQ = np.zeros(points.shape[:2]), np.zeros(points.shape[:2])
         misfit = 0.0
         corrections = {}
         for side in self.sides:
@@ -328,12 +327,47 @@ class BoundaryControl:
             na = np.clip(ca + RELAXATION * ga * step_a, -BOUND * aspect, BOUND * aspect)
             nb = np.clip(cb + RELAXATION * gb * step_b, -BOUND, BOUND)
             corrections[side] = (na, nb, ga, gb, step_a, step_b)
+        moved = BoundaryControl(self.sides, self.targets, corrections)
+        return (moved, *moved.fields(points.shape[:2]), misfit)
+
+    def fields(self, shape: tuple[int, int]) -> tuple[NDArray, NDArray]:
+        """The corrections spread over a grid of ``shape`` (ni, nj): ``dP, dQ``, each (ni, nj),
+        zero on the boundary."""
+        dP, dQ = np.zeros(shape), np.zeros(shape)
+        for side in self.sides:
+            na, nb = self.corrections[side][:2]
             transpose, flip = _SIDES[side]
             sign_b = -1.0 if flip else 1.0         # Q r_eta is even in eta: Q flips with it
             va, vb = _view(dQ if transpose else dP, side), _view(dP if transpose else dQ, side)
-            va[1:-1] += spread(na, p.shape[1])
-            vb[1:-1] += sign_b * spread(nb, p.shape[1])
+            va[1:-1] += spread(na, va.shape[1])
+            vb[1:-1] += sign_b * spread(nb, vb.shape[1])
         for a in (dP, dQ):
             a[[0, -1], :] = 0.0
             a[:, [0, -1]] = 0.0
-        return BoundaryControl(self.sides, self.targets, corrections), dP, dQ, misfit
+        return dP, dQ
+
+    def resumed(self, previous: BoundaryControl, scale: float = 1.0) -> BoundaryControl:
+        """These targets with the corrections ``previous`` had reached on the same sides.
+
+        For a grid refined again after its side nodes slid a little (same node counts:
+        the corrections and their step gains are taken as they are), or for the fine grid
+        started from a coarse one's solution: then a side's corrections are interpolated
+        along it and multiplied by ``scale``, the ratio of the index spacings (a source's
+        ``P r_xi`` keeps its effect when ``P`` scales with the spacing), gains restarted.
+        """
+        corrections = dict(self.corrections)
+        for side in self.sides:
+            if side not in previous.corrections:
+                continue
+            mine, theirs = corrections[side], previous.corrections[side]
+            if theirs[0].shape == mine[0].shape:
+                corrections[side] = theirs
+                continue
+            n, m = mine[0].size, theirs[0].size
+            if m == 0:
+                continue
+            at, known = np.arange(1, n + 1) / (n + 1), np.arange(1, m + 1) / (m + 1)
+            along = scale * np.interp(at, known, theirs[0])
+            across = scale * np.interp(at, known, theirs[1])
+            corrections[side] = (along, across, *mine[2:])
+        return BoundaryControl(self.sides, self.targets, corrections)

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ...errors import InvalidGeometryError
 
-__all__ = ["distribution_mesh", "normalized_arc_length", "transfinite"]
+__all__ = ["carried_inward", "distribution_mesh", "normalized_arc_length", "transfinite"]
 
 
 def _fractions(x: ArrayLike, name: str) -> NDArray:
@@ -151,3 +151,40 @@ def transfinite(bottom: ArrayLike, top: ArrayLike, left: ArrayLike, right: Array
          - ((1 - s) * (1 - t) * B[0] + s * (1 - t) * B[-1] + (1 - s) * t * T[0] + s * t * T[-1]))
     x[:, 0], x[:, -1], x[0], x[-1] = B, T, L, R
     return x
+
+
+def carried_inward(before: ArrayLike, after: ArrayLike) -> NDArray:
+    """The grid ``before`` with its boundary moved to that of ``after``, the moves of the
+    sides carried into the interior by :func:`transfinite` interpolation.
+
+    A grid refined before whose side nodes then slid (along the sides, the corners
+    held) is a poor start for an iterative smoother if only its boundary moves: a smooth
+    slide of a whole side is the long-wave error relaxation sweeps remove slowest. The
+    displacement ``d`` of the sides, interpolated transfinitely with the weights of the
+    grid's own lines (normalized arc length along each line of ``before``), is added to
+    every node; the result equals ``after`` on the boundary.
+
+    Parameters
+    ----------
+    before, after : (ni, nj, d) float
+        Two grids; only the boundary of ``after`` is read. Their corners must agree.
+
+    Returns
+    -------
+    (ni, nj, d) float
+    """
+    a, b = np.asarray(before, dtype=float), np.asarray(after, dtype=float)
+    if a.ndim != 3 or a.shape != b.shape or min(a.shape[:2]) < 2:
+        raise InvalidGeometryError(f"before and after must be two (ni, nj, d) grids of one shape, "
+                                   f"got {a.shape} and {b.shape}")
+    d = b - a
+    legs_i = np.linalg.norm(np.diff(a, axis=0), axis=-1)            # (ni - 1, nj)
+    legs_j = np.linalg.norm(np.diff(a, axis=1), axis=-1)            # (ni, nj - 1)
+    along_i = np.concatenate([np.zeros((1, a.shape[1])), np.cumsum(legs_i, axis=0)])
+    along_j = np.concatenate([np.zeros((a.shape[0], 1)), np.cumsum(legs_j, axis=1)], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(along_i[-1] > 0, along_i / along_i[-1], np.linspace(0, 1, a.shape[0])[:, None])
+        t = np.where(along_j[:, -1:] > 0, along_j / along_j[:, -1:], np.linspace(0, 1, a.shape[1])[None])
+    moved = a + transfinite(d[:, 0], d[:, -1], d[0], d[-1], weights=(s, t))
+    moved[0], moved[-1], moved[:, 0], moved[:, -1] = b[0], b[-1], b[:, 0], b[:, -1]
+    return moved

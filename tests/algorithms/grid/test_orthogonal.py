@@ -155,3 +155,41 @@ def test_a_sharp_corner_is_not_squeezed_further_by_the_squared_sides():
     assert grid.orthogonal_dropped is not None and "more skewed" in grid.orthogonal_dropped
     np.testing.assert_array_equal(grid.points, plain.points)
     assert grid.quality.max_skewness < 75 / 90 + 0.005 and grid.quality.folded_cells == 0   # the corner's own
+
+
+def test_a_refinement_resumed_from_its_sources_needs_fewer_sweeps_for_the_same_grid():
+    """The trapezoid's squared grid, its bottom's nodes then slid along it (as a network's
+    shared edge slides): refined again from the sources it had reached, it meets its sides
+    in fewer sweeps than from none, and both runs find the same grid."""
+    from surfprep.algorithms.grid.elliptic import refine
+    surface = _trapezoid()
+    first = refine(surface, grid_surface(surface, dims=(41, 31), smooth="none").parameters,
+                   orthogonal=True)
+    assert first.converged and first.control is not None
+    slid = first.parameters.copy()
+    slid[1:-1, 0, 0] += 0.004 * np.sin(np.pi * np.linspace(0, 1, 41)[1:-1])
+    fresh = refine(surface, slid, orthogonal=True, warm=True)
+    resumed = refine(surface, slid, orthogonal=True, warm=True, resume=first.control)
+    assert fresh.converged and resumed.converged
+    assert resumed.sweeps < 0.7 * fresh.sweeps
+    cell = 4.0 / 40
+    a, b = surface.evaluate(*fresh.parameters.transpose(2, 0, 1)), surface.evaluate(
+        *resumed.parameters.transpose(2, 0, 1))
+    assert np.abs(a - b).max() < 0.02 * cell
+    assert max(np.abs(x - 90).max() for x in side_angles(b)) < 0.5
+
+
+def test_sources_resumed_on_a_finer_grid_are_interpolated_and_scaled():
+    x, y = np.meshgrid(np.linspace(0, 2, 9), np.linspace(0, 1, 7), indexing="ij")
+    coarse = BoundaryControl.start(np.stack([x, y, np.zeros_like(x)], axis=-1), sides=("j0",))
+    along = np.linspace(1.0, 2.0, 7)
+    coarse = BoundaryControl(coarse.sides, coarse.targets,
+                             {"j0": (along, -along, *coarse.corrections["j0"][2:])})
+    x, y = np.meshgrid(np.linspace(0, 2, 17), np.linspace(0, 1, 13), indexing="ij")
+    fine = BoundaryControl.start(np.stack([x, y, np.zeros_like(x)], axis=-1), sides=("j0", "i0"))
+    resumed = fine.resumed(coarse, 0.5)
+    a, b = resumed.corrections["j0"][:2]
+    assert a.shape == (15,)
+    np.testing.assert_allclose(a, 0.5 * np.interp(np.arange(1, 16) / 16, np.arange(1, 8) / 8, along))
+    np.testing.assert_allclose(b, -a)
+    np.testing.assert_array_equal(resumed.corrections["i0"][0], 0.0)      # not in the coarse one

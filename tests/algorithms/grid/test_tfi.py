@@ -60,3 +60,26 @@ def test_tfi_refuses_sides_that_do_not_meet():
         distribution_mesh(uniform(4), uniform(5), uniform(3), uniform(3))
     with pytest.raises(InvalidGeometryError, match="from 0 to 1"):
         distribution_mesh(uniform(4)[::-1], uniform(4), uniform(3), uniform(3))
+
+
+def test_sides_slid_on_a_bilinear_grid_are_carried_in_as_the_interpolation_of_the_new_sides():
+    """``carried_inward`` adds the transfinite interpolation of the sides' moves; on a grid
+    that is itself the interpolation of its sides (a uniform one) the result is the
+    interpolation of the moved sides, exactly."""
+    from surfprep.algorithms.grid.tfi import carried_inward
+    ni, nj = 9, 7
+    x, y = np.meshgrid(np.linspace(0, 2, ni), np.linspace(0, 1, nj), indexing="ij")
+    before = np.stack([x, y], axis=-1)
+    after = before.copy()
+    wave_i, wave_j = np.sin(np.pi * uniform(ni)), np.sin(np.pi * uniform(nj))
+    after[:, 0, 0] += 0.05 * wave_i                   # the bottom's nodes slide along it
+    after[:, -1, 0] -= 0.03 * wave_i
+    after[0, :, 1] += 0.04 * wave_j
+    after[-1, :, 1] += 0.02 * wave_j ** 2
+    moved = carried_inward(before, after)
+    S, T = np.meshgrid(uniform(ni), uniform(nj), indexing="ij")
+    expected = transfinite(after[:, 0], after[:, -1], after[0], after[-1], weights=(S, T))
+    np.testing.assert_allclose(moved, expected, atol=1e-14)
+    assert np.abs(moved[1:-1, 1:-1] - before[1:-1, 1:-1]).max() > 0.01    # the interior moved
+    with pytest.raises(InvalidGeometryError, match="one shape"):
+        carried_inward(before, after[:-1])
