@@ -86,7 +86,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -96,6 +96,7 @@ from ..surface import NurbsSurface
 from .elliptic_kernels import sweep
 from .orthogonal import SIDE_NAMES, BoundaryControl
 from .periodic import Seam, grid_controls
+from .respacing import respaced
 
 __all__ = ["EllipticResult", "corner_jacobians", "refine"]
 
@@ -313,8 +314,8 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
     fi, fj = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
     gi, gj = np.meshgrid(fi, fj, indexing="ij")
     coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
-    result = refine(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
-                    seam=seam, tol=tol, max_sweeps=max_sweeps)
+    result = _solve(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
+                    seam=seam, tol=tol, max_sweeps=max_sweeps, relaxation=None, warm=False, resume=None)
     solved = result.parameters
     if seam is not None:                 # back to unwrapped parameters before interpolating
         solved = _unwrapped(seam, solved, coarse)
@@ -379,11 +380,38 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     InvalidGeometryError
         A parameter array of the wrong shape, with NaN, or outside the domain; a
         start grid that is already folded.
+
+    Notes
+    -----
+    A surface whose patches, joined C0, run at very different speeds is solved in its
+    parameters re-spaced at the joins (:mod:`.respacing`: the same geometry; the
+    parameters are mapped there and back, the boundary returned as given).
     """
     st = _check_grid(surface, parameters)
-    ni, nj = st.shape[:2]
-    if ni < 3 or nj < 3:
+    if min(st.shape[:2]) < 3:
         return EllipticResult(st, (), True, 0, 0)
+
+    def solve(on: NurbsSurface, start: NDArray) -> EllipticResult:
+        return _solve(on, start, control=control, orthogonal=orthogonal, heights=heights, seam=seam,
+                      tol=tol, max_sweeps=max_sweeps, relaxation=relaxation, warm=warm, resume=resume)
+
+    chart = respaced(surface)
+    if chart is None:
+        return solve(surface, st)
+    result = solve(chart.surface, chart.to_chart(st))
+    out = chart.from_chart(result.parameters)
+    for axis in (0, 1):                  # the held sides exactly as given (not the seam: solved)
+        if seam is None or seam.axis != axis:
+            index = (slice(None),) * axis + ([0, -1],)
+            out[index] = st[index]
+    return replace(result, parameters=out)
+
+
+def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: bool | Collection[str],
+           heights: Mapping[str, float] | None, seam: Seam | None, tol: float, max_sweeps: int,
+           relaxation: float | None, warm: bool, resume: BoundaryControl | None) -> EllipticResult:
+    """:func:`refine` on checked parameters ``st`` (ni, nj, 2), at least 3 x 3."""
+    ni, nj = st.shape[:2]
     sign = _orientation(st[..., 0], st[..., 1])
     start_jac = sign * corner_jacobians(st[..., 0], st[..., 1])
     if np.any(start_jac <= 0.0):
@@ -399,10 +427,11 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
                                       short=_short(start_points)) if chosen else None
         if sides is not None and resume is not None:
             sides = sides.resumed(resume)
+    start = st
     if max(ni, nj) > COARSEN_ABOVE and not warm:
         st, coarse = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
-            st = _check_grid(surface, parameters)          # the coarse start folded: plain start
+            st = start                                     # the coarse start folded: plain start
         elif sides is not None and resume is None and coarse.control is not None:
             # the sources the coarse grid found, at the fine grid's spacing
             ratio = 0.5 * ((coarse.parameters.shape[0] - 1) / (ni - 1)
