@@ -37,6 +37,7 @@ from .held import HeldLine, held_line, split_along
 from .periodic import Seam
 from .quality import GridQuality, grid_quality
 from .region import SIDE_NAMES, Region
+from .respacing import Respacing, respaced
 from .tfi import distribution_mesh, transfinite
 
 __all__ = ["DEFAULT_CELLS", "SKEW_SLACK", "Spacing", "SurfaceGrid", "corner_angles", "corner_skewness",
@@ -293,6 +294,18 @@ def _region_start(region: Region, x: dict[str, NDArray]) -> NDArray:
     return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
 
 
+def _respaced_start(chart: Respacing, fractions: dict[str, NDArray]) -> NDArray:
+    """The distribution mesh of the sides' ``fractions`` (of the original parameters) made in
+    the re-spaced parameters of ``chart`` and mapped back: (ni, nj, 2)."""
+    u0, u1, v0, v1 = chart.surface.domain
+    f = {}
+    for name, k, lo, hi in (("j0", 0, u0, u1), ("j1", 0, u0, u1), ("i0", 1, v0, v1), ("i1", 1, v0, v1)):
+        x = lo + fractions[name] * (hi - lo)
+        f[name] = (np.interp(x, chart.breaks[k], chart.spaced[k]) - lo) / (hi - lo)
+    s, t = distribution_mesh(f["j0"], f["j1"], f["i0"], f["i1"])
+    return chart.from_chart(np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1))
+
+
 def _transposed(surface: NurbsSurface) -> NurbsSurface:
     """The surface with its u and v swapped (exact)."""
     weights = None if surface.weights is None else surface.weights.T
@@ -485,6 +498,11 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         else:
             s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
         st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
+        chart = None if hold else respaced(surface)
+        if chart is not None:
+            # patches joined C0 at very different speeds: the interior blended in the
+            # parameters re-spaced at the joins (the sides' nodes as they are)
+            st[1:-1, 1:-1] = _respaced_start(chart, fractions)[1:-1, 1:-1]
     st[..., 0] = np.clip(st[..., 0], u0, u1)
     st[..., 1] = np.clip(st[..., 1], v0, v1)
 

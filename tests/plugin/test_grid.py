@@ -70,7 +70,10 @@ def test_a_trimmed_face_is_refused_with_its_reason_or_gridded_whole():
     result = surfprep.grid(CATIA_FACE, whole_surfaces=True, dims=(61, 41))
     block = result.network.blocks[0]
     assert block.dims == (61, 41)
-    assert block.start_quality.max_skewness > 0.9          # the surface's parameters are awful
+    # the surface's parameters are awful (its Bezier patches run at speeds ~2700x apart: blended
+    # in them, the start grid's worst cell had skewness 0.997); blended in its knots re-spaced
+    # at the C0 joins, the start is already fair
+    assert block.start_quality.max_skewness < 0.3 and block.start_quality.folded_cells == 0
     assert block.quality.max_skewness < 0.3 and block.quality.folded_cells == 0
 
 

@@ -71,3 +71,5 @@ def test_the_catia_v4_face_settles_at_201_by_201():
     grid = grid_surface(face.surface, dims=(201, 201), orthogonal=False)
     assert grid.elliptic.converged
     assert grid.quality.folded_cells == 0 and grid.quality.max_skewness < 0.2
+    # the algebraic start, blended in the re-spaced parameters (in the original ones: 0.998)
+    assert grid.start_quality.max_skewness < 0.2 and grid.start_quality.folded_cells == 0
