@@ -284,14 +284,25 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
 
 def _region_start(region: Region, x: dict[str, NDArray]) -> NDArray:
     """TFI in ``(u, v)`` of the four sides' nodes, blended by their arc-length fractions;
-    each corner the mean of its two sides' ends (a loop's pcurves meet to its tolerance)."""
+    each corner the mean of its two sides' ends (a loop's pcurves meet to its tolerance).
+    On a surface of patches joined C0 at very different speeds, TFI in its parameters
+    re-spaced at the joins (:mod:`.respacing`)."""
     sides = {name: region.sides[name].uv(x[name]) for name in SIDE_NAMES}
     for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1),
                          ("j1", -1, "i1", -1)):
         corner = 0.5 * (sides[a][ia] + sides[b][ib])
         sides[a][ia] = sides[b][ib] = corner
     weights = distribution_mesh(*(region.sides[name].fractions_of(x[name]) for name in SIDE_NAMES))
-    return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
+    chart = respaced(region.surface)
+    if chart is None:
+        return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
+    # patches joined C0 at very different speeds: blended in the parameters re-spaced at the
+    # joins, the sides' nodes as they are
+    mapped = {name: chart.to_chart(uv) for name, uv in sides.items()}
+    st = chart.from_chart(transfinite(mapped["j0"], mapped["j1"], mapped["i0"], mapped["i1"],
+                                      weights=weights))
+    st[:, 0], st[:, -1], st[0], st[-1] = sides["j0"], sides["j1"], sides["i0"], sides["i1"]
+    return st
 
 
 def _respaced_start(chart: Respacing, fractions: dict[str, NDArray]) -> NDArray:
