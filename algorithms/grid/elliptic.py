@@ -93,7 +93,8 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
-from .elliptic_kernels import sweep
+from .elliptic_kernels import corner_jacobians, sweep
+from .multigrid import COARSEST, POST, PRE, SMOOTHING, correct
 from .orthogonal import SIDE_NAMES, BoundaryControl
 from .periodic import Seam, grid_controls
 from .respacing import respaced
@@ -104,6 +105,9 @@ __all__ = ["EllipticResult", "corner_jacobians", "refine"]
 SWEEPS_PER_EVALUATION = 16
 #: a grid with more nodes than this along a side starts from its half-size solution
 COARSEN_ABOVE = 33
+#: a grid with more nodes than this along a side gets a coarse-grid correction in every
+#: block of sweeps (:mod:`.multigrid`)
+MULTIGRID_ABOVE = 64
 _MIN_RELAXATION = 0.05
 #: the iteration stops as stalled when the residual has not fallen by this factor
 #: over the last STALL_WINDOW evaluations
@@ -167,28 +171,6 @@ class EllipticResult:
         if plain.converged or not self.residuals:
             return True
         return bool(plain.residuals) and plain.residuals[-1] < NEARLY * self.residuals[-1]
-
-
-def corner_jacobians(s: NDArray, t: NDArray) -> NDArray:
-    """Signed area of the four corner triangles of every cell of a 2-D grid.
-
-    Parameters
-    ----------
-    s, t : (ni, nj) float
-
-    Returns
-    -------
-    (4, ni - 1, nj - 1) float; all of one sign when no cell is folded.
-    """
-    p = np.stack([s, t], axis=-1)
-    p00, p10, p01, p11 = p[:-1, :-1], p[1:, :-1], p[:-1, 1:], p[1:, 1:]
-
-    def cross(o: NDArray, a: NDArray, b: NDArray) -> NDArray:
-        u, v = a - o, b - o
-        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-    return np.stack([cross(p00, p10, p01), cross(p10, p11, p00),
-                     cross(p11, p01, p10), cross(p01, p00, p11)])
 
 
 def _side_terms(points: NDArray, short: float) -> tuple[NDArray, ...]:
@@ -306,7 +288,7 @@ def _unwrapped(seam: Seam, solved: NDArray, start: NDArray) -> NDArray:
 
 def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal: bool | Collection[str],
                   heights: Mapping[str, float] | None, seam: Seam | None, tol: float,
-                  max_sweeps: int) -> tuple[NDArray, EllipticResult]:
+                  max_sweeps: int, multigrid: bool) -> tuple[NDArray, EllipticResult]:
     """Interior ``(s, t)`` from the solution on a grid of about half the nodes, and that solution."""
     from scipy.ndimage import map_coordinates
     ni, nj = st.shape[:2]
@@ -315,7 +297,8 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
     gi, gj = np.meshgrid(fi, fj, indexing="ij")
     coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
     result = _solve(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
-                    seam=seam, tol=tol, max_sweeps=max_sweeps, relaxation=None, warm=False, resume=None)
+                    seam=seam, tol=tol, max_sweeps=max_sweeps, relaxation=None, warm=False, resume=None,
+                    multigrid=multigrid)
     solved = result.parameters
     if seam is not None:                 # back to unwrapped parameters before interpolating
         solved = _unwrapped(seam, solved, coarse)
@@ -333,7 +316,7 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
            seam: Seam | None = None, tol: float = 1e-4,
            max_sweeps: int = 2000,
            relaxation: float | None = None, warm: bool = False,
-           resume: BoundaryControl | None = None) -> EllipticResult:
+           resume: BoundaryControl | None = None, multigrid: bool = True) -> EllipticResult:
     """Solve the elliptic system (8)-(9) for the interior nodes of a surface grid.
 
     Parameters
@@ -363,13 +346,20 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
     max_sweeps : int
         Most SOR sweeps on the finest grid.
     relaxation : float, optional
-        SOR factor; default ``min(1.95, 2 / (1 + sin(pi / n)))``, ``n`` the longer side.
+        SOR factor; default ``min(1.95, 2 / (1 + sin(pi / n)))``, ``n`` the longer side
+        (used where no coarse-grid correction is made).
     warm : bool
         The start is already nearly a solution (a grid refined before, its boundary
         moved a little): iterate on it directly, without the coarse-grid start.
     resume : BoundaryControl, optional
         With ``orthogonal``: the sources an earlier refinement of this grid reached
         (:attr:`EllipticResult.control`), to start from instead of none.
+    multigrid : bool
+        On grids with more than :data:`MULTIGRID_ABOVE` nodes along a side (and no seam),
+        iterate by V-cycles: Gauss--Seidel sweeps round a coarse-grid correction
+        (:mod:`.multigrid`), instead of SOR alone (about ten times fewer sweeps on a
+        450 x 230 block). Given up for SOR when a correction cannot be made without
+        folding a cell.
 
     Returns
     -------
@@ -393,7 +383,8 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
 
     def solve(on: NurbsSurface, start: NDArray) -> EllipticResult:
         return _solve(on, start, control=control, orthogonal=orthogonal, heights=heights, seam=seam,
-                      tol=tol, max_sweeps=max_sweeps, relaxation=relaxation, warm=warm, resume=resume)
+                      tol=tol, max_sweeps=max_sweeps, relaxation=relaxation, warm=warm, resume=resume,
+                      multigrid=multigrid)
 
     chart = respaced(surface)
     if chart is None:
@@ -409,7 +400,8 @@ def refine(surface: NurbsSurface, parameters: NDArray, *, control: bool = True,
 
 def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: bool | Collection[str],
            heights: Mapping[str, float] | None, seam: Seam | None, tol: float, max_sweeps: int,
-           relaxation: float | None, warm: bool, resume: BoundaryControl | None) -> EllipticResult:
+           relaxation: float | None, warm: bool, resume: BoundaryControl | None,
+           multigrid: bool) -> EllipticResult:
     """:func:`refine` on checked parameters ``st`` (ni, nj, 2), at least 3 x 3."""
     ni, nj = st.shape[:2]
     sign = _orientation(st[..., 0], st[..., 1])
@@ -429,7 +421,8 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
             sides = sides.resumed(resume)
     start = st
     if max(ni, nj) > COARSEN_ABOVE and not warm:
-        st, coarse = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps)
+        st, coarse = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps,
+                                   multigrid)
         if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
             st = start                                     # the coarse start folded: plain start
         elif sides is not None and resume is None and coarse.control is not None:
@@ -468,6 +461,11 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
             seam.sync(s, t, x)
         return residual
 
+    # coarse-grid corrections (:mod:`.multigrid`) on grids large enough, not across a seam
+    multigrid = multigrid and seam is None and min(ni, nj) >= 2 * COARSEST and max(ni, nj) > MULTIGRID_ABOVE
+    sor = omega
+    if multigrid:
+        omega = SMOOTHING
     while sweeps < max_sweeps:
         d = surface.derivatives(*_inside(seam, s, t), 1)
         x, rs, rt = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
@@ -489,12 +487,23 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
             break
         if _stalled(scores):
             break                        # not converging: the iterate nearest to a solution is returned
-        for _ in range(SWEEPS_PER_EVALUATION - 1):
-            one_sweep()
-            sweeps += 1
+        if multigrid:                    # a V-cycle: smoothing sweeps round a coarse-grid correction
+            for _ in range(PRE - 1):
+                one_sweep()
+            if not correct(surface, s, t, x, rs, rt, P, Q, box, sign):
+                multigrid, omega = False, sor      # SOR from here
+            for _ in range(POST):
+                one_sweep()
+            sweeps += PRE - 1 + POST
+        else:
+            for _ in range(SWEEPS_PER_EVALUATION - 1):
+                one_sweep()
+                sweeps += 1
         if _folded(s, t, sign, floor):
             s[...], t[...] = saved
             refused += 1
+            if multigrid:                # the plain sweeps from here
+                multigrid, omega = False, sor
             omega *= 0.5
             if omega < _MIN_RELAXATION:
                 break

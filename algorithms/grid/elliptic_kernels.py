@@ -27,11 +27,36 @@ from numpy.typing import NDArray
 
 from ..jit import AVAILABLE, jit
 
-__all__ = ["LIMIT", "sweep", "sweep_numpy"]
+__all__ = ["LIMIT", "corner_jacobians", "numerators", "sweep", "sweep_numpy"]
+
+#: the kernel's stand-in for "no target" (an array of another shape: never read)
+_NO_TARGET = np.zeros((1, 1, 3))
 
 #: largest step of a node, as a fraction of its distance to the nearest line whose
 #: crossing would fold one of its cells (:func:`_reach`)
 LIMIT = 0.5
+
+
+def corner_jacobians(s: NDArray, t: NDArray) -> NDArray:
+    """Signed area of the four corner triangles of every cell of a 2-D grid.
+
+    Parameters
+    ----------
+    s, t : (ni, nj) float
+
+    Returns
+    -------
+    (4, ni - 1, nj - 1) float; all of one sign when no cell is folded.
+    """
+    p = np.stack([s, t], axis=-1)
+    p00, p10, p01, p11 = p[:-1, :-1], p[1:, :-1], p[:-1, 1:], p[1:, 1:]
+
+    def cross(o: NDArray, a: NDArray, b: NDArray) -> NDArray:
+        u, v = a - o, b - o
+        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+    return np.stack([cross(p00, p10, p01), cross(p10, p11, p00),
+                     cross(p11, p01, p10), cross(p01, p00, p11)])
 
 
 @jit
@@ -100,8 +125,9 @@ def _may_fold(s, t, i, j, d):  # pragma: no cover - compiled
 
 
 @jit
-def _sweep_kernel(s, t, x, rs, rt, p, q, omega, u0, u1, v0, v1):  # pragma: no cover - compiled
+def _sweep_kernel(s, t, x, rs, rt, p, q, target, omega, u0, u1, v0, v1):  # pragma: no cover - compiled
     ni, nj = s.shape
+    has_target = target.shape[0] == ni
     worst = 0.0
     for i in range(1, ni - 1):
         for j in range(1, nj - 1):
@@ -128,7 +154,10 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, omega, u0, u1, v0, v1):  # pragma: no c
                 xe = 0.25 * (x[i + 1, j + 1, k] - x[i + 1, j - 1, k]
                              - x[i - 1, j + 1, k] + x[i - 1, j - 1, k])
                 r = (g22 * (x[i + 1, j, k] + x[i - 1, j, k]) + g11 * (x[i, j + 1, k] + x[i, j - 1, k])
-                     - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - diag * x[i, j, k]) / diag
+                     - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - diag * x[i, j, k])
+                if has_target:
+                    r -= target[i, j, k]
+                r /= diag
                 e += rs[i, j, k] * rs[i, j, k]
                 f += rs[i, j, k] * rt[i, j, k]
                 gg += rt[i, j, k] * rt[i, j, k]
@@ -162,8 +191,10 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, omega, u0, u1, v0, v1):  # pragma: no c
     return worst
 
 
-def _moves(s, t, x, rs, rt, p, q):
-    """Unrelaxed tangential moves ``(ds, dt)`` and their size in cells, on the interior."""
+def numerators(x: NDArray, p: NDArray, q: NDArray) -> tuple[NDArray, NDArray]:
+    """The discrete operator of the system at the interior nodes of ``x`` (ni, nj, 3), before
+    its division by the diagonal: ``R`` (ni - 2, nj - 2, 3) of the module doc (zero at a
+    solution, up to its normal part) and the diagonal ``2 (g11 + g22)`` (ni - 2, nj - 2)."""
     c = (slice(1, -1), slice(1, -1))
     xi = 0.5 * (x[2:, 1:-1] - x[:-2, 1:-1])
     eta = 0.5 * (x[1:-1, 2:] - x[1:-1, :-2])
@@ -172,11 +203,22 @@ def _moves(s, t, x, rs, rt, p, q):
     g22 = np.einsum("...k,...k->...", eta, eta)
     g12 = np.einsum("...k,...k->...", xi, eta)
     diag = 2.0 * (g11 + g22)
+    r = (g22[..., None] * (x[2:, 1:-1] + x[:-2, 1:-1]) + g11[..., None] * (x[1:-1, 2:] + x[1:-1, :-2])
+         - 2.0 * g12[..., None] * xe + (g22 * p[c])[..., None] * xi + (g11 * q[c])[..., None] * eta
+         - diag[..., None] * x[c])
+    return r, diag
+
+
+def _moves(s, t, x, rs, rt, p, q, target=None):
+    """Unrelaxed tangential moves ``(ds, dt)`` and their size in cells, on the interior."""
+    c = (slice(1, -1), slice(1, -1))
+    numerator, diag = numerators(x, p, q)
+    if target is not None:
+        numerator = numerator - target[c]
+    g11_g22 = 0.5 * diag
     ok = diag > 0
     diag = np.where(ok, diag, 1.0)
-    r = ((g22[..., None] * (x[2:, 1:-1] + x[:-2, 1:-1]) + g11[..., None] * (x[1:-1, 2:] + x[1:-1, :-2])
-          - 2.0 * g12[..., None] * xe + (g22 * p[c])[..., None] * xi + (g11 * q[c])[..., None] * eta)
-         / diag[..., None] - x[c])
+    r = numerator / diag[..., None]
     a, b = rs[c], rt[c]
     e = np.einsum("...k,...k->...", a, a)
     f = np.einsum("...k,...k->...", a, b)
@@ -189,7 +231,7 @@ def _moves(s, t, x, rs, rt, p, q):
     ds = np.where(ok, (gg * ar - f * at) / det, 0.0)
     dt = np.where(ok, (e * at - f * ar) / det, 0.0)
     move = np.sqrt(np.maximum(e * ds * ds + 2.0 * f * ds * dt + gg * dt * dt, 0.0))
-    size = np.sqrt(np.maximum(0.5 * (g11 + g22), 1e-300))
+    size = np.sqrt(np.maximum(0.5 * g11_g22, 1e-300))
     return ds, dt, move / size
 
 
@@ -216,7 +258,7 @@ def _reach_numpy(s: NDArray, t: NDArray) -> NDArray:
 
 
 def sweep_numpy(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p: NDArray, q: NDArray,
-                omega: float, box: tuple[float, float, float, float]) -> float:
+                omega: float, box: tuple[float, float, float, float], target: NDArray | None = None) -> float:
     """One red-black sweep in place (numpy); returns the largest move in cells.
 
     Parameters
@@ -232,6 +274,8 @@ def sweep_numpy(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p:
     omega : float
         Relaxation.
     box : (u0, u1, v0, v1)
+    target : (ni, nj, 3) float, optional
+        Solve ``R = target`` instead of ``R = 0`` (a coarse level of :mod:`.multigrid`).
     """
     u0, u1, v0, v1 = box
     ni, nj = s.shape
@@ -240,7 +284,7 @@ def sweep_numpy(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p:
     c = (slice(1, -1), slice(1, -1))
     for colour in (0, 1):
         mask = (ii + jj) % 2 == colour
-        ds, dt, cells = _moves(s, t, x, rs, rt, p, q)
+        ds, dt, cells = _moves(s, t, x, rs, rt, p, q, target)
         worst = max(worst, float(cells[mask].max(initial=0.0)))
         sc, tc = s[c], t[c]
         reach = _reach_numpy(s, t)
@@ -257,8 +301,9 @@ def sweep_numpy(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p:
 
 
 def sweep(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p: NDArray, q: NDArray,
-          omega: float, box: tuple[float, float, float, float]) -> float:
+          omega: float, box: tuple[float, float, float, float], target: NDArray | None = None) -> float:
     """One SOR sweep in place (compiled lexicographic; :func:`sweep_numpy` without numba)."""
     if not AVAILABLE:                   # pragma: no cover - numba is installed in CI
-        return sweep_numpy(s, t, x, rs, rt, p, q, omega, box)
-    return float(_sweep_kernel(s, t, x, rs, rt, p, q, float(omega), *map(float, box)))
+        return sweep_numpy(s, t, x, rs, rt, p, q, omega, box, target)
+    held = _NO_TARGET if target is None else target
+    return float(_sweep_kernel(s, t, x, rs, rt, p, q, held, float(omega), *map(float, box)))
