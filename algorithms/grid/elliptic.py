@@ -402,8 +402,10 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
            heights: Mapping[str, float] | None, seam: Seam | None, tol: float, max_sweeps: int,
            relaxation: float | None, warm: bool, resume: BoundaryControl | None,
            multigrid: bool) -> EllipticResult:
-    """:func:`refine` on checked parameters ``st`` (ni, nj, 2), at least 3 x 3."""
+    """:func:`refine` on checked parameters ``st`` (ni, nj, 2)."""
     ni, nj = st.shape[:2]
+    if ni < 3 or nj < 3:                 # no interior node (a coarse level of a narrow grid)
+        return EllipticResult(st, (), True, 0, 0)
     sign = _orientation(st[..., 0], st[..., 1])
     start_jac = sign * corner_jacobians(st[..., 0], st[..., 1])
     if np.any(start_jac <= 0.0):

@@ -96,3 +96,12 @@ def test_refine_holds_the_boundary_and_refuses_bad_starts():
         refine(surface, np.where(start > 0.5, np.nan, start))
     with pytest.raises(InvalidGeometryError, match=r"\(ni, nj, 2\)"):
         refine(surface, start[..., 0])
+
+
+@pytest.mark.parametrize("dims", [(81, 3), (3, 81), (81, 4)])
+def test_a_long_narrow_grid_is_refined(dims):
+    """Three nodes across: the coarse start's grid has two, no interior node (it crashed the
+    whole model's grid once, in the sides' control of that coarse grid)."""
+    grid = grid_surface(warped_plane(), dims=dims)
+    assert grid.points.shape == (*dims, 3)
+    assert grid.elliptic.converged and grid.quality.folded_cells == 0
