@@ -93,7 +93,7 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
-from .elliptic_kernels import corner_jacobians, sweep
+from .elliptic_kernels import corner_jacobians, folds, sweep
 from .multigrid import COARSEST, POST, PRE, SMOOTHING, correct
 from .orthogonal import SIDE_NAMES, BoundaryControl
 from .periodic import Seam, grid_controls
@@ -267,11 +267,6 @@ def _orientation(s: NDArray, t: NDArray) -> float:
     return 1.0 if total >= 0.0 else -1.0
 
 
-def _folded(s: NDArray, t: NDArray, sign: float, floor: NDArray) -> bool:
-    """True when a cell corner changed sign (or shrank below a tiny fraction of its start)."""
-    return bool(np.any(sign * corner_jacobians(s, t) <= floor))
-
-
 def _inside(seam: Seam | None, s: NDArray, t: NDArray) -> tuple[NDArray, NDArray]:
     """Parameters to evaluate the surface at: unwrapped ones brought into the domain."""
     return seam.wrapped(s, t) if seam is not None else (s, t)
@@ -425,7 +420,7 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
     if max(ni, nj) > COARSEN_ABOVE and not warm:
         st, coarse = _coarse_start(surface, st, control, orthogonal, heights, seam, tol, max_sweeps,
                                    multigrid)
-        if _folded(st[..., 0], st[..., 1], sign, np.zeros_like(start_jac)):
+        if folds(st[..., 0], st[..., 1], sign):
             st = start                                     # the coarse start folded: plain start
         elif sides is not None and resume is None and coarse.control is not None:
             # the sources the coarse grid found, at the fine grid's spacing
@@ -439,7 +434,6 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
     if seam is not None:                 # iterate on the grid padded across its seam
         s, t = seam.pad(s, t)
         box = seam.box()
-    floor = np.zeros((4, s.shape[0] - 1, s.shape[1] - 1))
     P, Q = np.zeros(s.shape), np.zeros(s.shape)
     if control:
         nodes = surface.evaluate(*_inside(seam, s, t))
@@ -501,7 +495,7 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
             for _ in range(SWEEPS_PER_EVALUATION - 1):
                 one_sweep()
                 sweeps += 1
-        if _folded(s, t, sign, floor):
+        if folds(s, t, sign):
             s[...], t[...] = saved
             refused += 1
             if multigrid:                # the plain sweeps from here

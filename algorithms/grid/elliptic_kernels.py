@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from ..jit import AVAILABLE, jit
 
-__all__ = ["LIMIT", "corner_jacobians", "numerators", "sweep", "sweep_numpy"]
+__all__ = ["LIMIT", "corner_jacobians", "folds", "numerators", "sweep", "sweep_numpy", "tangential_residual"]
 
 #: the kernel's stand-in for "no target" (an array of another shape: never read)
 _NO_TARGET = np.zeros((1, 1, 3))
@@ -58,6 +58,38 @@ def corner_jacobians(s: NDArray, t: NDArray) -> NDArray:
     return np.stack([cross(p00, p10, p01), cross(p10, p11, p00),
                      cross(p11, p01, p10), cross(p01, p00, p11)])
 
+
+
+@jit
+def _folds_kernel(s, t, sign):  # pragma: no cover - compiled
+    ni, nj = s.shape
+    for i in range(ni - 1):
+        for j in range(nj - 1):
+            ax = s[i + 1, j] - s[i, j]
+            ay = t[i + 1, j] - t[i, j]
+            bx = s[i, j + 1] - s[i, j]
+            by = t[i, j + 1] - t[i, j]
+            if sign * (ax * by - ay * bx) <= 0.0:
+                return True
+            cx = s[i + 1, j + 1] - s[i + 1, j]
+            cy = t[i + 1, j + 1] - t[i + 1, j]
+            if sign * (cx * (-ay) - cy * (-ax)) <= 0.0:
+                return True
+            dx = s[i, j + 1] - s[i + 1, j + 1]
+            dy = t[i, j + 1] - t[i + 1, j + 1]
+            if sign * (dx * (-cy) - dy * (-cx)) <= 0.0:
+                return True
+            if sign * ((-bx) * (-dy) - (-by) * (-dx)) <= 0.0:
+                return True
+    return False
+
+
+def folds(s: NDArray, t: NDArray, sign: float) -> bool:
+    """A corner of a cell of the grid ``s, t`` (ni, nj) is not of orientation ``sign`` (+1 or
+    -1): :func:`corner_jacobians` ``* sign <= 0`` anywhere, stopping at the first."""
+    if not AVAILABLE:                   # pragma: no cover - numba is installed in CI
+        return bool(np.any(sign * corner_jacobians(s, t) <= 0.0))
+    return bool(_folds_kernel(s, t, float(sign)))
 
 @jit
 def _line_distance(px, py, ax, ay, bx, by):  # pragma: no cover - compiled
@@ -207,6 +239,60 @@ def numerators(x: NDArray, p: NDArray, q: NDArray) -> tuple[NDArray, NDArray]:
          - 2.0 * g12[..., None] * xe + (g22 * p[c])[..., None] * xi + (g11 * q[c])[..., None] * eta
          - diag[..., None] * x[c])
     return r, diag
+
+
+@jit
+def _tangential_kernel(x, rs, rt, p, q, target, out):  # pragma: no cover - compiled
+    ni, nj = x.shape[0], x.shape[1]
+    has_target = target.shape[0] == ni
+    r = np.empty(3)
+    for i in range(1, ni - 1):
+        for j in range(1, nj - 1):
+            g11 = 0.0
+            g22 = 0.0
+            g12 = 0.0
+            for k in range(3):
+                a = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
+                b = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
+                g11 += a * a
+                g22 += b * b
+                g12 += a * b
+            diag = 2.0 * (g11 + g22)
+            for k in range(3):
+                xi = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
+                eta = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
+                xe = 0.25 * (x[i + 1, j + 1, k] - x[i + 1, j - 1, k]
+                             - x[i - 1, j + 1, k] + x[i - 1, j - 1, k])
+                r[k] = (g22 * (x[i + 1, j, k] + x[i - 1, j, k]) + g11 * (x[i, j + 1, k] + x[i, j - 1, k])
+                        - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - diag * x[i, j, k])
+                if has_target:
+                    r[k] -= target[i, j, k]
+            n0 = rs[i, j, 1] * rt[i, j, 2] - rs[i, j, 2] * rt[i, j, 1]
+            n1 = rs[i, j, 2] * rt[i, j, 0] - rs[i, j, 0] * rt[i, j, 2]
+            n2 = rs[i, j, 0] * rt[i, j, 1] - rs[i, j, 1] * rt[i, j, 0]
+            nn = n0 * n0 + n1 * n1 + n2 * n2
+            c = (r[0] * n0 + r[1] * n1 + r[2] * n2) / nn if nn > 0.0 else 0.0
+            out[i, j, 0] = r[0] - c * n0
+            out[i, j, 1] = r[1] - c * n1
+            out[i, j, 2] = r[2] - c * n2
+
+
+def tangential_residual(x: NDArray, rs: NDArray, rt: NDArray, p: NDArray, q: NDArray,
+                        target: NDArray | None = None) -> NDArray:
+    """The tangential part (normal ``rs x rt``) of ``R - target`` at every node of ``x``
+    (ni, nj, 3), :func:`numerators`' ``R``; zero on the boundary. (ni, nj, 3)."""
+    out = np.zeros(x.shape)
+    if AVAILABLE:
+        _tangential_kernel(x, rs, rt, p, q, _NO_TARGET if target is None else target, out)
+        return out
+    r, _ = numerators(x, p, q)                           # pragma: no cover - numba is installed in CI
+    if target is not None:
+        r = r - target[1:-1, 1:-1]
+    n = np.cross(rs[1:-1, 1:-1], rt[1:-1, 1:-1])
+    nn = np.einsum("...k,...k->...", n, n)
+    c = np.where(nn > 0, np.einsum("...k,...k->...", r, n) / np.where(nn > 0, nn, 1.0), 0.0)
+    out[1:-1, 1:-1] = r - n * c[..., None]
+    return out
 
 
 def _moves(s, t, x, rs, rt, p, q, target=None):

@@ -41,7 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
-from .elliptic_kernels import corner_jacobians, numerators, sweep
+from .elliptic_kernels import folds, sweep, tangential_residual
 
 __all__ = ["COARSEST", "POST", "PRE", "SMOOTHING", "correct"]
 
@@ -60,33 +60,22 @@ def _sor(shape: tuple[int, int]) -> float:
     return min(1.95, 2.0 / (1.0 + math.sin(math.pi / max(shape))))
 
 
-def _tangential(r: NDArray, rs: NDArray, rt: NDArray) -> NDArray:
-    """``r`` (..., 3) less its component along the normal ``rs x rt``."""
-    n = np.cross(rs, rt)
-    nn = np.einsum("...k,...k->...", n, n)
-    nn = np.where(nn > 0, nn, 1.0)
-    return r - n * (np.einsum("...k,...k->...", r, n) / nn)[..., None]
-
-
-def _operator(x: NDArray, rs: NDArray, rt: NDArray, P: NDArray, Q: NDArray,
-              target: NDArray | None) -> NDArray:
-    """The tangential part of ``R - target`` at every node of ``x`` (zero on the boundary):
-    (ni, nj, 3)."""
-    out = np.zeros(x.shape)
-    r, _ = numerators(x, P, Q)
-    if target is not None:
-        r = r - target[1:-1, 1:-1]
-    out[1:-1, 1:-1] = _tangential(r, rs[1:-1, 1:-1], rt[1:-1, 1:-1])
-    return out
+def _positions(n: int, at: NDArray) -> tuple[NDArray, NDArray]:
+    """Left neighbours and weights of fractional index positions ``at`` in ``0..n-1``."""
+    left = np.minimum(np.floor(at).astype(np.intp), n - 2)
+    return left, at - left
 
 
 def _sample(a: NDArray, at_i: NDArray, at_j: NDArray) -> NDArray:
-    """``a`` (ni, nj[, k]) interpolated linearly at fractional index positions (grids)."""
-    from scipy.ndimage import map_coordinates
-    gi, gj = np.meshgrid(at_i, at_j, indexing="ij")
-    if a.ndim == 2:
-        return map_coordinates(a, [gi, gj], order=1)
-    return np.stack([map_coordinates(a[..., k], [gi, gj], order=1) for k in range(a.shape[-1])], axis=-1)
+    """``a`` (ni, nj[, k]) interpolated linearly at the index positions ``at_i x at_j`` (a
+    tensor grid of fractional positions: separable)."""
+    extra = (1,) * (a.ndim - 2)
+    i, wi = _positions(a.shape[0], at_i)
+    wi = wi.reshape(-1, 1, *extra)
+    b = a[i] * (1.0 - wi) + a[i + 1] * wi
+    j, wj = _positions(a.shape[1], at_j)
+    wj = wj.reshape(1, -1, *extra)
+    return b[:, j] * (1.0 - wj) + b[:, j + 1] * wj
 
 
 def _full_weighting(r: NDArray) -> NDArray:
@@ -107,10 +96,6 @@ def _smooth(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, P: NDA
     """``sweeps`` sweeps in place on the linearized surface (``x`` moved with the nodes)."""
     for _ in range(sweeps):
         sweep(s, t, x, rs, rt, P, Q, omega, box, target)
-
-
-def _folds(s: NDArray, t: NDArray, sign: float) -> bool:
-    return bool(np.any(sign * corner_jacobians(s, t) <= 0.0))
 
 
 def correct(surface: NurbsSurface, s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray,
@@ -147,12 +132,12 @@ def correct(surface: NurbsSurface, s: NDArray, t: NDArray, x: NDArray, rs: NDArr
     ci, cj = (ni + 1) // 2, (nj + 1) // 2
     at_i, at_j = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
     ri, rj = (ni - 1) / (ci - 1), (nj - 1) / (cj - 1)
-    residual = _operator(x, rs, rt, P, Q, target)
+    residual = tangential_residual(x, rs, rt, P, Q, target)
     sc, tc = _sample(s, at_i, at_j), _sample(t, at_i, at_j)
     Pc, Qc = ri * _sample(P, at_i, at_j), rj * _sample(Q, at_i, at_j)
     d = surface.derivatives(sc, tc, 1)
     xc, rsc, rtc = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
-    tau = _operator(xc, rsc, rtc, Pc, Qc, None) \
+    tau = tangential_residual(xc, rsc, rtc, Pc, Qc) \
         - (ri * rj) ** 2 * _sample(_full_weighting(residual), at_i, at_j)
     tau[[0, -1]] = 0.0
     tau[:, [0, -1]] = 0.0
@@ -172,7 +157,7 @@ def correct(surface: NurbsSurface, s: NDArray, t: NDArray, x: NDArray, rs: NDArr
     for scale in (1.0, 0.5, 0.25):
         sn = np.clip(s + scale * ds, u0, u1)
         tn = np.clip(t + scale * dt, v0, v1)
-        if not _folds(sn, tn, sign):
+        if not folds(sn, tn, sign):
             x += rs * (sn - s)[..., None] + rt * (tn - t)[..., None]
             s[...], t[...] = sn, tn
             return True

@@ -105,3 +105,16 @@ def test_a_long_narrow_grid_is_refined(dims):
     grid = grid_surface(warped_plane(), dims=dims)
     assert grid.points.shape == (*dims, 3)
     assert grid.elliptic.converged and grid.quality.folded_cells == 0
+
+
+def test_the_compiled_fold_test_agrees_with_the_corner_jacobians():
+    from surfprep.algorithms.grid.elliptic_kernels import folds
+    rng = np.random.default_rng(3)
+    s, t = np.meshgrid(np.linspace(0, 1, 12), np.linspace(0, 2, 9), indexing="ij")
+    assert not folds(s, t, 1.0) and folds(s, t, -1.0)
+    for scale in (0.01, 0.03, 0.06, 0.1):
+        for _ in range(20):
+            ds = s + scale * rng.standard_normal(s.shape)
+            dt = t + scale * rng.standard_normal(t.shape)
+            for sign in (1.0, -1.0):
+                assert folds(ds, dt, sign) == bool(np.any(sign * corner_jacobians(ds, dt) <= 0.0))
