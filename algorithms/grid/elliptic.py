@@ -240,6 +240,18 @@ def _controls(points: NDArray) -> tuple[NDArray, NDArray]:
     return P, Q
 
 
+def _start_residual(surface: NurbsSurface, st: NDArray, control: bool) -> float:
+    """The residual of a start grid ``st`` (ni, nj, 2) not across a seam: the largest move a
+    Jacobi step would make, in cells (with the sides' controls, without sources)."""
+    s, t = st[..., 0].copy(), st[..., 1].copy()
+    d = surface.derivatives(s, t, 1)
+    x = d[..., 0, 0, :].copy()
+    P, Q = np.zeros(s.shape), np.zeros(s.shape)
+    if control:
+        P[1:-1, 1:-1], Q[1:-1, 1:-1] = _controls(x)
+    return sweep(s, t, x, d[..., 1, 0, :], d[..., 0, 1, :], P, Q, 1.0, surface.domain)
+
+
 def _check_grid(surface: NurbsSurface, parameters: NDArray) -> NDArray:
     st = np.array(parameters, dtype=float)
     if st.ndim != 3 or st.shape[2] != 2 or min(st.shape[:2]) < 2:
@@ -422,6 +434,11 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
                                    multigrid)
         if folds(st[..., 0], st[..., 1], sign):
             st = start                                     # the coarse start folded: plain start
+        elif seam is None and _start_residual(surface, st, control) > _start_residual(surface, start,
+                                                                                       control):
+            # the given start is nearer a solution than the coarse one interpolated (a grid
+            # graded in the parameters, next to a pole): kept, and the sides' sources start anew
+            st = start
         elif sides is not None and resume is None and coarse.control is not None:
             # the sources the coarse grid found, at the fine grid's spacing
             ratio = 0.5 * ((coarse.parameters.shape[0] - 1) / (ni - 1)

@@ -108,7 +108,7 @@ def _lengths(surface: NurbsSurface, breaks: NDArray, axis: int) -> NDArray:
     return np.linalg.norm(np.diff(points, axis=1), axis=-1).sum(axis=1).mean(axis=1)
 
 
-def respaced(surface: NurbsSurface, *, ratio: float = RATIO) -> Respacing | None:
+def respaced(surface: NurbsSurface, *, ratio: float | None = None) -> Respacing | None:
     """The surface with each group of knot spans between C0 joins as wide as it is long.
 
     Parameters
@@ -123,6 +123,7 @@ def respaced(surface: NurbsSurface, *, ratio: float = RATIO) -> Respacing | None
     Respacing, or None when neither direction needs it (one group, or speeds within
     ``ratio``; a collapsed surface).
     """
+    ratio = RATIO if ratio is None else ratio
     breaks, spaced, knots = [], [], []
     changed = False
     for axis, (k, p) in enumerate(((surface.knots_u, surface.degree_u), (surface.knots_v, surface.degree_v))):

@@ -282,27 +282,29 @@ def _spacing_error(points: NDArray, spacing: tuple[Spacing, Spacing], collapsed:
     return worst
 
 
-def _region_start(region: Region, x: dict[str, NDArray]) -> NDArray:
+def _region_start(region: Region, x: dict[str, NDArray], chart: Respacing | None = None) -> NDArray:
     """TFI in ``(u, v)`` of the four sides' nodes, blended by their arc-length fractions;
     each corner the mean of its two sides' ends (a loop's pcurves meet to its tolerance).
-    On a surface of patches joined C0 at very different speeds, TFI in its parameters
-    re-spaced at the joins (:mod:`.respacing`)."""
+    With ``chart``: TFI in the parameters re-spaced at the surface's C0 joins
+    (:mod:`.respacing`), mapped back."""
     sides = {name: region.sides[name].uv(x[name]) for name in SIDE_NAMES}
     for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1),
                          ("j1", -1, "i1", -1)):
         corner = 0.5 * (sides[a][ia] + sides[b][ib])
         sides[a][ia] = sides[b][ib] = corner
     weights = distribution_mesh(*(region.sides[name].fractions_of(x[name]) for name in SIDE_NAMES))
-    chart = respaced(region.surface)
     if chart is None:
         return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
-    # patches joined C0 at very different speeds: blended in the parameters re-spaced at the
-    # joins, the sides' nodes as they are
     mapped = {name: chart.to_chart(uv) for name, uv in sides.items()}
     st = chart.from_chart(transfinite(mapped["j0"], mapped["j1"], mapped["i0"], mapped["i1"],
                                       weights=weights))
     st[:, 0], st[:, -1], st[0], st[-1] = sides["j0"], sides["j1"], sides["i0"], sides["i1"]
     return st
+
+
+#: an algebraic start grid whose worst cell is more skewed than this ("poor" in
+#: :mod:`.quality`'s bands) is made again in the knots re-spaced at the surface's C0 joins
+POOR_START = 0.5
 
 
 def _respaced_start(chart: Respacing, fractions: dict[str, NDArray]) -> NDArray:
@@ -509,11 +511,6 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         else:
             s, t = distribution_mesh(fractions["j0"], fractions["j1"], fractions["i0"], fractions["i1"])
         st = np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1)
-        chart = None if hold else respaced(surface)
-        if chart is not None:
-            # patches joined C0 at very different speeds: the interior blended in the
-            # parameters re-spaced at the joins (the sides' nodes as they are)
-            st[1:-1, 1:-1] = _respaced_start(chart, fractions)[1:-1, 1:-1]
     st[..., 0] = np.clip(st[..., 0], u0, u1)
     st[..., 1] = np.clip(st[..., 1], v0, v1)
 
@@ -527,6 +524,20 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
         return points, grid_quality(points, normals)
 
     start_points, start_quality = measured(st)
+    chart = None if hold else respaced(surface)
+    if chart is not None and (start_quality.folded_cells or start_quality.max_skewness > POOR_START):
+        # patches joined C0 at very different speeds, and the algebraic grid in their
+        # parameters is poor: made in the knots re-spaced at the joins instead, if better
+        # (the sides' nodes as they are)
+        other = st.copy()
+        other[1:-1, 1:-1] = (_respaced_start(chart, fractions) if region.is_rectangle
+                             else _region_start(region, fractions, chart))[1:-1, 1:-1]
+        other[..., 0] = np.clip(other[..., 0], u0, u1)
+        other[..., 1] = np.clip(other[..., 1], v0, v1)
+        other_points, other_quality = measured(other)
+        if (other_quality.folded_cells, other_quality.max_skewness) \
+                < (start_quality.folded_cells, start_quality.max_skewness):
+            st, start_points, start_quality = other, other_points, other_quality
     # a closed face (a cylinder, a torus): its seam is solved across, not held
     seam = Seam.find(st, start_points, surface.domain, diag) if region.is_rectangle and not hold else None
     start_params = st
