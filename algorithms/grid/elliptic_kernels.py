@@ -125,35 +125,28 @@ def _reach(s, t, i, j):  # pragma: no cover - compiled
 
 
 @jit
-def _near_line(px, py, ax, ay, bx, by, d):  # pragma: no cover - compiled
-    """The point ``p`` lies closer than ``d`` to the line through ``a`` and ``b`` (or to
-    ``a`` when ``a == b``), tested with squares: no root, no division."""
-    dx = bx - ax
-    dy = by - ay
-    n2 = dx * dx + dy * dy
-    if n2 == 0.0:
-        return (px - ax) ** 2 + (py - ay) ** 2 < d * d
-    cross = (px - ax) * dy - (py - ay) * dx
-    return cross * cross < d * d * n2
+def _metric(x, i, j):  # pragma: no cover - compiled
+    """``g11, g22, g12`` of interior node (i, j) by central differences."""
+    g11 = 0.0
+    g22 = 0.0
+    g12 = 0.0
+    for k in range(3):
+        a = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
+        b = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
+        g11 += a * a
+        g22 += b * b
+        g12 += a * b
+    return g11, g22, g12
 
 
 @jit
-def _may_fold(s, t, i, j, d):  # pragma: no cover - compiled
-    """A line of :func:`_reach` lies closer than ``d`` to node (i, j): only then is the
-    exact distance needed (most steps are far shorter than any of them)."""
-    px = s[i, j]
-    py = t[i, j]
-    for di, dj in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
-        ax = s[i + di, j]
-        ay = t[i + di, j]
-        bx = s[i, j + dj]
-        by = t[i, j + dj]
-        cx = s[i + di, j + dj]
-        cy = t[i + di, j + dj]
-        if _near_line(px, py, ax, ay, bx, by, d) or _near_line(px, py, ax, ay, cx, cy, d) \
-                or _near_line(px, py, bx, by, cx, cy, d):
-            return True
-    return False
+def _numerator(x, p, q, g11, g22, g12, i, j, k):  # pragma: no cover - compiled
+    """Component ``k`` of the numerator ``R`` of interior node (i, j) (module doc)."""
+    xi = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
+    eta = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
+    xe = 0.25 * (x[i + 1, j + 1, k] - x[i + 1, j - 1, k] - x[i - 1, j + 1, k] + x[i - 1, j - 1, k])
+    return (g22 * (x[i + 1, j, k] + x[i - 1, j, k]) + g11 * (x[i, j + 1, k] + x[i, j - 1, k])
+            - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - 2.0 * (g11 + g22) * x[i, j, k])
 
 
 @jit
@@ -163,15 +156,7 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, target, omega, u0, u1, v0, v1):  # prag
     worst = 0.0
     for i in range(1, ni - 1):
         for j in range(1, nj - 1):
-            g11 = 0.0
-            g22 = 0.0
-            g12 = 0.0
-            for k in range(3):
-                a = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
-                b = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
-                g11 += a * a
-                g22 += b * b
-                g12 += a * b
+            g11, g22, g12 = _metric(x, i, j)
             diag = 2.0 * (g11 + g22)
             if diag <= 0.0:
                 continue
@@ -181,12 +166,7 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, target, omega, u0, u1, v0, v1):  # prag
             ar = 0.0
             at = 0.0
             for k in range(3):
-                xi = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
-                eta = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
-                xe = 0.25 * (x[i + 1, j + 1, k] - x[i + 1, j - 1, k]
-                             - x[i - 1, j + 1, k] + x[i - 1, j - 1, k])
-                r = (g22 * (x[i + 1, j, k] + x[i - 1, j, k]) + g11 * (x[i, j + 1, k] + x[i, j - 1, k])
-                     - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - diag * x[i, j, k])
+                r = _numerator(x, p, q, g11, g22, g12, i, j, k)
                 if has_target:
                     r -= target[i, j, k]
                 r /= diag
@@ -208,10 +188,9 @@ def _sweep_kernel(s, t, x, rs, rt, p, q, target, omega, u0, u1, v0, v1):  # prag
             # would fold a corner of the four cells around the node (none can fold)
             step = omega * np.sqrt(ds * ds + dt * dt)
             scale = omega
-            if _may_fold(s, t, i, j, step / LIMIT):
-                reach = _reach(s, t, i, j)
-                if step > LIMIT * reach:
-                    scale = omega * LIMIT * reach / step
+            reach = _reach(s, t, i, j)
+            if step > LIMIT * reach:
+                scale = omega * LIMIT * reach / step
             sn = min(max(s[i, j] + scale * ds, u0), u1)
             tn = min(max(t[i, j] + scale * dt, v0), v1)
             ds = sn - s[i, j]
@@ -248,23 +227,9 @@ def _tangential_kernel(x, rs, rt, p, q, target, out):  # pragma: no cover - comp
     r = np.empty(3)
     for i in range(1, ni - 1):
         for j in range(1, nj - 1):
-            g11 = 0.0
-            g22 = 0.0
-            g12 = 0.0
+            g11, g22, g12 = _metric(x, i, j)
             for k in range(3):
-                a = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
-                b = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
-                g11 += a * a
-                g22 += b * b
-                g12 += a * b
-            diag = 2.0 * (g11 + g22)
-            for k in range(3):
-                xi = 0.5 * (x[i + 1, j, k] - x[i - 1, j, k])
-                eta = 0.5 * (x[i, j + 1, k] - x[i, j - 1, k])
-                xe = 0.25 * (x[i + 1, j + 1, k] - x[i + 1, j - 1, k]
-                             - x[i - 1, j + 1, k] + x[i - 1, j - 1, k])
-                r[k] = (g22 * (x[i + 1, j, k] + x[i - 1, j, k]) + g11 * (x[i, j + 1, k] + x[i, j - 1, k])
-                        - 2.0 * g12 * xe + g22 * p[i, j] * xi + g11 * q[i, j] * eta - diag * x[i, j, k])
+                r[k] = _numerator(x, p, q, g11, g22, g12, i, j, k)
                 if has_target:
                     r[k] -= target[i, j, k]
             n0 = rs[i, j, 1] * rt[i, j, 2] - rs[i, j, 2] * rt[i, j, 1]
