@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -24,6 +25,9 @@ from ..arc_length_inversion import lengths_between, parameters_at_lengths
 from ..curve import NurbsCurve
 from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 __all__ = ["SIDE_NAMES", "Region", "Side"]
 
@@ -106,21 +110,29 @@ class Side:
         return np.interp(np.asarray(x, dtype=float), grid, s) / s[-1]
 
     @cached_property
-    def _dense(self) -> tuple[NDArray, NDArray]:
+    def _dense(self) -> tuple[NDArray, NDArray, cKDTree]:
+        from scipy.spatial import cKDTree
         x = np.linspace(0.0, 1.0, 4 * CELLS + 1)
-        return x, self.points(x)
+        q = self.points(x)
+        return x, q, cKDTree(q)
 
     def locate(self, points: ArrayLike) -> NDArray:
-        """Normalized ``x`` of the points of the side nearest to ``points (n, 3)``."""
+        """Normalized ``x`` of the points of the side nearest to ``points (n, 3)``: the foot on
+        the two segments of a dense polyline of the side beside its nearest vertex, then
+        Gauss--Newton on the side itself."""
         p = np.asarray(points, dtype=float)
-        x, q = self._dense
-        a, b = q[:-1], q[1:]
-        ab = b - a
-        denom = np.maximum(np.einsum("kc,kc->k", ab, ab), 1e-300)
-        w = np.clip(np.einsum("nkc,kc->nk", p[:, None] - a[None], ab) / denom, 0.0, 1.0)
-        d = np.linalg.norm(p[:, None] - (a[None] + w[..., None] * ab[None]), axis=2)
-        k = np.argmin(d, axis=1)
-        out = x[k] + w[np.arange(p.shape[0]), k] * (x[k + 1] - x[k])
+        x, q, tree = self._dense
+        nearest = tree.query(p)[1]
+        best = np.full(p.shape[0], np.inf)
+        out = x[nearest].copy()
+        for k in (np.maximum(nearest - 1, 0), np.minimum(nearest, len(x) - 2)):     # the segments k, k + 1
+            a, ab = q[k], q[k + 1] - q[k]
+            w = np.clip(np.einsum("nc,nc->n", p - a, ab) / np.maximum(np.einsum("nc,nc->n", ab, ab), 1e-300),
+                        0.0, 1.0)
+            d = np.linalg.norm(p - (a + w[:, None] * ab), axis=1)
+            closer = d < best
+            best = np.where(closer, d, best)
+            out = np.where(closer, x[k] + w * (x[k + 1] - x[k]), out)
         for _ in range(_NEWTON_STEPS):                 # Gauss-Newton on |P(x) - p|^2
             d = self.pcurve.derivatives(self.t(out), 1)
             uv, duv = d[:, 0], d[:, 1] * (self.t1 - self.t0)

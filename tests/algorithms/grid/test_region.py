@@ -84,3 +84,22 @@ def test_faces_that_are_not_four_sided_say_so():
     edges = [_edge(five[k], five[(k + 1) % 5]) for k in range(5)]
     face = TrimmedFace(_plane(), (TrimLoop(tuple(edges)),))
     assert face_region(face) == "it has 5 edges, not four: heal or split it into four-sided faces first"
+
+
+def test_locate_finds_the_nearest_point_of_a_curved_side():
+    """Points off a side whose pcurve is a quarter circle on a warped plane: the foot located
+    is the nearest point of the side found by a dense brute-force search."""
+    from helpers.grid_cases import warped_plane
+    from surfprep.algorithms.grid.region import Side
+    theta = np.linspace(0, np.pi / 2, 9)
+    arc = np.stack([0.5 + 0.4 * np.cos(theta), 0.1 + 0.4 * np.sin(theta)], axis=1)
+    surface = warped_plane()
+    side = Side(surface, NurbsCurve(arc, np.r_[0, np.linspace(0, 1, 9), 1], 1), 0.0, 1.0)
+    rng = np.random.default_rng(5)
+    x = np.sort(rng.uniform(0, 1, 40))
+    off = side.points(x) + rng.normal(scale=0.01, size=(40, 3))
+    found = side.locate(off)
+    dense_x = np.linspace(0, 1, 200001)
+    dense = side.points(dense_x)
+    truth = dense_x[np.argmin(np.linalg.norm(off[:, None] - dense[None], axis=2), axis=1)]
+    np.testing.assert_allclose(found, truth, atol=2e-5)
