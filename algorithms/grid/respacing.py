@@ -114,9 +114,9 @@ def respaced(surface: NurbsSurface, *, ratio: float | None = None) -> Respacing 
     Parameters
     ----------
     surface : NurbsSurface
-    ratio : float
+    ratio : float, optional
         A direction is re-spaced only when the speeds of its groups (mean length over
-        width) differ by more than this factor.
+        width) differ by more than this factor (default :data:`RATIO`).
 
     Returns
     -------
