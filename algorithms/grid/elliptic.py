@@ -72,7 +72,11 @@ taken on the exact nodes. Cells are checked after every block of sweeps: a
 block that would fold a cell (a corner Jacobian of the distribution mesh not of
 the grid's orientation) is taken back and the relaxation halved, and the
 refusal is counted. Large grids start from the solution on a grid of half the
-size (coarse to fine), so the fine sweeps only have short-wave errors left.
+size (coarse to fine; kept only when nearer a solution than the given start), and
+grids of more than :data:`MULTIGRID_ABOVE` nodes a side are iterated by V-cycles:
+Gauss--Seidel sweeps round FAS coarse-grid corrections (:mod:`.multigrid`), which
+remove the long waves SOR removes slowest. A surface of patches joined C0 at very
+different speeds is solved in its knots re-spaced at the joins (:mod:`.respacing`).
 
 References
 ----------
