@@ -97,8 +97,8 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError
 from ..surface import NurbsSurface
-from .elliptic_kernels import corner_jacobians, folds, sweep
-from .multigrid import COARSEST, POST, PRE, SMOOTHING, correct
+from .elliptic_kernels import corner_jacobians, folds, sor_relaxation, sweep
+from .multigrid import COARSEST, POST, PRE, SMOOTHING, correct, prolonged, restricted
 from .orthogonal import SIDE_NAMES, BoundaryControl
 from .periodic import Seam, grid_controls
 from .respacing import respaced
@@ -301,22 +301,14 @@ def _coarse_start(surface: NurbsSurface, st: NDArray, control: bool, orthogonal:
                   heights: Mapping[str, float] | None, seam: Seam | None, tol: float,
                   max_sweeps: int, multigrid: bool) -> tuple[NDArray, EllipticResult]:
     """Interior ``(s, t)`` from the solution on a grid of about half the nodes, and that solution."""
-    from scipy.ndimage import map_coordinates
-    ni, nj = st.shape[:2]
-    ci, cj = (ni + 1) // 2, (nj + 1) // 2
-    fi, fj = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
-    gi, gj = np.meshgrid(fi, fj, indexing="ij")
-    coarse = np.stack([map_coordinates(st[..., k], [gi, gj], order=1) for k in range(2)], axis=-1)
+    coarse = restricted(st)
     result = _solve(surface, coarse, control=control, orthogonal=orthogonal, heights=heights,
                     seam=seam, tol=tol, max_sweeps=max_sweeps, relaxation=None, warm=False, resume=None,
                     multigrid=multigrid)
     solved = result.parameters
     if seam is not None:                 # back to unwrapped parameters before interpolating
         solved = _unwrapped(seam, solved, coarse)
-    # back on the fine index positions
-    bi, bj = np.meshgrid(np.arange(ni) * (ci - 1) / (ni - 1), np.arange(nj) * (cj - 1) / (nj - 1),
-                         indexing="ij")
-    fine = np.stack([map_coordinates(solved[..., k], [bi, bj], order=1) for k in range(2)], axis=-1)
+    fine = prolonged(solved, st.shape)                  # back on the fine index positions
     out = st.copy()
     out[1:-1, 1:-1] = fine[1:-1, 1:-1]
     return out, result
@@ -449,7 +441,7 @@ def _solve(surface: NurbsSurface, st: NDArray, *, control: bool, orthogonal: boo
                            + (coarse.parameters.shape[1] - 1) / (nj - 1))
             sides, resume = sides.resumed(coarse.control, ratio), coarse.control
     n = max(ni, nj)
-    omega = relaxation if relaxation is not None else min(1.95, 2.0 / (1.0 + math.sin(math.pi / n)))
+    omega = relaxation if relaxation is not None else sor_relaxation(n)
     s, t = st[..., 0].copy(), st[..., 1].copy()
     box = surface.domain
     if seam is not None:                 # iterate on the grid padded across its seam

@@ -22,12 +22,15 @@ the largest unrelaxed tangential move in units of the local cell size
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ..jit import AVAILABLE, jit
 
-__all__ = ["LIMIT", "corner_jacobians", "folds", "numerators", "sweep", "sweep_numpy", "tangential_residual"]
+__all__ = ["LIMIT", "corner_jacobians", "folds", "numerators", "sor_relaxation", "sweep", "sweep_numpy",
+           "tangential_residual"]
 
 #: the kernel's stand-in for "no target" (an array of another shape: never read)
 _NO_TARGET = np.zeros((1, 1, 3))
@@ -306,6 +309,12 @@ def _reach_numpy(s: NDArray, t: NDArray) -> NDArray:
         a, b, d = at(di, 0), at(0, dj), at(di, dj)
         best = np.minimum.reduce([best, distance(a, b), distance(a, d), distance(b, d)])
     return best
+
+
+def sor_relaxation(n: int) -> float:
+    """The SOR factor for a grid of ``n`` nodes along its longer side: Young's optimum for
+    Laplace's equation, ``2 / (1 + sin(pi / n))``, at most 1.95 (the system is nonlinear)."""
+    return min(1.95, 2.0 / (1.0 + math.sin(math.pi / n)))
 
 
 def sweep_numpy(s: NDArray, t: NDArray, x: NDArray, rs: NDArray, rt: NDArray, p: NDArray, q: NDArray,

@@ -35,15 +35,13 @@ References
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import NDArray
 
 from ..surface import NurbsSurface
-from .elliptic_kernels import folds, sweep, tangential_residual
+from .elliptic_kernels import folds, sor_relaxation, sweep, tangential_residual
 
-__all__ = ["COARSEST", "POST", "PRE", "SMOOTHING", "correct"]
+__all__ = ["COARSEST", "POST", "PRE", "SMOOTHING", "coarse_shape", "correct", "prolonged", "restricted"]
 
 #: Gauss-Seidel sweeps before and after each coarse-grid correction
 PRE, POST = 2, 2
@@ -56,8 +54,9 @@ COARSEST = 9
 COARSEST_SWEEPS = 24
 
 
-def _sor(shape: tuple[int, int]) -> float:
-    return min(1.95, 2.0 / (1.0 + math.sin(math.pi / max(shape))))
+def coarse_shape(shape: tuple[int, ...]) -> tuple[int, int]:
+    """The coarse grid of a grid of ``shape`` (ni, nj, ...): about half the nodes, the same ends."""
+    return (shape[0] + 1) // 2, (shape[1] + 1) // 2
 
 
 def _positions(n: int, at: NDArray) -> tuple[NDArray, NDArray]:
@@ -66,7 +65,7 @@ def _positions(n: int, at: NDArray) -> tuple[NDArray, NDArray]:
     return left, at - left
 
 
-def _sample(a: NDArray, at_i: NDArray, at_j: NDArray) -> NDArray:
+def _resampled(a: NDArray, at_i: NDArray, at_j: NDArray) -> NDArray:
     """``a`` (ni, nj[, k]) interpolated linearly at the index positions ``at_i x at_j`` (a
     tensor grid of fractional positions: separable)."""
     extra = (1,) * (a.ndim - 2)
@@ -76,6 +75,19 @@ def _sample(a: NDArray, at_i: NDArray, at_j: NDArray) -> NDArray:
     j, wj = _positions(a.shape[1], at_j)
     wj = wj.reshape(1, -1, *extra)
     return b[:, j] * (1.0 - wj) + b[:, j + 1] * wj
+
+
+def restricted(a: NDArray) -> NDArray:
+    """``a`` (ni, nj[, k]) interpolated linearly onto the nodes of its :func:`coarse_shape` grid."""
+    ci, cj = coarse_shape(a.shape)
+    return _resampled(a, np.linspace(0, a.shape[0] - 1, ci), np.linspace(0, a.shape[1] - 1, cj))
+
+
+def prolonged(a: NDArray, shape: tuple[int, ...]) -> NDArray:
+    """``a`` on the coarse grid of a grid of ``shape`` interpolated linearly back onto its nodes."""
+    ni, nj = shape[:2]
+    ci, cj = a.shape[:2]
+    return _resampled(a, np.arange(ni) * (ci - 1) / (ni - 1), np.arange(nj) * (cj - 1) / (nj - 1))
 
 
 def _full_weighting(r: NDArray) -> NDArray:
@@ -129,27 +141,25 @@ def correct(surface: NurbsSurface, s: NDArray, t: NDArray, x: NDArray, rs: NDArr
     ni, nj = s.shape
     if min(ni, nj) < COARSEST:
         return False
-    ci, cj = (ni + 1) // 2, (nj + 1) // 2
-    at_i, at_j = np.linspace(0, ni - 1, ci), np.linspace(0, nj - 1, cj)
+    ci, cj = coarse_shape(s.shape)
     ri, rj = (ni - 1) / (ci - 1), (nj - 1) / (cj - 1)
     residual = tangential_residual(x, rs, rt, P, Q, target)
-    sc, tc = _sample(s, at_i, at_j), _sample(t, at_i, at_j)
-    Pc, Qc = ri * _sample(P, at_i, at_j), rj * _sample(Q, at_i, at_j)
+    sc, tc = restricted(s), restricted(t)
+    Pc, Qc = ri * restricted(P), rj * restricted(Q)
     d = surface.derivatives(sc, tc, 1)
     xc, rsc, rtc = d[..., 0, 0, :].copy(), d[..., 1, 0, :], d[..., 0, 1, :]
     tau = tangential_residual(xc, rsc, rtc, Pc, Qc) \
-        - (ri * rj) ** 2 * _sample(_full_weighting(residual), at_i, at_j)
+        - (ri * rj) ** 2 * restricted(_full_weighting(residual))
     tau[[0, -1]] = 0.0
     tau[:, [0, -1]] = 0.0
     s0, t0 = sc.copy(), tc.copy()
     if min(ci, cj) < COARSEST:                       # the coarsest level: sweeps alone
-        _smooth(sc, tc, xc, rsc, rtc, Pc, Qc, tau, box, COARSEST_SWEEPS, _sor(sc.shape))
+        _smooth(sc, tc, xc, rsc, rtc, Pc, Qc, tau, box, COARSEST_SWEEPS, sor_relaxation(max(sc.shape)))
     else:                                            # a V-cycle
         _smooth(sc, tc, xc, rsc, rtc, Pc, Qc, tau, box, PRE)
         correct(surface, sc, tc, xc, rsc, rtc, Pc, Qc, box, sign, tau)
         _smooth(sc, tc, xc, rsc, rtc, Pc, Qc, tau, box, POST)
-    back_i, back_j = np.arange(ni) * (ci - 1) / (ni - 1), np.arange(nj) * (cj - 1) / (nj - 1)
-    ds, dt = _sample(sc - s0, back_i, back_j), _sample(tc - t0, back_i, back_j)
+    ds, dt = prolonged(sc - s0, s.shape), prolonged(tc - t0, s.shape)
     for a in (ds, dt):
         a[[0, -1]] = 0.0
         a[:, [0, -1]] = 0.0

@@ -383,7 +383,8 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     (:data:`INTERFACE_PROGRESS`), after :data:`INTERFACE_ROUNDS` rounds, or once the
     rounds took ``budget`` seconds (the caller's: as long as gridding the blocks did)."""
     from ..measure import normals
-    from .elliptic import corner_jacobians, refine
+    from .elliptic import refine
+    from .elliptic_kernels import folds
     from .quality import grid_quality
     from .tfi import carried_inward
     params = [b.parameters.copy() for b in blocks]
@@ -437,9 +438,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             # solve then starts without the slide's long-wave error
             if grids[k].seam is None:
                 moved = carried_inward(grids[k].parameters, params[k])
-                before = corner_jacobians(grids[k].parameters[..., 0], grids[k].parameters[..., 1])
-                after = corner_jacobians(moved[..., 0], moved[..., 1])
-                if np.all(after * np.sign(before.sum()) > 0):
+                if not folds(moved[..., 0], moved[..., 1], grids[k].orientation):
                     params[k] = moved
             squared = orthogonal and grids[k].orthogonal_dropped is None and open_sides[k]
             seam = grids[k].seam
