@@ -60,20 +60,19 @@ class Respacing:
 
     def to_chart(self, parameters: NDArray) -> NDArray:
         """``(..., 2)`` parameters of the original surface to those of :attr:`surface`."""
-        return self._mapped(parameters, self.breaks, self.spaced)
+        p = np.asarray(parameters, dtype=float)
+        return np.stack([self.along(p[..., k], k) for k in (0, 1)], axis=-1)
 
     def from_chart(self, parameters: NDArray) -> NDArray:
         """``(..., 2)`` parameters of :attr:`surface` back to the original surface's."""
-        return self._mapped(parameters, self.spaced, self.breaks)
-
-    @staticmethod
-    def _mapped(parameters: NDArray, source: tuple[NDArray, NDArray],
-                target: tuple[NDArray, NDArray]) -> NDArray:
         p = np.asarray(parameters, dtype=float)
-        out = np.empty_like(p)
-        for k in (0, 1):
-            out[..., k] = np.interp(p[..., k], source[k], target[k])
-        return out
+        return np.stack([self.along(p[..., k], k, back=True) for k in (0, 1)], axis=-1)
+
+    def along(self, values: NDArray, axis: int, *, back: bool = False) -> NDArray:
+        """Values of one parameter (``axis`` 0: u, 1: v) of the original surface mapped to
+        the re-spaced one's (``back``: the other way)."""
+        source, target = (self.spaced, self.breaks) if back else (self.breaks, self.spaced)
+        return np.interp(values, source[axis], target[axis])
 
 
 def _groups(knots: NDArray, degree: int) -> NDArray:

@@ -314,7 +314,7 @@ def _respaced_start(chart: Respacing, fractions: dict[str, NDArray]) -> NDArray:
     f = {}
     for name, k, lo, hi in (("j0", 0, u0, u1), ("j1", 0, u0, u1), ("i0", 1, v0, v1), ("i1", 1, v0, v1)):
         x = lo + fractions[name] * (hi - lo)
-        f[name] = (np.interp(x, chart.breaks[k], chart.spaced[k]) - lo) / (hi - lo)
+        f[name] = (chart.along(x, k) - lo) / (hi - lo)
     s, t = distribution_mesh(f["j0"], f["j1"], f["i0"], f["i1"])
     return chart.from_chart(np.stack([u0 + s * (u1 - u0), v0 + t * (v1 - v0)], axis=-1))
 
