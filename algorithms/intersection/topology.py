@@ -36,7 +36,7 @@ from scipy.spatial import cKDTree
 from ...errors import InvalidGeometryError
 from ..tolerance import check_tolerance
 
-__all__ = ["EndKind", "Chain", "SegmentTopology", "build_topology", "topology_from_soup"]
+__all__ = ["Chain", "EndKind", "SegmentTopology", "build_topology", "topology_from_soup"]
 
 Domain = tuple[float, float, float, float]
 
@@ -155,6 +155,43 @@ def _clean_segments(seg: NDArray) -> tuple[NDArray, NDArray]:
     _, first = np.unique(key, axis=0, return_index=True)
     source = keep[np.sort(first)]
     return seg[source], source
+
+
+def _split_at_points(points: NDArray, seg: NDArray, tol: float) -> tuple[NDArray, NDArray]:
+    """Segments split at every point that lies on them within ``tol`` (not at their ends).
+
+    Two triangles beside an edge that lies in the other surface (a plane through a
+    row of mesh vertices) each give a segment along it, and where the tessellation
+    is finer on one side than the other the two overlap without sharing ends: split
+    at each other's ends they become the same pieces, which :func:`_clean_segments`
+    keeps once, instead of three-way junctions along a simple curve.
+
+    Returns ``(segments (s', 2) int, origin (s',) int)``: the pieces, in order along
+    each segment, and the segment each comes from.
+    """
+    if seg.shape[0] == 0:
+        return seg, np.arange(0)
+    a, b = points[seg[:, 0]], points[seg[:, 1]]
+    half = 0.5 * np.linalg.norm(b - a, axis=1)
+    tree = cKDTree(points)
+    near = tree.query_ball_point(0.5 * (a + b), half + tol)
+    pieces, origin = [], []
+    for k, found in enumerate(near):
+        inner = [q for q in found if q != seg[k, 0] and q != seg[k, 1]]
+        if inner:
+            q = np.array(inner)
+            d = b[k] - a[k]
+            s = (points[q] - a[k]) @ d / max(float(d @ d), 1e-300)
+            off = np.linalg.norm(points[q] - (a[k] + s[:, None] * d), axis=1)
+            on = (off <= tol) & (s > 0.0) & (s < 1.0)
+            if on.any():
+                chain = np.concatenate([[seg[k, 0]], q[on][np.argsort(s[on])], [seg[k, 1]]])
+                pieces.append(np.stack([chain[:-1], chain[1:]], axis=1))
+                origin.append(np.full(chain.size - 1, k))
+                continue
+        pieces.append(seg[k:k + 1])
+        origin.append(np.array([k]))
+    return np.concatenate(pieces), np.concatenate(origin)
 
 
 def _on_boundary(uv: NDArray | None, domain: Domain | None, uv_tol: float) -> NDArray | bool:
@@ -319,7 +356,9 @@ def build_topology(points: ArrayLike, uv_a: ArrayLike | None = None,
     pts = flat[rep]
     ua = None if uva is None else uva.reshape(-1, 2)[rep]
     ub = None if uvb is None else uvb.reshape(-1, 2)[rep]
-    segments, source = _clean_segments(labels.reshape(k, 2))
+    split, origin = _split_at_points(pts, labels.reshape(k, 2), tol)
+    segments, source = _clean_segments(split)
+    source = origin[source]
     boundary = np.zeros(pts.shape[0], dtype=bool)
     boundary |= _on_boundary(ua, domain_a, uv_tol)
     boundary |= _on_boundary(ub, domain_b, uv_tol)

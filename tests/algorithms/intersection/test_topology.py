@@ -153,6 +153,24 @@ def test_t_junction_three_curves():
     assert all(EndKind.BIFURCATION.value in k for k in kinds)
 
 
+def test_overlapping_segments_along_one_line_are_one_curve():
+    """A plane through a row of mesh vertices: the triangles on both sides of that row
+    each give segments along it, finer on one side than on the other, overlapping
+    without sharing their ends. Split at each other's ends they are one simple curve
+    (they were read as three-way junctions: the sheet z = 0.1 x y cut by y = 0.5 came
+    out as seven pieces)."""
+    x = lambda *v: np.array([[t, 0.5, 0.05 * t] for t in v])          # noqa: E731
+    coarse = [x(0.0, 0.4), x(0.4, 0.7), x(0.7, 1.0)]
+    fine = [x(0.0, 0.2), x(0.2, 0.4), x(0.4, 0.55), x(0.55, 0.7), x(0.7, 0.85), x(0.85, 1.0)]
+    shifted = [x(0.3, 0.6)]                                     # ends on neither side's ends
+    topo = build_topology(np.array(coarse + fine + shifted), tol=TOL)
+    assert len(topo.chains) == 1 and not topo.chains[0].closed
+    assert np.all(topo.uses <= 2)
+    chain = topo.points[topo.chains[0].point_ids]
+    assert np.all(np.diff(chain[:, 0]) > 0) or np.all(np.diff(chain[:, 0]) < 0)
+    assert {chain[0, 0], chain[-1, 0]} == {0.0, 1.0}
+
+
 def test_box_border_gap_merged():
     """A curve cut at an overlap-box border: the two halves end 1e-12 apart."""
     rng = np.random.default_rng(3)
