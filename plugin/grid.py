@@ -25,11 +25,10 @@ from typing import Any
 import numpy as np
 
 from ..algorithms import NurbsSurface
-from ..algorithms.grid.faces import face_regions, pole_halves
+from ..algorithms.grid.faces import POLE_CAPS, face_regions, rectangle_regions
 from ..algorithms.grid.io import write_cgns, write_plot3d, write_vtm, write_vts
 from ..algorithms.grid.network import NetworkGrid, grid_network
 from ..algorithms.grid.quality import cell_skewness
-from ..algorithms.grid.region import Region
 from ..algorithms.grid.structured import Spacing
 from ..algorithms.trimmed import TrimmedFace
 from ..errors import InvalidGeometryError, OutputFileError, SurfprepError
@@ -203,7 +202,8 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
          size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
          smooth: str = "elliptic", orthogonal: bool = True, tol: float = 1e-4,
          gap: float | None = None,
-         whole_surfaces: bool = False, hold=(), max_sweeps: int = 2000, progress=None) -> GridResult:
+         whole_surfaces: bool = False, hold=(), max_sweeps: int = 2000, pole_caps: str = "o",
+         progress=None) -> GridResult:
     """Structured grids on the four-sided faces of a model (or on surfaces), one block each.
 
     Parameters
@@ -235,6 +235,12 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         on one gridded face within ``gap`` and run from a side of it to the opposite
         side; it becomes a line of that face's block.
     max_sweeps : int
+    pole_caps : {"o", "h"}
+        A cap round a pole (a hemisphere, a nose of revolution: one side of its
+        rectangle collapsed, closed round it): ``"o"`` one block round the pole, its
+        cells there triangles; ``"h"`` five blocks, a square over the pole and four
+        round it (003 Fig. 5's O-to-H remapping: no cell touches the pole; three
+        blocks meet at each of four points). A sphere is two caps.
     progress : callable(done, total), optional
 
     Returns
@@ -259,6 +265,8 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
     gap = DEFAULT_RELATIVE_GAP * model_size if gap is None else float(gap)
     if not np.isfinite(gap) or gap <= 0:
         raise InvalidGeometryError(f"gap must be a positive length, got {gap!r}")
+    if pole_caps not in POLE_CAPS:
+        raise InvalidGeometryError(f"pole_caps must be one of {', '.join(POLE_CAPS)}, got {pole_caps!r}")
     surfaces, kept, kept_names, flips = [], [], [], []
     skipped = [s for s in skipped if s[0] in chosen]
     for k in chosen:
@@ -271,14 +279,15 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
             continue
         flip = not isinstance(item, NurbsSurface) and bool(item.reversed)
         # a surface's rectangle (a sphere's: a block round each pole), or the face's regions
-        regions = face_regions(item, gap_tol=gap) if not isinstance(item, NurbsSurface) else None
+        regions = face_regions(item, gap_tol=gap, pole_caps=pole_caps) \
+            if not isinstance(item, NurbsSurface) else None
         if isinstance(regions, str):
             if not whole_surfaces:
                 skipped.append((k, regions))
                 continue
             regions = None
         if regions is None:
-            regions = [Region.rectangle(h) for h in pole_halves(surface)]
+            regions = rectangle_regions(surface, pole_caps=pole_caps, clockwise=flip)
         name = names[k] if k < len(names) else None
         for n, region in enumerate(regions):
             if region.is_rectangle:             # the surface's rectangle, or half of it

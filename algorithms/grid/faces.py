@@ -19,7 +19,12 @@ from ..surface import NurbsSurface
 from ..trimmed import TrimmedFace
 from .region import Region
 
-__all__ = ["face_region", "face_regions", "four_sided_reason", "pole_halves"]
+__all__ = ["POLE_CAPS", "face_region", "face_regions", "four_sided_reason", "pole_halves", "rectangle_regions"]
+
+#: how a pole cap is gridded: ``"o"`` one block, its side at the pole collapsed (its
+#: cells there triangles); ``"h"`` the butterfly of :func:`.polar.cap_regions` (no cell
+#: touches the pole)
+POLE_CAPS = ("o", "h")
 
 #: a side shorter than this fraction of the surface's box diagonal is collapsed (a pole)
 POLE = 1e-9
@@ -69,6 +74,43 @@ def pole_halves(surface: NurbsSurface) -> list[NurbsSurface]:
             cut = float(across[1 + int(np.argmax(lengths[1:-1]))])
             return list(surface.split(cut, direction))
     return [surface]
+
+
+def rectangle_regions(surface: NurbsSurface, *, pole_caps: str = "o", clockwise: bool = False) -> list[Region]:
+    """The regions blocks cover on a surface's whole rectangle.
+
+    The rectangle, or its two :func:`pole_halves`; with ``pole_caps="h"`` each half
+    (or the surface) that is a cap round one pole, closed round it, is five regions of
+    its :class:`.polar.PoleChart` instead (003 Fig. 5: the O-type grid remapped to an
+    H-type one).
+
+    Parameters
+    ----------
+    surface : NurbsSurface (3D)
+    pole_caps : {"o", "h"}
+        See :data:`POLE_CAPS`.
+    clockwise : bool
+        A cap's regions taken clockwise in its chart (a face used reversed); rectangles
+        are oriented by the caller.
+
+    Returns
+    -------
+    list of Region
+
+    Raises
+    ------
+    InvalidGeometryError
+        An unknown ``pole_caps``.
+    """
+    from ...errors import InvalidGeometryError
+    from .polar import cap_regions, pole_cap
+    if pole_caps not in POLE_CAPS:
+        raise InvalidGeometryError(f"pole_caps must be one of {', '.join(POLE_CAPS)}, got {pole_caps!r}")
+    out = []
+    for half in pole_halves(surface):
+        chart = pole_cap(half) if pole_caps == "h" else None
+        out.extend([Region.rectangle(half)] if chart is None else cap_regions(chart, clockwise=clockwise))
+    return out
 
 
 def four_sided_reason(face: TrimmedFace) -> str | None:
@@ -137,11 +179,13 @@ def face_region(face: TrimmedFace) -> Region | str:
     return reason
 
 
-def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[Region] | str:
+def face_regions(face: TrimmedFace, *, gap_tol: float, pole_caps: str = "o",
+                 _depth: int = 0) -> list[Region] | str:
     """The four-sided regions blocks cover on a face, or why there are none.
 
     A face :func:`face_region` grids is one region (two when its rectangle runs from
-    pole to pole: :func:`pole_halves`). A face bounded by one loop of
+    pole to pole: :func:`pole_halves`; a pole cap's butterfly with ``pole_caps="h"``:
+    :func:`rectangle_regions`). A face bounded by one loop of
     three, five or more corners is split as healing splits it (:func:`..healing.decompose.decompose_face`: the loop's
     corners, quads around a centre joined by straight spokes in ``(u, v)``), one
     region per sub-patch; blocks of neighbouring sub-patches share their spoke; a
@@ -162,6 +206,8 @@ def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[
     face : TrimmedFace
     gap_tol : float
         Model units: largest gap between consecutive edges of the loop.
+    pole_caps : {"o", "h"}
+        See :data:`POLE_CAPS`.
 
     Returns
     -------
@@ -177,8 +223,10 @@ def face_regions(face: TrimmedFace, *, gap_tol: float, _depth: int = 0) -> list[
 
     region = face_region(face)
     if not isinstance(region, str):
-        halves = pole_halves(face.surface) if region.is_rectangle else [face.surface]
-        return [region] if len(halves) == 1 else [Region.rectangle(h) for h in halves]
+        if not region.is_rectangle:
+            return [region]
+        regions = rectangle_regions(face.surface, pole_caps=pole_caps, clockwise=bool(face.reversed))
+        return [region] if len(regions) == 1 and regions[0].is_rectangle else regions
     if len(face.loops) > 2:
         from .parts import separate_holes
         try:

@@ -22,7 +22,9 @@ whose sides meet edge to edge. :func:`grid_network`
    between the last cell leg in one block and the first in the other.
 
 Blocks are in the surfaces' order; each block's sides are ``"i0"`` (u = u0),
-``"i1"``, ``"j0"`` (v = v0), ``"j1"`` as in :mod:`.structured`.
+``"i1"``, ``"j0"`` (v = v0), ``"j1"`` as in :mod:`.structured`. A block on a region
+of a pole cap's chart (:mod:`.polar`) is returned with its parameters in the cap's
+``(u, v)``.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from numpy.typing import NDArray
 from ...errors import InvalidGeometryError, SurfprepError
 from ..surface import NurbsSurface
 from .io.blocks import Interface, side_nodes
+from .polar import PoleChart
 from .region import Region
 from .structured import (
     DEFAULT_CELLS,
@@ -57,6 +60,10 @@ MATCH_SAMPLES = 9
 INTERFACE_ROUNDS = 12
 INTERFACE_TOL = 1e-3
 INTERFACE_RELAXATION = 0.8
+#: a slide changes no interval of a shared edge by more than this factor against the
+#: distribution it was given (the Winslow stencil across an edge pulls its nodes toward
+#: a corner where three blocks meet, crowding the cells there: growth ratios of 2)
+SLIDE_STRETCH = 1.15
 #: the rounds stop when the largest move has not shrunk below this share of the round before
 INTERFACE_PROGRESS = 0.95
 #: an interface whose surfaces' normals differ by more than this (degrees) is a crease:
@@ -338,9 +345,20 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
                                            max_sweeps=max_sweeps, budget=budget,
                                            orthogonal=orthogonal)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
+    net = replace(net, blocks=tuple(_in_surface_parameters(b, r) for b, r in zip(net.blocks, surfaces, strict=True)))
     changed = () if dims is None else tuple(
         (index[b], "ij"[d], counts[b, d]) for (b, d) in sorted(counts) if b in index and counts[b, d] != dims[d])
     return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())), dims_changed=changed)
+
+
+def _in_surface_parameters(block: SurfaceGrid, region: Region) -> SurfaceGrid:
+    """A block on a region of a pole cap's chart with its parameters the cap's ``(u, v)``
+    (:meth:`.polar.PoleChart.to_surface`); any other block as it is."""
+    chart = region.surface
+    if not isinstance(chart, PoleChart):
+        return block
+    start = None if block.start_parameters is None else chart.to_surface(block.start_parameters)
+    return replace(block, parameters=chart.to_surface(block.parameters), start_parameters=start)
 
 
 def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...]:
@@ -352,6 +370,23 @@ def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...
     if f.reversed:
         after = after[::-1]
     return edge, before, after
+
+
+def _stretch_limited(t: NDArray, given: NDArray) -> NDArray:
+    """Side parameters ``t`` (increasing, ends fixed) with no interval more than
+    :data:`SLIDE_STRETCH` times longer or shorter than in ``given``: the intervals
+    clipped and rescaled to the same total until they hold."""
+    d0 = np.diff(given)
+    d = np.diff(t)
+    lo, hi = d0 / SLIDE_STRETCH, d0 * SLIDE_STRETCH
+    for _ in range(50):
+        d = np.clip(d, lo, hi)
+        d *= (given[-1] - given[0]) / d.sum()
+        if np.all(d >= lo * (1 - 1e-9)) and np.all(d <= hi * (1 + 1e-9)):
+            break
+    out = given[0] + np.concatenate([[0.0], np.cumsum(d)])
+    out[-1] = given[-1]
+    return out
 
 
 def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
@@ -382,9 +417,9 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     :data:`INTERFACE_TOL` of its cell, when the moves stop shrinking
     (:data:`INTERFACE_PROGRESS`), after :data:`INTERFACE_ROUNDS` rounds, or once the
     rounds took ``budget`` seconds (the caller's: as long as gridding the blocks did)."""
-    from ..measure import normals
     from .elliptic import refine
     from .elliptic_kernels import folds
+    from .polar import surface_normals as normals
     from .quality import grid_quality
     from .tfi import carried_inward
     params = [b.parameters.copy() for b in blocks]
@@ -398,6 +433,8 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
     open_sides = [tuple(side for side in SIDES if (k, side) not in shared) for k in range(len(blocks))]
     interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
                   and f.block not in still and f.other not in still and not _on_seam(blocks, f)]
+    # the distributions the shared edges were given, which a slide may stretch only so far
+    given = {(f.block, f.side): _side_parameters(grids[f.block], f.side) for f in interfaces}
     touched: set[int] = set()
     rounds = 0
     previous = math.inf
@@ -420,6 +457,7 @@ def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfa
             step = np.clip(INTERFACE_RELAXATION * step, -0.5 * dt[:-1], 0.5 * dt[1:])
             t_new = t.copy()
             t_new[1:-1] += step
+            t_new = _stretch_limited(t_new, given[f.block, f.side])
             try:
                 t_b = _transfer(surfaces[f.block], f.side, t_new, surfaces[f.other], f.other_side,
                                 f.reversed)
@@ -504,7 +542,7 @@ def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], s
     """Give every set of matched nodes (across all interfaces: a corner where several
     blocks meet is one set) the coordinates of its first block's node; measure the
     moves and the kinks."""
-    from ..measure import normals
+    from .polar import surface_normals as normals
     points = [b.points.copy() for b in blocks]
     parent: dict = {}
 
@@ -578,7 +616,7 @@ def _same_orientation(f: Interface) -> bool:
 def _crease(surfaces, blocks: list[SurfaceGrid], f: Interface) -> float:
     """Largest angle (degrees) between the two surfaces' normals along an interface,
     the second block's taken with the first's orientation."""
-    from ..measure import normals
+    from .polar import surface_normals as normals
     ends = []
     for block, side in ((f.block, f.side), (f.other, f.other_side)):
         uv = side_nodes(blocks[block].parameters, side)

@@ -120,8 +120,10 @@ def respaced(surface: NurbsSurface, *, ratio: float | None = None) -> Respacing 
     Returns
     -------
     Respacing, or None when neither direction needs it (one group, or speeds within
-    ``ratio``; a collapsed surface).
+    ``ratio``; a collapsed surface; a :class:`.polar.PoleChart`, which has no knots).
     """
+    if not isinstance(surface, NurbsSurface):
+        return None
     ratio = RATIO if ratio is None else ratio
     breaks, spaced, knots = [], [], []
     changed = False

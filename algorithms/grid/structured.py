@@ -28,13 +28,13 @@ from numpy.typing import NDArray
 
 from ...errors import DegenerateGeometryError, InvalidGeometryError
 from ..curve import NurbsCurve
-from ..measure import normals as surface_normals
 from ..surface import NurbsSurface
 from ..tensor import Direction
 from . import distribution
 from .elliptic import EllipticResult, corner_jacobians, refine
 from .held import HeldLine, held_line, split_along
 from .periodic import Seam
+from .polar import PoleChart, surface_normals
 from .quality import GridQuality, grid_quality
 from .region import SIDE_NAMES, Region
 from .respacing import Respacing, respaced
@@ -471,7 +471,7 @@ def grid_region(region: Region, *, dims: tuple[int, int] | None = None, size: fl
     """
     started = time.perf_counter()
     surface = region.surface
-    if not isinstance(surface, NurbsSurface) or surface.dimension != 3:
+    if not isinstance(surface, (NurbsSurface, PoleChart)) or surface.dimension != 3:
         raise InvalidGeometryError("a grid needs a 3D NurbsSurface")
     if smooth not in ("elliptic", "none"):
         raise InvalidGeometryError(f"smooth must be 'elliptic' or 'none', got {smooth!r}")

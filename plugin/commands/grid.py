@@ -60,6 +60,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--whole-surfaces", action="store_true", dest="whole_surfaces",
                         help="grid the whole surface of a trimmed face (its trims ignored) "
                              "instead of leaving the face out")
+    parser.add_argument("--pole-caps", choices=("o", "h"), default="o", dest="pole_caps",
+                        help="a cap round a pole (a hemisphere, a nose of revolution): o = one "
+                             "block round the pole, its cells there triangles (default); h = five "
+                             "blocks, a square over the pole and four round it (no cell touches "
+                             "the pole)")
     parser.add_argument("--hold", type=Path, metavar="CURVES",
                         help="STEP/IGES file of curves (edges) to keep as grid lines: each must "
                              "cross one face from a side to the opposite side (e.g. the curves "
@@ -114,7 +119,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     start = time.perf_counter()
     result = grid(model, faces=args.faces, dims=tuple(args.dims) if args.dims else None, size=args.size,
                   spacing=spacing, smooth=args.smooth, orthogonal=args.orthogonal, gap=args.gap,
-                  whole_surfaces=args.whole_surfaces,
+                  whole_surfaces=args.whole_surfaces, pole_caps=args.pole_caps,
                   hold=held,
                   progress=lambda done, total: console.progress(done, total, "face"))
     elapsed = time.perf_counter() - start

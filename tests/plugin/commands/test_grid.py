@@ -146,3 +146,19 @@ def test_a_ball_read_from_step_is_gridded(tmp_path, capsys):
     assert code == 0, stdout
     data = json.loads(report.read_text())
     assert len(data["blocks"]) == 2 and data["worst"]["folded_cells"] == 0 and not data["skipped"]
+
+
+def test_pole_caps_h_grids_a_sphere_without_a_pole_cell(tmp_path, capsys):
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+
+    import surfprep
+    ball, out, report = tmp_path / "ball.step", tmp_path / "ball.xyz", tmp_path / "ball.json"
+    surfprep.write(BRepPrimAPI_MakeSphere(2.0).Shape(), ball)
+    code, stdout, _ = run(capsys, "grid", ball, "-o", out, "--size", "0.3", "--pole-caps", "h",
+                          "--json", report)
+    assert code == 0, stdout
+    data = json.loads(report.read_text())
+    assert len(read_plot3d(out)) == len(data["blocks"]) == 10
+    assert all(not b["collapsed_sides"] for b in data["blocks"])
+    code, stdout, _ = run(capsys, "grid", ball, "-o", tmp_path / "o.xyz", "--size", "0.3")
+    assert code == 0 and len(read_plot3d(tmp_path / "o.xyz")) == 2
