@@ -240,7 +240,8 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
         rectangle collapsed, closed round it): ``"o"`` one block round the pole, its
         cells there triangles; ``"h"`` five blocks, a square over the pole and four
         round it (003 Fig. 5's O-to-H remapping: no cell touches the pole; three
-        blocks meet at each of four points). A sphere is two caps.
+        blocks meet at each of four points; a face sharing the rim is cut where the
+        blocks meet it). A sphere is two caps.
     progress : callable(done, total), optional
 
     Returns
@@ -307,7 +308,16 @@ def grid(obj: Any, *, faces: list[int] | None = None, dims: tuple[int, int] | No
                            hold=held,
                            progress=progress)
     skipped += [(kept[b], why) for b, why in network.failed]
-    return GridResult(network, tuple(kept[b] for b in network.indices),
-                      tuple(kept_names[b] for b in network.indices),
+    # a block cut to conform with its neighbours: its pieces named in order
+    pieces = {b: network.indices.count(b) for b in set(network.indices)}
+    seen: dict[int, int] = {}
+    names_out = []
+    for b in network.indices:
+        name = kept_names[b]
+        if pieces[b] > 1 and name is not None:
+            name = f"{name}_{seen.get(b, 0)}"
+        seen[b] = seen.get(b, 0) + 1
+        names_out.append(name)
+    return GridResult(network, tuple(kept[b] for b in network.indices), tuple(names_out),
                       tuple(flips[b] for b in network.indices), tuple(sorted(skipped)),
                       time.perf_counter() - started)

@@ -3,6 +3,8 @@
 A network is a list of surfaces (the faces of a healed model, one block each)
 whose sides meet edge to edge. :func:`grid_network`
 
+0. cuts the blocks whose sides hold another block's corner through that point
+   (:mod:`.conforming`), so every edge two blocks share is a whole side of both;
 1. finds the sides two surfaces share (:func:`match_sides`: ends and samples
    within ``gap`` of each other, in either direction);
 2. gives every set of sides linked through the blocks (opposite sides of a
@@ -13,8 +15,8 @@ whose sides meet edge to edge. :func:`grid_network`
    its side, so both grids stand on their own surfaces);
 4. grids every block (:func:`.structured.grid_surface`);
 5. with elliptic smoothing, lets the interface nodes slide along their edge
-   until the grid lines cross it smoothly (the Winslow stencil of both blocks
-   together moves them; the blocks are refined again around them);
+   until the grid lines cross it smoothly (:mod:`.sliding`: the Winslow stencil of
+   both blocks together moves them; the blocks are refined again around them);
 6. copies the first block's coordinates onto the other's side, so matched nodes
    are identical to the bit, and reports how far that moved them (the gap
    between the surfaces);
@@ -38,37 +40,24 @@ from numpy.typing import NDArray
 
 from ...errors import InvalidGeometryError, SurfprepError
 from ..surface import NurbsSurface
+from .conforming import conforming
+from .edges import SMOOTH_INTERFACE, crease, inner_line, side_parameters, transfer
 from .io.blocks import Interface, side_nodes
 from .polar import PoleChart
 from .region import Region
+from .sliding import slide_interfaces
 from .structured import (
     DEFAULT_CELLS,
     SIDES,
     Spacing,
     SurfaceGrid,
     grid_region,
-    plain_kept,
-    squeezes_corners,
 )
 
 __all__ = ["NetworkGrid", "grid_network", "match_sides"]
 
 #: samples compared along two sides to call them one edge
 MATCH_SAMPLES = 9
-#: rounds of sliding interface nodes at most, the move (in cells) they stop at, and
-#: the share of each move taken
-INTERFACE_ROUNDS = 12
-INTERFACE_TOL = 1e-3
-INTERFACE_RELAXATION = 0.8
-#: a slide changes no interval of a shared edge by more than this factor against the
-#: distribution it was given (the Winslow stencil across an edge pulls its nodes toward
-#: a corner where three blocks meet, crowding the cells there: growth ratios of 2)
-SLIDE_STRETCH = 1.15
-#: the rounds stop when the largest move has not shrunk below this share of the round before
-INTERFACE_PROGRESS = 0.95
-#: an interface whose surfaces' normals differ by more than this (degrees) is a crease:
-#: its nodes do not slide and its kink is not counted in the summary
-SMOOTH_INTERFACE = 15.0
 
 
 @dataclass(frozen=True)
@@ -90,7 +79,8 @@ class NetworkGrid:
     interface_angles : tuple of (float, float)
         Per interface: the kink of the grid lines and the crease (normals' angle), degrees.
     indices : tuple of int
-        The position of each block's surface in the list given.
+        The position of each block's surface in the list given (the pieces of a surface
+        cut to conform share it).
     failed : tuple of (int, str)
         Surfaces that could not be gridded (a degenerate surface...), with the reason;
         the others are gridded without them.
@@ -98,6 +88,11 @@ class NetworkGrid:
         With ``dims`` (NI != NJ): ``(block, "i" | "j", count)`` for each direction that
         got the other count, because a shared edge links it to a direction of the
         other kind.
+    cuts : int
+        Cuts made through blocks so that no block corner lies inside another block's
+        side (:mod:`.conforming`); the pieces of a surface share its index.
+    t_junctions_left : int
+        Block corners still inside another block's side (their grids do not meet there).
     """
 
     blocks: tuple[SurfaceGrid, ...]
@@ -110,6 +105,8 @@ class NetworkGrid:
     failed: tuple[tuple[int, str], ...] = ()
     time_s: float = field(default=0.0, compare=False)
     dims_changed: tuple[tuple[int, str, int], ...] = ()
+    cuts: int = 0
+    t_junctions_left: int = 0
 
     def report(self) -> dict:
         return {"blocks": [b.report() for b in self.blocks],
@@ -119,7 +116,7 @@ class NetworkGrid:
                                for f, (k, c) in zip(self.interfaces, self.interface_angles, strict=True)],
                 "snap": self.snap, "kink_deg": self.kink, "interface_rounds": self.interface_rounds,
                 "dims_changed": [{"block": b, "direction": d, "nodes": n} for b, d, n in self.dims_changed],
-                "time_s": self.time_s}
+                "cuts": self.cuts, "t_junctions_left": self.t_junctions_left, "time_s": self.time_s}
 
 
 def _direction(side: str) -> int:
@@ -194,6 +191,14 @@ class _Classes:
         self.parent[self.find(a)] = self.find(b)
 
 
+def _longest(region: Region) -> float:
+    """The longest side of a region (NaN where a side has no length)."""
+    try:
+        return max(side.length for side in region.sides.values())
+    except SurfprepError:
+        return math.nan
+
+
 def _counts(surfaces, interfaces, dims, size, skip: set[int] = frozenset()) -> dict[tuple[int, int], int]:
     """Node count of every direction ``(block, 0 | 1)``: one per linked set (blocks in
     ``skip`` get none)."""
@@ -224,33 +229,11 @@ def _counts(surfaces, interfaces, dims, size, skip: set[int] = frozenset()) -> d
             for key in classes.parent if key[0] not in skip}
 
 
-def _transfer(region_a: Region, side_a: str, fractions_a: NDArray, region_b: Region, side_b: str,
-              reverse: bool) -> NDArray:
-    """Normalized parameters on side ``b`` of the nodes of side ``a`` (their nearest points).
-
-    Raises InvalidGeometryError when the feet are not in order.
-    """
-    points = region_a.sides[side_a].points(fractions_a)
-    if reverse:
-        points = points[::-1]
-    t = region_b.sides[side_b].locate(points)
-    t[0], t[-1] = 0.0, 1.0
-    t = np.clip(t, 0.0, 1.0)
-    if np.any(np.diff(t) <= 0.0):
-        raise InvalidGeometryError(f"the nodes of a shared edge do not project in order onto side {side_b}")
-    return t
-
-
-def _side_parameters(grid: SurfaceGrid, side: str) -> NDArray:
-    """Normalized parameters of a gridded block's side nodes along that side."""
-    return np.asarray(grid.side_params[side], dtype=float)
-
-
 def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tuple[int, int] | None = None,
                  size: float | None = None, spacing: Spacing | tuple[Spacing, Spacing] | None = None,
                  smooth: str = "elliptic", orthogonal: bool = True, tol: float = 1e-4,
                  max_sweeps: int = 2000, hold: dict[int, list] | None = None,
-                 progress=None) -> NetworkGrid:
+                 conform: bool = True, progress=None) -> NetworkGrid:
     """Point-matched grids over a network of four-sided surfaces (see the module doc).
 
     Parameters
@@ -270,6 +253,10 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     hold : dict, optional
         Surface index to the curves held as grid lines on it (see
         :func:`~.structured.grid_surface`; tolerance ``gap``).
+    conform : bool
+        Cut blocks whose sides hold another block's corner (a T-junction) through that
+        point, so every shared edge is a whole side of both blocks and is matched
+        (:func:`.conforming.conforming`; a surface with held curves is not cut).
     progress : callable(done, total), optional
 
     Returns
@@ -284,6 +271,17 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     spacing = Spacing() if spacing is None else spacing
     failed: dict[int, str] = {}
     surfaces = [_as_region(s) for s in surfaces]
+    given = len(surfaces)
+    origin: tuple[int, ...] = tuple(range(given))
+    cuts = left = 0
+    if dims is None and size is None:
+        # from the blocks given (their pieces are shorter)
+        size = float(np.median([_longest(r) for r in surfaces if np.isfinite(_longest(r))] or [1.0])) \
+            / DEFAULT_CELLS
+    if conform:
+        made = conforming(surfaces, gap=gap, fixed=frozenset(hold or {}))
+        surfaces, origin, cuts, left = list(made.surfaces), made.origin, made.cuts, made.left
+        hold = {b: (hold or {})[k] for b, k in enumerate(origin) if k in (hold or {})}
     for b, region in enumerate(surfaces):
         try:
             if not all(np.isfinite(side.length) for side in region.sides.values()):
@@ -294,9 +292,6 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     found = match_sides([surfaces[b] for b in usable], gap=gap)
     interfaces = [Interface(usable[f.block], f.side, usable[f.other], f.other_side, f.reversed)
                   for f in found]
-    if dims is None and size is None:
-        size = float(np.median([max(side.length for side in surfaces[b].sides.values())
-                                for b in usable] or [1.0])) / DEFAULT_CELLS
     counts = _counts(surfaces, interfaces, dims, size, skip=set(failed))
     partner = {}
     for f in interfaces:
@@ -315,8 +310,8 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
                 if (b, side) in partner and partner[b, side][0] < b \
                         and blocks[partner[b, side][0]] is not None:
                     a, side_a, reverse = partner[b, side]
-                    fractions = _side_parameters(blocks[a], side_a)
-                    given[side] = _transfer(surfaces[a], side_a, fractions, surface, side, reverse)
+                    fractions = side_parameters(blocks[a], side_a)
+                    given[side] = transfer(surfaces[a], side_a, fractions, surface, side, reverse)
             blocks.append(grid_region(surface, dims=(counts[b, 0], counts[b, 1]), spacing=spacing,
                                       smooth=smooth, tol=tol, max_sweeps=max_sweeps, sides=given,
                                       # square to the network's open sides, not across its
@@ -341,14 +336,18 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     rounds = 0
     if smooth == "elliptic" and interfaces:
         budget = time.perf_counter() - started          # sliding may at most double the work
-        blocks, rounds = _slide_interfaces(surfaces, blocks, interfaces, tol=tol,
+        blocks, rounds = slide_interfaces(surfaces, blocks, interfaces, tol=tol,
                                            max_sweeps=max_sweeps, budget=budget,
                                            orthogonal=orthogonal)
     net = _snapped(surfaces, blocks, interfaces, started, rounds)
     net = replace(net, blocks=tuple(_in_surface_parameters(b, r) for b, r in zip(net.blocks, surfaces, strict=True)))
     changed = () if dims is None else tuple(
         (index[b], "ij"[d], counts[b, d]) for (b, d) in sorted(counts) if b in index and counts[b, d] != dims[d])
-    return replace(net, indices=tuple(keep), failed=tuple(sorted(failed.items())), dims_changed=changed)
+    lost = {}
+    for b, why in failed.items():
+        lost.setdefault(origin[b], why)
+    return replace(net, indices=tuple(origin[b] for b in keep), failed=tuple(sorted(lost.items())),
+                   dims_changed=changed, cuts=cuts, t_junctions_left=left)
 
 
 def _in_surface_parameters(block: SurfaceGrid, region: Region) -> SurfaceGrid:
@@ -359,182 +358,6 @@ def _in_surface_parameters(block: SurfaceGrid, region: Region) -> SurfaceGrid:
         return block
     start = None if block.start_parameters is None else chart.to_surface(block.start_parameters)
     return replace(block, parameters=chart.to_surface(block.parameters), start_parameters=start)
-
-
-def _edge_stencil(blocks: list[SurfaceGrid], f: Interface) -> tuple[NDArray, ...]:
-    """Nodes of an interface and of the lines beside it in both blocks, in block a's order."""
-    a, b = blocks[f.block].points, blocks[f.other].points
-    edge = side_nodes(a, f.side)
-    before = _inner_line(a, f.side)
-    after = _inner_line(b, f.other_side)
-    if f.reversed:
-        after = after[::-1]
-    return edge, before, after
-
-
-def _stretch_limited(t: NDArray, given: NDArray) -> NDArray:
-    """Side parameters ``t`` (increasing, ends fixed) with no interval more than
-    :data:`SLIDE_STRETCH` times longer or shorter than in ``given``: the intervals
-    clipped and rescaled to the same total until they hold."""
-    d0 = np.diff(given)
-    d = np.diff(t)
-    lo, hi = d0 / SLIDE_STRETCH, d0 * SLIDE_STRETCH
-    for _ in range(50):
-        d = np.clip(d, lo, hi)
-        d *= (given[-1] - given[0]) / d.sum()
-        if np.all(d >= lo * (1 - 1e-9)) and np.all(d <= hi * (1 + 1e-9)):
-            break
-    out = given[0] + np.concatenate([[0.0], np.cumsum(d)])
-    out[-1] = given[-1]
-    return out
-
-
-def _edge_moves(edge: NDArray, before: NDArray, after: NDArray) -> NDArray:
-    """Jacobi moves of the inner nodes of an interface along it (model units), from the
-    Winslow stencil of the two blocks together (:mod:`.elliptic_kernels`'s update, with
-    xi across the interface and eta along it), ``(n - 2,)``."""
-    r_xi = 0.5 * (after[1:-1] - before[1:-1])
-    r_eta = 0.5 * (edge[2:] - edge[:-2])
-    r_xe = 0.25 * (after[2:] - after[:-2] - before[2:] + before[:-2])
-    g11 = np.einsum("ij,ij->i", r_xi, r_xi)
-    g22 = np.einsum("ij,ij->i", r_eta, r_eta)
-    g12 = np.einsum("ij,ij->i", r_xi, r_eta)
-    diag = 2.0 * (g11 + g22)
-    diag = np.where(diag > 0, diag, 1.0)
-    move = (g22[:, None] * (after[1:-1] + before[1:-1]) + g11[:, None] * (edge[2:] + edge[:-2])
-            - 2.0 * g12[:, None] * r_xe) / diag[:, None] - edge[1:-1]
-    tangent = r_eta / np.maximum(np.linalg.norm(r_eta, axis=1), 1e-300)[:, None]
-    return np.einsum("ij,ij->i", move, tangent)
-
-
-def _slide_interfaces(surfaces: list[Region], blocks: list[SurfaceGrid], interfaces: list[Interface], *,
-                      tol: float, max_sweeps: int, budget: float = math.inf,
-                      orthogonal: bool = False) -> tuple[list[SurfaceGrid], int]:
-    """Let the nodes of every interface slide along it until the grid lines cross it
-    smoothly: each round moves them by the Winslow stencil of both blocks together
-    (:func:`_edge_moves`), gives both blocks the new side nodes and refines the
-    blocks again from where they were. Stops when no node would move more than
-    :data:`INTERFACE_TOL` of its cell, when the moves stop shrinking
-    (:data:`INTERFACE_PROGRESS`), after :data:`INTERFACE_ROUNDS` rounds, or once the
-    rounds took ``budget`` seconds (the caller's: as long as gridding the blocks did)."""
-    from .elliptic import refine
-    from .elliptic_kernels import folds
-    from .polar import surface_normals as normals
-    from .quality import grid_quality
-    from .tfi import carried_inward
-    params = [b.parameters.copy() for b in blocks]
-    side_params = [dict(b.side_params) for b in blocks]
-    grids = list(blocks)
-    # creases do not slide, nor do blocks that kept their algebraic grid or hold curves
-    # (refined piece by piece between them)
-    still = {k for k, b in enumerate(blocks) if b.kept_start is not None or b.held}
-    # the sides the lines leave at right angles: those that are no interface (of any kind)
-    shared = {(f.block, f.side) for f in interfaces} | {(f.other, f.other_side) for f in interfaces}
-    open_sides = [tuple(side for side in SIDES if (k, side) not in shared) for k in range(len(blocks))]
-    interfaces = [f for f in interfaces if _crease(surfaces, blocks, f) <= SMOOTH_INTERFACE
-                  and f.block not in still and f.other not in still and not _on_seam(blocks, f)]
-    # the distributions the shared edges were given, which a slide may stretch only so far
-    given = {(f.block, f.side): _side_parameters(grids[f.block], f.side) for f in interfaces}
-    touched: set[int] = set()
-    rounds = 0
-    previous = math.inf
-    began = time.perf_counter()
-    for rounds in range(1, INTERFACE_ROUNDS + 1):
-        worst = 0.0
-        changed: set[int] = set()
-        for f in interfaces:
-            edge, before, after = _edge_stencil(grids, f)
-            if edge.shape[0] < 3:
-                continue
-            move = _edge_moves(edge, before, after)
-            legs = np.linalg.norm(np.diff(edge, axis=0), axis=1)
-            cell = np.maximum(np.minimum(legs[1:], legs[:-1]), 1e-300)
-            worst = max(worst, float(np.max(np.abs(move) / cell)))
-            # along block a's side curve: arc length to parameter by the local chord
-            t = _side_parameters(grids[f.block], f.side)
-            dt = np.diff(t)
-            step = move / np.where(move > 0, legs[1:], legs[:-1]) * np.where(move > 0, dt[1:], dt[:-1])
-            step = np.clip(INTERFACE_RELAXATION * step, -0.5 * dt[:-1], 0.5 * dt[1:])
-            t_new = t.copy()
-            t_new[1:-1] += step
-            t_new = _stretch_limited(t_new, given[f.block, f.side])
-            try:
-                t_b = _transfer(surfaces[f.block], f.side, t_new, surfaces[f.other], f.other_side,
-                                f.reversed)
-            except InvalidGeometryError:
-                continue                      # this edge's nodes stay where they are this round
-            for block, side, values in ((f.block, f.side, t_new), (f.other, f.other_side, t_b)):
-                _set_side_parameters(params[block], surfaces[block], side, values)
-                side_params[block][side] = values
-                changed.add(block)
-        if worst < INTERFACE_TOL or worst > INTERFACE_PROGRESS * previous \
-                or time.perf_counter() - began > budget:
-            break                             # converged, the moves no longer shrink, or out of time
-        previous = worst
-        for k in changed:
-            # the sides' slide carried into the block (unless that folds a cell): the warm
-            # solve then starts without the slide's long-wave error
-            if grids[k].seam is None:
-                moved = carried_inward(grids[k].parameters, params[k])
-                if not folds(moved[..., 0], moved[..., 1], grids[k].orientation):
-                    params[k] = moved
-            squared = orthogonal and grids[k].orthogonal_dropped is None and open_sides[k]
-            seam = grids[k].seam
-            earlier = grids[k].elliptic
-            result = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
-                            orthogonal=squared, seam=seam,
-                            resume=earlier.control if earlier is not None else None)
-            if squared and not result.nearly_converged(tol):      # as grid_region: the plain grid
-                plain = refine(surfaces[k].surface, params[k], tol=tol, max_sweeps=max_sweeps, warm=True,
-                               seam=seam)
-                if result.yields_to(plain):
-                    result = plain
-                    grids[k] = replace(grids[k], orthogonal_dropped=(
-                        "the sides' orthogonality was not reached after the shared edges' nodes "
-                        "slid; the grid without it is kept"))
-            params[k] = result.parameters.copy()
-            points = surfaces[k].surface.evaluate(params[k][..., 0], params[k][..., 1])
-            grids[k] = replace(grids[k], points=points, parameters=params[k], elliptic=result,
-                               side_params=dict(side_params[k]))
-            touched.add(k)
-    for k in touched:
-        # the parameters its points were evaluated at (params[k] may hold a last round's side
-        # moves that were never refined: the loop stops once they are small)
-        g = grids[k]
-        p = g.elliptic.parameters
-        quality = grid_quality(g.points, g.orientation * normals(surfaces[k].surface, p[..., 0], p[..., 1]))
-        grids[k] = replace(g, parameters=p.copy(), quality=quality)
-        if orthogonal and g.orthogonal_dropped is None and open_sides[k] and squeezes_corners(quality, g.points):
-            # as grid_region: squared sides that squeeze a sharp corner's cells are given up
-            plain = refine(surfaces[k].surface, p, tol=tol, max_sweeps=max_sweeps, warm=True, seam=g.seam)
-            pp = plain.parameters
-            points = surfaces[k].surface.evaluate(pp[..., 0], pp[..., 1])
-            plain_quality = grid_quality(points, g.orientation * normals(surfaces[k].surface, pp[..., 0],
-                                                                         pp[..., 1]))
-            why = plain_kept(quality, plain, plain_quality, tol)
-            if why is not None:
-                grids[k] = replace(g, points=points, parameters=pp.copy(), elliptic=plain,
-                                   quality=plain_quality, orthogonal_dropped=why)
-    return grids, rounds
-
-
-def _on_seam(blocks: list[SurfaceGrid], f: Interface) -> bool:
-    """The interface is a block's own seam, solved across by its elliptic step (:mod:`.periodic`)."""
-    seam = blocks[f.block].seam
-    return f.block == f.other and seam is not None and {f.side, f.other_side} == (
-        {"i0", "i1"} if seam.axis == 0 else {"j0", "j1"})
-
-
-def _set_side_parameters(params: NDArray, region: Region, side: str, values: NDArray) -> None:
-    """Put a side's nodes, given by normalized side parameters, into a block's ``(u, v)``
-    (inside the domain: a trimmed face's pcurves may run off it by a rounding)."""
-    u0, u1, v0, v1 = region.surface.domain
-    uv = np.clip(region.sides[side].uv(values), [u0, v0], [u1, v1])
-    axis, index = _SIDE_INDEX[side]
-    if axis == 0:
-        params[index] = uv
-    else:
-        params[:, index] = uv
 
 
 def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], started: float,
@@ -576,7 +399,7 @@ def _snapped(surfaces, blocks: list[SurfaceGrid], interfaces: list[Interface], s
         uv = side_nodes(blocks[f.block].parameters, f.side)
         k = _kink(a, f.side, b, f.other_side, f.reversed,
                   blocks[f.block].orientation * normals(surfaces[f.block].surface, uv[:, 0], uv[:, 1]))
-        c = _crease(surfaces, blocks, f)
+        c = crease(surfaces, blocks, f)
         figures.append((k, c))
         if c <= SMOOTH_INTERFACE:
             kink = max(kink, k)
@@ -590,44 +413,6 @@ def _side_keys(block: int, side: str, dims: tuple[int, int]) -> list[tuple[int, 
     ni, nj = dims
     return {"i0": [(block, 0, j) for j in range(nj)], "i1": [(block, ni - 1, j) for j in range(nj)],
             "j0": [(block, i, 0) for i in range(ni)], "j1": [(block, i, nj - 1) for i in range(ni)]}[side]
-
-
-_SIDE_INDEX = {"i0": (0, 0), "i1": (0, -1), "j0": (1, 0), "j1": (1, -1)}
-
-
-def _inner_line(block: NDArray, side: str, depth: int = 1) -> NDArray:
-    """The line of nodes ``depth`` steps inside a side."""
-    axis, index = _SIDE_INDEX[side]
-    inner = depth if index == 0 else -1 - depth
-    return block[inner] if axis == 0 else block[:, inner]
-
-
-#: direction of each side in its block's boundary loop (counter-clockwise in (i, j))
-_LOOP_DIRECTION = {"j0": 1, "i1": 1, "j1": -1, "i0": -1}
-
-
-def _same_orientation(f: Interface) -> bool:
-    """True when the two blocks of an interface are oriented alike (their boundary
-    loops run along the shared edge in opposite directions)."""
-    along = _LOOP_DIRECTION[f.side] * _LOOP_DIRECTION[f.other_side] * (-1 if f.reversed else 1)
-    return along == -1
-
-
-def _crease(surfaces, blocks: list[SurfaceGrid], f: Interface) -> float:
-    """Largest angle (degrees) between the two surfaces' normals along an interface,
-    the second block's taken with the first's orientation."""
-    from .polar import surface_normals as normals
-    ends = []
-    for block, side in ((f.block, f.side), (f.other, f.other_side)):
-        uv = side_nodes(blocks[block].parameters, side)
-        ends.append(blocks[block].orientation * normals(surfaces[block].surface, uv[:, 0], uv[:, 1]))
-    na, nb = ends
-    if f.reversed:
-        nb = nb[::-1]
-    if not _same_orientation(f):
-        nb = -nb
-    cos = np.clip(np.einsum("ij,ij->i", na, nb), -1.0, 1.0)
-    return float(np.degrees(np.arccos(cos)).max())
 
 
 def _turn(a: NDArray, b: NDArray, c: NDArray, normals: NDArray) -> NDArray:
@@ -648,15 +433,15 @@ def _kink(a: NDArray, side_a: str, b: NDArray, side_b: str, reverse: bool,
     turning alone.
     """
     edge = side_nodes(a, side_a)
-    before = _inner_line(a, side_a)
-    after = _inner_line(b, side_b)
+    before = inner_line(a, side_a)
+    after = inner_line(b, side_b)
     if reverse:
         after = after[::-1]
     turn = _turn(before, edge, after, normals)
     deep = min(a.shape[0 if side_a[0] == "i" else 1], b.shape[0 if side_b[0] == "i" else 1]) >= 3
     if deep:
-        before2 = _inner_line(a, side_a, 2)
-        after2 = _inner_line(b, side_b, 2)
+        before2 = inner_line(a, side_a, 2)
+        after2 = inner_line(b, side_b, 2)
         if reverse:
             after2 = after2[::-1]
         turn = turn - 0.5 * (_turn(before2, before, edge, normals) + _turn(edge, after, after2, normals))

@@ -164,6 +164,12 @@ def _run(args: argparse.Namespace, console: Console) -> int:
         console.note(f"{len(net.dims_changed)} block direction(s) got {max(n for *_, n in net.dims_changed)} "
                      "nodes, not the --dims asked: shared edges link them to directions of the other kind "
                      "(faces split into blocks, faces meeting i to j)")
+    if net.cuts:
+        console.note(f"{net.cuts} cut(s) through faces so that no block corner lies inside another "
+                     "block's side (T-junctions): every shared edge is a whole side of both blocks")
+    if net.t_junctions_left:
+        console.note(f"{net.t_junctions_left} block corner(s) still lie inside another block's side: "
+                     "the grids do not meet there")
     console.print(f"{len(net.blocks)} block(s), {len(net.interfaces)} shared edge(s) point-matched "
                   f"(largest snap {net.snap:.2g} mm, kink {net.kink:.1f} deg) in {elapsed:.2f} s, "
                   f"written to {written}")

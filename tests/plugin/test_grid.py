@@ -148,9 +148,14 @@ def test_trimmed_four_sided_faces_of_a_real_model(data_dir):
     # come out with cells of 140-166 degrees in one block, a face with a hole near its
     # rim with skewness 0.93; no fold anywhere)
     skew = [b["quality"]["max_skewness"] for b in report["blocks"]]
-    assert max(q for q, k in zip(skew, result.faces) if k in four) < 0.5
+    # (0.50 before faces were cut at T-junctions: a slanted cut leaves a piece at 0.52)
+    assert max(q for q, k in zip(skew, result.faces) if k in four) < 0.55
     assert max(q for q, k in zip(skew, result.faces) if k in others) < 0.95
-    assert len(result.network.interfaces) >= 40
+    # cut where a block's corner lies inside another's side, the faces meet node for node
+    # along 741 shared edges (180 before: most of the split faces' sides met their
+    # neighbours at T-junctions); 25 corners are left when the cuts stop
+    assert result.network.cuts > 100 and len(result.network.interfaces) >= 600
+    assert result.network.t_junctions_left <= 30
     _assert_point_matched(result)
     # the blocks lie on their faces: every node within the model's tolerance of the face's surface
     from surfprep.algorithms.projection import distance_to_surface
@@ -313,3 +318,29 @@ def test_a_surface_with_one_pole_stays_one_block():
     from surfprep.algorithms.grid.faces import pole_halves
     patch = pole_patch()
     assert pole_halves(patch) == [patch]
+
+
+def test_a_capsule_with_h_type_caps_is_cut_to_meet_them(tmp_path):
+    """A cylinder between two hemispheres: with pole_caps="h" each cap's rim is split in
+    four by its butterfly, and the cylinder is cut where those corners lie on its ends
+    (T-junctions), so every shared edge is matched node for node and no cell touches a
+    pole; with the default O-type caps the three faces are three blocks."""
+    import cadquery as cq
+    path = tmp_path / "capsule.step"
+    solid = (cq.Workplane().cylinder(4, 1).union(cq.Workplane().sphere(1).translate((0, 0, 2)))
+             .union(cq.Workplane().sphere(1).translate((0, 0, -2))).clean())
+    surfprep.write(solid.val(), path)
+    plain = surfprep.grid(path, size=0.2)
+    assert len(plain.blocks) == 3 and plain.network.cuts == 0
+    result = surfprep.grid(path, size=0.2, pole_caps="h")
+    net = result.network
+    assert net.cuts > 0 and net.t_junctions_left == 0 and not result.skipped
+    assert all(not b.collapsed_sides for b in net.blocks)
+    _assert_point_matched(result)
+    # every block side lies on another block's side or nowhere: all sides shared (a closed solid)
+    shared = {(f.block, f.side) for f in net.interfaces} | {(f.other, f.other_side) for f in net.interfaces}
+    assert len(shared) == 4 * len(net.blocks)
+    worst = result.report()["worst"]
+    assert worst["folded_cells"] == 0 and worst["max_skewness"] < 0.4
+    area = sum(_cells_area(b) for b in result.blocks)
+    assert area == pytest.approx(4 * np.pi + 2 * np.pi * 4, rel=5e-3)
