@@ -88,7 +88,8 @@ def _corners(region: Region) -> NDArray:
                            region.sides["j1"].points(np.array([0.0, 1.0]))])
 
 
-def t_junctions(surfaces: list[NurbsSurface | Region], *, gap: float) -> dict[tuple[int, str], NDArray]:
+def t_junctions(surfaces: list[NurbsSurface | Region], *, gap: float, blocks=None,
+                corners=None) -> dict[tuple[int, str], NDArray]:
     """Corners of blocks that lie inside a side of another block.
 
     Parameters
@@ -97,6 +98,9 @@ def t_junctions(surfaces: list[NurbsSurface | Region], *, gap: float) -> dict[tu
     gap : float
         Model units: a corner within ``gap`` of a side, and farther than ``gap`` from
         both its ends, lies inside it.
+    blocks, corners : iterable of int, optional
+        Look only at the sides of ``blocks`` and only for the corners of ``corners``
+        (default: all of them).
 
     Returns
     -------
@@ -106,14 +110,16 @@ def t_junctions(surfaces: list[NurbsSurface | Region], *, gap: float) -> dict[tu
     """
     from scipy.spatial import cKDTree
     regions = [_as_region(s) for s in surfaces]
-    if not regions:
+    owners = np.arange(len(regions)) if corners is None else np.unique(np.fromiter(corners, dtype=int))
+    if not regions or owners.size == 0:
         return {}
-    corners = np.concatenate([_corners(r) for r in regions])
+    corners = np.concatenate([_corners(regions[k]) for k in owners])
     corners[~np.isfinite(corners)] = np.inf
-    owner = np.repeat(np.arange(len(regions)), 4)
+    owner = np.repeat(owners, 4)
     tree = cKDTree(corners)
     out = {}
-    for r, region in enumerate(regions):
+    for r in (range(len(regions)) if blocks is None else blocks):
+        region = regions[r]
         for name in SIDE_NAMES:
             side = region.sides[name]
             try:
@@ -277,9 +283,10 @@ def conforming(surfaces: list[NurbsSurface | Region], *, gap: float,
     Conforming
     """
     items = list(surfaces)
+    regions = [_as_region(s) for s in items]          # kept: their sides' lengths are cached
     origin = list(range(len(items)))
     cuts = 0
-    found = t_junctions(items, gap=gap)
+    found = t_junctions(regions, gap=gap)
     for _ in range(MAX_ROUNDS):
         if not found or len(items) >= MAX_GROWTH * max(len(surfaces), 1):
             break
@@ -289,20 +296,31 @@ def conforming(surfaces: list[NurbsSurface | Region], *, gap: float,
                 by_block.setdefault(b, {})[name] = f
         if not by_block:
             break
-        out, out_origin, made = [], [], 0
+        out, out_regions, out_origin, moved, fresh = [], [], [], {}, []
         for b, item in enumerate(items):
             pieces = _cut(item, by_block[b]) if b in by_block else None
             if pieces is None:
+                moved[b] = len(out)
                 out.append(item)
+                out_regions.append(regions[b])
                 out_origin.append(origin[b])
                 continue
-            made += len(pieces) - 1
+            fresh.extend(range(len(out), len(out) + len(pieces)))
             out.extend(pieces)
+            out_regions.extend(_as_region(p) for p in pieces)
             out_origin.extend([origin[b]] * len(pieces))
-        if not made:
+        if not fresh:
             break
-        cuts += made
-        items, origin = out, out_origin
-        found = t_junctions(items, gap=gap)
+        cuts += len(fresh) - (len(items) - len(moved))
+        items, regions, origin = out, out_regions, out_origin
+        # the blocks not cut keep what was found on them; the pieces are looked at whole,
+        # and the others only for the pieces' corners
+        found = {(moved[b], name): f for (b, name), f in found.items() if b in moved}
+        new = t_junctions(regions, gap=gap, blocks=fresh)
+        for key, f in t_junctions(regions, gap=gap, blocks=sorted(moved.values()), corners=fresh).items():
+            both = np.sort(np.concatenate([found.get(key, np.zeros(0)), f]))
+            length = regions[key[0]].sides[key[1]].length
+            found[key] = both[np.concatenate([[True], np.diff(both) * length > gap])]
+        found.update(new)
     left = sum(f.size for (b, _), f in found.items())
     return Conforming(tuple(items), tuple(origin), cuts, left)
