@@ -25,6 +25,7 @@ def test_readme_python_examples_run(tmp_path, monkeypatch):
     assert abs(namespace["contact"][1] - 10) < 1e-6
     assert namespace["network"].joins_before[0].max_gap > 1e-3 > 1e3 * namespace["join"].max_gap
     assert len(namespace["blocks"]) == 8 and namespace["worst"]["folded_cells"] == 0
+    assert namespace["caps"][0] == 10 and namespace["caps"][1] < 0.4
     assert namespace["pieces"].report()["pieces"] == 7 and namespace["pieces"].valid
     assert abs(namespace["lens"].volume - 108.908545) < 1e-4
     assert (tmp_path / "fuselage.cgns").stat().st_size > 0
