@@ -90,7 +90,8 @@ class GridResult:
                      "max_growth_ratio": max(x.max_growth_ratio for x in q)}
         return {"blocks": net["blocks"], "interfaces": net["interfaces"], "worst": worst,
                 "snap": net["snap"], "kink_deg": net["kink_deg"],
-                "interface_rounds": net["interface_rounds"],
+                "interface_rounds": net["interface_rounds"], "cuts": net["cuts"],
+                "t_junctions_left": net["t_junctions_left"],
                 "dims_changed": [{**d, "face": self.faces[d["block"]]} for d in net["dims_changed"]],
                 "skipped": [{"face": k, "reason": r} for k, r in self.skipped],
                 "time_s": self.time_s}

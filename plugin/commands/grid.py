@@ -38,9 +38,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="Plot3D as Fortran unformatted (default formatted text)")
     size = parser.add_mutually_exclusive_group()
     size.add_argument("--dims", type=int, nargs=2, metavar=("NI", "NJ"),
-                      help="NI x NJ nodes per face (i along the face's u); where shared edges link "
-                           "an i direction to a j direction (faces split into blocks) those take the "
-                           "larger, and a note says so")
+                      help="NI x NJ nodes per block (i along the face's u; a face split into blocks, "
+                           "or cut where a neighbour's corner meets its side, gets them per block); where "
+                           "shared edges link an i direction to a j direction those take the larger, and "
+                           "a note says so")
     size.add_argument("--size", type=float, metavar="H",
                       help="target cell size in mm (default: the median face's longest side / 40)")
     parser.add_argument("--first-spacing", type=float, metavar="D", dest="first",
