@@ -37,7 +37,9 @@ from ...errors import SurfprepError
 from ..curve import NurbsCurve
 from ..fitting import interpolate_curve
 from ..surface import NurbsSurface
+from .elliptic_kernels import corner_jacobians
 from .region import SIDE_NAMES, Region, Side
+from .tfi import transfinite
 
 __all__ = ["MAX_GROWTH", "MAX_ROUNDS", "SNAP", "Conforming", "conforming", "t_junctions"]
 
@@ -50,6 +52,8 @@ MAX_ROUNDS = 8
 MAX_GROWTH = 4.0
 #: cuts closer than this fraction of a side (to each other or to its ends) are one
 _APART = 1e-9
+#: nodes a side of the coarse grid that checks a piece for folds
+_CHECK = 9
 #: points of a cut's transfinite line interpolated by its pcurve
 CUT_SAMPLES = 17
 #: a side of the rectangle: its name, the direction it runs in, and the parameter it holds
@@ -236,13 +240,37 @@ def _split_rectangle(surface: NurbsSurface, fractions: NDArray, direction: str) 
     return pieces + [rest]
 
 
+def _folded(region: Region) -> bool:
+    """A coarse (9 x 9) transfinite grid of the region in its surface's parameters has cells
+    turned against the others (a cut leaving a very non-convex region)."""
+    x = np.linspace(0.0, 1.0, _CHECK)
+    uv = {name: region.sides[name].uv(x) for name in SIDE_NAMES}
+    for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1), ("j1", -1, "i1", -1)):
+        uv[a][ia] = uv[b][ib] = 0.5 * (uv[a][ia] + uv[b][ib])     # a loop's sides meet to its tolerance
+    st = transfinite(uv["j0"], uv["j1"], uv["i0"], uv["i1"])
+    turn = corner_jacobians(st[..., 0], st[..., 1])
+    return not (np.all(turn > 0.0) or np.all(turn < 0.0))
+
+
 def _cut(item: NurbsSurface | Region, found: dict[str, NDArray]) -> list | None:
     """One round's cuts of a block: across i where its ``j`` sides hold corners, else across
-    j; None when none can be made. A rectangle is split along iso-lines (its pieces are
-    rectangles) unless a corner on one side has one on the other nearly across (within
-    :data:`SNAP`, not exactly): then it is cut as any region is, the cut slanted from one
-    to the other."""
+    j; None when none can be made, or when a piece would fold in the surface's
+    parameters (a coarse transfinite grid of it, :func:`_folded`) where the block does
+    not. A rectangle is split along iso-lines (its pieces are rectangles) unless a corner
+    on one side has one on the other nearly across (within :data:`SNAP`, not exactly):
+    then it is cut as any region is, the cut slanted from one to the other."""
     region = _as_region(item)
+    pieces = _pieces(item, region, found)
+    if pieces is None:
+        return None
+    cut = [_as_region(p) for p in pieces]
+    if not all(p.is_rectangle for p in cut) and any(_folded(p) for p in cut) and not _folded(region):
+        return None                           # a cut that would fold a block is not made
+    return pieces
+
+
+def _pieces(item: NurbsSurface | Region, region: Region, found: dict[str, NDArray]) -> list | None:
+    """The pieces of :func:`_cut`, unchecked."""
     empty = np.zeros(0)
     for near, far, transpose in (("j0", "j1", False), ("i0", "i1", True)):
         on_near, on_far = found.get(near, empty), found.get(far, empty)
