@@ -152,11 +152,17 @@ def match_sides(regions: list[NurbsSurface | Region], *, gap: float) -> list[Int
     keys = [k for k in samples if lengths[k] > gap]
     used: set[tuple[int, str]] = set()
     out = []
+    if not keys:
+        return out
+    # candidates by their ends: a side's first sample within gap of the other's first or last
+    from scipy.spatial import cKDTree
+    firsts = cKDTree(np.array([samples[k][0] for k in keys]))
     for x, key_a in enumerate(keys):
         if key_a in used:
             continue
         a = samples[key_a]
-        for key_b in keys[x + 1:]:
+        near = sorted(set(firsts.query_ball_point(a[0], gap)) | set(firsts.query_ball_point(a[-1], gap)))
+        for key_b in (keys[y] for y in near if y > x):
             if key_b in used:
                 continue
             b = samples[key_b]
