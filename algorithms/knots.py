@@ -230,23 +230,27 @@ def restrict_array(points_w: ArrayLike, knots: ArrayLike, degree: int, a: float,
         raise InvalidGeometryError(f"need a < b, got a = {a!r}, b = {b!r}")
     check_in_domain(a, knots, degree, "a")
     check_in_domain(b, knots, degree, "b")
-    a, b = _on_knot(a, knots), _on_knot(b, knots)
+    knots = _at_bound(_at_bound(knots, a), b)
     points_w, knots = _trim_start(points_w, knots, degree, a)
     return _trim_end(points_w, knots, degree, b)
 
 
-#: a cut this close to a knot (relative to the knot vector's span) is at that knot
+#: a knot this close to a cut (relative to the knot vector's span) is taken at the cut
 _KNOT_SNAP = 1e-12
 
 
-def _on_knot(value: float, knots: NDArray) -> float:
-    """``value``, or the knot it rounds to: a split a rounding off a knot of multiplicity
-    ``degree`` inserted ``degree`` more knots a few ulps away, a span of width 1e-16 at the
-    end of the piece (its end multiplicity 2 p + 1 there in effect) and derivatives off by
-    orders of magnitude (a half cylinder split at its join: S_u of 152 for 45)."""
-    k = int(np.argmin(np.abs(knots - value)))
-    span = float(knots[-1] - knots[0])
-    return float(knots[k]) if abs(float(knots[k]) - value) <= _KNOT_SNAP * max(span, 1.0) else value
+def _at_bound(knots: NDArray, value: float) -> NDArray:
+    """The knots with those a rounding off ``value`` moved onto it (the geometry moves by a
+    rounding; the piece's domain is what was asked). A split a rounding off a knot of
+    multiplicity ``degree`` inserted ``degree`` more knots a few ulps away: a span of width
+    1e-16 at the end of the piece and derivatives off by orders of magnitude (a half
+    cylinder split at its join: S_u of 152 for 45)."""
+    near = np.abs(knots - value) <= _KNOT_SNAP * max(float(knots[-1] - knots[0]), 1.0)
+    if not near.any() or np.all(knots[near] == value):
+        return knots
+    out = knots.copy()
+    out[near] = value
+    return out
 
 
 # -------------------------------------------------------------------- curves
