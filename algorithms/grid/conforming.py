@@ -252,13 +252,14 @@ def _folded(region: Region) -> bool:
     return not (np.all(turn > 0.0) or np.all(turn < 0.0))
 
 
-def _cut(item: NurbsSurface | Region, found: dict[str, NDArray]) -> list | None:
+def _cut(item: NurbsSurface | Region, found: dict[str, NDArray]) -> list[tuple] | None:
     """One round's cuts of a block: across i where its ``j`` sides hold corners, else across
     j; None when none can be made, or when a piece would fold in the surface's
     parameters (a coarse transfinite grid of it, :func:`_folded`) where the block does
     not. A rectangle is split along iso-lines (its pieces are rectangles) unless a corner
     on one side has one on the other nearly across (within :data:`SNAP`, not exactly):
-    then it is cut as any region is, the cut slanted from one to the other."""
+    then it is cut as any region is, the cut slanted from one to the other. Returns the
+    pieces, each with its region."""
     region = _as_region(item)
     pieces = _pieces(item, region, found)
     if pieces is None:
@@ -266,7 +267,7 @@ def _cut(item: NurbsSurface | Region, found: dict[str, NDArray]) -> list | None:
     cut = [_as_region(p) for p in pieces]
     if not all(p.is_rectangle for p in cut) and any(_folded(p) for p in cut) and not _folded(region):
         return None                           # a cut that would fold a block is not made
-    return pieces
+    return list(zip(pieces, cut, strict=True))
 
 
 def _pieces(item: NurbsSurface | Region, region: Region, found: dict[str, NDArray]) -> list | None:
@@ -334,8 +335,8 @@ def conforming(surfaces: list[NurbsSurface | Region], *, gap: float,
                 out_origin.append(origin[b])
                 continue
             fresh.extend(range(len(out), len(out) + len(pieces)))
-            out.extend(pieces)
-            out_regions.extend(_as_region(p) for p in pieces)
+            out.extend(p for p, _ in pieces)
+            out_regions.extend(r for _, r in pieces)
             out_origin.extend([origin[b]] * len(pieces))
         if not fresh:
             break
