@@ -144,8 +144,11 @@ def t_junctions(surfaces: list[NurbsSurface | Region], *, gap: float, blocks=Non
             p = p[inner]
             if p.shape[0] == 0:
                 continue
-            x = side.locate(p)
-            on = np.linalg.norm(side.points(x) - p, axis=1) <= gap
+            try:
+                x = side.locate(p)
+                on = np.linalg.norm(side.points(x) - p, axis=1) <= gap
+            except SurfprepError:
+                continue
             if not on.any():
                 continue
             f = np.sort(side.fractions_of(x[on]))
@@ -327,7 +330,10 @@ def conforming(surfaces: list[NurbsSurface | Region], *, gap: float,
             break
         out, out_regions, out_origin, moved, fresh = [], [], [], {}, []
         for b, item in enumerate(items):
-            pieces = _cut(item, by_block[b]) if b in by_block else None
+            try:
+                pieces = _cut(item, by_block[b]) if b in by_block else None
+            except SurfprepError:
+                pieces = None                 # a cut that cannot be made (a degenerate line): the T stays
             if pieces is None:
                 moved[b] = len(out)
                 out.append(item)
