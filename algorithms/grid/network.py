@@ -56,6 +56,9 @@ from .structured import (
 
 __all__ = ["NetworkGrid", "grid_network", "match_sides"]
 
+#: a block side longer than this many times its surface's box diagonal is refused (its
+#: pcurve runs off the domain, where the surface is extrapolated: 1.3e7 mm on a 304 mm part)
+LONG_SIDE = 10.0
 #: samples compared along two sides to call them one edge
 MATCH_SAMPLES = 9
 
@@ -197,6 +200,22 @@ class _Classes:
         self.parent[self.find(a)] = self.find(b)
 
 
+def _refused(region: Region) -> str | None:
+    """Why a block cannot be gridded (a side of no finite length, or one far longer than its
+    surface is wide: :data:`LONG_SIDE`), or None."""
+    try:
+        lengths = [side.length for side in region.sides.values()]
+        if not all(np.isfinite(lengths)):
+            return "a side of no finite length"
+        across = float(np.linalg.norm(np.ptp(region.surface.bounding_box(), axis=0)))
+    except SurfprepError as exc:
+        return str(exc)
+    if max(lengths) > LONG_SIDE * across:
+        return (f"a side {max(lengths):.3g} long on a surface {across:.3g} across: the region's "
+                "sides leave the surface's domain (a split gone astray)")
+    return None
+
+
 def _longest(region: Region) -> float:
     """The longest side of a region (NaN where a side has no length)."""
     try:
@@ -275,7 +294,6 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
     if dims is not None and size is not None:
         raise InvalidGeometryError("give dims or size, not both")
     spacing = Spacing() if spacing is None else spacing
-    failed: dict[int, str] = {}
     surfaces = [_as_region(s) for s in surfaces]
     given = len(surfaces)
     origin: tuple[int, ...] = tuple(range(given))
@@ -284,20 +302,17 @@ def grid_network(surfaces: list[NurbsSurface | Region], *, gap: float, dims: tup
         # from the blocks given (their pieces are shorter)
         size = float(np.median([_longest(r) for r in surfaces if np.isfinite(_longest(r))] or [1.0])) \
             / DEFAULT_CELLS
+
     if conform:
-        made = conforming(surfaces, gap=gap, fixed=frozenset(hold or {}))
+        # (blocks refused below are not cut)
+        fixed = frozenset(hold or {}) | {b for b, r in enumerate(surfaces) if _refused(r) is not None}
+        made = conforming(surfaces, gap=gap, fixed=fixed)
         surfaces, origin, cuts, left = list(made.surfaces), made.origin, made.cuts, made.left
         hold = {b: (hold or {})[k] for b, k in enumerate(origin) if k in (hold or {})}
-    for b, region in enumerate(surfaces):
-        try:
-            if not all(np.isfinite(side.length) for side in region.sides.values()):
-                raise InvalidGeometryError("a side of no finite length")
-        except SurfprepError as exc:
-            failed[b] = str(exc)
+    failed = {b: why for b, why in ((b, _refused(r)) for b, r in enumerate(surfaces)) if why is not None}
     usable = [b for b in range(len(surfaces)) if b not in failed]
-    found = match_sides([surfaces[b] for b in usable], gap=gap)
     interfaces = [Interface(usable[f.block], f.side, usable[f.other], f.other_side, f.reversed)
-                  for f in found]
+                  for f in match_sides([surfaces[b] for b in usable], gap=gap)]
     counts = _counts(surfaces, interfaces, dims, size, skip=set(failed))
     partner = {}
     for f in interfaces:

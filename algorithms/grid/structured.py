@@ -225,6 +225,8 @@ def _dims(lengths: dict[str, float], dims, size) -> tuple[int, int]:
             raise InvalidGeometryError(f"dims must be two node counts, got {dims!r}") from None
         if ni < 2 or nj < 2 or (ni, nj) != tuple(dims):
             raise InvalidGeometryError(f"dims must be two integers >= 2, got {dims!r}")
+        if max(ni, nj) > 100_001:
+            raise InvalidGeometryError(f"dims {ni} x {nj}: at most 1e5 cells along a side")
         return ni, nj
     long_i = max(lengths["j0"], lengths["j1"])
     long_j = max(lengths["i0"], lengths["i1"])

@@ -120,3 +120,32 @@ def test_a_surface_that_cannot_be_gridded_is_left_out_and_said():
     assert len(net.interfaces) == 1
     with pytest.raises(InvalidGeometryError, match="no surface could be gridded"):
         grid_network([degenerate], gap=1e-9, size=0.1)
+
+
+def test_a_region_whose_side_runs_far_beyond_its_surface_is_refused_with_the_reason():
+    """A region's pcurve zigzagging across the domain (as a split gone astray left one on
+    occt_b1_euclid.stp: a side 1.3e7 mm long on a 7.7 mm surface, whose node count then
+    asked for 3.4 GB): that block is refused and named; the others are gridded."""
+    from surfprep.algorithms import NurbsCurve
+    from surfprep.algorithms.grid.region import Region
+    plane = warped_plane()
+    u0, u1, v0, v1 = plane.domain
+    # from (u0, v1) down to (u0, v0), crossing the domain 60 times on the way
+    zig = np.array([[u0 + (u1 - u0) * (k % 2), v1 - (v1 - v0) * k / 60] for k in range(61)])
+    zig[-1, 0] = u0
+    zigzag = NurbsCurve(zig, np.concatenate([[0.0], np.linspace(0, 1, 61), [1.0]]), 1)
+
+    def seg(a, b):
+        return NurbsCurve(np.array([a, b], dtype=float), [0, 0, 1, 1], 1)
+    runs = [(seg((u0, v0), (u1, v0)), 0.0, 1.0), (seg((u1, v0), (u1, v1)), 0.0, 1.0),
+            (seg((u1, v1), (u0, v1)), 0.0, 1.0), (zigzag, 0.0, 1.0)]
+    astray = Region.from_runs(plane, runs)
+    net = grid_network([warped_plane().split(0.5, "u")[0], astray], gap=1e-9, size=0.1)
+    assert [b for b, _ in net.failed] == [1] and "astray" in net.failed[0][1]
+    assert len(net.blocks) == 1
+
+
+def test_dims_beyond_a_hundred_thousand_nodes_a_side_are_refused():
+    from surfprep.algorithms.grid import grid_surface
+    with pytest.raises(InvalidGeometryError, match="at most 1e5"):
+        grid_surface(warped_plane(), dims=(200_000, 3))
