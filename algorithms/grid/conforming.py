@@ -248,9 +248,7 @@ def _folded(region: Region) -> bool:
     """A coarse (9 x 9) transfinite grid of the region in its surface's parameters has cells
     turned against the others (a cut leaving a very non-convex region)."""
     x = np.linspace(0.0, 1.0, _CHECK)
-    uv = {name: region.sides[name].uv(x) for name in SIDE_NAMES}
-    for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1), ("j1", -1, "i1", -1)):
-        uv[a][ia] = uv[b][ib] = 0.5 * (uv[a][ia] + uv[b][ib])     # a loop's sides meet to its tolerance
+    uv = region.sides_uv(dict.fromkeys(SIDE_NAMES, x))
     st = transfinite(uv["j0"], uv["j1"], uv["i0"], uv["i1"])
     turn = corner_jacobians(st[..., 0], st[..., 1])
     return not (np.all(turn > 0.0) or np.all(turn < 0.0))

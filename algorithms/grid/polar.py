@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import PchipInterpolator
 
 from ..curve import NurbsCurve
+from ..healing.loop_sides import uv_segment
 from ..measure import normals as _surface_normals
 from ..surface import NurbsSurface
 from .region import Region
@@ -152,19 +153,18 @@ class PoleChart:
         scale = np.where(near, _CENTRE / np.where(rho > 0.0, rho, 1.0), 1.0)
         xs = np.where(near & (rho == 0.0), _CENTRE, x * scale)
         ys = y * scale
-        rs = np.minimum(np.hypot(xs, ys), 1.0)
+        r = np.hypot(xs, ys)
         uv = self.to_surface(np.stack([xs, ys], axis=-1))
         d = self.surface.derivatives(uv[..., 0], uv[..., 1], 1)
-        d_angle = self._da(np.mod(np.arctan2(ys, xs), 2.0 * math.pi))   # parameter per radian
-        d_radial = (self.rim - self.pole) * self._dg(rs)            # parameter per chart unit
         s_angle, s_radial = (d[..., 1, 0, :], d[..., 0, 1, :]) if self.angle_axis == 0 \
             else (d[..., 0, 1, :], d[..., 1, 0, :])
-        r2 = np.hypot(xs, ys) ** 2
+        # per radian and per chart unit of radius
+        along = s_angle * self._da(np.mod(np.arctan2(ys, xs), 2.0 * math.pi))[..., None]
+        across = s_radial * ((self.rim - self.pole) * self._dg(np.minimum(r, 1.0)))[..., None]
         out = np.full(x.shape + (2, 2, 3), np.nan)
         out[..., 0, 0, :] = d[..., 0, 0, :]
-        for k, (theta_k, rho_k) in enumerate(((-ys / r2, xs / np.sqrt(r2)), (xs / r2, ys / np.sqrt(r2)))):
-            value = s_angle * (d_angle * theta_k)[..., None] + s_radial * (d_radial * rho_k)[..., None]
-            out[(Ellipsis, 1, 0, slice(None)) if k == 0 else (Ellipsis, 0, 1, slice(None))] = value
+        out[..., 1, 0, :] = along * (-ys / r**2)[..., None] + across * (xs / r)[..., None]   # theta_x, rho_x
+        out[..., 0, 1, :] = along * (xs / r**2)[..., None] + across * (ys / r)[..., None]    # theta_y, rho_y
         return out
 
     def normals(self, x: ArrayLike, y: ArrayLike) -> NDArray:
@@ -225,6 +225,16 @@ def pole_cap(surface: NurbsSurface) -> PoleChart | None:
     return None
 
 
+def _length_table(steps: NDArray, values: NDArray) -> tuple[NDArray, NDArray] | None:
+    """Cumulative ``steps`` as a fraction of their sum, and the ``values`` at them, both
+    increasing (steps of no length dropped); None when there is no length."""
+    length = np.concatenate([[0.0], np.cumsum(steps)])
+    keep = np.concatenate([[True], np.diff(length) > 1e-12 * max(length[-1], 1e-300)])
+    if length[-1] <= 0.0 or keep.sum() < 2:
+        return None
+    return length[keep] / length[-1], values[keep]
+
+
 def _meridian_radius(surface: NurbsSurface, angle_axis: int, pole: float, rim: float) -> tuple[NDArray, NDArray]:
     """Mean arc length from the pole along the meridians, normalized to 1 at the rim, at
     levels 0..1 of the radial parameter: ``(radius, levels)``, both increasing."""
@@ -236,12 +246,8 @@ def _meridian_radius(surface: NurbsSurface, angle_axis: int, pole: float, rim: f
         points = surface.evaluate(angles[:, None], radial[None, :])
     else:
         points = surface.evaluate(radial[None, :], angles[:, None])
-    steps = np.linalg.norm(np.diff(points, axis=1), axis=-1).mean(axis=0)
-    length = np.concatenate([[0.0], np.cumsum(steps)])
-    keep = np.concatenate([[True], np.diff(length) > 1e-12 * max(length[-1], 1e-300)])
-    if length[-1] <= 0.0 or keep.sum() < 2:
-        return levels, levels                                   # no length: linear in the parameter
-    return length[keep] / length[-1], levels[keep]
+    table = _length_table(np.linalg.norm(np.diff(points, axis=1), axis=-1).mean(axis=0), levels)
+    return (levels, levels) if table is None else table          # no length: linear in the parameter
 
 
 def _turning(surface: NurbsSurface, angle_axis: int, pole: float, rim: float) -> tuple[NDArray, NDArray]:
@@ -252,11 +258,10 @@ def _turning(surface: NurbsSurface, angle_axis: int, pole: float, rim: float) ->
     angles = np.linspace(a0, a1, 4 * _ALONG + 1)
     middle = np.full_like(angles, 0.5 * (pole + rim))
     points = surface.evaluate(angles, middle) if angle_axis == 0 else surface.evaluate(middle, angles)
-    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=-1))])
-    keep = np.concatenate([[True], np.diff(length) > 1e-12 * max(length[-1], 1e-300)])
-    if length[-1] <= 0.0 or keep.sum() < 2:
+    table = _length_table(np.linalg.norm(np.diff(points, axis=0), axis=-1), angles)
+    if table is None:
         return np.array([0.0, 2.0 * math.pi]), np.array([a0, a1])
-    return 2.0 * math.pi * length[keep] / length[-1], angles[keep]
+    return 2.0 * math.pi * table[0], table[1]
 
 
 def _arc(a: float, b: float) -> NurbsCurve:
@@ -267,10 +272,6 @@ def _arc(a: float, b: float) -> NurbsCurve:
     cp = np.array([[math.cos(a), math.sin(a)], [math.cos(m) / math.cos(h), math.sin(m) / math.cos(h)],
                    [math.cos(b), math.sin(b)]])
     return NurbsCurve(cp, np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0]), 2, weights=np.array([1.0, math.cos(h), 1.0]))
-
-
-def _segment(a: ArrayLike, b: ArrayLike) -> NurbsCurve:
-    return NurbsCurve(np.array([a, b], dtype=float), np.array([0.0, 0.0, 1.0, 1.0]), 1)
 
 
 def _bulged(a: NDArray, b: NDArray, turn: float) -> NurbsCurve:
@@ -319,9 +320,9 @@ def cap_regions(chart: PoleChart, *, corner_radius: float = CORNER_RADIUS,
     out = [Region.from_runs(chart, [(side, 0.0, 1.0) for side in sides], clockwise=clockwise)]
     for k in range(4):
         runs = [(sides[k], 0.0, 1.0),
-                (_segment(inner[k + 1], rim[k + 1]), 0.0, 1.0),
+                (uv_segment(inner[k + 1], rim[k + 1]), 0.0, 1.0),
                 (_arc(angles[k + 1], angles[k]), 0.0, 1.0),
-                (_segment(rim[k], inner[k]), 0.0, 1.0)]
+                (uv_segment(rim[k], inner[k]), 0.0, 1.0)]
         out.append(Region.from_runs(chart, runs, clockwise=clockwise))
     return out
 

@@ -167,6 +167,16 @@ class Region:
     sides: dict = field(default_factory=dict)
     is_rectangle: bool = False
 
+    def sides_uv(self, x: dict) -> dict:
+        """The ``(u, v)`` of nodes on the four sides, ``x[name]`` their normalized
+        parameters (:class:`Side`): name to ``(n, 2)``, each corner the mean of its two
+        sides' ends (a loop's pcurves meet to its tolerance), so they can be blended."""
+        uv = {name: self.sides[name].uv(x[name]) for name in SIDE_NAMES}
+        for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1),
+                             ("j1", -1, "i1", -1)):
+            uv[a][ia] = uv[b][ib] = 0.5 * (uv[a][ia] + uv[b][ib])
+        return uv
+
     @classmethod
     def rectangle(cls, surface: NurbsSurface) -> Region:
         """The surface's whole parameter rectangle."""

@@ -289,11 +289,7 @@ def _region_start(region: Region, x: dict[str, NDArray], chart: Respacing | None
     each corner the mean of its two sides' ends (a loop's pcurves meet to its tolerance).
     With ``chart``: TFI in the parameters re-spaced at the surface's C0 joins
     (:mod:`.respacing`), mapped back."""
-    sides = {name: region.sides[name].uv(x[name]) for name in SIDE_NAMES}
-    for a, ia, b, ib in (("j0", 0, "i0", 0), ("j0", -1, "i1", 0), ("j1", 0, "i0", -1),
-                         ("j1", -1, "i1", -1)):
-        corner = 0.5 * (sides[a][ia] + sides[b][ib])
-        sides[a][ia] = sides[b][ib] = corner
+    sides = region.sides_uv(x)
     weights = distribution_mesh(*(region.sides[name].fractions_of(x[name]) for name in SIDE_NAMES))
     if chart is None:
         return transfinite(sides["j0"], sides["j1"], sides["i0"], sides["i1"], weights=weights)
