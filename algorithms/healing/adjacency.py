@@ -38,6 +38,8 @@ __all__ = [
 
 #: samples per edge for the pairing test
 EDGE_SAMPLES = 17
+#: an edge using less of its 3D curve than the whole by this share of its domain uses part
+_PART = 1e-9
 _PAIR_CHUNK = 128             # edge pairs per batch of the pairing test
 
 
@@ -74,7 +76,9 @@ def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
     The inner loops count: the walls of a slot through a face meet that face along
     its inner loop (occt_cornetta.stp, occt_k1_alias.stp). Left out, the walls' edges
     looked free, chained into a four-sided "hole" at the slot's mouth, and its patch
-    put a third face on each of those edges."""
+    put a third face on each of those edges. An edge using part of its 3D curve (the
+    pieces of a face split along a cut) is sampled over that part, its curve restricted
+    to it."""
     out = []
     for i, face in enumerate(faces):
         if face is None or not face.loops:
@@ -86,9 +90,14 @@ def face_edges(faces: list[TrimmedFace | None]) -> list[FaceEdge]:
         for k, e in numbered:
             if e.degenerated or e.curve3d is None or e.is_seam:
                 continue
-            t0, t1 = e.curve3d.domain
-            out.append(FaceEdge(i, k, e.curve3d, e.curve3d.evaluate(np.linspace(t0, t1,
-                                                                                EDGE_SAMPLES))))
+            curve = e.curve3d
+            lo, hi = curve.domain
+            t0, t1 = max(e.t0, lo), min(e.t1, hi)
+            if max(t0 - lo, hi - t1) > _PART * (hi - lo):   # part of its curve (a split face)
+                curve = curve.restrict(t0, t1)
+            else:
+                t0, t1 = lo, hi
+            out.append(FaceEdge(i, k, curve, curve.evaluate(np.linspace(t0, t1, EDGE_SAMPLES))))
     return out
 
 

@@ -111,6 +111,7 @@ from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs
 from .close_gaps import closed_in_geometry
+from .crossings import trim_crossings as trim_crossings_of
 from .cut import covered_holes_dropped, cut_under_patches
 from .jobs import (
     PatchOrigin,
@@ -196,7 +197,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
          gap_tol: float | None = None, patches: Any = None,
          overlap: OverlapRepair | str = "trim", split_faces: bool = True,
          replace: str = "defects", meshes: Any = (), fill: str = "holes",
-         close_gaps: bool = True, progress=None,
+         close_gaps: bool = True, trim_crossings: bool = True, progress=None,
          stage: Callable[[str], None] | None = None) -> HealResult:
     """Replace faulty regions by four-sided bicubic approximants joined G0/G1.
 
@@ -253,6 +254,12 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         the B-spline faces along them moved onto one common curve per edge (step 6 of
         the module doc; default). False leaves them as sewing does (faster on large
         models: ``overture_asmo_icem.igs`` 199 s with it).
+    trim_crossings : bool
+        Faces that cut through each other, each running on past the curve where they
+        meet (found where a face's free edges come near another face, :mod:`.crossings`),
+        are cut along that curve and the overshooting pieces dropped (default); the
+        report's ``crossings`` lists each curve, the areas cut away, or why it was left.
+        False leaves them (a directed patch in ``patches`` replaces a crossing instead).
     progress : callable(done, total), optional
         Called before each approximant and after the last.
     stage : callable(str), optional
@@ -311,6 +318,14 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     if cut.cuts or partial:
         edges = face_edges(faces)
     pairs = pair_edges(edges, gap_tol)
+    crossings = []
+    if trim_crossings:
+        work, faces, crossings = trim_crossings_of(work, faces, edges, pairs, gap_tol=gap_tol,
+                                                   tight=TIGHT_FACTOR * model.size,
+                                                   skipped=skipped)
+        if any(c.left is None for c in crossings):
+            edges = face_edges(faces)
+            pairs = pair_edges(edges, gap_tol)
     whole = {i for i, f in enumerate(faces) if f is not None
              and four_sided_boundary(f) is None
              and (not split_faces or quad_boundaries(f, gap_tol=gap_tol) is None)}
@@ -383,6 +398,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     result.extra["free_loops"] = [loop.as_dict() for loop in loops]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
+    result.extra["crossings"] = [c.as_dict() for c in crossings]
     result.extra["retrimmed"] = [r.as_dict() for r in retrims]
     result.extra["snapped_sides"] = snapped
     result.extra["trimmed_overlaps"] = [

@@ -121,6 +121,7 @@ class HealResult:
             "trimmed_overlaps": self.extra.get("trimmed_overlaps", []),
             "cuts": self.extra.get("cuts", []),
             "partial_overlaps": self.extra.get("partial_overlaps", []),
+            "crossings": self.extra.get("crossings", []),
             "retrimmed": self.extra.get("retrimmed", []),
             "snapped_sides": self.extra.get("snapped_sides", 0),
             "skipped": list(self.skipped),

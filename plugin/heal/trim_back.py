@@ -68,6 +68,9 @@ def trim_partial_overlaps(model, faces: list[TrimmedFace | None], candidates: li
                                f"{i}), but both are trimmed: left as they are")
                 continue
             i, j, share = j, i, overlap_share(faces[i], faces[j], gap_tol)
+        expected = overlap_area(faces[j], faces[i], gap_tol)
+        if expected <= 0.0:
+            continue     # samples near a curve where j crosses i, none on it (.crossings)
         try:
             tool = slab(faces[i].surface, SLAB_GAPS * gap_tol, tight)
             k = origin.index(j)
@@ -77,7 +80,6 @@ def trim_partial_overlaps(model, faces: list[TrimmedFace | None], candidates: li
             continue
         if not cuts:
             continue
-        expected = overlap_area(faces[j], faces[i], gap_tol)
         if abs(cuts[0].area_cut - expected) > AREA_AGREEMENT * expected:
             skipped.append(f"faces {i} and {j} overlap over about {expected:.4g}, but cutting "
                            f"{j} back to {i} would remove {cuts[0].area_cut:.4g}: left as "

@@ -263,6 +263,16 @@ def truth(x, y):
     return bend(x, y) + SLOPE * np.maximum(x - X_CROSS, 0.0)
 
 
+def truth_area() -> float:
+    """Area of the intended surface :func:`truth` over [0, 2] x [0, 1]."""
+    x, y = np.linspace(0, 2, 1601), np.linspace(0, 1, 801)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    h = 1e-6
+    zx = (truth(gx + h, gy) - truth(gx - h, gy)) / (2 * h)
+    zy = (truth(gx, gy + h) - truth(gx, gy - h)) / (2 * h)
+    return float(np.trapezoid(np.trapezoid(np.sqrt(1 + zx ** 2 + zy ** 2), y, axis=1), x))
+
+
 def sheet(x0, x1, slope):
     x, y = np.linspace(x0, x1, 9), np.linspace(0, 1, 6)
     gx, gy = np.meshgrid(x, y, indexing="ij")

@@ -10,7 +10,7 @@ import json
 
 import numpy as np
 import pytest
-from helpers.heal_cases import SLOPE, X_CROSS, compound, corners, crossings, sheet, truth
+from helpers.heal_cases import SLOPE, X_CROSS, compound, corners, crossings, sheet, truth, truth_area
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
 from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
@@ -86,15 +86,6 @@ def test_patch_follows_the_sheets_where_smooth(healed):
         smooth = np.abs(pts[:, 0] - X_CROSS) > 0.15       # away from the crease
         assert err[smooth].max() < 2e-3
         assert err.max() < 0.03                           # rounds the crease off
-
-
-def truth_area() -> float:
-    x, y = np.linspace(0, 2, 1601), np.linspace(0, 1, 801)
-    gx, gy = np.meshgrid(x, y, indexing="ij")
-    h = 1e-6
-    zx = (truth(gx + h, gy) - truth(gx - h, gy)) / (2 * h)
-    zy = (truth(gx, gy + h) - truth(gx, gy - h)) / (2 * h)
-    return float(np.trapezoid(np.trapezoid(np.sqrt(1 + zx ** 2 + zy ** 2), y, axis=1), x))
 
 
 def test_patch_over_a_whole_face_replaces_it():
