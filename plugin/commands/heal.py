@@ -101,6 +101,11 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="leave the edges sewing closed by raising their tolerance as they "
                              "are (by default the B-spline faces along them are moved onto "
                              "one common curve per edge: the gaps close in the geometry)")
+    parser.add_argument("--no-trim-crossings", action="store_false", dest="trim_crossings",
+                        help="leave faces that cut through each other as they are (by "
+                             "default, where a face runs on past the curve where it meets "
+                             "another, both are cut along the curve and the overshooting "
+                             "pieces dropped)")
     parser.add_argument("--job-time-limit", type=seconds_argument,
                         default=DEFAULT_JOB_TIME_LIMIT, metavar="S", dest="job_time_limit",
                         help="stop an approximant that takes longer than S seconds to build, "
@@ -131,6 +136,13 @@ def _summary(report: dict) -> list[str]:
         lines.append(f"overlaps trimmed back: {len(partial)} partial "
                      f"({sum(o['area_cut'] for o in partial):.4g} mm2 of doubled area cut), "
                      f"{len(report.get('trimmed_overlaps', []))} strip(s)")
+    crossings = report.get("crossings", [])
+    if crossings:
+        trimmed = [c for c in crossings if c["action"] == "trimmed back"]
+        lines.append(f"{len(crossings)} curve(s) where faces cut through each other: "
+                     f"{len(trimmed)} trimmed back "
+                     f"({sum(sum(c['area_cut']) for c in trimmed):.4g} mm2 of overshoot cut), "
+                     f"{len(crossings) - len(trimmed)} left")
     if joins:
         lines.append(f"{len(joins)} shared edge(s): max gap "
                      f"{max(j['max_gap'] for j in joins):.3g} mm, max normal angle "
@@ -168,7 +180,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
                       patches=args.patches, overlap=args.overlap,
                       split_faces=args.split_faces, replace=args.replace,
                       meshes=args.meshes, fill=args.fill, close_gaps=args.close_gaps,
-                      progress=progress,
+                      trim_crossings=args.trim_crossings, progress=progress,
                       stage=lambda what: console.stage(f"heal: {what}"))
     report = {"input": str(args.input), **result.report(), "dropped": dropped_report(model),
               "repaired": repaired_report(model)}
@@ -202,7 +214,9 @@ COMMAND = Command(
         "surroundings continue across them) are filled, four-sided ones by one "
         "approximant, others by four-sided patches around a centre on a thin-plate "
         "cap continuing the surroundings; open boundaries stay open unless --fill all; faces lying on other faces are dropped, a face "
-        "lying partly on another is trimmed back to the other's boundary; directed "
+        "lying partly on another is trimmed back to the other's boundary, faces cutting "
+        "through each other (each running on past the curve where they meet) are cut "
+        "along it and the overshoots dropped; directed "
         "patches come from --patches and replace what they cover (the faces under "
         "them are cut away). The approximants are joined G0 (shared control "
         "rows averaged) or G1 (tangent planes at corners, collinear control triples "

@@ -84,6 +84,30 @@ def test_heal_directed_patch_over_crossing(tmp_path, capsys):
     assert rep["valid"]["after"] and surfprep.read(out).n_faces == 3
 
 
+def test_heal_trims_a_crossing_without_a_spec(tmp_path, capsys):
+    # the same sheets without a spec: cut along their crossing, the overshoots dropped;
+    # --no-trim-crossings leaves them
+    def sheet(x0, x1, slope):
+        x, y = np.linspace(x0, x1, 9), np.linspace(0, 1, 6)
+        gx, gy = np.meshgrid(x, y, indexing="ij")
+        return interpolate_surface(np.stack([gx, gy, 0.05 * np.sin(2 * gy) + slope * (gx - 1.0)],
+                                            axis=-1))
+    src = tmp_path / "crossing.step"
+    surfprep.write([make_face(sheet(0, 1.2, 0.0)), make_face(sheet(0.8, 2, 0.4))], src)
+    out, report = tmp_path / "healed.step", tmp_path / "r.json"
+    code, stdout, err = run(capsys, "heal", src, "-o", out, "--json", report)
+    assert code == 0, err
+    assert "1 curve(s) where faces cut through each other: 1 trimmed back" in stdout
+    rep = json.loads(report.read_text())
+    assert [c["action"] for c in rep["crossings"]] == ["trimmed back"]
+    assert rep["free_edges"]["before"] == 8 and rep["free_edges"]["after"] == 6
+    code, stdout, err = run(capsys, "heal", src, "-o", tmp_path / "left.step", "--json", report,
+                            "--no-trim-crossings")
+    assert code == 0, err
+    rep = json.loads(report.read_text())
+    assert rep["crossings"] == [] and rep["free_edges"]["after"] == 8
+
+
 @pytest.mark.parametrize("overlap, faces_out", [("trim", 2), ("union", 1)])
 def test_heal_overlap_option(tmp_path, capsys, overlap, faces_out):
     # a strip overlap of two four-sided sheets: --overlap trim keeps two faces (the later
