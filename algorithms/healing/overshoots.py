@@ -38,16 +38,18 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
 from ..face_region import FaceRegion
 from ..projection import project_to_surface
 from ..trimmed import TrimmedFace
 from .adjacency import face_edges, pair_edges, polyline_distance
 
-__all__ = ["OVERSHOOT_SHARE", "CrossingDecision", "edges_pass_through", "overshoot_pieces"]
+__all__ = ["OVERSHOOT_SHARE", "SIDE_GRID", "CrossingDecision", "SurfaceSides", "edges_pass_through",
+           "overshoot_pieces"]
 
-#: grid samples per knot span where the edges' points are first placed on a surface
-_SEED_SAMPLES = 8
+#: samples per direction of a surface for the first signed distances (SurfaceSides)
+SIDE_GRID = 33
 
 #: of two dangling pieces along a crossing curve, the smaller is the overshoot when its
 #: component's area is at most this share of the other's
@@ -73,28 +75,62 @@ class CrossingDecision:
     reason: str | None = None
 
 
-def edges_pass_through(region: FaceRegion, edges: NDArray, gap_tol: float) -> bool:
+class SurfaceSides:
+    """A face's surface sampled once (``SIDE_GRID`` squared points with their normals, in a
+    k-d tree), to tell on which side of it many points lie: the nearest sample's tangent
+    plane gives each point a first signed distance, exact for a plane and off by about
+    the surface's curvature times the samples' spacing squared elsewhere."""
+
+    def __init__(self, region: FaceRegion) -> None:
+        self.region = region
+        surface = region.surface
+        u0, u1, v0, v1 = surface.domain
+        u, v = np.linspace(u0, u1, SIDE_GRID), np.linspace(v0, v1, SIDE_GRID)
+        uu, vv = np.meshgrid(u, v, indexing="ij")
+        self.uv = np.stack([uu.ravel(), vv.ravel()], axis=1)
+        self.points = surface.evaluate_grid(u, v).reshape(-1, 3)
+        self.normals = surface.normals(self.uv[:, 0], self.uv[:, 1])
+        self.tree = cKDTree(self.points)
+        cp = surface.control_points[..., :3].reshape(-1, 3)
+        self.lo, self.hi = cp.min(axis=0), cp.max(axis=0)
+
+    def first_guess(self, points: NDArray) -> tuple[NDArray, NDArray]:
+        """Signed distances ``(n,)`` of ``points (n, 3)`` to the nearest sample's tangent
+        plane, and that sample's ``(n, 2)`` parameters."""
+        nearest = self.tree.query(points)[1]
+        d = np.einsum("nc,nc->n", points - self.points[nearest], self.normals[nearest])
+        return d, self.uv[nearest]
+
+
+def edges_pass_through(sides: SurfaceSides, edges: NDArray, gap_tol: float) -> bool:
     """Whether one of the polylines ``edges (m, k, 3)`` (another face's edges, sampled)
-    passes through the face of ``region``: from farther than ``gap_tol`` on one side of
+    passes through the face of ``sides``: from farther than ``gap_tol`` on one side of
     its surface to farther than ``gap_tol`` on the other, crossing the surface inside
     the face (or on its boundary: two sheets crossing flush at their sides). Where two
     faces cut through each other, an edge of one does (a flap's side through the other
     sheet, a wall's corner through the lid it overshoots); faces that only meet, or
     overlap their neighbours by less than ``gap_tol`` at a gap, do not -- the cheap test
     before intersecting them. Only the polylines whose box meets the surface's control
-    box (grown by ``gap_tol``) are projected onto it.
+    box (grown by ``gap_tol``) and whose first signed distances
+    (:meth:`SurfaceSides.first_guess`) change sign are projected onto the surface
+    (Newton from the nearest sample).
     """
-    surface = region.surface
     edges = np.asarray(edges, float)
-    cp = surface.control_points[..., :3].reshape(-1, 3)
-    lo, hi = cp.min(axis=0) - gap_tol, cp.max(axis=0) + gap_tol
-    near = np.all((edges.max(axis=1) >= lo) & (edges.min(axis=1) <= hi), axis=1)
+    near = np.all((edges.max(axis=1) >= sides.lo - gap_tol)
+                  & (edges.min(axis=1) <= sides.hi + gap_tol), axis=1)
     edges = edges[near]
     if not edges.size:
         return False
     m, k, _ = edges.shape
-    foot = project_to_surface(surface, edges.reshape(-1, 3), n_seeds=1,
-                              samples_per_span=_SEED_SAMPLES)
+    rough, guess = sides.first_guess(edges.reshape(-1, 3))
+    rough = rough.reshape(m, k)
+    maybe = (rough.min(axis=1) < -0.5 * gap_tol) & (rough.max(axis=1) > 0.5 * gap_tol)
+    if not np.any(maybe):
+        return False
+    edges, guess = edges[maybe], guess.reshape(m, k, 2)[maybe]
+    m = edges.shape[0]
+    surface = sides.region.surface
+    foot = project_to_surface(surface, edges.reshape(-1, 3), guess=guess.reshape(-1, 2))
     uv = foot.uv.reshape(m, k, 2)
     normal = surface.normals(foot.uv[:, 0], foot.uv[:, 1]).reshape(m, k, 3)
     d = np.einsum("mkc,mkc->mk", edges - foot.points.reshape(m, k, 3), normal)
@@ -103,7 +139,7 @@ def edges_pass_through(region: FaceRegion, edges: NDArray, gap_tol: float) -> bo
     if not e.size:
         return False
     w = (d[e, s] / (d[e, s] - d[e, s + 1]))[:, None]
-    return bool(np.any(region.contains((1 - w) * uv[e, s] + w * uv[e, s + 1])))
+    return bool(np.any(sides.region.contains((1 - w) * uv[e, s] + w * uv[e, s + 1])))
 
 
 def overshoot_pieces(pieces: list[TrimmedFace], origin: list[int], areas: NDArray,

@@ -30,8 +30,8 @@ import numpy as np
 
 from ...algorithms.face_region import FaceRegion
 from ...algorithms.face_split import Cut, split_face
-from ...algorithms.healing.adjacency import FaceEdge
-from ...algorithms.healing.overshoots import edges_pass_through, overshoot_pieces
+from ...algorithms.healing.adjacency import FaceEdge, polyline_distance
+from ...algorithms.healing.overshoots import SurfaceSides, edges_pass_through, overshoot_pieces
 from ...algorithms.trimmed import TrimmedFace
 from ...errors import SurfprepError
 from ..intersect import intersect
@@ -43,6 +43,9 @@ __all__ = ["CURVE_SHARE", "Crossing", "crossing_candidates", "trim_crossings"]
 
 #: the crossing curves are computed to this share of ``tight``
 CURVE_SHARE = 0.1
+#: a curve's end farther than this times ``tight`` from a face's boundary and its other
+#: curves stops inside the face (split_face's own test is 10 x CURVE_SHARE x tight)
+_ENDS_SHARE = 10.0
 #: samples of each crossing curve compared with the pieces' edges
 _CURVE_SAMPLES = 257
 
@@ -128,12 +131,12 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
     polylines: dict[int, list] = {}
     for e in edges:
         polylines.setdefault(e.face, []).append(e.samples)
-    regions: dict[int, FaceRegion] = {}
+    sides: dict[int, SurfaceSides] = {}
 
     def through(i: int, j: int) -> bool:        # an edge of i passes through face j
-        if j not in regions:
-            regions[j] = FaceRegion(faces[j])
-        return edges_pass_through(regions[j], np.stack(polylines[i]), gap_tol)
+        if j not in sides:
+            sides[j] = SurfaceSides(FaceRegion(faces[j]))
+        return edges_pass_through(sides[j], np.stack(polylines[i]), gap_tol)
 
     candidates = [(i, j) for i, j in candidates if i in polylines and j in polylines
                   and (through(i, j) or through(j, i))]
@@ -151,10 +154,11 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
                       and r.curve.pcurve_b is not None)
     if not curves:
         return model, faces, []
-    refused: dict[int, str] = {}
+    refused = _stopping_inside(faces, curves, sides, _ENDS_SHARE * tight)
+    done: dict = {}      # (face, its curves) -> pieces: a face keeps them while they stay
     while True:          # faces split along the curves whose two faces can both be cut
         usable = [(i, j, r) for i, j, r in curves if i not in refused and j not in refused]
-        split = _split_faces(faces, usable, 10.0 * CURVE_SHARE * tight, refused)
+        split = _split_faces(faces, usable, 10.0 * CURVE_SHARE * tight, refused, done)
         if split is not None:
             break
     pieces, origin, built = [], [], []
@@ -180,29 +184,63 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
         if i in refused or j in refused:
             f = i if i in refused else j
             crossings.append(Crossing((i, j), float(r.length), (0.0, 0.0),
-                                      f"face {f}: it cannot be cut along the curve ({refused[f]})"))
+                                      f"face {f}: {refused[f]}"))
     skipped.extend(_notes(crossings))
     if not dropped:
         return model, faces, crossings
     return _with_pieces(model, faces, pieces, origin, built, dropped) + (crossings,)
 
 
-def _split_faces(faces, curves, tol3d: float, refused: dict[int, str]) -> dict | None:
+def _stopping_inside(faces, curves, sides: dict, near: float) -> dict[int, str]:
+    """Faces where a curve ends inside, neither on the boundary nor on another of the
+    face's curves (within ``near`` plus the sag of the face's sampled boundary): two
+    faces poking through each other without one dividing the other, which no cut trims
+    (:func:`split_face` would refuse it, at a cost growing with the face's curves). Per
+    such face the reason."""
+    lines: dict[int, list] = {}
+    for i, j, r in curves:
+        c = r.curve.curve3d
+        line = c.evaluate(np.linspace(*c.domain, _CURVE_SAMPLES))
+        for f, g in ((i, j), (j, i)):
+            lines.setdefault(f, []).append((g, line))
+    out = {}
+    for f, mine in lines.items():
+        if f not in sides:
+            sides[f] = SurfaceSides(FaceRegion(faces[f]))
+        for n, (g, line) in enumerate(mine):
+            ends, region = line[[0, -1]], sides[f].region
+            reach = near + region.boundary_sag
+            inside = region.edge_distance(ends) > reach
+            for m, (_, other) in enumerate(mine):
+                if m != n and inside.any():
+                    inside &= polyline_distance(ends, other) > reach
+            if inside.any():
+                out[f] = (f"a curve stops inside it (where it meets face {g}: the two poke "
+                          "through each other, neither divided)")
+                break
+    return out
+
+
+def _split_faces(faces, curves, tol3d: float, refused: dict[int, str], done: dict) -> dict | None:
     """Per face cut by ``curves`` its pieces and their OpenCascade faces; None when a face
     cannot be cut or a piece built (the face added to ``refused`` with the reason: the
-    caller splits again without its curves)."""
-    cuts: dict[int, list[Cut]] = {}
+    caller splits again without its curves). ``done`` keeps the faces split so far by
+    their curves, so a face whose curves did not change is not split again."""
+    cuts: dict[int, list] = {}
     for i, j, r in curves:
-        cuts.setdefault(i, []).append(Cut(r.curve.pcurve_a, r.curve.curve3d))
-        cuts.setdefault(j, []).append(Cut(r.curve.pcurve_b, r.curve.curve3d))
+        cuts.setdefault(i, []).append((id(r), Cut(r.curve.pcurve_a, r.curve.curve3d)))
+        cuts.setdefault(j, []).append((id(r), Cut(r.curve.pcurve_b, r.curve.curve3d)))
     out = {}
     for f, face_cuts in cuts.items():
-        try:
-            pieces = split_face(faces[f], face_cuts, tol3d=tol3d)
-            out[f] = (pieces, [trimmed_face_to_occ(p) for p in pieces])
-        except SurfprepError as exc:
-            refused[f] = str(exc)
-            return None
+        key = (f, tuple(k for k, _ in face_cuts))
+        if key not in done:
+            try:
+                pieces = split_face(faces[f], [c for _, c in face_cuts], tol3d=tol3d)
+                done[key] = (pieces, [trimmed_face_to_occ(p) for p in pieces])
+            except SurfprepError as exc:
+                refused[f] = f"it cannot be cut along the curves ({exc})"
+                return None
+        out[f] = done[key]
     return out
 
 
@@ -212,7 +250,7 @@ def _notes(crossings: list[Crossing]) -> list[str]:
     done = [c for c in crossings if c.left is None]
     if done:
         pairs = ", ".join(f"{i}-{j}" for i, j in dict.fromkeys(c.faces for c in done))
-        notes.append(f"{len(done)} curves where faces cut through each other: both faces "
+        notes.append(f"{len(done)} curve(s) where faces cut through each other: both faces "
                      f"trimmed back to each (faces {pairs}; area cut away "
                      f"{sum(sum(c.area_cut) for c in done):.4g})")
     kinds: dict[str, list] = {}
@@ -222,7 +260,7 @@ def _notes(crossings: list[Crossing]) -> list[str]:
             kinds.setdefault(kind, []).append(c.faces)
     for kind, pairs in kinds.items():
         listed = ", ".join(f"{i}-{j}" for i, j in dict.fromkeys(pairs))
-        notes.append(f"{len(pairs)} curves where faces cut through each other left as they "
+        notes.append(f"{len(pairs)} curve(s) where faces cut through each other left as they "
                      f"are: {kind} (faces {listed}; the report's crossings say why)")
     return notes
 
