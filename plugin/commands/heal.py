@@ -171,6 +171,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
             raise InputFileError(f"--mesh {mesh} does not exist or is not a file")
     from ..heal import heal
     from ..io import staged_write
+    from .notes import grouped
     model = read_model(args.input, console, strict=args.strict)
     with step_time_limit(args.job_time_limit, "an approximant") as restart:
         def progress(done: int, total: int) -> None:
@@ -194,7 +195,7 @@ def _run(args: argparse.Namespace, console: Console) -> int:
     for line in _summary(report):
         console.print(line)
     console.print(f"written to {report['output']}")
-    for note in report["skipped"] + report["topology_violations"]:
+    for note in grouped(report["skipped"] + report["topology_violations"]):
         console.note(f"note: {note}")
     if report_path is not None:
         console.note(f"report written to {report_path}")
