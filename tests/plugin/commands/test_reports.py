@@ -46,11 +46,24 @@ def normalized(value, key: str = ""):
     return value
 
 
+#: per face pair of a self-intersection, counts from before the curves along shared edges
+#: are dropped: the fuselage's faces meet tangentially, and how many border points and
+#: curves are found there at the tolerance's edge follows the last bits of the CPU's
+#: floating-point paths (an AVX-512 machine finds 166 where another found 174); the
+#: result, the curves kept and everything measured on them, is compared in full
+KNIFE_EDGE = ("border", "curves_before_clipping", "found_by_characteristic")
+
+
 def mismatches(got, want, where: str = "$") -> list[str]:
-    """Every place where ``got`` differs from ``want`` (floats to RTOL)."""
+    """Every place where ``got`` differs from ``want`` (floats to RTOL; the counters of
+    ``KNIFE_EDGE`` only as non-negative integers)."""
     if isinstance(want, dict) and isinstance(got, dict):
         out = [f"{where}: keys {sorted(set(got) ^ set(want))}"] if set(got) != set(want) else []
         for k in sorted(set(got) & set(want)):
+            if k in KNIFE_EDGE and isinstance(want[k], int):
+                if not (isinstance(got[k], int) and got[k] >= 0):
+                    out.append(f"{where}.{k}: {got[k]!r}, not a count")
+                continue
             out += mismatches(got[k], want[k], f"{where}.{k}")
         return out
     if isinstance(want, list) and isinstance(got, list):
@@ -120,3 +133,7 @@ def test_comparison_sees_a_changed_figure():
     assert mismatches({"faces": [{"area": 1.0, "name": "b"}], "n": 2}, want)
     assert mismatches({"faces": [], "n": 2}, want)
     assert mismatches({"faces": [{"area": 1.0, "name": "a"}]}, want)
+    # the knife-edge counters are compared as counts only
+    assert not mismatches({"pairs": [{"border": 166}]}, {"pairs": [{"border": 174}]})
+    assert mismatches({"pairs": [{"border": -1}]}, {"pairs": [{"border": 174}]})
+    assert mismatches({"pairs": [{"curves": 1}]}, {"pairs": [{"curves": 0}]})
