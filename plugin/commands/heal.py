@@ -4,6 +4,7 @@ bicubic approximants (:func:`surfprep.plugin.heal.heal`)."""
 from __future__ import annotations
 
 import argparse
+import math
 from collections import Counter
 from pathlib import Path
 
@@ -122,11 +123,14 @@ def _summary(report: dict) -> list[str]:
     worst_err = max((p["max_error"] for p in patches if p["max_error"] is not None),
                     default=float("nan"))
     worst_dev = max((p["deviation_from_input"] for p in patches), default=float("nan"))
+    errors = ""                  # no approximant, or none measured: no figure, not "nan"
+    if math.isfinite(worst_err):
+        errors += f", largest error {worst_err:.3g} mm"
+    if math.isfinite(worst_dev):
+        errors += f" (largest distance from the input faces, dense: {worst_dev:.3g} mm)"
     lines = [(f"{len(patches)} approximant(s) "
              f"({len({p['index'] for p in patches if p['kind'] == 'hole'})} hole(s) "
-             "filled), "
-             f"largest error {worst_err:.3g} mm (largest distance from the input faces, "
-             f"dense: {worst_dev:.3g} mm), {len(report['dropped_overlaps'])} duplicate "
+             f"filled){errors}, {len(report['dropped_overlaps'])} duplicate "
              f"face(s) dropped, {report['time_s']:.2f} s")]
     cuts, partial = report.get("cuts", []), report.get("partial_overlaps", [])
     if cuts:
@@ -136,6 +140,10 @@ def _summary(report: dict) -> list[str]:
         lines.append(f"overlaps trimmed back: {len(partial)} partial "
                      f"({sum(o['area_cut'] for o in partial):.4g} mm2 of doubled area cut), "
                      f"{len(report.get('trimmed_overlaps', []))} strip(s)")
+    stages = report.get("stage_times_s", {})
+    if stages:
+        lines.append("time per stage: " + ", ".join(f"{name} {t:.2f} s" for name, t in stages.items()
+                                                    if t >= 0.005))
     crossings = report.get("crossings", [])
     if crossings:
         trimmed = [c for c in crossings if c["action"] == "trimmed back"]

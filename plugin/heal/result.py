@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 from OCP.TopoDS import TopoDS_Shape
@@ -11,6 +12,34 @@ from ..io import CadModel
 from .jobs import PatchOrigin
 
 __all__ = ["HealResult", "PatchReport"]
+
+
+class StageClock:
+    """Seconds spent in each stage of :func:`surfprep.heal`: calling it with a stage's
+    name ends the stage before and tells ``stage`` (the caller's callback, if any);
+    :meth:`times` ends the last and returns ``{stage: seconds}``."""
+
+    def __init__(self, stage=None) -> None:
+        self._tell = stage
+        self._times: dict[str, float] = {}
+        self._current: str | None = None
+        self._since = time.perf_counter()
+
+    def _end(self) -> float:
+        now = time.perf_counter()
+        if self._current is not None:
+            self._times[self._current] = self._times.get(self._current, 0.0) + now - self._since
+        return now
+
+    def __call__(self, name: str) -> None:
+        self._current, self._since = name, self._end()
+        if self._tell is not None:
+            self._tell(name)
+
+    def times(self) -> dict[str, float]:
+        self._end()
+        self._current = None
+        return dict(self._times)
 
 
 @dataclass(frozen=True)
@@ -110,7 +139,8 @@ class HealResult:
         net = self.network
         return {
             "continuity": self.continuity.value, "tol": self.tol, "gap_tol": self.gap_tol,
-            "time_s": self.time_s, "faces_in": self.extra.get("faces_in"),
+            "time_s": self.time_s, "stage_times_s": self.extra.get("stage_times_s", {}),
+            "faces_in": self.extra.get("faces_in"),
             "faces_out": self.model.n_faces,
             "patches": [p.as_dict() for p in self.patches],
             "shared_edges": [j.as_dict() for j in self.joins],

@@ -38,7 +38,7 @@ def normalized(value, key: str = ""):
     """The report without its times, with paths reduced to their file names."""
     if isinstance(value, dict):
         return {k: normalized(v, k) for k, v in value.items()
-                if not (k == "time_s" or k.endswith("_time_s"))}
+                if not (k == "time_s" or k.endswith(("_time_s", "_times_s")))}
     if isinstance(value, list):
         return [normalized(v, key) for v in value]
     if isinstance(value, str) and key in ("file", "files", "input", "output"):

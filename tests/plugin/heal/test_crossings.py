@@ -54,6 +54,17 @@ def test_two_sheets_are_trimmed_back_to_their_crossing(sheets):
     assert not any("overlap over" in note for note in rep["skipped"])  # a crossing is no overlap
 
 
+def test_the_report_gives_the_time_of_each_stage(sheets):
+    rep = sheets[2].report()
+    stages = rep["stage_times_s"]
+    assert list(stages) == ["reading the faces", "directed patches and overlaps",
+                            "finding gaps, holes and crossings",
+                            "triangulating the faces as sources", "approximants",
+                            "joining, sewing and checking", "closing gaps in the geometry"]
+    assert all(t >= 0 for t in stages.values())
+    assert 0.9 * rep["time_s"] <= sum(stages.values()) <= rep["time_s"]
+
+
 def test_nothing_crosses_in_the_output_but_the_shared_edge(sheets):
     # OpenCascade's section of the two output faces: only the curve x = 1 they share
     f, g = all_faces(sheets[2].model.shape)
