@@ -314,18 +314,24 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
                             tol=tol, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,
                             skipped=skipped)
     work, faces = cut.model, cut.faces
-    work, faces, partial = trim_overlaps_of(work, faces, gap_tol=gap_tol,
-                                            tight=TIGHT_FACTOR * model.size, skipped=skipped)
-    if cut.cuts or partial:
+    if cut.cuts:
         edges = face_edges(faces)
-    say("finding gaps, holes and crossings")
     pairs = pair_edges(edges, gap_tol)
+    work, faces, partial, duplicates = trim_overlaps_of(
+        work, faces, edges, pairs, gap_tol=gap_tol, tight=TIGHT_FACTOR * model.size,
+        skipped=skipped)
+    changed = bool(partial)                 # since the duplicates were found
+    if partial:
+        edges = face_edges(faces)
+        pairs = pair_edges(edges, gap_tol)
+    say("finding gaps, holes and crossings")
     crossings = []
     if trim_crossings:
         work, faces, crossings = trim_crossings_of(work, faces, edges, pairs, gap_tol=gap_tol,
                                                    tight=TIGHT_FACTOR * model.size,
                                                    skipped=skipped)
         if any(c.left is None for c in crossings):
+            changed = True
             edges = face_edges(faces)
             pairs = pair_edges(edges, gap_tol)
     whole = {i for i, f in enumerate(faces) if f is not None
@@ -337,7 +343,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     if retrims:
         edges = face_edges(faces)
         pairs = pair_edges(edges, gap_tol)
-    dropped = duplicate_faces(faces, edges, pairs, gap_tol)
+    dropped = (duplicate_faces(faces, edges, pairs, gap_tol) if changed or retrims
+               else duplicates)
     gone = {b for _, b in dropped}
     kept = [i for i, f in enumerate(faces) if f is not None and i not in gone]
     every_edge = edges                      # the dropped faces' too: a drop may be taken back

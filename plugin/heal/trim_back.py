@@ -21,7 +21,7 @@ reported and left (the slab would cover the part trimmed away).
 
 from __future__ import annotations
 
-from ...algorithms.healing.adjacency import duplicate_faces, face_edges, pair_edges
+from ...algorithms.healing.adjacency import duplicate_faces
 from ...algorithms.healing.partial_overlap import (
     PartialOverlap,
     overlap_area,
@@ -102,17 +102,19 @@ def _unit(surface):
                    knots_v=(surface.knots_v - v0) / (v1 - v0))
 
 
-def trim_overlaps_of(work, faces: list[TrimmedFace | None], *, gap_tol: float, tight: float,
-                     skipped: list[str]):
+def trim_overlaps_of(work, faces: list[TrimmedFace | None], edges, pairs, *, gap_tol: float,
+                     tight: float, skipped: list[str]):
     """:func:`trim_partial_overlaps` over the readable faces of ``work`` that are no
-    duplicates (:func:`duplicate_faces`, dropped later); strips (:func:`is_strip`) are
-    left to :func:`surfprep.algorithms.healing.strip_overlap.find_overlaps`. Returns
-    ``(model, faces, overlaps)``."""
-    edges = face_edges(faces)
-    twins = {b for _, b in duplicate_faces(faces, edges, pair_edges(edges, gap_tol), gap_tol)}
+    duplicates (:func:`duplicate_faces` on ``edges`` and their ``pairs``, dropped later);
+    strips (:func:`is_strip`) are left to
+    :func:`surfprep.algorithms.healing.strip_overlap.find_overlaps`. Returns ``(model,
+    faces, overlaps, duplicates)``, the duplicates those of the faces given (the same as
+    the faces returned when no overlap was trimmed)."""
+    duplicates = duplicate_faces(faces, edges, pairs, gap_tol)
+    twins = {b for _, b in duplicates}
     readable = [i for i, f in enumerate(faces) if f is not None and i not in twins]
     strips: set = set()            # strips are told apart by is_strip (cheaper)
     work, faces, _, partial = trim_partial_overlaps(work, faces, readable, strips,
                                                     gap_tol=gap_tol, tight=tight,
                                                     skipped=skipped)
-    return work, faces, partial
+    return work, faces, partial, duplicates
