@@ -216,10 +216,10 @@ def split_face(face: TrimmedFace, cuts: list[Cut], *, tol: float | None = None,
         by_loop.setdefault(m.loop, []).append(m)
     for li, ms in by_loop.items():
         for pieces, start, stop in _runs(loops[li], ms, eps):
-            if not pieces:               # two marks at one point of the loop
+            if not pieces:   # two cut ends a rounding apart, not one vertex (seen on real files)
                 raise InvalidGeometryError(
-                    f"two cuts end at one boundary point (loop {li}, near "
-                    f"{np.round(start.along, 6)} along it)")
+                    f"two cut ends on loop {li} (near {np.round(start.along, 6)} along it) "
+                    "leave nothing of the loop between them but are not one vertex")
             graph.run(pieces, start.vertex, stop.vertex, max(start.gap, stop.gap))
     graph.check_ends()
     cycles = graph.cycles()
