@@ -490,18 +490,7 @@ def box_table() -> list[str]:
     from OCP.TopTools import TopTools_ListOfShape
     cross = _crossing()
 
-    def quad(p00, p10, p01, p11):
-        s = np.linspace(0.0, 1.0, 4)
-        u, v = np.meshgrid(s, s, indexing="ij")
-        p = [np.asarray(x, float) for x in (p00, p10, p01, p11)]
-        return interpolate_surface(((1 - u) * (1 - v))[..., None] * p[0] + (u * (1 - v))[..., None] * p[1]
-                                   + ((1 - u) * v)[..., None] * p[2] + (u * v)[..., None] * p[3])
-    o, h = 0.1, 1.1
-    faces = [make_face(f) for f in (
-        quad((0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)), quad((0, 0, 0), (1, 0, 0), (0, 0, h), (1, 0, h)),
-        quad((1, 0, 0), (1, 1, 0), (1, 0, h), (1, 1, h)), quad((1, 1, 0), (0, 1, 0), (1, 1, h), (0, 1, h)),
-        quad((0, 1, 0), (0, 0, 0), (0, 1, h), (0, 0, h)),
-        quad((-o, -o, 1), (1 + o, -o, 1), (-o, 1 + o, 1), (1 + o, 1 + o, 1)))]
+    faces = [make_face(f) for f in cross.overshooting_box(0.1, 1.1)]
     shape = cross.compound(faces)
 
     def volume(s) -> float:

@@ -279,6 +279,29 @@ def sheet(x0, x1, slope):
     return interpolate_surface(np.stack([gx, gy, bend(gx, gy) + slope * (gx - X_CROSS)], -1))
 
 
+def bilinear_quad(p00, p10, p01, p11) -> NurbsSurface:
+    """The bilinear patch through four corners (``p10`` at u = 1, ``p01`` at v = 1), as a
+    bicubic interpolant of 4 x 4 of its points (exactly bilinear)."""
+    s = np.linspace(0.0, 1.0, 4)
+    u, v = np.meshgrid(s, s, indexing="ij")
+    p = [np.asarray(x, float) for x in (p00, p10, p01, p11)]
+    return interpolate_surface(((1 - u) * (1 - v))[..., None] * p[0] + (u * (1 - v))[..., None] * p[1]
+                               + ((1 - u) * v)[..., None] * p[2] + (u * v)[..., None] * p[3])
+
+
+def overshooting_box(over: float = 0.1, height: float = 1.1) -> list[NurbsSurface]:
+    """A unit cube's bottom, its four walls running up to ``height`` and a lid at z = 1
+    reaching ``over`` beyond the walls: the lid and the walls cut through each other
+    (their overshoots a collar above the lid and a rim around it)."""
+    o, h = over, height
+    return [bilinear_quad((0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)),
+            bilinear_quad((0, 0, 0), (1, 0, 0), (0, 0, h), (1, 0, h)),
+            bilinear_quad((1, 0, 0), (1, 1, 0), (1, 0, h), (1, 1, h)),
+            bilinear_quad((1, 1, 0), (0, 1, 0), (1, 1, h), (0, 1, h)),
+            bilinear_quad((0, 1, 0), (0, 0, 0), (0, 1, h), (0, 0, h)),
+            bilinear_quad((-o, -o, 1), (1 + o, -o, 1), (-o, 1 + o, 1), (1 + o, 1 + o, 1))]
+
+
 def compound(shapes):
     """A compound of the faces."""
     from surfprep.plugin.io import to_shape

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.heal_cases import bilinear_quad
 
-from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.algorithms.healing.overshoots import OVERSHOOT_SHARE, overshoot_pieces
 from surfprep.algorithms.trimmed import TrimmedFace, natural_loop
 
@@ -16,12 +16,7 @@ GAP = 1e-4
 
 
 def quad(p00, p10, p01, p11) -> TrimmedFace:
-    s = np.linspace(0.0, 1.0, 4)
-    a, b = np.meshgrid(s, s, indexing="ij")
-    p = [np.asarray(x, float) for x in (p00, p10, p01, p11)]
-    pts = (((1 - a) * (1 - b))[..., None] * p[0] + (a * (1 - b))[..., None] * p[1]
-           + ((1 - a) * b)[..., None] * p[2] + (a * b)[..., None] * p[3])
-    surface = interpolate_surface(pts)
+    surface = bilinear_quad(p00, p10, p01, p11)
     return TrimmedFace(surface, (natural_loop(surface),))
 
 

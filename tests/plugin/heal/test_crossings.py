@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.heal_cases import SLOPE, X_CROSS, compound, sheet, truth_area
+from helpers.heal_cases import overshooting_box as box_surfaces
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepAlgoAPI import BRepAlgoAPI_Section
 from OCP.BRepBuilderAPI import BRepBuilderAPI_Sewing
@@ -19,7 +20,6 @@ from OCP.TopAbs import TopAbs_EDGE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-from surfprep.algorithms.fitting import interpolate_surface
 from surfprep.plugin.convert import to_nurbs
 from surfprep.plugin.heal import heal
 from surfprep.plugin.occ.faces import make_face
@@ -102,26 +102,8 @@ def test_a_crossing_half_way_is_left_with_the_reason():
     assert any("left as they are" in note for note in r.report()["skipped"])
 
 
-def quad(p00, p10, p01, p11):
-    s = np.linspace(0.0, 1.0, 4)
-    u, v = np.meshgrid(s, s, indexing="ij")
-    p = [np.asarray(x, float) for x in (p00, p10, p01, p11)]
-    pts = (((1 - u) * (1 - v))[..., None] * p[0] + (u * (1 - v))[..., None] * p[1]
-           + ((1 - u) * v)[..., None] * p[2] + (u * v)[..., None] * p[3])
-    return interpolate_surface(pts)
-
-
 def overshooting_box(over=0.1, height=1.1):
-    """A unit cube's bottom, four walls running up to ``height`` and a lid at z = 1
-    reaching ``over`` beyond the walls: the lid and the walls cut through each other."""
-    o, h = over, height
-    faces = [quad((0, 0, 0), (0, 1, 0), (1, 0, 0), (1, 1, 0)),
-             quad((0, 0, 0), (1, 0, 0), (0, 0, h), (1, 0, h)),
-             quad((1, 0, 0), (1, 1, 0), (1, 0, h), (1, 1, h)),
-             quad((1, 1, 0), (0, 1, 0), (1, 1, h), (0, 1, h)),
-             quad((0, 1, 0), (0, 0, 0), (0, 1, h), (0, 0, h)),
-             quad((-o, -o, 1), (1 + o, -o, 1), (-o, 1 + o, 1), (1 + o, 1 + o, 1))]
-    return compound([make_face(f) for f in faces])
+    return compound([make_face(f) for f in box_surfaces(over, height)])
 
 
 def volume(shape) -> float:
