@@ -503,12 +503,14 @@ def box_table() -> list[str]:
         BRepGProp.SurfaceProperties_s(s, props)
         return float(props.Mass())
     rows = []
-    start = time.perf_counter()
-    r = surfprep.heal(shape)
-    t = time.perf_counter() - start
-    rows.append(f"| surfprep heal (defaults) | {r.model.shape.ShapeType().name[7:].lower()} | "
-                f"{count_free_edges(r.model.shape)} | {r.valid_after} | {area(r.model.shape):.6g} | "
-                f"{volume(r.model.shape):.6g} | {t:.3f} |")
+    for when in ("first", "second"):          # the first pays for loading the kernels
+        start = time.perf_counter()
+        r = surfprep.heal(shape)
+        t = time.perf_counter() - start
+        rows.append(f"| surfprep heal (defaults), {when} call in the process | "
+                    f"{r.model.shape.ShapeType().name[7:].lower()} | "
+                    f"{count_free_edges(r.model.shape)} | {r.valid_after} | "
+                    f"{area(r.model.shape):.6g} | {volume(r.model.shape):.6g} | {t:.3f} |")
     start = time.perf_counter()
     maker = BOPAlgo_MakerVolume()
     args = TopTools_ListOfShape()
@@ -615,7 +617,7 @@ def files_table() -> list[str]:
 
 def main() -> None:
     import sys
-    tables = (hole_table, nsided_table, gap_table, crossing_table, box_table, table1_rows,
+    tables = (box_table, hole_table, nsided_table, gap_table, crossing_table, table1_rows,
               files_table)
     if len(sys.argv) > 1:                  # e.g. python benchmarks/heal.py crossing_table
         tables = tuple(t for t in tables if t.__name__ in sys.argv[1:])
