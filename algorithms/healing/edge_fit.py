@@ -424,6 +424,16 @@ def _second_differences(n: int) -> sparse.csr_matrix:
     return sparse.diags([1.0, -2.0, 1.0], [0, 1, 2], shape=(n - 2, n), format="csr")
 
 
+def _path_laplacian(n: int) -> sparse.csr_matrix:
+    """``D^T D`` of the ``(n - 1, n)`` first differences: tridiagonal, -1 off the
+    diagonal, 1 2 ... 2 1 on it (zero for n = 1)."""
+    if n < 2:
+        return sparse.csr_matrix((n, n))
+    main = np.full(n, 2.0)
+    main[[0, -1]] = 1.0
+    return sparse.diags([-np.ones(n - 1), main, -np.ones(n - 1)], [-1, 0, 1], format="csr")
+
+
 def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, shape: tuple[int, int]) -> NDArray:
     """Control-point displacements ``d`` (n_u n_v, 3) minimizing
 
@@ -436,12 +446,12 @@ def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, shape: tuple[int, 
     steps of iterated Tikhonov regularization (the same factorization applied to what
     the samples still miss) take out the pull the membrane keeps on them."""
     nu, nv = shape
-    first_u = sparse.diags([-1.0, 1.0], [0, 1], shape=(max(nu - 1, 0), nu), format="csr")
-    first_v = sparse.diags([-1.0, 1.0], [0, 1], shape=(max(nv - 1, 0), nv), format="csr")
-    membrane = [sparse.kron(first_u, sparse.identity(nv)), sparse.kron(sparse.identity(nu), first_v)]
+    # |D_u d|^2 + |D_v d|^2 = d^T (L_u (x) I + I (x) L_v) d, L = D^T D the path Laplacian
+    # on each side of the net: its Kronecker sum, built without multiplying the big
+    # difference matrices
+    energy = sparse.kronsum(_path_laplacian(nv), _path_laplacian(nu), format="csc")
     gram = (matrix.T @ matrix).tocsc()
     scale = float(gram.diagonal().max())
-    energy = sum((m.T @ m for m in membrane), sparse.csc_matrix((nu * nv, nu * nv)))
     decay = (_DECAY * max(nu, nv)) ** 2
     system = _SMOOTH * scale * (energy + sparse.identity(nu * nv) / decay) + gram
     solve = splinalg.splu(system.tocsc()).solve
