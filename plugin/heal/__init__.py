@@ -331,6 +331,10 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
                                                    tight=TIGHT_FACTOR * model.size,
                                                    skipped=skipped)
         if any(c.left is None for c in crossings):
+            if continuity is Continuity.G1:
+                skipped.append("faces trimmed back to the curve where they cut through each "
+                               "other meet there at the angle they cross at, not G1: a "
+                               "directed patch over the crossing (patches=) blends it")
             changed = True
             edges = face_edges(faces)
             pairs = pair_edges(edges, gap_tol)

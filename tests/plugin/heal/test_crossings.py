@@ -83,6 +83,15 @@ def test_nothing_crosses_in_the_output_but_the_shared_edge(sheets):
     assert np.max(np.abs(points[:, 0] - X_CROSS)) < 1e-6
 
 
+def test_with_g1_asked_the_crease_is_said(sheets):
+    a, b, r = sheets
+    assert not any("not G1" in note for note in r.report()["skipped"])   # G0 asked
+    g1 = heal(compound([make_face(a), make_face(b)]), continuity="G1")
+    assert [c["action"] for c in g1.report()["crossings"]] == ["trimmed back"]
+    assert any("not G1" in note for note in g1.report()["skipped"])
+    assert g1.tight_free_edges_after == 6 and g1.valid_after
+
+
 def test_crossings_are_left_when_asked(sheets):
     a, b, _ = sheets
     r = heal(compound([make_face(a), make_face(b)]), trim_crossings=False)
