@@ -8,9 +8,9 @@ points'): a closed model without free edges costs nothing here, and the work fol
 the free edges. Of those, the pairs where an edge of one passes through the other face
 (:func:`~surfprep.algorithms.healing.overshoots.edges_pass_through`: from beyond
 ``gap_tol`` on one side to beyond it on the other, inside the face) are intersected by
-:func:`surfprep.intersect` (the triangle method, to ``CURVE_SHARE`` x ``tight`` so that the faces trimmed to the
-curve meet within ``tight`` in the geometry); every face a curve crosses is split along
-its curves (:func:`~surfprep.algorithms.face_split.split_face`), and which pieces are
+:func:`surfprep.intersect` (the triangle method, to ``CURVE_SHARE`` x ``tight``, so that
+the faces trimmed to the curve meet within ``tight`` in the geometry); every face a
+curve crosses is split along its curves (:func:`~surfprep.algorithms.face_split.split_face`), and which pieces are
 overshoots is decided by the model around them
 (:func:`~surfprep.algorithms.healing.overshoots.overshoot_pieces`: a piece whose side
 ends in free edges where the other is part of the model, or, of two sheets, the piece
