@@ -77,7 +77,7 @@ from .shared_edges import (
 __all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "close_gaps", "closed_in_geometry"]
 
 #: samples per edge where the gap is first measured ...
-PROBE_SAMPLES = 17
+PROBE_SAMPLES = 65
 #: ... where a moving face is fitted (this many evenly and as many clustered at the ends;
 #: knot spans are split while one holds 12 of them) ...
 FIT_SAMPLES = 513
