@@ -235,8 +235,10 @@ def restrict_array(points_w: ArrayLike, knots: ArrayLike, degree: int, a: float,
     return _trim_end(points_w, knots, degree, b)
 
 
-#: a knot this close to a cut (relative to the knot vector's span) is taken at the cut
-_KNOT_SNAP = 1e-12
+#: a knot this close to a cut (relative to the knots' magnitude: 64 roundings) is taken
+#: at the cut; a wider snap would move the geometry by the snap over the span's width
+#: (1e-12 of the span moved a surface by 1.6e-11 of its size next to a short span)
+_KNOT_SNAP = 64 * np.finfo(float).eps
 
 
 def _at_bound(knots: NDArray, value: float) -> NDArray:
@@ -245,7 +247,7 @@ def _at_bound(knots: NDArray, value: float) -> NDArray:
     multiplicity ``degree`` inserted ``degree`` more knots a few ulps away: a span of width
     1e-16 at the end of the piece and derivatives off by orders of magnitude (a half
     cylinder split at its join: S_u of 152 for 45)."""
-    near = np.abs(knots - value) <= _KNOT_SNAP * max(float(knots[-1] - knots[0]), 1.0)
+    near = np.abs(knots - value) <= _KNOT_SNAP * max(float(np.abs(knots).max()), abs(value), 1.0)
     if not near.any() or np.all(knots[near] == value):
         return knots
     out = knots.copy()

@@ -407,3 +407,19 @@ def test_a_split_a_rounding_off_a_full_knot_moves_the_knot_onto_it():
     one_sided = half.derivatives(at + 1e-9, 0.5, 1)[1, 0]
     assert np.allclose(high.derivatives(high.domain[0], 0.5, 1)[1, 0], one_sided, atol=1e-6)
     assert np.allclose(low.evaluate(low.domain[1], 0.3), half.evaluate(at, 0.3), atol=1e-12)
+
+
+def test_a_cut_near_a_knot_but_not_a_rounding_off_it_leaves_the_knot():
+    """Hypothesis's case: a bilinear surface restricted from 1e-12 of its v domain above
+    the knot where that domain starts. A snap of knots within 1e-12 of the span moved that knot onto
+    the cut, shifting the geometry over the short span by 1.6e-11 of its size; only knots
+    a rounding off a cut (64 roundings) are moved now, and the piece is the surface."""
+    cp = np.array([[[0.87249983, 8.70144848, 6.31707108], [-9.94523, 7.14808553, -9.32828849]],
+                   [[4.59310893, -6.48688759, 7.26357845], [0.8292244, -4.00576219, -1.54625558]]])
+    s = NurbsSurface(cp, [4.52409183e-03, 1.36961687e+00, 3.89301723e+00, 5.19642324e+00],
+                     [-4.99627532, 3.13270239, 10.47836922, 19.50984133], 1, 1)
+    u0, u1, v0, v1 = s.domain
+    box = (u0, u1, v0 + 1e-12 * (v1 - v0), v1)
+    piece = restrict_surface(s, *box)
+    assert piece.domain == box
+    assert_same_surface(piece, s, *surface_samples(s, 40, box))
