@@ -9,7 +9,8 @@ __all__ = ["grouped"]
 
 _LIST = re.compile(r"\[[\d,\s]+\]")
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?")
-_PLURAL = {"face": "faces", "faces": "faces", "patch": "patches", "patches": "patches"}
+_SINGULAR = {"faces": "face", "patches": "patch"}
+_PLURAL = {"face": "faces", "patch": "patches"}
 _SUBJECT = re.compile(r"\b(face|faces|patch|patches)\s+\[?(\d+(?:(?:,\s*| and )\d+)*)\]?")
 
 
@@ -35,8 +36,8 @@ def grouped(notes: list[str]) -> list[str]:
             continue
         names = [_subject(note) for note in same[1:]]
         word = _SUBJECT.search(same[0])
-        noun = "note" if word is None else word.group(1)
-        noun = _PLURAL.get(noun, noun) if len(names) > 1 else noun.removesuffix("es" if noun == "patches" else "s")
+        noun = "note" if word is None else _SINGULAR.get(word.group(1), word.group(1))
+        noun = _PLURAL.get(noun, noun) if len(names) > 1 else noun
         listed = ", ".join(n for n in names if n) or "..."
         out.append(f"{same[0]} [and {len(same) - 1} more like it: {noun} {listed}]")
     return out

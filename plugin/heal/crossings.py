@@ -131,11 +131,17 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
     polylines: dict[int, list] = {}
     for e in edges:
         polylines.setdefault(e.face, []).append(e.samples)
+    regions: dict[int, FaceRegion] = {}
     sides: dict[int, SurfaceSides] = {}
+
+    def region(f: int) -> FaceRegion:
+        if f not in regions:
+            regions[f] = FaceRegion(faces[f])
+        return regions[f]
 
     def through(i: int, j: int) -> bool:        # an edge of i passes through face j
         if j not in sides:
-            sides[j] = SurfaceSides(FaceRegion(faces[j]))
+            sides[j] = SurfaceSides(region(j))
         return edges_pass_through(sides[j], np.stack(polylines[i]), gap_tol)
 
     candidates = [(i, j) for i, j in candidates if i in polylines and j in polylines
@@ -154,7 +160,9 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
                       and r.curve.pcurve_b is not None)
     if not curves:
         return model, faces, []
-    refused = _stopping_inside(faces, curves, sides, _ENDS_SHARE * tight)
+    lines = {id(r): r.curve.curve3d.evaluate(np.linspace(*r.curve.curve3d.domain, _CURVE_SAMPLES))
+             for _, _, r in curves}
+    refused = _stopping_inside(curves, lines, region, _ENDS_SHARE * tight)
     done: dict = {}      # (face, its curves) -> pieces: a face keeps them while they stay
     while True:          # faces split along the curves whose two faces can both be cut
         usable = [(i, j, r) for i, j, r in curves if i not in refused and j not in refused]
@@ -170,9 +178,7 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
             origin.append(f)
             built.append(occ)
     areas = np.array([face_area(b) if b is not None else 0.0 for b in built])
-    polylines = [r.curve.curve3d.evaluate(np.linspace(*r.curve.curve3d.domain, _CURVE_SAMPLES))
-                 for _, _, r in usable]
-    dropped, decisions = overshoot_pieces(pieces, origin, areas, polylines,
+    dropped, decisions = overshoot_pieces(pieces, origin, areas, [lines[id(r)] for _, _, r in usable],
                                           [(i, j) for i, j, _ in usable], gap_tol)
     crossings, counted = [], set()
     for (i, j, r), d in zip(usable, decisions):
@@ -188,29 +194,27 @@ def trim_crossings(model, faces: list[TrimmedFace | None], edges: list[FaceEdge]
     skipped.extend(_notes(crossings))
     if not dropped:
         return model, faces, crossings
-    return _with_pieces(model, faces, pieces, origin, built, dropped) + (crossings,)
+    return _with_pieces(model, origin, built, dropped) + (crossings,)
 
 
-def _stopping_inside(faces, curves, sides: dict, near: float) -> dict[int, str]:
+def _stopping_inside(curves, lines: dict, region, near: float) -> dict[int, str]:
     """Faces where a curve ends inside, neither on the boundary nor on another of the
     face's curves (within ``near`` plus the sag of the face's sampled boundary): two
     faces poking through each other without one dividing the other, which no cut trims
     (:func:`split_face` would refuse it, at a cost growing with the face's curves). Per
-    such face the reason."""
-    lines: dict[int, list] = {}
+    such face the reason. ``lines`` holds each curve's polyline by ``id``, ``region(f)``
+    gives face ``f``'s :class:`FaceRegion`."""
+    by_face: dict[int, list] = {}
     for i, j, r in curves:
-        c = r.curve.curve3d
-        line = c.evaluate(np.linspace(*c.domain, _CURVE_SAMPLES))
         for f, g in ((i, j), (j, i)):
-            lines.setdefault(f, []).append((g, line))
+            by_face.setdefault(f, []).append((g, lines[id(r)]))
     out = {}
-    for f, mine in lines.items():
-        if f not in sides:
-            sides[f] = SurfaceSides(FaceRegion(faces[f]))
+    for f, mine in by_face.items():
+        face = region(f)
+        reach = near + face.boundary_sag
         for n, (g, line) in enumerate(mine):
-            ends, region = line[[0, -1]], sides[f].region
-            reach = near + region.boundary_sag
-            inside = region.edge_distance(ends) > reach
+            ends = line[[0, -1]]
+            inside = face.edge_distance(ends) > reach
             for m, (_, other) in enumerate(mine):
                 if m != n and inside.any():
                     inside &= polyline_distance(ends, other) > reach
@@ -265,7 +269,7 @@ def _notes(crossings: list[Crossing]) -> list[str]:
     return notes
 
 
-def _with_pieces(model, faces, pieces, origin, built, dropped):
+def _with_pieces(model, origin, built, dropped):
     """``model`` with every face that lost a piece replaced by the pieces it keeps."""
     losing = {origin[p] for p in dropped}
     kept: dict[int, list] = {}
@@ -274,9 +278,7 @@ def _with_pieces(model, faces, pieces, origin, built, dropped):
             kept.setdefault(f, []).append(built[p])
     occ, names, colors = [], [], []
     for f, (face, name, color) in enumerate(zip(model.faces, model.face_names, model.face_colors)):
-        mine = kept.get(f, [face]) if f in losing or faces[f] is None else [face]
-        if f in losing and not mine:
-            continue
+        mine = kept.get(f, []) if f in losing else [face]
         for n, piece in enumerate(mine, start=1):
             occ.append(piece)
             names.append(name if len(mine) == 1 or name is None else f"{name}.{n}")
