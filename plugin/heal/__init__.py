@@ -253,7 +253,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         Close in the geometry the edges sewing closed only by raising their tolerance:
         the B-spline faces along them moved onto one common curve per edge (step 6 of
         the module doc; default). False leaves them as sewing does (faster on large
-        models: ``overture_asmo_icem.igs`` 199 s with it).
+        models: ``overture_asmo_icem.igs`` 101 s with it, 35 s without).
     trim_crossings : bool
         Faces that cut through each other, each running on past the curve where they
         meet (found where a face's free edges come near another face, :mod:`.crossings`),
