@@ -30,6 +30,10 @@ _GRAD_DIP = 0.25
 _BRANCH_ROUNDS = 8
 #: a half-branch counts as traced when a trace arrives within this angle of it
 _ARRIVAL_COS = np.cos(np.radians(30.0))
+#: a point whose two branches would cross at less than this angle (uv plane) lies on a
+#: tangential contact, not at a branch point: ``|lambda_min / lambda_max|`` of its
+#: Hessian below ``tan^2(angle / 2)`` (the branches leave along ``d^T H d = 0``)
+_MIN_BRANCH_ANGLE = np.radians(1.0)
 
 
 def _g_hessian(field: DistanceField, kind: CurveKind, jet) -> NDArray:
@@ -223,6 +227,19 @@ def continue_at_singular_points(field: DistanceField, curves: list[TracedCurve],
     return work
 
 
+def _tangential_contact(hess: NDArray) -> NDArray:
+    """``(k,) bool``: which Hessians ``(k, 2, 2)`` are those of points on a curve where
+    the two surfaces touch, not of branch points. Along such a curve ``grad g``
+    vanishes everywhere, so Newton on ``grad g = 0`` converges wherever it starts,
+    to a point whose Hessian is of rank one to rounding: its "branches" cross at
+    under ``_MIN_BRANCH_ANGLE``. (Faces 43 and 177 of occt_bearing_euclid.iges meet
+    tangentially along a side of one of them: 198 such points; splitting 115
+    traces at each and tracing their branches took 580 s and added no curve.)"""
+    lam = np.linalg.eigvalsh(0.5 * (hess + np.swapaxes(hess, 1, 2)))
+    big = np.abs(lam).max(axis=1)
+    return np.abs(lam).min(axis=1) < np.tan(0.5 * _MIN_BRANCH_ANGLE) ** 2 * big
+
+
 def _split_at_found(field: DistanceField, kind: CurveKind, work: list[TracedCurve],
                     fresh: list[int], found: list, gtol: float | None, h_max: float
                     ) -> tuple[list[TracedCurve], int]:
@@ -246,6 +263,7 @@ def _split_at_found(field: DistanceField, kind: CurveKind, work: list[TracedCurv
             g, _ = curve_value(jet, kind)
             ok &= np.abs(g) <= 1e-6 * np.abs(hess).max(axis=(1, 2)) * field.diagonal
         ok &= np.linalg.norm(jet.uv - uv, axis=1) <= reach
+        ok &= ~_tangential_contact(hess)
         for i in np.flatnonzero(ok):
             if any(np.linalg.norm(f[0] - jet.uv[i]) <= 1e-9 * field.diagonal for f in found):
                 continue
@@ -262,22 +280,66 @@ def _split_at_found(field: DistanceField, kind: CurveKind, work: list[TracedCurv
     fresh_set, first_new = set(fresh), len(found) - new
     out = []
     for k, c in enumerate(work):
-        pieces = [c]
-        for f in found if k in fresh_set else found[first_new:]:
-            pieces = [q for piece in pieces for q in _split_once(field, piece, f[:5], h_max)]
-        out.extend(pieces)
+        out.extend(_split_in_order(field, c, found if k in fresh_set else found[first_new:],
+                                   h_max))
     return out, new
 
 
-def _split_once(field: DistanceField, curve: TracedCurve, point: list, h_max: float
-                ) -> list[TracedCurve]:
-    """``curve`` split at ``point`` when it passes it (:func:`_split`), else as it is."""
+def _reach(curve: TracedCurve, h_max: float) -> float:
+    """How far from ``curve`` (uv units) a point may lie and still cut it: twice its
+    longest step, at most ``h_max``."""
     steps = np.linalg.norm(np.diff(curve.uv, axis=0), axis=1)
-    reach = 2 * float(steps.max(initial=0.0)) if steps.size else 0.0
-    if any(np.linalg.norm(curve.uv[e] - point[0]) == 0 for e in (0, -1)):
+    return min(2 * float(steps.max(initial=0.0)), h_max)
+
+
+def _first_cut(curve: TracedCurve, centres: NDArray, reach: float) -> int | None:
+    """Index of the first of ``centres (m, 2)`` that cuts ``curve`` (:func:`_split`
+    would not return None: a sample within ``reach``) and is not one of its end
+    samples; None when none does."""
+    uv = curve.uv
+    if curve.closed:
+        uv = np.vstack([uv, uv[:1]])
+    low, high = uv.min(axis=0) - reach, uv.max(axis=0) + reach
+    near = np.flatnonzero(np.all((centres >= low) & (centres <= high), axis=1))
+    if near.size == 0:
+        return None
+    ends = np.all(centres[near] == curve.uv[0], axis=1) | np.all(centres[near] == curve.uv[-1],
+                                                                  axis=1)
+    near = near[~ends]
+    for chunk in np.array_split(near, max(1, near.size * uv.shape[0] // 2_000_000)):
+        if chunk.size == 0:
+            continue
+        d = np.linalg.norm(centres[chunk, None, :] - uv[None], axis=2).min(axis=1)
+        hit = np.flatnonzero(d <= reach)
+        if hit.size:
+            return int(chunk[hit[0]])
+    return None
+
+
+def _split_in_order(field: DistanceField, curve: TracedCurve, points: list, h_max: float
+                    ) -> list[TracedCurve]:
+    """``curve`` split at each of ``points`` it passes, in their order: the pieces
+    of splitting it at the first (:func:`_split`), each split at the following
+    ones, and so on. Each piece is compared with all the points still to come at
+    once, so the cost follows the cuts, not pieces x points (198 singular points
+    along a tangential contact of occt_bearing_euclid.iges faces 43 x 177, each
+    tried on every piece one by one: 580 s)."""
+    if not points:
         return [curve]
-    parts = _split(field, curve, point, min(reach, h_max))
-    return parts if parts is not None else [curve]
+    centres = np.array([p[0] for p in points])
+    out: list[TracedCurve] = []
+    stack = [(curve, 0)]
+    while stack:
+        piece, start = stack.pop()
+        reach = _reach(piece, h_max)
+        k = _first_cut(piece, centres[start:], reach) if start < len(points) else None
+        if k is None:
+            out.append(piece)
+            continue
+        k += start
+        parts = _split(field, piece, points[k][:5], reach)
+        stack.extend((p, k + 1) for p in reversed(parts if parts is not None else [piece]))
+    return out
 
 
 def _returns_at(uv: NDArray, centre: NDArray, delta: float) -> int | None:

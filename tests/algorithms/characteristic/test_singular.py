@@ -20,7 +20,7 @@ import pytest
 
 from surfprep.algorithms import NurbsSurface
 from surfprep.algorithms.characteristic.algorithm import choose_field
-from surfprep.algorithms.characteristic.curves import CurveKind, EndReason, trace_curves
+from surfprep.algorithms.characteristic.curves import CurveKind, EndReason, TracedCurve, trace_curves
 from surfprep.algorithms.characteristic.singular import continue_at_singular_points
 from surfprep.algorithms.characteristic.trace import (
     to_intersection_curve,
@@ -143,3 +143,25 @@ def test_isolated_point_has_no_branches():
     uv, st = start_on(field, np.array([X0 + 1e-4, Y0, 0.0]))
     traced = trace_intersections(field, uv, st, np.array([0.1]), tol=tol, branches=True)
     assert all(t.uv.shape[0] <= 2 for t in traced)        # nothing leaves the point
+
+
+def test_tangential_contact_is_not_split_into_branch_points():
+    """The parabolic cylinder ``z = (y - Y0)^2`` touches the plane along the line
+    ``y = Y0``: ``grad phi`` vanishes all along it, so Newton on ``grad phi = 0``
+    converges wherever it starts, to points with a rank-one Hessian. They are points
+    of the contact, not branch points: a trace along the line comes back whole, with
+    no branch added (real files' tangential joins gave hundreds of such points and
+    hours of splitting)."""
+    tol = 1e-7
+    trough = graph(lambda x, y: (y - Y0) ** 2 + 0 * x, 1, 2)
+    field = choose_field(trough, plane(), tol=tol, phi_on="a")
+    x = np.linspace(0.05, 0.95, 61)
+    uv = np.stack([x, np.full_like(x, Y0)], axis=1)
+    uv[:, 1] += 1e-9 * np.sin(37 * x)              # rounding-sized wiggle: |grad| dips
+    jet = field.jet(uv)
+    trace = TracedCurve(CurveKind.INTERSECTION, uv, jet.st, jet.phi, jet.grad,
+                        jet.projection.det_k, EndReason.DOMAIN, EndReason.DOMAIN)
+    assert np.abs(jet.phi).max() <= tol
+    pieces = continue_at_singular_points(field, [trace], tol=tol, h_max=0.02)
+    assert len(pieces) == 1
+    np.testing.assert_array_equal(pieces[0].uv, uv)
