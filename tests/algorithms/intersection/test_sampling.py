@@ -144,3 +144,27 @@ def test_a_dip_of_the_fourth_derivative_estimate_is_raised_to_its_neighbours():
     ring = np.array([0.01, 1.0, 1.0, 1.0, 2.0])
     assert _with_neighbours(ring, closed=True)[0] == pytest.approx(_NEIGHBOUR_SHARE * 2.0)
     assert _with_neighbours(ring, closed=False)[0] == pytest.approx(_NEIGHBOUR_SHARE * 1.0)
+
+
+def test_repeated_dense_samples_do_not_inflate_the_plan():
+    """Seven dense samples a rounding apart (a corner where a refined curve piled up,
+    occt_spaceship_alias.stp faces 1 x 3) made fourth divided differences of
+    rounding over 1e-48 and a plan of millions of samples; the repeats are left out
+    and the curve comes out as without them, within tol densely."""
+    c, tol = 0.5, 1e-7
+    dense = dense_arc(c, 120, tol)
+    k = 40
+    rng = np.random.default_rng(5)
+    idx = np.concatenate([np.arange(k + 1), np.full(6, k), np.arange(k + 1, dense.points.shape[0])])
+    wiggle = np.zeros((idx.size, 1))
+    wiggle[k + 1:k + 7] = 1.0
+    piled = RefinedCurve(dense.points[idx] + 1e-13 * wiggle * rng.standard_normal((idx.size, 3)),
+                         dense.uv_a[idx] + 1e-15 * wiggle * rng.standard_normal((idx.size, 2)),
+                         dense.uv_b[idx] + 1e-15 * wiggle * rng.standard_normal((idx.size, 2)),
+                         False, dense.converged[idx], dense.singular[idx])
+    (clean,) = cubic_samples(plane_z(c), sphere_patch(), [dense], tol=tol)
+    (sampled,) = cubic_samples(plane_z(c), sphere_patch(), [piled], tol=tol)
+    assert sampled.curve.points.shape[0] <= clean.curve.points.shape[0] + 2
+    curve3d = sampled.interpolants[0]
+    t = np.linspace(sampled.parameters[0], sampled.parameters[-1], 20001)
+    assert exact_distance(curve3d.evaluate(t), c).max() <= tol
