@@ -184,6 +184,51 @@ class TrimmedFace:
         """All edge occurrences of all loops."""
         return tuple(e for loop in self.loops for e in loop.edges)
 
+    def parameter_box(self) -> tuple[float, float, float, float]:
+        """``(u0, u1, v0, v1)`` holding the face: the box of its loops' pcurve control
+        points (each pcurve, restricted to the part its edge uses, lies in their hull;
+        all loops, so that a hole taken for the outer loop cannot shrink it), within the surface's domain; the whole
+        domain without loops, or when a pcurve reaches outside the domain (a
+        periodic surface's pcurve shifted by a period)."""
+        domain = self.surface.domain
+        if not self.loops:
+            return domain
+        u0, u1, v0, v1 = domain
+        pad = 1e-9 * max(u1 - u0, v1 - v0)
+        poles = np.concatenate([_used_poles(c, e.t0, e.t1) for e in self.edges
+                                for c in (e.pcurve, e.seam_pcurve) if c is not None])
+        low, high = poles.min(axis=0), poles.max(axis=0)
+        if not (np.all(np.isfinite(poles)) and low[0] >= u0 - pad and high[0] <= u1 + pad
+                and low[1] >= v0 - pad and high[1] <= v1 + pad):
+            return domain
+        return (max(float(low[0]), u0), min(float(high[0]), u1),
+                max(float(low[1]), v0), min(float(high[1]), v1))
+
+    def bounding_box(self) -> NDArray:
+        """``(2, d)`` box holding the face: the control net's box of the surface
+        restricted to :meth:`parameter_box` (exact restriction, so the face lies
+        inside it; the whole surface's box when the face spans its domain or the
+        restriction would be degenerate). Tighter than ``surface.bounding_box()``
+        for a face trimmed from a larger surface."""
+        box = self.parameter_box()
+        u0, u1, v0, v1 = self.surface.domain
+        if box == (u0, u1, v0, v1) or not (box[1] > box[0] and box[3] > box[2]):
+            return self.surface.bounding_box()
+        return self.surface.restrict(*box).bounding_box()
+
+
+def _used_poles(pcurve: NurbsCurve, t0: float, t1: float) -> NDArray:
+    """``(m, 2)`` control points of ``pcurve`` over ``[t0, t1]`` (the curve restricted
+    when the edge uses only part of it; as it is when it cannot be)."""
+    a, b = pcurve.domain
+    lo, hi = min(t0, t1), max(t0, t1)
+    if a <= lo < hi <= b and (lo > a or hi < b):
+        try:
+            pcurve = pcurve.restrict(lo, hi)
+        except (InvalidGeometryError, ValueError):
+            pass
+    return np.asarray(pcurve.control_points, dtype=float)[:, :2]
+
 
 def curve3d_points(edge: TrimEdge, surface: NurbsSurface, t: np.ndarray) -> np.ndarray:
     """Points ``(m, 3)`` of the edge at ``t (m,)``: its 3D curve, else its pcurve through the surface."""

@@ -1,7 +1,9 @@
 """Intersection curves of faces: :func:`intersect` on anything that holds faces.
 
 For every pair of faces (across ``a`` and ``b``, or within ``a`` when ``b`` is
-None) whose boxes overlap, the two *surfaces* are intersected by
+None) whose boxes overlap (each face's box: its surface restricted to the box of
+its loops in ``(u, v)``, :meth:`TrimmedFace.bounding_box`), the two *surfaces* are
+intersected by
 :func:`surfprep.algorithms.intersection.intersect_surfaces`. Every curve is
 then clipped to both faces' trimmed domains
 (:func:`surfprep.algorithms.intersection.clip_curve`: the point-in-face test of
@@ -160,6 +162,13 @@ def _boxes(faces: Sequence[FaceOperand]) -> NDArray:
         if faces else np.zeros((0, 2, 3))
 
 
+def _face_boxes(faces: Sequence[FaceOperand]) -> NDArray:
+    """Boxes of the faces (not of their whole surfaces: a face cut from a larger surface
+    gets the box of the surface restricted to its loops' parameter box)."""
+    return np.stack([np.asarray(f.trimmed.bounding_box(), dtype=float) for f in faces]) \
+        if faces else np.zeros((0, 2, 3))
+
+
 def _size(boxes: NDArray) -> float:
     return float(np.linalg.norm(boxes[:, 1].max(axis=0) - boxes[:, 0].min(axis=0)))
 
@@ -310,6 +319,8 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
         tol = DEFAULT_TOL_FACTOR * size
     tol = check_tolerance(tol, "tol", low=MIN_TOL_FACTOR * size, high=size)
     pad = tol
+    boxes_a = _face_boxes(faces_a)
+    boxes_b = boxes_a if b is None else _face_boxes(faces_b)
     overlap = np.all((boxes_a[:, None, 0] <= boxes_b[None, :, 1] + pad)
                      & (boxes_b[None, :, 0] <= boxes_a[:, None, 1] + pad), axis=-1)
     if b is None:

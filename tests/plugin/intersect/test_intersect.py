@@ -307,3 +307,30 @@ def test_a_pair_stopped_by_the_callers_time_limit_is_recorded_and_the_run_goes_o
     assert len(result.records) == len(seen) - 1 == 2
     assert sorted(r.faces for r in result) == sorted(p for p in (seen[0], seen[2]))
     assert result.report()["stopped_pairs"][0]["faces"] == list(seen[1])
+
+
+def test_faces_whose_own_boxes_are_apart_are_not_intersected():
+    """Two small faces cut from crossing planes, both away from where the planes cross:
+    the surfaces' boxes overlap, the faces' do not, and no pair is worked on; faces of
+    the same planes that reach the crossing still give its segment."""
+    from surfprep import NurbsCurve, NurbsSurface, TrimmedFace
+    from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
+
+    def square(x0, x1):
+        c = np.array([[x0, 0.0], [x1, 0.0], [x1, 1.0], [x0, 1.0]])
+        return TrimLoop(tuple(TrimEdge(None, NurbsCurve(np.array([a, b]), [0, 0, 1, 1], 1),
+                                       0.0, 1.0) for a, b in zip(c, np.roll(c, -1, axis=0))))
+
+    knots = [0, 0, 1, 1]
+    flat = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]], float),
+                        knots, knots, 1, 1)                      # z = 0
+    slope = NurbsSurface(np.array([[[0, 0, -0.5], [0, 1, -0.5]], [[1, 0, 0.5], [1, 1, 0.5]]],
+                                  float), knots, knots, 1, 1)      # z = x - 0.5
+    apart = intersect(TrimmedFace(flat, (square(0.0, 0.2),)),
+                      TrimmedFace(slope, (square(0.8, 1.0),)), tol=1e-7)
+    assert len(apart) == 0 and len(apart.records) == 0
+    meeting = intersect(TrimmedFace(flat, (square(0.3, 0.7),)),
+                        TrimmedFace(slope, (square(0.4, 1.0),)), tol=1e-7)
+    assert len(meeting) == 1 and len(meeting.records) == 1
+    np.testing.assert_allclose(meeting[0].points[:, 0], 0.5, atol=1e-7)
+    assert meeting[0].length == pytest.approx(1.0, abs=1e-7)
