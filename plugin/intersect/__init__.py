@@ -196,7 +196,7 @@ def _one_pair(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | No
               method: Method, within: bool):
     """The curves of one face pair clipped to both faces (not those along a shared edge
     ``within`` one operand), its contact points, coincident regions and its record."""
-    curves, found_by, record = pair_curves(fa, fb, tol, mesh_tol, method)
+    curves, found_by, record = pair_curves(fa, fb, tol, mesh_tol, method, within=within)
     pieces = [FaceIntersection(piece, fa, fb, tol, how)
               for curve, how in zip(curves, found_by)
               for piece in clip_curve(curve, fa.region, fb.region, tol)

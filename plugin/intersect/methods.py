@@ -217,11 +217,14 @@ class IntersectionResult(list):
 
 
 def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                 tangential: Sequence[IntersectionCurve] = ()) -> list[IntersectionCurve]:
-    """The triangle method on a face pair, its failures as warnings."""
+                 tangential: Sequence[IntersectionCurve] = (), *, within: bool = False
+                 ) -> list[IntersectionCurve]:
+    """The triangle method on a face pair, its failures as warnings; ``within`` (two faces
+    of one shape): surfaces that only touch along a side are not followed there."""
     try:
         return intersect_surfaces(fa.surface, fb.surface, tol=tol, mesh_tol=mesh_tol,
-                                  stray=StrayCurves.DROP, tangential=tangential)
+                                  stray=StrayCurves.DROP, tangential=tangential,
+                                  touching_sides=not within)
     except (InvalidGeometryError, InvalidToleranceError, ValueError, IndexError,
             FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: triangle intersection skipped: {exc}",
@@ -230,9 +233,13 @@ def _mesh_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float |
 
 
 def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | None,
-                method: Method) -> tuple[list[IntersectionCurve], list[FoundBy],
-                                         CharacteristicRecord | None]:
+                method: Method, *, within: bool = False
+                ) -> tuple[list[IntersectionCurve], list[FoundBy], CharacteristicRecord | None]:
     """Untrimmed curves of one face pair by ``method``, how each was found, the record.
+
+    ``within``: the faces belong to one shape, whose curves along the faces' edges
+    are dropped anyway: the triangle method does not look for surfaces touching
+    along a side of their domains (``touching_sides=False``).
 
     ``"auto"`` is :func:`surfprep.algorithms.characteristic.auto_intersection`
     (prefilter, characteristic stage, the characteristic method alone where the
@@ -241,7 +248,7 @@ def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | 
     method's failures turned into warnings.
     """
     if method is Method.MESH:
-        curves = _mesh_curves(fa, fb, tol, mesh_tol)
+        curves = _mesh_curves(fa, fb, tol, mesh_tol, within=within)
         return curves, [FoundBy.MESH] * len(curves), None
     a, b = fa.surface, fb.surface
     try:
@@ -250,13 +257,14 @@ def pair_curves(fa: FaceOperand, fb: FaceOperand, tol: float, mesh_tol: float | 
         else:
             record = auto_intersection(
                 a, b, tol=tol, mesh_tol=mesh_tol,
-                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential))
+                triangles=lambda tangential: _mesh_curves(fa, fb, tol, mesh_tol, tangential,
+                                                          within=within))
     except (InvalidGeometryError, InvalidToleranceError, FloatingPointError) as exc:
         warnings.warn(f"faces {fa.index} and {fb.index}: characteristic method skipped: {exc}",
                       stacklevel=3)
         if method is Method.CHARACTERISTIC:
             return [], [], None
-        curves = _mesh_curves(fa, fb, tol, mesh_tol)
+        curves = _mesh_curves(fa, fb, tol, mesh_tol, within=within)
         return curves, [FoundBy.MESH] * len(curves), None
     return list(record.curves), list(record.found_by), record
 

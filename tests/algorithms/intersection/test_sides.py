@@ -114,3 +114,26 @@ def test_may_run_along_tells_a_side_on_the_surface_from_a_crossing():
                   for s, t, g in zip(sides, ts, guesses)]
     assert may_run_along_many(standing, flat, sides, ts, guesses, tol=TOL) == one_by_one
     assert one_by_one[0] and one_by_one[2]          # on the plane; no probe inside: True
+
+
+def test_touching_sides_can_be_left_out():
+    """Two planes meeting at a right angle along a side of each (an L): the
+    tessellations do not cross, the side is found by default; a caller that drops
+    every curve along a face's edges (a shape's self-intersection) leaves it out.
+    A crossing is still found."""
+    k = [0, 0, 1, 1]
+    flat = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]], float),
+                        k, k, 1, 1)
+
+    def upright(x):                                   # the plane x = const, z in [0, 1]
+        return NurbsSurface(np.array([[[x, 0, 0], [x, 0, 1]], [[x, 1, 0], [x, 1, 1]]],
+                                     float), k, k, 1, 1)
+
+    (side,) = intersect_surfaces(flat, upright(0.0), tol=TOL)
+    check_on_both([side], flat, upright(0.0))
+    assert side.length == pytest.approx(1.0, abs=TOL)
+    assert intersect_surfaces(flat, upright(0.0), tol=TOL, touching_sides=False) == []
+    (cut,) = intersect_surfaces(flat, upright(0.5), tol=TOL, touching_sides=False)
+    np.testing.assert_allclose(cut.points[:, [0, 2]], 0.0 * cut.points[:, [0, 2]] + [0.5, 0],
+                               atol=TOL)
+    assert cut.length == pytest.approx(1.0, abs=TOL)

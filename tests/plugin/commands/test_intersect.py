@@ -127,11 +127,11 @@ def test_a_pair_over_the_time_limit_is_stopped_and_the_run_goes_on(files, tmp_pa
     real = verb.pair_curves
     calls = []
 
-    def first_hangs(fa, fb, *args):
+    def first_hangs(fa, fb, *args, **kwargs):
         calls.append((fa.index, fb.index))
         if len(calls) == 1:
             clock.sleep(60)
-        return real(fa, fb, *args)
+        return real(fa, fb, *args, **kwargs)
 
     monkeypatch.setattr(verb, "pair_curves", first_hangs)
     report = tmp_path / "r.json"

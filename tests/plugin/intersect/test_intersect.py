@@ -292,11 +292,11 @@ def test_a_pair_stopped_by_the_callers_time_limit_is_recorded_and_the_run_goes_o
     real = verb.pair_curves
     seen = []
 
-    def second_is_stopped(fa, fb, *args):
+    def second_is_stopped(fa, fb, *args, **kwargs):
         seen.append((fa.index, fb.index))
         if len(seen) == 2:
             raise TimeLimitExceeded("a face pair ran longer than 1 s")
-        return real(fa, fb, *args)
+        return real(fa, fb, *args, **kwargs)
 
     monkeypatch.setattr(verb, "pair_curves", second_is_stopped)
     sphere = unit_sphere()
