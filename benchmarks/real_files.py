@@ -47,15 +47,24 @@ class Run:
     error: str
 
 
-def run(command: str, file: Path, workdir: Path, timeout: float) -> Run:
-    """``surfprep COMMAND FILE`` in a fresh process, killed after ``timeout`` seconds."""
-    report_path = workdir / f"{command}.json"
-    argv = [sys.executable, "-m", "surfprep.plugin", command, str(file),
-            "--json", str(report_path)]
-    if command != "info":
-        argv += ["-o", str(workdir / f"{command}.step")]
+@dataclass(frozen=True)
+class Process:
+    """A finished (or killed) process: exit code (None when killed by the timeout),
+    signal, wall time, peak memory of it and its children, stdout and stderr."""
+
+    code: int | None
+    signal: int | None
+    time_s: float
+    peak_mb: float
+    stdout: str
+    stderr: str
+
+
+def run_process(argv: list[str], timeout: float) -> Process:
+    """``argv`` in a fresh process (its own session), killed after ``timeout`` seconds;
+    peak memory from ``wait4`` (``ru_maxrss``: the process and its reaped children)."""
     start = time.perf_counter()
-    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                start_new_session=True)
     timed_out = threading.Event()
 
@@ -65,22 +74,40 @@ def run(command: str, file: Path, workdir: Path, timeout: float) -> Run:
 
     timer = threading.Timer(timeout, kill)
     timer.start()
+    out: list[bytes] = []
+    reader = threading.Thread(target=lambda: out.append(process.stdout.read()))
+    reader.start()
     stderr = process.stderr.read().decode("utf-8", "replace")
+    reader.join()
     _, status, usage = os.wait4(process.pid, 0)
     elapsed = time.perf_counter() - start
     timer.cancel()
     process.returncode = 0                       # reaped by wait4: keep Popen quiet
+    killed = timed_out.is_set()
+    return Process(code=None if killed else
+                   (os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else None),
+                   signal=os.WTERMSIG(status) if os.WIFSIGNALED(status) and not killed
+                   else None,
+                   time_s=elapsed, peak_mb=usage.ru_maxrss / 1024,
+                   stdout=b"".join(out).decode("utf-8", "replace"), stderr=stderr)
+
+
+def run(command: str, file: Path, workdir: Path, timeout: float) -> Run:
+    """``surfprep COMMAND FILE`` in a fresh process, killed after ``timeout`` seconds."""
+    report_path = workdir / f"{command}.json"
+    argv = [sys.executable, "-m", "surfprep.plugin", command, str(file),
+            "--json", str(report_path)]
+    if command != "info":
+        argv += ["-o", str(workdir / f"{command}.step")]
+    done = run_process(argv, timeout)
     report = None
     if report_path.is_file():
         report = json.loads(report_path.read_text())
-    errors = [line for line in stderr.splitlines() if line.startswith("surfprep: error:")]
-    if "Traceback" in stderr:
+    errors = [line for line in done.stderr.splitlines() if line.startswith("surfprep: error:")]
+    if "Traceback" in done.stderr:
         errors.insert(0, "TRACEBACK")
-    return Run(code=None if timed_out.is_set() else
-               (os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else None),
-               signal=os.WTERMSIG(status) if os.WIFSIGNALED(status) and not timed_out.is_set()
-               else None,
-               time_s=elapsed, peak_mb=usage.ru_maxrss / 1024, report=report,
+    return Run(code=done.code, signal=done.signal, time_s=done.time_s, peak_mb=done.peak_mb,
+               report=report,
                error=errors[0].removeprefix("surfprep: error: ") if errors else "")
 
 
@@ -115,17 +142,27 @@ def outcome(command: str, result: Run, timeout: float) -> str:
     return f"exit {result.code}: {done}/{len(r['faces'])} faces{tail}"
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def file_options(description: str) -> argparse.ArgumentParser:
+    """A parser with ``--timeout`` and ``--files`` (what the real-file benchmarks share)."""
+    parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--timeout", type=float, default=300.0,
                         help="seconds before a run is killed and reported as a timeout")
     parser.add_argument("--files", nargs="+", default=None,
                         help="only files whose name contains one of these")
+    return parser
+
+
+def chosen_files(keys: list[str] | None) -> list[Path]:
+    """The STEP/IGES files of ``../shared/data``, those whose name holds one of ``keys``."""
+    files = sorted(p for p in DATA.iterdir() if p.suffix.lower() in SUFFIXES)
+    return [p for p in files if any(key in p.name for key in keys)] if keys else files
+
+
+def main() -> None:
+    parser = file_options(__doc__.splitlines()[0])
     parser.add_argument("--commands", nargs="+", choices=COMMANDS, default=list(COMMANDS))
     args = parser.parse_args()
-    files = sorted(p for p in DATA.iterdir() if p.suffix.lower() in SUFFIXES)
-    if args.files:
-        files = [p for p in files if any(key in p.name for key in args.files)]
+    files = chosen_files(args.files)
     print(f"{len(files)} files x {args.commands}, timeout {args.timeout:.0f} s, "
           f"one fresh process per cell\n")
     print("| file | MB | " + " | ".join(args.commands) + " |")
