@@ -126,10 +126,48 @@ def _check_ends(array: ArrayLike | None, k: int, dim: int, name: str) -> NDArray
 
 
 # ------------------------------------------------------------------ merging
+#: points are first gathered in cubes of this share of the merge distance (all the
+#: points of one cube are within it of each other)
+_CUBE_SHARE = 1e-3
+
+
+def _close_pairs(points: NDArray, tol: float) -> NDArray:
+    """``(k, 2) int`` pairs of points within ``tol`` that connect the same components as
+    all such pairs: the points of one small cube (edge ``_CUBE_SHARE tol``) joined to
+    its first point, and between cubes the representatives of two cubes whose
+    points come within ``tol`` (candidates from the representatives within ``tol``
+    plus the cubes' diagonals, checked point by point). All pairs at once cost the
+    square of the points piled in one spot: 5986 segment ends at 18 places gave
+    17.8 million pairs and 1.1 GB (nist_ctc_02_rc.stp faces 476 x 477)."""
+    n = points.shape[0]
+    cube = _CUBE_SHARE * tol
+    keys = np.floor((points - points.min(axis=0)) / cube).astype(np.int64)
+    _, cell, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    cell = cell.ravel()
+    if counts.size == n:                          # no two points in one cube
+        return cKDTree(points).query_pairs(tol, output_type="ndarray")
+    members = np.argsort(cell, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    first = members[starts[:-1]]
+    inside = np.stack([first[cell], np.arange(n)], axis=1)[first[cell] != np.arange(n)]
+    reach = tol + 2 * np.sqrt(3) * cube
+    candidates = cKDTree(points[first]).query_pairs(reach, output_type="ndarray")
+    single = (counts[candidates[:, 0]] == 1) & (counts[candidates[:, 1]] == 1)
+    near = np.zeros(candidates.shape[0], dtype=bool)
+    a, b = first[candidates[single, 0]], first[candidates[single, 1]]
+    near[single] = np.linalg.norm(points[a] - points[b], axis=1) <= tol
+    bound = np.nextafter(tol, np.inf)
+    for k in np.flatnonzero(~single):             # a cube of several points: any pair
+        p, q = (points[members[starts[c]:starts[c + 1]]] for c in candidates[k])
+        near[k] = cKDTree(q).query(p, distance_upper_bound=bound)[0].min() <= tol
+    between = first[candidates[near]]
+    return np.concatenate([inside, between]).astype(np.int64, copy=False)
+
+
 def _cluster(points: NDArray, tol: float) -> NDArray:
     """Labels ``(n,) int`` of points connected by distances <= tol, numbered by first member."""
     n = points.shape[0]
-    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
+    pairs = _close_pairs(points, tol) if n else np.zeros((0, 2), dtype=np.int64)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
     # renumber so that labels increase with the lowest member index

@@ -159,7 +159,7 @@ def test_overlapping_segments_along_one_line_are_one_curve():
     without sharing their ends. Split at each other's ends they are one simple curve
     (they were read as three-way junctions: the sheet z = 0.1 x y cut by y = 0.5 came
     out as seven pieces)."""
-    x = lambda *v: np.array([[t, 0.5, 0.05 * t] for t in v])          # noqa: E731
+    x = lambda *v: np.array([[t, 0.5, 0.05 * t] for t in v])
     coarse = [x(0.0, 0.4), x(0.4, 0.7), x(0.7, 1.0)]
     fine = [x(0.0, 0.2), x(0.2, 0.4), x(0.4, 0.55), x(0.55, 0.7), x(0.7, 0.85), x(0.85, 1.0)]
     shifted = [x(0.3, 0.6)]                                     # ends on neither side's ends
@@ -256,3 +256,36 @@ def test_bad_shapes():
         build_topology(np.zeros((2, 2, 3)), np.zeros((2, 2, 3)), tol=TOL)
     with pytest.raises(InvalidGeometryError, match="NaN"):
         build_topology(np.full((1, 2, 3), np.nan), tol=TOL)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_points_piled_in_one_spot_cluster_as_all_pairs_would(seed):
+    """Segment ends piled by the thousand at a few spots (two half cylinders touching
+    along their seams: 5986 ends at 18 places, 17.8 million pairs within the merge
+    distance) are merged into the same groups as every pair within it would give,
+    scattered points and spots just within and just beyond the distance included."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    from surfprep.algorithms.intersection.topology import _cluster
+
+    rng = np.random.default_rng(seed)
+    tol = 1e-3
+    spots = rng.uniform(0, 0.05, (6, 3))
+    spots[1] = spots[0] + [0.999 * tol, 0, 0]       # within the distance of spot 0
+    spots[3] = spots[2] + [1.001 * tol, 0, 0]       # just beyond spot 2
+    piles = [s + rng.uniform(-1e-7, 1e-7, (400, 3)) for s in spots]
+    scattered = rng.uniform(0, 0.05, (300, 3))
+    points = np.concatenate(piles + [scattered, spots[:2]])[rng.permutation(6 * 400 + 302)]
+    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
+    n = points.shape[0]
+    _, truth = connected_components(coo_matrix((np.ones(len(pairs)), tuple(pairs.T)),
+                                               shape=(n, n)), directed=False)
+    labels = _cluster(points, tol)
+    # the same partition: each label maps to one true component and back
+    joint = np.unique(np.stack([labels, truth], axis=1), axis=0)
+    assert joint.shape[0] == np.unique(labels).size == np.unique(truth).size
+    # numbered by first member
+    first = [int(np.flatnonzero(labels == k)[0]) for k in range(labels.max() + 1)]
+    assert first == sorted(first)
