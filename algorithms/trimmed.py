@@ -186,10 +186,11 @@ class TrimmedFace:
 
     def parameter_box(self) -> tuple[float, float, float, float]:
         """``(u0, u1, v0, v1)`` holding the face: the box of its loops' pcurve control
-        points (each pcurve, restricted to the part its edge uses, lies in their hull;
-        all loops, so that a hole taken for the outer loop cannot shrink it), within the surface's domain; the whole
-        domain without loops, or when a pcurve reaches outside the domain (a
-        periodic surface's pcurve shifted by a period)."""
+        points (each pcurve, restricted to the part its edge uses, lies in their
+        hull; all loops, so that a hole taken for the outer loop cannot shrink it),
+        within the surface's domain; the whole domain without loops, or when a
+        pcurve reaches outside the domain (a periodic surface's pcurve shifted by a
+        period)."""
         domain = self.surface.domain
         if not self.loops:
             return domain
@@ -214,7 +215,10 @@ class TrimmedFace:
         u0, u1, v0, v1 = self.surface.domain
         if box == (u0, u1, v0, v1) or not (box[1] > box[0] and box[3] > box[2]):
             return self.surface.bounding_box()
-        return self.surface.restrict(*box).bounding_box()
+        try:
+            return self.surface.restrict(*box).bounding_box()
+        except (InvalidGeometryError, ValueError):          # a box too thin to cut out
+            return self.surface.bounding_box()
 
 
 def _used_poles(pcurve: NurbsCurve, t0: float, t1: float) -> NDArray:

@@ -320,10 +320,9 @@ def _split_in_order(field: DistanceField, curve: TracedCurve, points: list, h_ma
                     ) -> list[TracedCurve]:
     """``curve`` split at each of ``points`` it passes, in their order: the pieces
     of splitting it at the first (:func:`_split`), each split at the following
-    ones, and so on. Each piece is compared with all the points still to come at
-    once, so the cost follows the cuts, not pieces x points (198 singular points
-    along a tangential contact of occt_bearing_euclid.iges faces 43 x 177, each
-    tried on every piece one by one: 580 s)."""
+    ones, and so on: the pieces of trying every point on every piece one by one,
+    with each piece compared with all the points still to come at once (one
+    array operation per piece instead of one Python call per piece and point)."""
     if not points:
         return [curve]
     centres = np.array([p[0] for p in points])
