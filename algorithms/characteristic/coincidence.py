@@ -34,11 +34,20 @@ def _on_other(ra: FaceRegion, rb: FaceRegion, tol: float, samples: int
     uu, vv = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0), indexing="ij")
     uv = np.stack([uu.ravel(), vv.ravel()], axis=1)
     uv = uv[ra.contains(uv)]
-    if uv.shape[0] == 0:
+    inside = uv.shape[0]
+    if inside == 0:
         return uv, uv, np.zeros(0), 0
-    foot = project_to_surface(rb.surface, ra.surface.evaluate(uv[:, 0], uv[:, 1]))
+    # a point within tol of a foot inside face b lies within tol of b's box: only
+    # those are projected (faces that share an edge: a strip along it)
+    points = ra.surface.evaluate(uv[:, 0], uv[:, 1])
+    box = rb.face.bounding_box()
+    near = np.all((points >= box[0] - tol) & (points <= box[1] + tol), axis=1)
+    uv, points = uv[near], points[near]
+    if uv.shape[0] == 0:
+        return uv, uv, np.zeros(0), inside
+    foot = project_to_surface(rb.surface, points)
     on = (foot.distance <= tol) & rb.contains(foot.uv)
-    return uv[on], foot.uv[on], foot.distance[on], uv.shape[0]
+    return uv[on], foot.uv[on], foot.distance[on], inside
 
 
 def face_coincidence(ra: FaceRegion, rb: FaceRegion, tol: float,
