@@ -157,16 +157,14 @@ class FaceIntersection:
 
 
 # ------------------------------------------------------------------ driver
-def _boxes(faces: Sequence[FaceOperand]) -> NDArray:
-    return np.stack([np.asarray(f.surface.bounding_box(), dtype=float) for f in faces]) \
-        if faces else np.zeros((0, 2, 3))
-
-
-def _face_boxes(faces: Sequence[FaceOperand]) -> NDArray:
-    """Boxes of the faces (not of their whole surfaces: a face cut from a larger surface
-    gets the box of the surface restricted to its loops' parameter box)."""
-    return np.stack([np.asarray(f.trimmed.bounding_box(), dtype=float) for f in faces]) \
-        if faces else np.zeros((0, 2, 3))
+def _boxes(faces: Sequence[FaceOperand], *, trimmed: bool = False) -> NDArray:
+    """``(n, 2, 3)`` control-net boxes of the faces' surfaces; with ``trimmed`` of the
+    faces themselves (a face cut from a larger surface gets the box of the surface
+    restricted to its loops' parameter box, :meth:`TrimmedFace.bounding_box`)."""
+    if not faces:
+        return np.zeros((0, 2, 3))
+    return np.stack([np.asarray(f.trimmed.bounding_box() if trimmed else
+                                f.surface.bounding_box(), dtype=float) for f in faces])
 
 
 def _size(boxes: NDArray) -> float:
@@ -311,16 +309,15 @@ def intersect(a: ShapeLike, b: ShapeLike | None = None, *, tol: float | None = N
     method = Method(method)
     faces_a = face_operands(a)
     faces_b = faces_a if b is None else face_operands(b)
-    boxes_a, boxes_b = _boxes(faces_a), _boxes(faces_b)
-    size = _size(np.concatenate([boxes_a, boxes_b]))
+    size = _size(_boxes(faces_a if b is None else faces_a + faces_b))
     if not size > 0:
         raise InvalidGeometryError("the faces to intersect have no extent (a zero-size model)")
     if tol is None:
         tol = DEFAULT_TOL_FACTOR * size
     tol = check_tolerance(tol, "tol", low=MIN_TOL_FACTOR * size, high=size)
     pad = tol
-    boxes_a = _face_boxes(faces_a)
-    boxes_b = boxes_a if b is None else _face_boxes(faces_b)
+    boxes_a = _boxes(faces_a, trimmed=True)
+    boxes_b = boxes_a if b is None else _boxes(faces_b, trimmed=True)
     overlap = np.all((boxes_a[:, None, 0] <= boxes_b[None, :, 1] + pad)
                      & (boxes_b[None, :, 0] <= boxes_a[:, None, 1] + pad), axis=-1)
     if b is None:

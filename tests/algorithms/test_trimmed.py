@@ -3,22 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
-from helpers.surfaces import bumpy
+from helpers.surfaces import bumpy, straight_loop
 
 from surfprep import NurbsCurve, TrimmedFace
 from surfprep.algorithms.face_region import FaceRegion
 from surfprep.algorithms.face_split import Cut, split_face
-from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
 from surfprep.algorithms.volume_builders import solid_sphere
-
-
-def polygon_loop(corners) -> TrimLoop:
-    """A loop of straight pcurves through ``corners (k, 2)`` (closed), no 3D curves."""
-    corners = np.asarray(corners, dtype=float)
-    edges = []
-    for a, b in zip(corners, np.roll(corners, -1, axis=0)):
-        edges.append(TrimEdge(None, NurbsCurve(np.array([a, b]), [0, 0, 1, 1], 1), 0.0, 1.0))
-    return TrimLoop(tuple(edges))
 
 
 def face_points(face: TrimmedFace, n: int = 201) -> np.ndarray:
@@ -34,7 +24,7 @@ def face_points(face: TrimmedFace, n: int = 201) -> np.ndarray:
 def test_a_small_face_on_a_large_surface_gets_a_small_box_that_holds_it():
     surface = bumpy()
     # a pentagon in (u, v) over one of the bumps
-    face = TrimmedFace(surface, (polygon_loop([[0.2, 0.5], [0.4, 0.52], [0.42, 0.66],
+    face = TrimmedFace(surface, (straight_loop([[0.2, 0.5], [0.4, 0.52], [0.42, 0.66],
                                                [0.3, 0.7], [0.21, 0.64]]),))
     assert face.parameter_box() == (0.2, 0.42, 0.5, 0.7)
     box = face.bounding_box()
@@ -63,6 +53,6 @@ def test_faces_that_span_the_domain_keep_the_surface_box():
     np.testing.assert_array_equal(TrimmedFace(surface).bounding_box(), surface.bounding_box())
     # a pcurve outside the domain (as a periodic surface's, shifted by a period): the
     # loops are not trusted for a box
-    shifted = TrimmedFace(surface, (polygon_loop([[1.2, 0.5], [1.4, 0.5], [1.4, 0.7]]),))
+    shifted = TrimmedFace(surface, (straight_loop([[1.2, 0.5], [1.4, 0.5], [1.4, 0.7]]),))
     assert shifted.parameter_box() == surface.domain
     np.testing.assert_array_equal(shifted.bounding_box(), surface.bounding_box())

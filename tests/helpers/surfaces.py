@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from surfprep.algorithms import NurbsSurface
+from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.algorithms.basis import greville_abscissae
+from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
 
 R2 = np.sqrt(0.5)
 
@@ -279,3 +280,11 @@ def wall() -> NurbsSurface:
         cp[:, j, :2] = base
         cp[:, j, 2] = z
     return NurbsSurface(cp, [0, 0, 0, 1, 1, 1], [0, 0, 1, 1], 2, 1)
+
+
+def straight_loop(corners) -> TrimLoop:
+    """A trimming loop of straight degree-1 pcurves through ``corners (k, 2)`` in
+    ``(u, v)``, closed back to the first, without 3D curves."""
+    c = np.asarray(corners, dtype=float)
+    return TrimLoop(tuple(TrimEdge(None, NurbsCurve(np.array([a, b]), [0, 0, 1, 1], 1),
+                                   0.0, 1.0) for a, b in zip(c, np.roll(c, -1, axis=0))))

@@ -313,13 +313,12 @@ def test_faces_whose_own_boxes_are_apart_are_not_intersected():
     """Two small faces cut from crossing planes, both away from where the planes cross:
     the surfaces' boxes overlap, the faces' do not, and no pair is worked on; faces of
     the same planes that reach the crossing still give its segment."""
-    from surfprep import NurbsCurve, NurbsSurface, TrimmedFace
-    from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
+    from helpers.surfaces import straight_loop
+
+    from surfprep import NurbsSurface, TrimmedFace
 
     def square(x0, x1):
-        c = np.array([[x0, 0.0], [x1, 0.0], [x1, 1.0], [x0, 1.0]])
-        return TrimLoop(tuple(TrimEdge(None, NurbsCurve(np.array([a, b]), [0, 0, 1, 1], 1),
-                                       0.0, 1.0) for a, b in zip(c, np.roll(c, -1, axis=0))))
+        return straight_loop([[x0, 0.0], [x1, 0.0], [x1, 1.0], [x0, 1.0]])
 
     knots = [0, 0, 1, 1]
     flat = NurbsSurface(np.array([[[0, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0]]], float),
