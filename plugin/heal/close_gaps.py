@@ -18,11 +18,19 @@ curve per edge (:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges`):
   pcurve the common curve's closest points on it (sliding along the iso-curve for a side
   of an untrimmed face) and goes to the common curve there, so a boundary that only runs
   beside its neighbour within its own surface is re-trimmed, not bent;
+* a face that does not move keeps its surface, not its trimming: where the other face's
+  points along an open edge lie on its surface, or its feet there lie nearer the other
+  face than its own boundary does (and smoother), the common curve is those points or
+  feet and the face is re-trimmed to them (its new pcurve their parameters, its ends
+  where they were). Two faces meeting at an angle whose trimming curves run apart within
+  their surfaces (an exporter's wavy pcurve on a plane) then meet without either
+  surface moving, even where neither is a B-spline;
 * a free edge, or a shared one closed already, is held: each moving face keeps its side
   there (its ends follow the vertices), the edge's curve is the mean of its faces';
 * a face whose fit misses by more than ``_FIT_SHARE`` x ``tight``, would move farther
   than ``allowed`` within its parameter box, or fails ``BRepCheck`` once moved (or makes
-  a neighbour fail it) is kept as it was and the others fitted again with it fixed.
+  a neighbour fail it) is kept as it was and the others fitted again with it fixed; a
+  re-trimmed face that fails so keeps its trimming too.
 
 The faces are updated in place (``BRep_Builder.UpdateFace`` with the new pcurves on the
 new surface, the edges' 3D curves the common curves, the vertices moved), so the shell's
@@ -67,6 +75,7 @@ from .rollback import TIGHT_FACTOR
 from .shared_edges import (
     SharedEdge,
     edges_by_face,
+    feet_on_face,
     images_on_face,
     pcurve,
     pcurve_points,
@@ -76,7 +85,9 @@ from .shared_edges import (
 
 __all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "close_gaps", "closed_in_geometry"]
 
-#: samples per edge where the gap is first measured ...
+#: samples per edge where the gap is first measured (this many evenly and as many
+#: clustered at the ends, where an exporter's pcurves wave most: catia theorem's planes
+#: lie 2e-5 beside their neighbours at s = 0.003 and within 1.2e-5 at every 1/64) ...
 PROBE_SAMPLES = 65
 #: ... where a moving face is fitted (this many evenly and as many clustered at the ends;
 #: knot spans are split while one holds 12 of them) ...
@@ -122,6 +133,9 @@ class ClosedGaps:
     moved : tuple of dict
         Per face moved: its index in the shape, how far it moved (in its parameter box),
         the fit's residual, the knots inserted.
+    retrimmed : tuple of dict
+        Per face re-trimmed without moving its surface: its index, how far its boundary
+        moved along the edges re-trimmed (largest over them).
     notes : tuple of str
     """
 
@@ -130,12 +144,13 @@ class ClosedGaps:
     largest_before: float = 0.0
     largest_after: float = 0.0
     moved: tuple = ()
+    retrimmed: tuple = ()
     notes: tuple = ()
 
     def as_dict(self) -> dict:
         return {"open_edges_before": self.open_before, "open_edges_after": self.open_after,
                 "largest_gap_before": self.largest_before, "largest_gap_after": self.largest_after,
-                "faces_moved": list(self.moved)}
+                "faces_moved": list(self.moved), "faces_retrimmed": list(self.retrimmed)}
 
 
 @dataclass
@@ -161,7 +176,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     shared: dict = {}                   # the faces' surfaces, read once
     edges = [read_edge(edge_faces, k, faces, vertices, shared)
              for k in range(1, edge_faces.Extent() + 1)]
-    probe = np.linspace(0.0, 1.0, PROBE_SAMPLES)
+    probe = np.union1d(np.linspace(0.0, 1.0, PROBE_SAMPLES),
+                       0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, PROBE_SAMPLES)))
     for e in edges:
         if len(e.faces) >= 2:
             images = [images_on_face(e, i, faces, probe) for i in range(len(e.faces))]
@@ -176,51 +192,61 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     surfaces = {f: s for f in candidates if (s := same_surface(faces, f, edges)) is not None}
     of_face = edges_by_face(edges)
     fixed: set[int] = set()
+    rigid: set[int] = set()             # faces whose re-trimming was taken back
     fits: dict = {}
+    retrimmed: dict = {}
     done: dict = {}                     # common curves: a later round asks most again
     fitted = {} if fitted is None else fitted
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
-        if not moving:
+        trimmable = set(candidates) - set(moving) - rigid
+        if not moving and not any(f in trimmable for e in open_ for f in e.faces):
             break
-        fits, commons, positions, failed = _fit_round(moving, surfaces, edges, of_face, faces,
-                                                     tight, allowed, notes, done, fitted)
+        fits, commons, positions, failed, retrimmed = _fit_round(
+            moving, trimmable, surfaces, edges, of_face, faces, tight, allowed, notes, done,
+            fitted)
         fixed |= failed
-        if failed and _round < _ROUNDS - 1 or not fits:
+        if failed and _round < _ROUNDS - 1 or not (fits or retrimmed):
             continue                # the others fitted again with these where they are
         # (in the last round the faces that fit move, their gaps to the others narrowed)
         journal = _Journal()
+        changed = set(fits) | set(retrimmed)
         try:
-            after, apart = _apply(fits, commons, edges, of_face, faces, vertices, positions,
-                                  journal, surfaces)
+            after, apart = _apply(fits, retrimmed, commons, edges, of_face, faces, vertices,
+                                  positions, journal, surfaces)
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
-            bad = _invalid(fits, of_face, faces) | _widening(edges, fits, after, apart, tight)
+            bad = _invalid(changed, of_face, faces) | _widening(edges, changed, after, apart,
+                                                                tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
                 raise
             _undo(journal, shape)
             notes.append(f"moving faces onto common edges failed ({exc}): put back as they were")
-            fits = {}
+            fits, retrimmed = {}, {}
             break
         if not bad:
             break
         _undo(journal, shape)
         notes.append(f"faces {sorted(f - 1 for f in bad)} fail BRepCheck, or leave an edge wider "
-                     "than it was, once moved onto their neighbours' edges: kept as they are")
-        fixed |= bad                # the others fitted again with these where they are
-        fits = {}
-    if not fits:
+                     "than it was, once moved onto (or re-trimmed to) their neighbours' edges: "
+                     "kept as they are")
+        fixed |= bad & set(fits)    # the others fitted again with these where they are
+        rigid |= bad - set(fits)
+        fits, retrimmed = {}, {}
+    if not fits and not retrimmed:
         return _unchanged(open_, largest, notes, f"{len(open_)} edges between faces that cannot "
-                          "move (not B-spline, or their fit failed) left open")
+                          "move (not B-spline, or their fit failed) nor be re-trimmed to each "
+                          "other left open")
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
                    "knots_inserted": fits[f][0].inserted} for f in sorted(fits)
                   if fits[f][0].surface is not surfaces[f])
+    trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
     remaining = sum(1 for e in open_ if after.get(id(e), e.gap) > tight)
     return ClosedGaps(len(open_), remaining, largest,
                       max([after.get(id(e), e.gap) for e in open_] + list(after.values())),
-                      moved, tuple(notes))
+                      moved, trimmed, tuple(notes))
 
 
 def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> HealResult:
@@ -235,15 +261,16 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
         closed = close_gaps(result.model.shape, tight=TIGHT_FACTOR * size, allowed=allowed,
                             fitted=fitted)
         passes.append(closed)
-        if not closed.moved or closed.open_after == 0:
+        if not (closed.moved or closed.retrimmed) or closed.open_after == 0:
             break
     first, last = passes[0], passes[-1]
     out = replace(result, skipped=result.skipped + last.notes)
     out.extra["closed_gaps"] = {
         **last.as_dict(), "open_edges_before": first.open_before,
         "largest_gap_before": first.largest_before, "passes": len(passes),
-        "faces_moved": [m for p in passes for m in p.moved]}
-    if not any(p.moved for p in passes):
+        "faces_moved": [m for p in passes for m in p.moved],
+        "faces_retrimmed": [m for p in passes for m in p.retrimmed]}
+    if not any(p.moved or p.retrimmed for p in passes):
         return out
     shape = result.model.shape
     return replace(out, tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * size).free_in_geometry,
@@ -251,7 +278,7 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
 
 
 def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> ClosedGaps:
-    return ClosedGaps(len(open_), len(open_), largest, largest, (), (*notes, why))
+    return ClosedGaps(len(open_), len(open_), largest, largest, notes=(*notes, why))
 
 
 # ------------------------------------------------------------------ fitting
@@ -267,15 +294,19 @@ class _Common:
     curve: NurbsCurve | None = None               # C: the cubic through the even samples
     uv: dict = field(default_factory=dict)        # (face, seam side) -> (m, 2)
     goals: dict = field(default_factory=dict)     # (face, seam side) -> (m, 3), else points
+    retrimmed: dict = field(default_factory=dict)  # fixed face re-trimmed -> its boundary's shift
 
 
-def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, faces,
-               tight: float, allowed: float, notes: list[str], done: dict, fitted: dict):
+def _fit_round(moving: list[int], trimmable: set[int], surfaces, edges: list[SharedEdge],
+               of_face, faces, tight: float, allowed: float, notes: list[str], done: dict,
+               fitted: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
-    fixed: ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position},
-    failed faces)``. ``done`` holds the common curves of earlier rounds, by edge, the
-    faces that move and the vertices; ``fitted`` the fits, by face, surface and targets
-    (a face whose neighbours all stayed as they were gets the same targets again)."""
+    fixed (those of ``trimmable`` re-trimmed where that closes an edge better):
+    ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position}, failed faces,
+    {re-trimmed face: how far its boundary moved})``. ``done`` holds the common curves
+    of earlier rounds, by edge, the faces that move or may be re-trimmed and the
+    vertices; ``fitted`` the fits, by face, surface and targets (a face whose neighbours
+    all stayed as they were gets the same targets again)."""
     moving_set = set(moving)
     # even samples and Chebyshev-Lobatto points: dense at the vertices too, where two
     # edges' targets meet in a kink the fit resolves only with short knot spans (each
@@ -283,6 +314,10 @@ def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, fa
     s = np.union1d(np.linspace(0.0, 1.0, FIT_SAMPLES),
                    0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, FIT_SAMPLES)))
     touched = {id(e): e for f in moving for e in of_face[f]}
+    # open edges between faces that do not move, one of which may be re-trimmed
+    touched.update((id(e), e) for e in edges
+                   if e.gap > tight and not any(f in moving_set for f in e.faces)
+                   and any(f in trimmable for f in e.faces))
     images: dict[tuple[int, int], NDArray] = {}
 
     def image(e: SharedEdge, i: int, at: NDArray, reverse: bool = False) -> NDArray:
@@ -295,21 +330,29 @@ def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, fa
     for e in touched.values():
         for i in range(len(e.faces)):
             images[id(e), i] = image(e, i, s)
-    position = _vertex_positions(edges, moving_set, images, image)
+    position = _vertex_positions(touched.values(), edges, moving_set, images, image)
     commons = {}
     for key, e in touched.items():
-        # the same when its faces move or stay as in an earlier round and its vertices
-        # are where they were
-        seen = (key, tuple(f in moving_set for f in e.faces),
+        # the same when its faces move, may be re-trimmed or stay as in an earlier round
+        # and its vertices are where they were
+        seen = (key, tuple(f in moving_set for f in e.faces), tuple(f in trimmable for f in e.faces),
                 position[e.first].tobytes(), position[e.last].tobytes())
         if seen not in done:
-            done[seen] = _common(e, s, images, position, moving_set, surfaces, faces, tight)
-        commons[key] = done[seen]
+            done[seen] = _common(e, s, images, position, moving_set, trimmable, surfaces, faces,
+                                 tight, allowed)
+        if done[seen] is not None:
+            commons[key] = done[seen]
+    retrimmed: dict[int, float] = {}
+    for common in commons.values():
+        for f, shift in common.retrimmed.items():
+            retrimmed[f] = max(retrimmed.get(f, 0.0), shift)
     fits, failed = {}, set()
     for f in moving:
         targets = []
         for e in of_face[f]:
-            common = commons[id(e)]
+            common = commons.get(id(e))
+            if common is None:          # (an edge of a fixed face only re-trimmed)
+                continue
             for side in ((False, True) if e.seam else (False,)):
                 uv = common.uv.get((f, side))
                 if uv is None:          # a pole: the old pcurve, every point to the vertex
@@ -349,7 +392,7 @@ def _fit_round(moving: list[int], surfaces, edges: list[SharedEdge], of_face, fa
         why = (f"it would move {moved:.3g} > {allowed:.3g}" if moved > allowed
                else f"its fit leaves {fit.residual:.3g} > {_FIT_SHARE * tight:.3g}")
         notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({why}); kept as it is")
-    return fits, commons, position, failed
+    return fits, commons, position, failed, retrimmed
 
 
 def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
@@ -364,10 +407,13 @@ def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
     return h.digest()
 
 
-def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfaces, faces,
-            tight: float) -> _Common:
+def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimmable: set[int],
+            surfaces, faces, tight: float, allowed: float) -> _Common | None:
     """The common curve of ``e`` (the module doc), its ends pulled onto the vertices.
-    An edge open at ``tight``: a fixed face's image if it has one, else the image of the
+    An edge open at ``tight``: where a fixed face may be re-trimmed, the other face's image
+    or its feet on the fixed face's surface when :func:`_retrim` finds them better (None
+    when no face of ``e`` moves and none can be re-trimmed so); else a fixed face's image
+    if it has one, else the image of the
     face whose boundary lies nearest the other faces' surfaces and is smoothest
     (:func:`~surfprep.algorithms.healing.edge_targets.roughness`: a wavy pcurve
     beside a smooth one loses), as it is when it lies
@@ -389,12 +435,19 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfa
         return curve + (1.0 - w) * (position[e.first] - curve[0]) + w * (position[e.last] - curve[-1])
 
     closed = len(e.faces) == 1 or e.gap <= tight
+    trimmed = None
     if closed:
         ref = still[0] if still else 0
         mean = np.mean([images[id(e), i] for i in range(len(e.faces))], axis=0)
     elif still:
         ref = still[0]
         mean = images[id(e), ref]
+        option = _retrim(e, s, images, position, moving, trimmable, surfaces, faces, tight,
+                         allowed)
+        if option is not None:
+            ref, mean, trimmed = option
+        elif not any(f in moving for f in e.faces):
+            return None
     else:
         best = None
         for ref in range(len(e.faces)):
@@ -414,6 +467,14 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfa
     # face fitted to them would lie off its edge there
     curve = _through(t, to_vertices(mean), even)
     common = _Common(t, curve.evaluate(t), even, curve)
+    if trimmed is not None:
+        # the fixed face's new pcurve: the common curve's feet on its surface, its ends
+        # where its corners are (its other edges end there)
+        old = pcurve_points(e, trimmed, faces, s)
+        uv, feet = feet_on_face(e, trimmed, faces, common.points, s)
+        common.uv[e.faces[trimmed], False] = pinned_ends(uv, old, s)
+        common.retrimmed[e.faces[trimmed]] = float(np.max(np.linalg.norm(
+            feet - images[id(e), trimmed], axis=1)))
     for i, f in enumerate(e.faces):
         if f not in moving:
             continue
@@ -428,6 +489,51 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], surfa
             common.uv[f, side] = np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)],
                                           axis=1)
     return common
+
+
+def _retrim(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimmable: set[int],
+            surfaces, faces, tight: float, allowed: float) -> tuple[int, NDArray, int] | None:
+    """A common curve for the open two-face edge ``e`` lying on the surface of a face
+    that does not move but may be re-trimmed (``trimmable``), as ``(ref, points, j)``:
+    the other face ``ref``'s image, or its feet on face ``j``'s surface, to which ``j``
+    is re-trimmed. A fixed ``ref`` qualifies when its image lies on ``j``'s surface
+    within ``_FIT_SHARE`` x ``tight`` (the two surfaces meet along it); a moving one
+    when its feet lie within ``allowed``, and it wins against ``j``'s own boundary
+    (the common curve otherwise) when its distance plus its waves
+    (:func:`~surfprep.algorithms.healing.edge_targets.roughness`) are smaller. The
+    re-trimmed boundary may shift by ``allowed`` at most, and its ends stay: ``j``'s
+    corners must be at the vertices (within ``_FIT_SHARE`` x ``tight``; its other edges
+    end there). None when nothing qualifies."""
+    if len(e.faces) != 2 or e.seam or e.degenerated:
+        return None
+    best = None
+    for j in (0, 1):
+        if e.faces[j] not in trimmable:
+            continue
+        i = 1 - j
+        own = images[id(e), j]
+        if max(float(np.linalg.norm(own[0] - position[e.first])),
+               float(np.linalg.norm(own[-1] - position[e.last]))) > _FIT_SHARE * tight:
+            continue
+        base = images[id(e), i]
+        _, feet = feet_on_face(e, j, faces, base, s)
+        off = float(np.max(np.linalg.norm(feet - base, axis=1)))
+        if float(np.max(np.linalg.norm(feet - own, axis=1))) > allowed:
+            continue
+        if e.faces[i] not in moving:
+            if off <= _FIT_SHARE * tight and (best is None or off < best[0]):
+                best = (off, i, base, j)
+            continue
+        if off > allowed:
+            continue
+        points = base if off <= _FIT_SHARE * tight else feet
+        score = off + _ROUGHNESS_WEIGHT * roughness(points, s)
+        kept = (float(np.max(np.linalg.norm(_feet(e, i, own, images, surfaces, faces, s) - own,
+                                            axis=1)))
+                + _ROUGHNESS_WEIGHT * roughness(own, s))
+        if score < kept and (best is None or score < best[0]):
+            best = (score, i, points, j)
+    return None if best is None else best[1:]
 
 
 def _even(s: NDArray) -> NDArray:
@@ -451,10 +557,11 @@ def _feet(e: SharedEdge, i: int, points: NDArray, images, surfaces, faces, s: ND
     return foot
 
 
-def _vertex_positions(edges: list[SharedEdge], moving: set[int], images, image) -> dict[int, NDArray]:
-    """Per vertex of an edge of a moving face: the mean of its faces' corners there (of
-    the fixed faces' if any)."""
-    wanted = {v for e in edges if any(f in moving for f in e.faces) for v in (e.first, e.last)}
+def _vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image
+                      ) -> dict[int, NDArray]:
+    """Per vertex of an edge of ``around``: the mean of its faces' corners there (of the
+    fixed faces' if any)."""
+    wanted = {v for e in around for v in (e.first, e.last)}
     corners: dict[int, list[tuple[bool, NDArray]]] = {v: [] for v in wanted}
     ends = np.array([0.0, 1.0])
     for e in edges:
@@ -485,10 +592,11 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
 
 
 # ------------------------------------------------------------------ applying
-def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, positions,
+def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, vertices, positions,
            journal: _Journal, surfaces) -> tuple[dict[int, float], dict[tuple[int, int], float]]:
     """Put the moved surfaces, their pcurves (the common curves' projections), the
-    common curves and the vertices into the shape, recording in ``journal`` what they
+    re-trimmed faces' new pcurves, the common curves and the vertices into the shape,
+    recording in ``journal`` what they
     replace; returns per edge touched twice the largest distance, on ``CHECK_SAMPLES``
     points, between its curve and its faces' surfaces (a bound on how far apart two of
     its faces' points are; its tolerance is set to 1.1 times that distance), and that
@@ -497,7 +605,8 @@ def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, pos
     by_id = {id(e): e for e in edges}
     # the faces' surfaces as they are now (the fixed ones' as read, the moved ones' put)
     fresh = {f: pair for f, pair in (edges[0].surfaces if edges else {}).items() if f not in fits}
-    for f, (fit, _) in fits.items():
+    for f in [*fits, *sorted(retrimmed)]:
+        fit = fits[f][0] if f in fits else None
         face = TopoDS.Face_s(faces.FindKey(f))
         location = TopLoc_Location()
         raw = BRep_Tool.Surface_s(face, location)
@@ -507,16 +616,16 @@ def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, pos
             tol = BRep_Tool.Tolerance_s(e.edge)
             old.append((e, pcurve(e, i, faces), pcurve(e, i, faces, True) if e.seam else None, tol,
                         BRep_Tool.Range_s(e.edge, face)))
-            common = commons[id(e)]
-            if (f, False) not in common.uv:           # a pole keeps its pcurve
-                new.append(old[-1])
+            common = commons.get(id(e))
+            if common is None or (f, False) not in common.uv:
+                new.append(old[-1])             # a pole, or an edge not re-trimmed
                 continue
             pcurves = [curve2d_to_occ(_through(common.t, common.uv[f, side], common.even))
                        for side in ((False, True) if e.seam else (False,))]
             new.append((e, pcurves[0], pcurves[1] if e.seam else None, tol,
                         (float(common.t[0]), float(common.t[-1]))))
         journal.faces.append((face, raw, location, BRep_Tool.Tolerance_s(face), old))
-        if fit.surface is not surfaces[f]:          # else only its pcurves change
+        if fit is not None and fit.surface is not surfaces[f]:     # else only its pcurves change
             put = surface_to_occ(fit.surface)
             builder.UpdateFace(face, put, TopLoc_Location(), BRep_Tool.Tolerance_s(face))
             fresh[f] = (put, fit.surface)
@@ -554,17 +663,17 @@ def _apply(fits, commons, edges: list[SharedEdge], of_face, faces, vertices, pos
         builder.UpdateVertex(vertex, gp_Pnt(*p), BRep_Tool.Tolerance_s(vertex))
         fixer.SetTolerance(vertex, _MIN_TOLERANCE, TopAbs_VERTEX)
     # the vertices hold every curve's end there, on the fixed faces' edges too
-    for g in _around(fits, of_face):
+    for g in _around(set(fits) | set(retrimmed), of_face):
         BRepLib.UpdateTolerances_s(faces.FindKey(g), False)
     return after, apart
 
 
 def _widening(edges: list[SharedEdge], fits, after: dict[int, float],
               apart: dict[tuple[int, int], float], tight: float) -> set[int]:
-    """The moving faces to blame for the edges that end wider than ``_WIDER`` times
-    their gap (or ``tight``): those lying alone far enough from the edge's curve to
-    widen it, else all its moving faces (a closed edge next to one waving face keeps
-    its other, well-fitted face moving)."""
+    """The faces of ``fits`` (moved or re-trimmed) to blame for the edges that end wider
+    than ``_WIDER`` times their gap (or ``tight``): those lying alone far enough from
+    the edge's curve to widen it, else all its changed faces (a closed edge next to one
+    waving face keeps its other, well-fitted face moving)."""
     blamed: set[int] = set()
     for e in edges:
         limit = _WIDER * max(e.gap, tight)
@@ -577,8 +686,9 @@ def _widening(edges: list[SharedEdge], fits, after: dict[int, float],
 
 
 def _invalid(fits, of_face, faces) -> set[int]:
-    """The moved faces that fail ``BRepCheck``, and those next to a fixed face that fails
-    it once they moved (its vertices moved with them)."""
+    """The faces of ``fits`` (moved or re-trimmed) that fail ``BRepCheck``, and those
+    next to another face that fails it once they changed (its vertices moved with
+    them)."""
     bad = set()
     for g in _around(fits, of_face):
         if BRepCheck_Analyzer(faces.FindKey(g)).IsValid():

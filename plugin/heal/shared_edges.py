@@ -13,18 +13,21 @@ from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
 from OCP.Geom import Geom_BSplineSurface
 from OCP.Geom2d import Geom2d_TrimmedCurve
+from OCP.gp import gp_Pnt, gp_Pnt2d
+from OCP.ShapeAnalysis import ShapeAnalysis_Surface
 from OCP.TopAbs import TopAbs_FORWARD, TopAbs_REVERSED
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 
 from ...algorithms.curve import NurbsCurve
+from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
 from ..occ.edges import EXACT_2D, converts_exactly
 from ..occ.geom import curve_from_occ, surface_from_occ
 
-__all__ = ["SharedEdge", "edges_by_face", "face_surface", "images_on_face", "pcurve",
-           "pcurve_points", "read_edge", "same_surface"]
+__all__ = ["SharedEdge", "edges_by_face", "face_surface", "feet_on_face", "images_on_face",
+           "pcurve", "pcurve_points", "read_edge", "same_surface"]
 
 
 @dataclass
@@ -104,6 +107,37 @@ def images_on_face(e: SharedEdge, i: int, faces, s: NDArray, reverse: bool = Fal
         if np.all((uv[:, 0] >= u0) & (uv[:, 0] <= u1) & (uv[:, 1] >= v0) & (uv[:, 1] <= v1)):
             return nurbs.evaluate(uv[:, 0], uv[:, 1])
     return np.array([surface.Value(u, v).Coord() for u, v in uv])
+
+
+def feet_on_face(e: SharedEdge, i: int, faces, points: NDArray, s: NDArray,
+                 reverse: bool = False) -> tuple[NDArray, NDArray]:
+    """Closest points of the surface of ``e``'s ``i``-th face to ``points`` (m, 3), each
+    started from the face's pcurve at the same ``s`` (m,): ``(uv (m, 2), feet (m, 3))``.
+    A B-spline surface converting in the same parameters is projected as a NURBS
+    surface (clamped to its domain), any other surface point by point by OpenCascade's
+    ``ShapeAnalysis_Surface`` (an unbounded or periodic surface: the foot nearest the
+    start)."""
+    f = e.faces[i]
+    guess = pcurve_points(e, i, faces, s, reverse)
+    surface, nurbs = face_surface(e, f, faces)
+    if nurbs is not None and same_surface(faces, f, [e]) is nurbs:
+        found = project_to_surface(nurbs, points, guess=guess)
+        return found.uv, found.points
+    analysis = ShapeAnalysis_Surface(surface)
+    scale = float(np.ptp(points, axis=0).max()) if len(points) else 0.0
+    precision = 1e-12 * max(scale, float(np.abs(points).max(initial=1.0)))
+    uv = np.empty((len(points), 2))
+    for k, (p, (u, v)) in enumerate(zip(points, guess)):
+        uv[k] = analysis.NextValueOfUV(gp_Pnt2d(u, v), gp_Pnt(*p), precision, -1.0).Coord()
+    # on a periodic surface each foot in the period of its start (a torus's feet came
+    # back a period away from the pcurve, and the pcurve through them crossed the face)
+    for k, (periodic, period) in enumerate(((surface.IsUPeriodic(), surface.UPeriod),
+                                           (surface.IsVPeriodic(), surface.VPeriod))):
+        if periodic:
+            step = period()
+            uv[:, k] += step * np.round((guess[:, k] - uv[:, k]) / step)
+    feet = np.array([surface.Value(u, v).Coord() for u, v in uv])
+    return uv, feet
 
 
 def face_surface(e: SharedEdge, f: int, faces):

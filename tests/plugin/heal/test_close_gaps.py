@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve2d, BRepAdaptor_Surface
-from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+from OCP.BRepBuilderAPI import (
+    BRepBuilderAPI_MakeEdge,
+    BRepBuilderAPI_MakeFace,
+    BRepBuilderAPI_MakePolygon,
+    BRepBuilderAPI_MakeWire,
+)
 from OCP.Geom import Geom_Plane
 from OCP.gp import gp_Dir, gp_Pnt
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
@@ -16,9 +21,10 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
-from surfprep.algorithms.fitting import interpolate_surface
+from surfprep.algorithms.fitting import interpolate_curve, interpolate_surface
 from surfprep.plugin.heal.close_gaps import close_gaps
 from surfprep.plugin.occ.faces import make_face
+from surfprep.plugin.occ.geom import curve_to_occ, surface_from_occ
 from surfprep.plugin.occ.shapes import all_faces, is_valid, max_edge_tolerance, sew
 
 TIGHT = 1e-7
@@ -109,6 +115,64 @@ def test_a_gap_no_b_spline_can_close_is_left_with_a_note():
     assert is_valid(shape)
 
 
+def _wavy_flat():
+    """A face of the plane z = 0 over x in [-1, 0] whose side x = 0 waves within the
+    plane, ``x = 2e-4 sin(3 pi y)`` (an exporter's approximate trimming curve)."""
+    y = np.linspace(0.0, 1.0, 41)
+    wave = curve_to_occ(interpolate_curve(np.stack([2e-4 * np.sin(3 * np.pi * y), y, 0 * y], axis=1)))
+    polygon = BRepBuilderAPI_MakePolygon(gp_Pnt(0, 1, 0), gp_Pnt(-1, 1, 0), gp_Pnt(-1, 0, 0),
+                                         gp_Pnt(0, 0, 0))
+    wire = BRepBuilderAPI_MakeWire(polygon.Wire(), BRepBuilderAPI_MakeEdge(wave).Edge()).Wire()
+    return BRepBuilderAPI_MakeFace(Geom_Plane(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), wire).Face()
+
+
+def _faces_by_type(shape):
+    """(faces on planes, the other faces) of ``shape``."""
+    faces = all_faces(shape)
+    flat = [isinstance(BRep_Tool.Surface_s(f), Geom_Plane) for f in faces]
+    return ([f for f, p in zip(faces, flat) if p], [f for f, p in zip(faces, flat) if not p])
+
+
+def test_a_plane_whose_trimming_waves_beside_its_neighbour_is_re_trimmed_not_moved():
+    # the B-spline face rises from the line x = 0 of the plane: its side lies on the
+    # plane, the plane's trimming curve waves 2e-4 beside it within the plane; the plane
+    # takes the B-spline's side as its edge and neither surface moves
+    x, y = np.meshgrid(np.linspace(0, 1, 6), np.linspace(0, 1, 6), indexing="ij")
+    rising = interpolate_surface(np.stack([x, y, 0.3 * x + 0.05 * x ** 2], axis=-1))
+    shape, _ = sew([_wavy_flat(), make_face(rising)], 1e-3)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 0)
+    assert closed.moved == () and len(closed.retrimmed) == 1
+    assert closed.retrimmed[0]["moved"] == pytest.approx(2e-4, rel=1e-2)   # its boundary
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT                        # measured on 2001 points
+    assert BRep_Tool.Tolerance_s(edge) <= TIGHT
+    planes, [curved] = _faces_by_type(shape)
+    assert len(planes) == 1 and BRepAdaptor_Surface(planes[0]).Value(-0.5, 0.5).Z() == 0.0
+    after = surface_from_occ(BRep_Tool.Surface_s(curved))  # the B-spline surface as it was
+    u = np.linspace(0.0, 1.0, 41)
+    assert np.max(np.abs(after.evaluate_grid(u, u) - rising.evaluate_grid(u, u))) <= 1e-12
+    assert is_valid(shape)
+
+
+def test_two_planes_meeting_at_an_angle_close_by_re_trimming_one():
+    # neither face is a B-spline: the wavy plane takes the tilted plane's straight edge
+    tilted = BRepBuilderAPI_MakeFace(BRepBuilderAPI_MakePolygon(
+        gp_Pnt(0, 0, 0), gp_Pnt(1, 0, 0.3), gp_Pnt(1, 1, 0.3), gp_Pnt(0, 1, 0), True).Wire(),
+        True).Face()
+    shape, _ = sew([_wavy_flat(), tilted], 1e-3)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 0)
+    assert closed.moved == () and len(closed.retrimmed) == 1
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT
+    planes, others = _faces_by_type(shape)
+    assert len(planes) == 2 and not others
+    assert is_valid(shape)
+
+
 def test_a_face_that_would_move_too_far_is_kept():
     faces = [make_face(_patch(0.0, 1.0)), make_face(_patch(1.0, 2.0, dz=2e-4))]
     shape, _ = sew(faces, 1e-3)
@@ -126,8 +190,9 @@ def test_heal_closes_the_capsules_gaps_unless_told_not_to():
     raising their tolerance to 0.049; heal moves the six B-spline faces along them onto
     common curves (largest edge tolerance 4.1e-6, each face within gap_tol of where it
     was); --no-close-gaps / close_gaps=False leaves them as sewing does."""
-    import surfprep
     from helpers.paths import SAMPLES
+
+    import surfprep
 
     path = SAMPLES / "overture_marscapsule_proe.igs"
     closed = surfprep.heal(path)
