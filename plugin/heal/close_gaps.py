@@ -94,6 +94,12 @@ PROBE_SAMPLES = 65
 FIT_SAMPLES = 513
 #: ... and where the result is measured (the edges' tolerances)
 CHECK_SAMPLES = 1025
+#: a face whose fit misses at its samples, or whose moved edges are measured wider than
+#: they were (its surface waving between the samples), is fitted again on this many
+#: times as many samples along the same common curves (t4m's faces, whose neighbours'
+#: edges wave 1e-3 off them with a period of ten samples, fitted to 1.5e-4..2.4e-4 on
+#: FIT_SAMPLES and to 5e-5 on four times as many)
+_DENSER = 4
 #: rounds of fitting, faces whose fit failed or that fail BRepCheck once moved fixed for
 #: the next (fits and common curves are remembered, so a round costs what changed; a
 #: last round that still fails puts everything back: asmo needs 5)
@@ -192,6 +198,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     surfaces = {f: s for f in candidates if (s := same_surface(faces, f, edges)) is not None}
     of_face = edges_by_face(edges)
     fixed: set[int] = set()
+    dense: set[int] = set()             # faces fitted on _DENSER times the samples
     rigid: set[int] = set()             # faces whose re-trimming was taken back
     fits: dict = {}
     retrimmed: dict = {}
@@ -203,8 +210,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
         if not moving and not any(f in trimmable for e in open_ for f in e.faces):
             break
         fits, commons, positions, failed, retrimmed = _fit_round(
-            moving, trimmable, surfaces, edges, of_face, faces, tight, allowed, notes, done,
-            fitted)
+            moving, trimmable, dense, surfaces, edges, of_face, faces, tight, allowed, notes,
+            done, fitted)
         fixed |= failed
         if failed and _round < _ROUNDS - 1 or not (fits or retrimmed):
             continue                # the others fitted again with these where they are
@@ -228,10 +235,15 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
         if not bad:
             break
         _undo(journal, shape)
-        notes.append(f"faces {sorted(f - 1 for f in bad)} fail BRepCheck, or leave an edge wider "
-                     "than it was, once moved onto (or re-trimmed to) their neighbours' edges: "
-                     "kept as they are")
-        fixed |= bad & set(fits)    # the others fitted again with these where they are
+        # a moved face fitted on few samples gets one more chance on many; the others
+        # are fitted again with these where they are
+        again = (bad & set(fits)) - dense
+        if bad - again:
+            notes.append(f"faces {sorted(f - 1 for f in bad - again)} fail BRepCheck, or leave an "
+                         "edge wider than it was, once moved onto (or re-trimmed to) their "
+                         "neighbours' edges: kept as they are")
+        dense |= again
+        fixed |= (bad & set(fits)) - again
         rigid |= bad - set(fits)
         fits, retrimmed = {}, {}
     if not fits and not retrimmed:
@@ -297,22 +309,19 @@ class _Common:
     retrimmed: dict = field(default_factory=dict)  # fixed face re-trimmed -> its boundary's shift
 
 
-def _fit_round(moving: list[int], trimmable: set[int], surfaces, edges: list[SharedEdge],
-               of_face, faces, tight: float, allowed: float, notes: list[str], done: dict,
-               fitted: dict):
+def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces,
+               edges: list[SharedEdge], of_face, faces, tight: float, allowed: float,
+               notes: list[str], done: dict, fitted: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
-    fixed (those of ``trimmable`` re-trimmed where that closes an edge better):
+    fixed (those of ``trimmable`` re-trimmed where that closes an edge better); the
+    faces of ``dense``, and those whose fit misses, on ``_DENSER`` times the samples:
     ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position}, failed faces,
     {re-trimmed face: how far its boundary moved})``. ``done`` holds the common curves
     of earlier rounds, by edge, the faces that move or may be re-trimmed and the
     vertices; ``fitted`` the fits, by face, surface and targets (a face whose neighbours
     all stayed as they were gets the same targets again)."""
     moving_set = set(moving)
-    # even samples and Chebyshev-Lobatto points: dense at the vertices too, where two
-    # edges' targets meet in a kink the fit resolves only with short knot spans (each
-    # holding enough samples)
-    s = np.union1d(np.linspace(0.0, 1.0, FIT_SAMPLES),
-                   0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, FIT_SAMPLES)))
+    s = _samples()
     touched = {id(e): e for f in moving for e in of_face[f]}
     # open edges between faces that do not move, one of which may be re-trimmed
     touched.update((id(e), e) for e in edges
@@ -347,17 +356,9 @@ def _fit_round(moving: list[int], trimmable: set[int], surfaces, edges: list[Sha
         for f, shift in common.retrimmed.items():
             retrimmed[f] = max(retrimmed.get(f, 0.0), shift)
     fits, failed = {}, set()
+    many = _samples(_DENSER)
     for f in moving:
-        targets = []
-        for e in of_face[f]:
-            common = commons.get(id(e))
-            if common is None:          # (an edge of a fixed face only re-trimmed)
-                continue
-            for side in ((False, True) if e.seam else (False,)):
-                uv = common.uv.get((f, side))
-                if uv is None:          # a pole: the old pcurve, every point to the vertex
-                    uv = pcurve_points(e, e.faces.index(f), faces, s, side)
-                targets.append(EdgeTarget(uv, common.goals.get((f, side), common.points)))
+        targets = _targets(f, of_face, commons, surfaces, faces, position, s)
         offset = max(float(np.max(np.linalg.norm(
             surfaces[f].evaluate(t.uv[:, 0], t.uv[:, 1]) - t.points, axis=1))) for t in targets)
         if offset <= _STILL * tight:        # its edges are on it already: the surface stays
@@ -370,21 +371,20 @@ def _fit_round(moving: list[int], trimmable: set[int], surfaces, edges: list[Sha
                          f"at least {offset:.3g} > {allowed:.3g}: its edges lie that far from "
                          "them); kept as it is")
             continue
-        key = (f, _digest(targets, surfaces[f]))
-        if key in fitted:
-            fit, moved = fitted[key]
-        else:
-            try:
-                fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
-            except (SurfprepError, np.linalg.LinAlgError, RuntimeError) as exc:
-                # (a least-squares or factorization failure of scipy/numpy on this
-                # face's system is this face's failure, not the model's)
-                failed.add(f)
-                notes.append(f"face {f - 1}: not moved onto its neighbours' edges "
-                             f"({type(exc).__name__}: {exc}); kept as it is")
-                continue
-            moved = _moved(surfaces[f], fit.surface, faces, f)
-            fitted[key] = fit, moved
+        try:
+            fit, moved = None, np.inf
+            if f not in dense:
+                fit, moved = _fit(f, targets, surfaces, faces, tight, fitted)
+            if f in dense or not fit.converged and moved <= allowed:
+                fit, moved = _fit(f, _targets(f, of_face, commons, surfaces, faces, position, many),
+                                  surfaces, faces, tight, fitted)
+        except (SurfprepError, np.linalg.LinAlgError, RuntimeError) as exc:
+            # (a least-squares or factorization failure of scipy/numpy on this
+            # face's system is this face's failure, not the model's)
+            failed.add(f)
+            notes.append(f"face {f - 1}: not moved onto its neighbours' edges "
+                         f"({type(exc).__name__}: {exc}); kept as it is")
+            continue
         if fit.converged and moved <= allowed:
             fits[f] = (fit, moved)
             continue
@@ -393,6 +393,76 @@ def _fit_round(moving: list[int], trimmable: set[int], surfaces, edges: list[Sha
                else f"its fit leaves {fit.residual:.3g} > {_FIT_SHARE * tight:.3g}")
         notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({why}); kept as it is")
     return fits, commons, position, failed, retrimmed
+
+
+def _samples(density: int = 1) -> NDArray:
+    """Where the edges are sampled in [0, 1]: ``density`` x (``FIT_SAMPLES`` - 1) + 1 even
+    samples and as many Chebyshev-Lobatto points, dense at the vertices too, where two
+    edges' targets meet in a kink the fit resolves only with short knot spans (each
+    holding enough samples)."""
+    n = density * (FIT_SAMPLES - 1) + 1
+    return np.union1d(np.linspace(0.0, 1.0, n), 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, n)))
+
+
+def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -> list[EdgeTarget]:
+    """Where moving face ``f``'s edges must go, sampled at ``at``: the common curves' own
+    samples when ``at`` is theirs, else each common curve evaluated at ``at`` and
+    projected onto the face as :func:`_common` does (a closed edge: the face's own
+    side, its ends at the vertices)."""
+    targets = []
+    for e in of_face[f]:
+        common = commons.get(id(e))
+        if common is None:          # (an edge of a fixed face only re-trimmed)
+            continue
+        i = e.faces.index(f)
+        own = at.size == common.t.size     # (the samples of one density are one array)
+        for side in ((False, True) if e.seam else (False,)):
+            if own:
+                uv = common.uv.get((f, side))
+                if uv is None:      # a pole: the old pcurve, every point to the vertex
+                    uv = pcurve_points(e, i, faces, at, side)
+                targets.append(EdgeTarget(uv, common.goals.get((f, side), common.points)))
+                continue
+            guess = pcurve_points(e, i, faces, at, side)
+            if common.curve is None:            # a pole
+                targets.append(EdgeTarget(guess, np.repeat(position[e.first][None], at.size, axis=0)))
+            elif (f, side) in common.goals:     # a closed edge: the face keeps its side
+                own_side = surfaces[f].evaluate(guess[:, 0], guess[:, 1])
+                targets.append(EdgeTarget(guess, _to_vertices(own_side, at, position[e.first],
+                                                              position[e.last])))
+            else:
+                t = common.t[0] + at * (common.t[-1] - common.t[0])
+                points = common.curve.evaluate(t)
+                targets.append(EdgeTarget(_uv_on(surfaces[f], points, guess, at), points))
+    return targets
+
+
+def _fit(f: int, targets: list[EdgeTarget], surfaces, faces, tight: float, fitted: dict):
+    """``(EdgeFit, how far it moved)`` of face ``f`` onto ``targets``, remembered in
+    ``fitted`` by face, surface and targets."""
+    key = (f, _digest(targets, surfaces[f]))
+    if key not in fitted:
+        fit = fit_to_edges(surfaces[f], targets, tol=_FIT_SHARE * tight)
+        fitted[key] = fit, _moved(surfaces[f], fit.surface, faces, f)
+    return fitted[key]
+
+
+def _to_vertices(curve: NDArray, s: NDArray, start: NDArray, end: NDArray) -> NDArray:
+    """``curve`` (m, 3) at ``s`` (m,) with its ends' shifts onto the vertices ``start``
+    and ``end`` blended by ``3 s^2 - 2 s^3``: level at both ends, so the targets of two
+    edges in line keep one slope through their vertex (a kink there the fit resolves
+    only with ever shorter knot spans)."""
+    w = (s * s * (3.0 - 2.0 * s))[:, None]
+    return curve + (1.0 - w) * (start - curve[0]) + w * (end - curve[-1])
+
+
+def _uv_on(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArray) -> NDArray:
+    """Parameters of a moving face's new pcurve: ``points`` (m, 3) at ``s`` projected onto
+    ``surface`` from its old pcurve ``guess`` (m, 2), its ends where they were, within the
+    domain."""
+    uv = pinned_ends(spread_ends(on_surface(surface, points, guess, s), s), guess, s)
+    u0, u1, v0, v1 = surface.domain
+    return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
 
 
 def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
@@ -426,13 +496,8 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimm
         a, b = e.ranges[0]
         return _Common(a + s * (b - a), np.repeat(position[e.first][None], s.size, axis=0),
                        _even(s))
-    # the ends' shifts onto the vertices blended by 3 s^2 - 2 s^3: level at both ends, so
-    # the targets of two edges in line keep one slope through their vertex (a kink there
-    # the fit resolves only with ever shorter knot spans)
-    w = (s * s * (3.0 - 2.0 * s))[:, None]
-
     def to_vertices(curve: NDArray) -> NDArray:
-        return curve + (1.0 - w) * (position[e.first] - curve[0]) + w * (position[e.last] - curve[-1])
+        return _to_vertices(curve, s, position[e.first], position[e.last])
 
     closed = len(e.faces) == 1 or e.gap <= tight
     trimmed = None
@@ -484,10 +549,7 @@ def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimm
                 common.uv[f, side] = guess
                 common.goals[f, side] = to_vertices(images[id(e), i])
                 continue
-            uv = pinned_ends(spread_ends(on_surface(surfaces[f], common.points, guess, s), s), guess, s)
-            u0, u1, v0, v1 = surfaces[f].domain
-            common.uv[f, side] = np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)],
-                                          axis=1)
+            common.uv[f, side] = _uv_on(surfaces[f], common.points, guess, s)
     return common
 
 
