@@ -27,7 +27,7 @@ curve per edge (:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges`):
   surface moving, even where neither is a B-spline;
 * a free edge, or a shared one closed already, is held: each moving face keeps its side
   there (its ends follow the vertices), the edge's curve is the mean of its faces';
-* a face whose fit misses by more than ``_FIT_SHARE`` x ``tight``, would move farther
+* a face whose fit misses by more than ``FIT_SHARE`` x ``tight``, would move farther
   than ``allowed`` within its parameter box, or fails ``BRepCheck`` once moved (or makes
   a neighbour fail it) is kept as it was and the others fitted again with it fixed; a
   re-trimmed face that fails so keeps its trimming too.
@@ -60,23 +60,27 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
-from ...algorithms.curve import NurbsCurve
-from ...algorithms.fitting import interpolate_curve
 from ...algorithms.healing.edge_fit import EdgeFit, EdgeTarget, fit_to_edges
-from ...algorithms.healing.edge_targets import on_surface, pinned_ends, roughness, spread_ends
-from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
 from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
 from ..occ.shapes import is_valid, max_edge_tolerance
+from .common_curves import (
+    FIT_SAMPLES,
+    FIT_SHARE,
+    common_curve,
+    through,
+    to_vertices,
+    uv_on,
+    vertex_positions,
+)
 from .result import HealResult
 from .rollback import TIGHT_FACTOR
 from .shared_edges import (
     SharedEdge,
     edges_by_face,
-    feet_on_face,
     images_on_face,
     pcurve,
     pcurve_points,
@@ -90,10 +94,8 @@ __all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "close_gaps", "closed_i
 #: clustered at the ends, where an exporter's pcurves wave most: catia theorem's planes
 #: lie 2e-5 beside their neighbours at s = 0.003 and within 1.2e-5 at every 1/64) ...
 PROBE_SAMPLES = 65
-#: ... where a moving face is fitted (this many evenly and as many clustered at the ends;
-#: knot spans are split while one holds 12 of them) ...
-FIT_SAMPLES = 513
-#: ... and where the result is measured (the edges' tolerances)
+#: ... and where the result is measured (the edges' tolerances; the faces are fitted on
+#: :data:`~.common_curves.FIT_SAMPLES`)
 CHECK_SAMPLES = 1025
 #: a face whose fit misses at its samples, or whose moved edges are measured wider than
 #: they were (its surface waving between the samples), is fitted again on this many
@@ -106,15 +108,9 @@ _DENSER = 4
 #: round costs what changed; a last round that still fails puts everything back: asmo
 #: needs 5, kcs 9 since faces get a second fit and fixed faces may be re-trimmed)
 _ROUNDS = 16
-#: a face moves when its fit leaves at most this share of the tight tolerance (two faces
-#: then meet within it)
-_FIT_SHARE = 0.4
 #: a face whose edges all lie within this share of the tight tolerance of their common
 #: curves keeps its surface (only its pcurves change)
 _STILL = 1e-3
-#: weight of an image's waves (:func:`~surfprep.algorithms.healing.edge_targets.roughness`)
-#: against its distance from the other faces in choosing the common curve
-_ROUGHNESS_WEIGHT = 2.0
 #: an edge measured wider than this times its gap before (or ``tight``) after the move
 #: takes its moved faces back
 _WIDER = 2.0
@@ -309,28 +305,13 @@ def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> Close
 
 
 # ------------------------------------------------------------------ fitting
-@dataclass
-class _Common:
-    """An edge's common curve: ``points`` C(t) at ``t`` (the reference face's pcurve
-    parameters), and per (face, seam side) of a moving face its new pcurve's samples and,
-    where it does not go to C, where its side goes."""
-
-    t: NDArray
-    points: NDArray
-    even: NDArray                                 # indices of the evenly spaced samples
-    curve: NurbsCurve | None = None               # C: the cubic through the even samples
-    uv: dict = field(default_factory=dict)        # (face, seam side) -> (m, 2)
-    goals: dict = field(default_factory=dict)     # (face, seam side) -> (m, 3), else points
-    retrimmed: dict = field(default_factory=dict)  # fixed face re-trimmed -> its boundary's shift
-
-
 def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces,
                edges: list[SharedEdge], of_face, faces, tight: float, allowed: float,
                notes: list[str], done: dict, fitted: dict):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed (those of ``trimmable`` re-trimmed where that closes an edge better); the
     faces of ``dense``, and those whose fit misses, on ``_DENSER`` times the samples:
-    ``({face: (EdgeFit, moved)}, {id(edge): _Common}, {vertex: position}, failed faces,
+    ``({face: (EdgeFit, moved)}, {id(edge): CommonCurve}, {vertex: position}, failed faces,
     {re-trimmed face: how far its boundary moved})``. ``done`` holds the common curves
     of earlier rounds, by edge, the faces that move or may be re-trimmed and the
     vertices; ``fitted`` the fits, by face, surface and targets (a face whose neighbours
@@ -354,7 +335,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
     for e in touched.values():
         for i in range(len(e.faces)):
             images[id(e), i] = image(e, i, s)
-    position = _vertex_positions(touched.values(), edges, moving_set, images, image)
+    position = vertex_positions(touched.values(), edges, moving_set, images, image)
     commons = {}
     for key, e in touched.items():
         # the same when its faces move, may be re-trimmed or stay as in an earlier round
@@ -362,7 +343,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
         seen = (key, tuple(f in moving_set for f in e.faces), tuple(f in trimmable for f in e.faces),
                 position[e.first].tobytes(), position[e.last].tobytes())
         if seen not in done:
-            done[seen] = _common(e, s, images, position, moving_set, trimmable, surfaces, faces,
+            done[seen] = common_curve(e, s, images, position, moving_set, trimmable, surfaces, faces,
                                  tight, allowed)
         if done[seen] is not None:
             commons[key] = done[seen]
@@ -379,7 +360,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
         if offset <= _STILL * tight:        # its edges are on it already: the surface stays
             fits[f] = (EdgeFit(surfaces[f], offset, 0.0, 0, True), 0.0)
             continue
-        if offset > allowed + _FIT_SHARE * tight:
+        if offset > allowed + FIT_SHARE * tight:
             # a point of its edges would move farther than allowed: no fit can pass
             failed.add(f)
             notes.append(f"face {f - 1}: not moved onto its neighbours' edges (it would move "
@@ -389,7 +370,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
         try:
             fit, moved = _fit(f, targets, surfaces, faces, tight, fitted)
             if f in dense or not fit.converged and moved <= allowed:
-                # on many samples, from the knots the few found (t4m: 14 -> s)
+                # on many samples, from the knots the few found (t4m: 14 s -> 1 s)
                 fit, moved = _fit(f, _targets(f, of_face, commons, surfaces, faces, position, many),
                                   surfaces, faces, tight, fitted, like=fit.surface)
         except (SurfprepError, np.linalg.LinAlgError, RuntimeError) as exc:
@@ -404,7 +385,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
             continue
         failed.add(f)
         why = (f"it would move {moved:.3g} > {allowed:.3g}" if moved > allowed
-               else f"its fit leaves {fit.residual:.3g} > {_FIT_SHARE * tight:.3g}")
+               else f"its fit leaves {fit.residual:.3g} > {FIT_SHARE * tight:.3g}")
         notes.append(f"face {f - 1}: not moved onto its neighbours' edges ({why}); kept as it is")
     return fits, commons, position, failed, retrimmed
 
@@ -421,7 +402,7 @@ def _samples(density: int = 1) -> NDArray:
 def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -> list[EdgeTarget]:
     """Where moving face ``f``'s edges must go, sampled at ``at``: the common curves' own
     samples when ``at`` is theirs, else each common curve evaluated at ``at`` and
-    projected onto the face as :func:`_common` does (a closed edge: the face's own
+    projected onto the face as :func:`common_curve` does (a closed edge: the face's own
     side, its ends at the vertices)."""
     targets = []
     for e in of_face[f]:
@@ -442,12 +423,12 @@ def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -
                 targets.append(EdgeTarget(guess, np.repeat(position[e.first][None], at.size, axis=0)))
             elif (f, side) in common.goals:     # a closed edge: the face keeps its side
                 own_side = surfaces[f].evaluate(guess[:, 0], guess[:, 1])
-                targets.append(EdgeTarget(guess, _to_vertices(own_side, at, position[e.first],
+                targets.append(EdgeTarget(guess, to_vertices(own_side, at, position[e.first],
                                                               position[e.last])))
             else:
                 t = common.t[0] + at * (common.t[-1] - common.t[0])
                 points = common.curve.evaluate(t)
-                targets.append(EdgeTarget(_uv_on(surfaces[f], points, guess, at), points))
+                targets.append(EdgeTarget(uv_on(surfaces[f], points, guess, at), points))
     return targets
 
 
@@ -459,7 +440,7 @@ def _fit(f: int, targets: list[EdgeTarget], surfaces, faces, tight: float, fitte
     key = (f, _digest(targets, surfaces[f]))
     if key not in fitted:
         start = surfaces[f] if like is None else _refined_like(surfaces[f], like)
-        fit = fit_to_edges(start, targets, tol=_FIT_SHARE * tight)
+        fit = fit_to_edges(start, targets, tol=FIT_SHARE * tight)
         fitted[key] = fit, _moved(surfaces[f], fit.surface, faces, f)
     return fitted[key]
 
@@ -475,24 +456,6 @@ def _refined_like(surface: NurbsSurface, like: NurbsSurface) -> NurbsSurface:
     return out
 
 
-def _to_vertices(curve: NDArray, s: NDArray, start: NDArray, end: NDArray) -> NDArray:
-    """``curve`` (m, 3) at ``s`` (m,) with its ends' shifts onto the vertices ``start``
-    and ``end`` blended by ``3 s^2 - 2 s^3``: level at both ends, so the targets of two
-    edges in line keep one slope through their vertex (a kink there the fit resolves
-    only with ever shorter knot spans)."""
-    w = (s * s * (3.0 - 2.0 * s))[:, None]
-    return curve + (1.0 - w) * (start - curve[0]) + w * (end - curve[-1])
-
-
-def _uv_on(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArray) -> NDArray:
-    """Parameters of a moving face's new pcurve: ``points`` (m, 3) at ``s`` projected onto
-    ``surface`` from its old pcurve ``guess`` (m, 2), its ends where they were, within the
-    domain."""
-    uv = pinned_ends(spread_ends(on_surface(surface, points, guess, s), s), guess, s)
-    u0, u1, v0, v1 = surface.domain
-    return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
-
-
 def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
     """A fingerprint of ``targets`` and ``surface`` (their arrays' bytes)."""
     h = hashlib.blake2b(digest_size=16)
@@ -503,193 +466,6 @@ def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
         h.update(t.uv.tobytes())
         h.update(t.points.tobytes())
     return h.digest()
-
-
-def _common(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimmable: set[int],
-            surfaces, faces, tight: float, allowed: float) -> _Common | None:
-    """The common curve of ``e`` (the module doc), its ends pulled onto the vertices.
-    An edge open at ``tight``: where a fixed face may be re-trimmed, the other face's image
-    or its feet on the fixed face's surface when :func:`_retrim` finds them better (None
-    when no face of ``e`` moves and none can be re-trimmed so); else a fixed face's image
-    if it has one, else the image of the
-    face whose boundary lies nearest the other faces' surfaces and is smoothest
-    (:func:`~surfprep.algorithms.healing.edge_targets.roughness`: a wavy pcurve
-    beside a smooth one loses), as it is when it lies
-    on them within ``_FIT_SHARE`` x ``tight``, or midway to its feet on them; projected
-    onto every moving face, which goes to it. A free edge, or one already closed at
-    ``tight``: the mean of its faces' images, each moving face holding its own side
-    (only its ends follow the vertices)."""
-    still = [i for i, f in enumerate(e.faces) if f not in moving]
-    if e.degenerated:
-        a, b = e.ranges[0]
-        return _Common(a + s * (b - a), np.repeat(position[e.first][None], s.size, axis=0),
-                       _even(s))
-    def to_vertices(curve: NDArray) -> NDArray:
-        return _to_vertices(curve, s, position[e.first], position[e.last])
-
-    closed = len(e.faces) == 1 or e.gap <= tight
-    trimmed = None
-    if closed:
-        ref = still[0] if still else 0
-        mean = np.mean([images[id(e), i] for i in range(len(e.faces))], axis=0)
-    elif still:
-        ref = still[0]
-        mean = images[id(e), ref]
-        option = _retrim(e, s, images, position, moving, trimmable, surfaces, faces, tight,
-                         allowed)
-        retrim = None if option is None else _on_retrimmed(e, s, option, position, faces, tight)
-        if retrim is not None:
-            ref, mean, trimmed = option
-        elif not any(f in moving for f in e.faces):
-            return None
-    else:
-        best = None
-        for ref in range(len(e.faces)):
-            base = images[id(e), ref]
-            feet = [_feet(e, i, base, images, surfaces, faces, s)
-                    for i in range(len(e.faces)) if i != ref]
-            score = (max(float(np.max(np.linalg.norm(foot - base, axis=1))) for foot in feet)
-                     + _ROUGHNESS_WEIGHT * roughness(base, s))
-            if best is None or score < best[0]:
-                best = (score, ref, base, feet)
-        score, ref, base, feet = best
-        mean = base if score <= _FIT_SHARE * tight else np.mean([base, *feet], axis=0)
-    a, b = e.ranges[ref]
-    t, even = a + s * (b - a), _even(s)
-    # the targets are the edge's curve (the cubic through the even samples) at every
-    # sample: points mixing feet and images can wave between the even samples, and a
-    # face fitted to them would lie off its edge there
-    if trimmed is not None:
-        curve, uv = retrim
-        common = _Common(t, curve.evaluate(t), even, curve)
-        common.uv[e.faces[trimmed], False] = uv
-        common.retrimmed[e.faces[trimmed]] = float(np.max(np.linalg.norm(
-            curve.evaluate(t) - images[id(e), trimmed], axis=1)))
-    else:
-        curve = _through(t, to_vertices(mean), even)
-        common = _Common(t, curve.evaluate(t), even, curve)
-    for i, f in enumerate(e.faces):
-        if f not in moving:
-            continue
-        for side in ((False, True) if e.seam else (False,)):
-            guess = pcurve_points(e, i, faces, s, side)
-            if closed:          # each face keeps its own side, its ends at the vertices
-                common.uv[f, side] = guess
-                common.goals[f, side] = to_vertices(images[id(e), i])
-                continue
-            common.uv[f, side] = _uv_on(surfaces[f], common.points, guess, s)
-    return common
-
-
-def _retrim(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimmable: set[int],
-            surfaces, faces, tight: float, allowed: float) -> tuple[int, NDArray, int] | None:
-    """A common curve for the open two-face edge ``e`` lying on the surface of a face
-    that does not move but may be re-trimmed (``trimmable``), as ``(ref, points, j)``:
-    the other face ``ref``'s image, or its feet on face ``j``'s surface, to which ``j``
-    is re-trimmed. A fixed ``ref`` qualifies when its image lies on ``j``'s surface
-    within ``_FIT_SHARE`` x ``tight`` (the two surfaces meet along it); a moving one
-    when its feet lie within ``allowed``, and it wins against ``j``'s own boundary
-    (the common curve otherwise) when its distance plus its waves
-    (:func:`~surfprep.algorithms.healing.edge_targets.roughness`) are smaller. The
-    re-trimmed boundary may shift by ``allowed`` at most, and its ends stay: ``j``'s
-    corners must be at the vertices (within ``_FIT_SHARE`` x ``tight``; its other edges
-    end there). None when nothing qualifies."""
-    if len(e.faces) != 2 or e.seam or e.degenerated:
-        return None
-    best = None
-    for j in (0, 1):
-        if e.faces[j] not in trimmable:
-            continue
-        i = 1 - j
-        own = images[id(e), j]
-        if max(float(np.linalg.norm(own[0] - position[e.first])),
-               float(np.linalg.norm(own[-1] - position[e.last]))) > _FIT_SHARE * tight:
-            continue
-        base = images[id(e), i]
-        _, feet = feet_on_face(e, j, faces, base, s)
-        off = float(np.max(np.linalg.norm(feet - base, axis=1)))
-        if float(np.max(np.linalg.norm(feet - own, axis=1))) > allowed:
-            continue
-        if e.faces[i] not in moving:
-            if off <= _FIT_SHARE * tight and (best is None or off < best[0]):
-                best = (off, i, base, j)
-            continue
-        if off > allowed:
-            continue
-        points = base if off <= _FIT_SHARE * tight else feet
-        score = off + _ROUGHNESS_WEIGHT * roughness(points, s)
-        kept = (float(np.max(np.linalg.norm(_feet(e, i, own, images, surfaces, faces, s) - own,
-                                            axis=1)))
-                + _ROUGHNESS_WEIGHT * roughness(own, s))
-        if score < kept and (best is None or score < best[0]):
-            best = (score, i, points, j)
-    return None if best is None else best[1:]
-
-
-def _on_retrimmed(e: SharedEdge, s: NDArray, option: tuple[int, NDArray, int], position,
-                  faces, tight: float):
-    """The common curve of ``e`` for a :func:`_retrim` option ``(ref, points, j)`` and face
-    ``j``'s new pcurve samples: ``points`` with their ends' shifts onto the vertices
-    (:func:`_to_vertices`), put back onto ``j``'s surface (off a plane the shifts,
-    faded over the whole edge, take the curve off it: kcs by up to 5e-3), the cubic
-    through them, its feet on ``j`` with ``j``'s ends where they were. None when that
-    curve lies off ``j``'s surface by more than ``_FIT_SHARE`` x ``tight`` (beyond the
-    border of its domain, where the feet stop)."""
-    ref, points, j = option
-    a, b = e.ranges[ref]
-    t = a + s * (b - a)
-    goal = feet_on_face(e, j, faces, _to_vertices(points, s, position[e.first], position[e.last]),
-                        s)[1]
-    curve = _through(t, goal, _even(s))
-    on = curve.evaluate(t)
-    uv, feet = feet_on_face(e, j, faces, on, s)
-    if float(np.max(np.linalg.norm(feet - on, axis=1))) > _FIT_SHARE * tight:
-        return None
-    return curve, pinned_ends(uv, pcurve_points(e, j, faces, s), s)
-
-
-def _even(s: NDArray) -> NDArray:
-    """Indices of the evenly spaced samples among ``s`` (:data:`FIT_SAMPLES` of them)."""
-    return np.searchsorted(s, np.linspace(0.0, 1.0, FIT_SAMPLES))
-
-
-def _through(t: NDArray, points: NDArray, even: NDArray):
-    """The cubic interpolating ``points`` at the evenly spaced ``t`` (the samples
-    clustered at the ends would make the interpolation ill-conditioned)."""
-    return interpolate_curve(points[even], parameters=t[even])
-
-
-def _feet(e: SharedEdge, i: int, points: NDArray, images, surfaces, faces, s: NDArray) -> NDArray:
-    """Closest points of moving face ``e.faces[i]``'s surface to ``points`` (started from
-    its pcurve at the same parameters); where one lands farther than twice the edge's
-    gap (a wrong local minimum), the face's own point there."""
-    foot = project_to_surface(surfaces[e.faces[i]], points, guess=pcurve_points(e, i, faces, s)).points
-    far = np.linalg.norm(foot - points, axis=1) > 2.0 * e.gap + 1e-12
-    foot[far] = images[id(e), i][far]
-    return foot
-
-
-def _vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image
-                      ) -> dict[int, NDArray]:
-    """Per vertex of an edge of ``around``: the mean of its faces' corners there (of the
-    fixed faces' if any)."""
-    wanted = {v for e in around for v in (e.first, e.last)}
-    corners: dict[int, list[tuple[bool, NDArray]]] = {v: [] for v in wanted}
-    ends = np.array([0.0, 1.0])
-    for e in edges:
-        if e.first not in wanted and e.last not in wanted:
-            continue
-        for i, f in enumerate(e.faces):
-            got = images.get((id(e), i))
-            pts = got[[0, -1]] if got is not None else image(e, i, ends)
-            for v, p in ((e.first, pts[0]), (e.last, pts[1])):
-                if v in corners:
-                    corners[v].append((f not in moving, p))
-    out = {}
-    for v, items in corners.items():
-        fixed = [p for still, p in items if still]
-        out[v] = np.mean(fixed if fixed else [p for _, p in items], axis=0)
-    return out
 
 
 def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
@@ -732,7 +508,7 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
             if common is None or (f, False) not in common.uv:
                 new.append(old[-1])             # a pole, or an edge not re-trimmed
                 continue
-            pcurves = [curve2d_to_occ(_through(common.t, common.uv[f, side], common.even))
+            pcurves = [curve2d_to_occ(through(common.t, common.uv[f, side], common.even))
                        for side in ((False, True) if e.seam else (False,))]
             new.append((e, pcurves[0], pcurves[1] if e.seam else None, tol,
                         (float(common.t[0]), float(common.t[-1]))))
