@@ -70,9 +70,11 @@ def uv_on(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArray) ->
     return np.stack([np.clip(uv[:, 0], u0, u1), np.clip(uv[:, 1], v0, v1)], axis=1)
 
 
-def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimmable: set[int],
-            surfaces, faces, tight: float, allowed: float) -> CommonCurve | None:
-    """The common curve of ``e`` (the module doc), its ends pulled onto the vertices.
+def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int],
+                 trimmable: set[int], surfaces, faces, tight: float, allowed: float
+                 ) -> CommonCurve | None:
+    """The common curve of ``e`` (the rules in :mod:`.close_gaps`), its ends pulled onto
+    the vertices.
     An edge open at ``tight``: where a fixed face may be re-trimmed, the other face's image
     or its feet on the fixed face's surface when :func:`_retrim` finds them better (None
     when no face of ``e`` moves and none can be re-trimmed so); else a fixed face's image
@@ -88,7 +90,8 @@ def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int], 
     if e.degenerated:
         a, b = e.ranges[0]
         return CommonCurve(a + s * (b - a), np.repeat(position[e.first][None], s.size, axis=0),
-                       even_samples(s))
+                           even_samples(s))
+
     def to_ends(curve: NDArray) -> NDArray:
         return to_vertices(curve, s, position[e.first], position[e.last])
 
@@ -235,7 +238,7 @@ def _feet(e: SharedEdge, i: int, points: NDArray, images, surfaces, faces, s: ND
 
 
 def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image
-                      ) -> dict[int, NDArray]:
+                     ) -> dict[int, NDArray]:
     """Per vertex of an edge of ``around``: the mean of its faces' corners there (of the
     fixed faces' if any)."""
     wanted = {v for e in around for v in (e.first, e.last)}
