@@ -220,12 +220,11 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
         journal = _Journal()
         changed = set(fits) | set(retrimmed)
         try:
-            after, apart = _apply(fits, retrimmed, commons, edges, of_face, faces, vertices,
-                                  positions, journal, surfaces)
+            after, apart, moved_vertices = _apply(fits, retrimmed, commons, edges, of_face,
+                                                  faces, vertices, positions, journal, surfaces)
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
-            invalid = _invalid(changed, of_face, faces, edges,
-                               _moved_vertices(commons, {id(e): e for e in edges}))
+            invalid = _invalid(changed, of_face, faces, edges, moved_vertices)
             bad = invalid | _widening(edges, changed, after, apart, tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
@@ -481,14 +480,16 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
 
 # ------------------------------------------------------------------ applying
 def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, vertices, positions,
-           journal: _Journal, surfaces) -> tuple[dict[int, float], dict[tuple[int, int], float]]:
+           journal: _Journal, surfaces
+           ) -> tuple[dict[int, float], dict[tuple[int, int], float], set[int]]:
     """Put the moved surfaces, their pcurves (the common curves' projections), the
     re-trimmed faces' new pcurves, the common curves and the vertices into the shape,
     recording in ``journal`` what they
     replace; returns per edge touched twice the largest distance, on ``CHECK_SAMPLES``
     points, between its curve and its faces' surfaces (a bound on how far apart two of
     its faces' points are; its tolerance is set to 1.1 times that distance), and that
-    distance per edge and face."""
+    distance per edge and face, and the vertices it moved (those of the edges given a
+    common curve)."""
     builder = BRep_Builder()
     by_id = {id(e): e for e in edges}
     # the faces' surfaces as they are now (the fixed ones' as read, the moved ones' put)
@@ -545,7 +546,7 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
                     deviation = max(deviation, off)
         after[key] = 2.0 * deviation
         fixer.SetTolerance(e.edge, max(1.1 * deviation, _MIN_TOLERANCE), TopAbs_EDGE)
-    moved = _moved_vertices(commons, by_id)
+    moved = {v for key in commons for v in (by_id[key].first, by_id[key].last)}
     for v, p in positions.items():
         if v not in moved:          # (a vertex of an edge no face was fitted or re-trimmed to)
             continue
@@ -556,7 +557,7 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
     # the vertices hold every curve's end there, on the fixed faces' edges too
     for g in _around(set(fits) | set(retrimmed), of_face, edges, moved):
         BRepLib.UpdateTolerances_s(faces.FindKey(g), False)
-    return after, apart
+    return after, apart, moved
 
 
 def _widening(edges: list[SharedEdge], fits, after: dict[int, float],
@@ -594,11 +595,6 @@ def _invalid(fits, of_face, faces, edges: list[SharedEdge], vertices: set[int]) 
                     for h in e.faces if h in fits}
         bad |= near
     return bad
-
-
-def _moved_vertices(commons, by_id) -> set[int]:
-    """The vertices of the edges given common curves (those :func:`_apply` moves)."""
-    return {v for key in commons for v in (by_id[key].first, by_id[key].last)}
 
 
 def _around(fits, of_face, edges: list[SharedEdge] = (), vertices: set[int] = frozenset()

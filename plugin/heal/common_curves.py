@@ -132,7 +132,7 @@ def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int],
         common = CommonCurve(t, curve.evaluate(t), even, curve)
         common.uv[e.faces[trimmed], False] = uv
         common.retrimmed[e.faces[trimmed]] = float(np.max(np.linalg.norm(
-            curve.evaluate(t) - images[id(e), trimmed], axis=1)))
+            common.points - images[id(e), trimmed], axis=1)))
     else:
         curve = through(t, to_ends(mean), even)
         common = CommonCurve(t, curve.evaluate(t), even, curve)

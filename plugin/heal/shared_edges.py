@@ -124,8 +124,7 @@ def feet_on_face(e: SharedEdge, i: int, faces, points: NDArray, s: NDArray,
         found = project_to_surface(nurbs, points, guess=guess)
         return found.uv, found.points
     analysis = ShapeAnalysis_Surface(surface)
-    scale = float(np.ptp(points, axis=0).max()) if len(points) else 0.0
-    precision = 1e-12 * max(scale, float(np.abs(points).max(initial=1.0)))
+    precision = 1e-12 * float(np.abs(points).max(initial=1.0))
     uv = np.empty((len(points), 2))
     for k, (p, (u, v)) in enumerate(zip(points, guess)):
         uv[k] = analysis.NextValueOfUV(gp_Pnt2d(u, v), gp_Pnt(*p), precision, -1.0).Coord()
