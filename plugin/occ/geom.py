@@ -35,19 +35,19 @@ from ...errors import ConversionError, OpenCascadeError
 from .failures import describe, is_occ_failure
 
 __all__ = [
-    "surface_from_occ",
-    "surface_to_occ",
+    "curve2d_to_occ",
     "curve_from_occ",
     "curve_to_occ",
-    "curve2d_to_occ",
+    "surface_from_occ",
+    "surface_to_occ",
 ]
 
 
 # ------------------------------------------------------------------ helpers
 def _array1(values: NDArray, cls=TColStd_Array1OfReal):
     arr = cls(1, len(values))
-    for i, x in enumerate(values):
-        arr.SetValue(i + 1, x.item() if hasattr(x, "item") else x)
+    for i, x in enumerate(np.asarray(values).tolist()):    # (Python floats and ints)
+        arr.SetValue(i + 1, x)
     return arr
 
 
