@@ -11,7 +11,10 @@ that at equal parameters) is moved the least so that its sides run along one com
 curve per edge (:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges`):
 
 * a vertex goes to the mean of its faces' corners (of the faces that do not move, if
-  any: analytic faces, and B-spline faces whose move failed);
+  any: analytic faces, and B-spline faces whose move failed); where those fixed
+  corners lie apart (a gap between two fixed faces that stays open), each group of
+  faces joined there by edges that can close goes to its own fixed corners' mean, the
+  vertex's tolerance covering the groups;
 * an open edge's common curve is the image of a face that does not move; else the image
   of the face lying nearest the others' surfaces and smoothest, or the mean of it and
   its feet on them; its ends pulled onto the vertices. Each moving face gets as its new
@@ -88,7 +91,7 @@ from .shared_edges import (
     same_surface,
 )
 
-__all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "close_gaps", "closed_in_geometry"]
+__all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "Fitted", "close_gaps", "closed_in_geometry"]
 
 #: samples per edge where the gap is first measured (this many evenly and as many
 #: clustered at the ends, where an exporter's pcurves wave most: catia theorem's planes
@@ -158,6 +161,36 @@ class ClosedGaps:
 
 
 @dataclass
+class Fitted:
+    """The fits of :func:`close_gaps`, kept across its calls on one shape (the passes of
+    :func:`closed_in_geometry`: a face kept in one pass meets mostly the same targets in
+    the next, and a fit that failed once applied would fail the same way)."""
+
+    fits: dict = field(default_factory=dict)       # (face, digest of surface, targets) -> (EdgeFit, moved)
+    rejected: dict = field(default_factory=dict)   # id(EdgeFit) -> (the fit, "invalid" | "wider")
+
+    def verdict(self, fit: EdgeFit) -> str | None:
+        """Why ``fit`` was taken back once applied: ``"invalid"`` (a face failed
+        BRepCheck), ``"wider"`` (an edge came out wider than it was), or None."""
+        got = self.rejected.get(id(fit))
+        return None if got is None else got[1]
+
+    def reject(self, fit: EdgeFit, why: str) -> None:
+        self.rejected[id(fit)] = (fit, why)        # (the fit kept: its id stays its own)
+
+
+@dataclass
+class _Remembered:
+    """What one :func:`close_gaps` call computes once for all its rounds (a round changes
+    a few faces; the rest is asked again)."""
+
+    commons: dict = field(default_factory=dict)    # common curves, by edge, faces' roles, vertices
+    images: dict = field(default_factory=dict)     # (edge, i, moving) -> the face's image on the samples
+    dense: dict = field(default_factory=dict)      # (face, its edges' common curves) -> dense targets
+    occ: dict = field(default_factory=dict)        # (common curve, face, side) -> OpenCascade curve
+
+
+@dataclass
 class _Journal:
     """What was changed, to put it back."""
 
@@ -166,14 +199,14 @@ class _Journal:
     vertices: list = field(default_factory=list)   # (vertex, point, tol)
 
 
-def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = None,
+def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = None,
                retrim: bool = True) -> ClosedGaps:
     """Close in the geometry the gaps of ``shape`` (a sewn shell, solid or compound)
     wider than ``tight``, moving B-spline faces by at most ``allowed`` (the module doc),
     and re-trimming the faces that do not move where that closes an edge (unless
     ``retrim`` is False). ``shape`` is changed in place. ``fitted`` keeps the fits by
     face, surface and targets across calls on the same shape (the passes of
-    :func:`closed_in_geometry`)."""
+    :func:`closed_in_geometry`), and those taken back once applied."""
     faces = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, faces)
     vertices = TopTools_IndexedMapOfShape()
@@ -203,8 +236,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
     rigid: set[int] = set()             # faces whose re-trimming was taken back
     fits: dict = {}
     retrimmed: dict = {}
-    done: dict = {}                     # common curves: a later round asks most again
-    fitted = {} if fitted is None else fitted
+    memo = _Remembered()
+    fitted = Fitted() if fitted is None else fitted
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         trimmable = set(candidates) - set(moving) - rigid if retrim else set()
@@ -212,7 +245,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
             break
         fits, commons, positions, failed, retrimmed = _fit_round(
             moving, trimmable, dense, surfaces, edges, of_face, faces, tight, allowed, notes,
-            done, fitted)
+            memo, fitted)
         fixed |= failed
         if failed and _round < _ROUNDS - 1 or not (fits or retrimmed):
             continue                # the others fitted again with these where they are
@@ -221,7 +254,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
         changed = set(fits) | set(retrimmed)
         try:
             after, apart, moved_vertices = _apply(fits, retrimmed, commons, edges, of_face,
-                                                  faces, vertices, positions, journal, surfaces)
+                                                  faces, vertices, positions, journal, surfaces,
+                                                  memo.occ)
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
             invalid = _invalid(changed, of_face, faces, edges, moved_vertices)
@@ -240,6 +274,9 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: dict | None = Non
         # many; the others are fitted again with these where they are, and a face that
         # failed BRepCheck is not re-trimmed either
         again = (bad & set(fits)) - dense - invalid
+        for f in bad & set(fits):
+            if fits[f][0].surface is not surfaces[f]:      # (a fit, kept in fitted)
+                fitted.reject(fits[f][0], "invalid" if f in invalid else "wider")
         if bad - again:
             notes.append(f"faces {sorted(f - 1 for f in bad - again)} fail BRepCheck, or leave an "
                          "edge wider than it was, once moved onto (or re-trimmed to) their "
@@ -268,21 +305,25 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     ``tight`` = ``TIGHT_FACTOR`` x ``size``) and its figures measured again: free edges in
     the geometry (:func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`), validity and the
     largest edge tolerance; ``extra["closed_gaps"]`` says what moved. Passes are
-    repeated (at most ``_PASSES``) while one moves a face and leaves an edge open: faces
-    kept in one pass meet neighbours that have moved in the next. Faces that do not move
+    repeated (at most ``_PASSES``) while one moves a face and leaves fewer edges open than
+    the one before, but not none: faces kept in one pass meet neighbours that have moved
+    in the next. Faces that do not move
     are re-trimmed only in one more pass after those, on the edges still open: a round
     that fails then (a re-trim, or a move next to one, failing BRepCheck) costs none of
     what the moves closed (spaceship: 62 free edges in the geometry, 82 with re-trims
     from the first pass)."""
     passes = []
-    fitted: dict = {}                   # a face kept in one pass meets mostly the same targets
+    fitted = Fitted()
     tight = TIGHT_FACTOR * size
     for _ in range(_PASSES):
         closed = close_gaps(result.model.shape, tight=tight, allowed=allowed, fitted=fitted,
                             retrim=False)
         passes.append(closed)
-        if not closed.moved or closed.open_after == 0 or closed.open_after >= closed.open_before:
-            break                       # (a pass that closed nothing repeats itself: t4m 18 s)
+        # (a pass that closed nothing repeats itself: t4m 18 s; and one closing nothing the
+        # last left open found nothing new: asmo's second pass, 215 -> 214 after 291 -> 214)
+        before = passes[-2].open_after if len(passes) > 1 else closed.open_before
+        if not closed.moved or closed.open_after == 0 or closed.open_after >= before:
+            break
     if passes[-1].open_after:
         passes.append(close_gaps(result.model.shape, tight=tight, allowed=allowed, fitted=fitted))
     first, last = passes[0], passes[-1]
@@ -306,15 +347,18 @@ def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> Close
 # ------------------------------------------------------------------ fitting
 def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces,
                edges: list[SharedEdge], of_face, faces, tight: float, allowed: float,
-               notes: list[str], done: dict, fitted: dict):
+               notes: list[str], memo: _Remembered, fitted: Fitted):
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed (those of ``trimmable`` re-trimmed where that closes an edge better); the
     faces of ``dense``, and those whose fit misses, on ``_DENSER`` times the samples:
     ``({face: (EdgeFit, moved)}, {id(edge): CommonCurve}, {vertex: position}, failed faces,
-    {re-trimmed face: how far its boundary moved})``. ``done`` holds the common curves
-    of earlier rounds, by edge, the faces that move or may be re-trimmed and the
-    vertices; ``fitted`` the fits, by face, surface and targets (a face whose neighbours
-    all stayed as they were gets the same targets again)."""
+    {re-trimmed face: how far its boundary moved})``. ``memo`` holds what earlier rounds
+    computed (the common curves, by edge, the faces that move or may be re-trimmed and
+    the vertices; the faces' images; the dense targets); ``fitted`` the fits, by face,
+    surface and targets (a face whose neighbours all stayed as they were gets the same
+    targets again), and those taken back in an earlier pass: one widening an edge is
+    fitted on more samples at once, one failing BRepCheck (or fitted on more samples
+    already) leaves its face fixed without being applied again."""
     moving_set = set(moving)
     s = _samples()
     touched = {id(e): e for f in moving for e in of_face[f]}
@@ -332,20 +376,25 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
         return images_on_face(e, i, faces, at, reverse)
 
     for e in touched.values():
-        for i in range(len(e.faces)):
-            images[id(e), i] = image(e, i, s)
-    position = vertex_positions(touched.values(), edges, moving_set, images, image)
+        for i, f in enumerate(e.faces):
+            # (a moving face's image is its own surface's, as read: the same every round)
+            key = (id(e), i, f in moving_set)
+            if key not in memo.images:
+                memo.images[key] = image(e, i, s)
+                memo.images[key].flags.writeable = False
+            images[id(e), i] = memo.images[key]
+    position = vertex_positions(touched.values(), edges, moving_set, images, image, tight)
     commons = {}
     for key, e in touched.items():
         # the same when its faces move, may be re-trimmed or stay as in an earlier round
         # and its vertices are where they were
         seen = (key, tuple(f in moving_set for f in e.faces), tuple(f in trimmable for f in e.faces),
-                position[e.first].tobytes(), position[e.last].tobytes())
-        if seen not in done:
-            done[seen] = common_curve(e, s, images, position, moving_set, trimmable, surfaces, faces,
-                                 tight, allowed)
-        if done[seen] is not None:
-            commons[key] = done[seen]
+                *(p.tobytes() for p in position.ends(e)))
+        if seen not in memo.commons:
+            memo.commons[seen] = common_curve(e, s, images, position, moving_set, trimmable,
+                                              surfaces, faces, tight, allowed)
+        if memo.commons[seen] is not None:
+            commons[key] = memo.commons[seen]
     retrimmed: dict[int, float] = {}
     for common in commons.values():
         for f, shift in common.retrimmed.items():
@@ -368,16 +417,29 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
             continue
         try:
             fit, moved = _fit(f, targets, surfaces, faces, tight, fitted)
-            if f in dense or not fit.converged and moved <= allowed:
-                # on many samples, from the knots the few found (t4m: 14 s -> 1 s)
-                fit, moved = _fit(f, _targets(f, of_face, commons, surfaces, faces, position, many),
-                                  surfaces, faces, tight, fitted, like=fit.surface)
+            if (f in dense or fitted.verdict(fit) == "wider"
+                    or not fit.converged and moved <= allowed):
+                # on many samples, from the knots the few found (t4m: 14 s -> 1 s); the
+                # same common curves give the same targets (memo.commons keeps them alive,
+                # so their ids are theirs)
+                key = (f, tuple(id(commons.get(id(e))) for e in of_face[f]))
+                if key not in memo.dense:
+                    memo.dense[key] = _targets(f, of_face, commons, surfaces, faces, position, many)
+                fit, moved = _fit(f, memo.dense[key], surfaces, faces, tight, fitted,
+                                  like=fit.surface)
         except (SurfprepError, np.linalg.LinAlgError, RuntimeError) as exc:
             # (a least-squares or factorization failure of scipy/numpy on this
             # face's system is this face's failure, not the model's)
             failed.add(f)
             notes.append(f"face {f - 1}: not moved onto its neighbours' edges "
                          f"({type(exc).__name__}: {exc}); kept as it is")
+            continue
+        if fitted.verdict(fit) is not None:
+            failed.add(f)
+            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (the same fit "
+                         + ("failed BRepCheck" if fitted.verdict(fit) == "invalid"
+                            else "left an edge wider than it was") + " in an earlier pass); "
+                         "kept as it is")
             continue
         if fit.converged and moved <= allowed:
             fits[f] = (fit, moved)
@@ -419,11 +481,10 @@ def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -
                 continue
             guess = pcurve_points(e, i, faces, at, side)
             if common.curve is None:            # a pole
-                targets.append(EdgeTarget(guess, np.repeat(position[e.first][None], at.size, axis=0)))
+                targets.append(EdgeTarget(guess, np.repeat(position.ends(e)[0][None], at.size, axis=0)))
             elif (f, side) in common.goals:     # a closed edge: the face keeps its side
                 own_side = surfaces[f].evaluate(guess[:, 0], guess[:, 1])
-                targets.append(EdgeTarget(guess, to_vertices(own_side, at, position[e.first],
-                                                              position[e.last])))
+                targets.append(EdgeTarget(guess, to_vertices(own_side, at, *position.ends(e))))
             else:
                 t = common.t[0] + at * (common.t[-1] - common.t[0])
                 points = common.curve.evaluate(t)
@@ -431,17 +492,17 @@ def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -
     return targets
 
 
-def _fit(f: int, targets: list[EdgeTarget], surfaces, faces, tight: float, fitted: dict,
+def _fit(f: int, targets: list[EdgeTarget], surfaces, faces, tight: float, fitted: Fitted,
          like: NurbsSurface | None = None):
     """``(EdgeFit, how far it moved)`` of face ``f`` onto ``targets``, remembered in
     ``fitted`` by face, surface and targets; with ``like`` (an earlier fit's surface)
     started from the face's surface refined to its degrees and knots."""
     key = (f, _digest(targets, surfaces[f]))
-    if key not in fitted:
+    if key not in fitted.fits:
         start = surfaces[f] if like is None else _refined_like(surfaces[f], like)
         fit = fit_to_edges(start, targets, tol=FIT_SHARE * tight)
-        fitted[key] = fit, _moved(surfaces[f], fit.surface, faces, f)
-    return fitted[key]
+        fitted.fits[key] = fit, _moved(surfaces[f], fit.surface, faces, f)
+    return fitted.fits[key]
 
 
 def _refined_like(surface: NurbsSurface, like: NurbsSurface) -> NurbsSurface:
@@ -480,7 +541,7 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
 
 # ------------------------------------------------------------------ applying
 def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, vertices, positions,
-           journal: _Journal, surfaces
+           journal: _Journal, surfaces, occ: dict
            ) -> tuple[dict[int, float], dict[tuple[int, int], float], set[int]]:
     """Put the moved surfaces, their pcurves (the common curves' projections), the
     re-trimmed faces' new pcurves, the common curves and the vertices into the shape,
@@ -489,7 +550,8 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
     points, between its curve and its faces' surfaces (a bound on how far apart two of
     its faces' points are; its tolerance is set to 1.1 times that distance), and that
     distance per edge and face, and the vertices it moved (those of the edges given a
-    common curve)."""
+    common curve). ``occ`` keeps the curves converted for OpenCascade across rounds,
+    by common curve, face and seam side (a round puts back mostly the same)."""
     builder = BRep_Builder()
     by_id = {id(e): e for e in edges}
     # the faces' surfaces as they are now (the fixed ones' as read, the moved ones' put)
@@ -509,7 +571,7 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
             if common is None or (f, False) not in common.uv:
                 new.append(old[-1])             # a pole, or an edge not re-trimmed
                 continue
-            pcurves = [curve2d_to_occ(through(common.t, common.uv[f, side], common.even))
+            pcurves = [_pcurve_to_occ(common, f, side, occ)[0]
                        for side in ((False, True) if e.seam else (False,))]
             new.append((e, pcurves[0], pcurves[1] if e.seam else None, tol,
                         (float(common.t[0]), float(common.t[-1]))))
@@ -532,11 +594,22 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
         deviation = 0.0
         if not e.degenerated:
             curve = common.curve
-            builder.UpdateEdge(e.edge, curve_to_occ(curve), TopLoc_Location(), BRep_Tool.Tolerance_s(e.edge))
+            if (id(common), None, None) not in occ:
+                occ[id(common), None, None] = curve_to_occ(curve)
+            builder.UpdateEdge(e.edge, occ[id(common), None, None], TopLoc_Location(),
+                               BRep_Tool.Tolerance_s(e.edge))
             a, b = float(common.t[0]), float(common.t[-1])
             builder.Range(e.edge, a, b, True)
+            # its pcurves as now put: a new one as converted, an old one as read
+            curves = {}
+            for i, f in enumerate(e.faces):
+                for side in ((False, True) if e.seam else (False,)):
+                    if (f, side) in common.uv and (f in fits or f in retrimmed):
+                        curves[i, side] = _pcurve_to_occ(common, f, side, occ)[1]
+                    elif (i, side) in e.curves:
+                        curves[i, side] = e.curves[i, side]
             now = replace(e, ranges=[BRep_Tool.Range_s(e.edge, TopoDS.Face_s(faces.FindKey(f)))
-                                     for f in e.faces], curves={}, surfaces=fresh)
+                                     for f in e.faces], curves=curves, surfaces=fresh)
             on_curve = curve.evaluate(a + check * (b - a))
             for i, f in enumerate(e.faces):
                 for side in ((False, True) if e.seam else (False,)):
@@ -547,7 +620,7 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
         after[key] = 2.0 * deviation
         fixer.SetTolerance(e.edge, max(1.1 * deviation, _MIN_TOLERANCE), TopAbs_EDGE)
     moved = {v for key in commons for v in (by_id[key].first, by_id[key].last)}
-    for v, p in positions.items():
+    for v, p in positions.at.items():
         if v not in moved:          # (a vertex of an edge no face was fitted or re-trimmed to)
             continue
         vertex = TopoDS.Vertex_s(vertices.FindKey(v))
@@ -558,6 +631,16 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
     for g in _around(set(fits) | set(retrimmed), of_face, edges, moved):
         BRepLib.UpdateTolerances_s(faces.FindKey(g), False)
     return after, apart, moved
+
+
+def _pcurve_to_occ(common, f: int, side: bool, occ: dict):
+    """``(Geom2d_BSplineCurve, NurbsCurve)``: face ``f``'s new pcurve along ``common``
+    (the cubic through its samples), converted once (kept in ``occ``)."""
+    key = (id(common), f, side)
+    if key not in occ:
+        curve = through(common.t, common.uv[f, side], common.even)
+        occ[key] = (curve2d_to_occ(curve), curve)
+    return occ[key]
 
 
 def _widening(edges: list[SharedEdge], fits, after: dict[int, float],

@@ -22,8 +22,8 @@ from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from .shared_edges import SharedEdge, feet_on_face, pcurve_points
 
-__all__ = ["FIT_SAMPLES", "FIT_SHARE", "CommonCurve", "common_curve", "even_samples", "through",
-           "to_vertices", "uv_on", "vertex_positions"]
+__all__ = ["FIT_SAMPLES", "FIT_SHARE", "CommonCurve", "VertexPositions", "common_curve",
+           "even_samples", "through", "to_vertices", "uv_on", "vertex_positions"]
 
 #: evenly spaced samples per edge where a moving face is fitted (as many again clustered
 #: at the ends; knot spans are split while one holds 12 of them): the common curve is
@@ -89,11 +89,11 @@ def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int],
     still = [i for i, f in enumerate(e.faces) if f not in moving]
     if e.degenerated:
         a, b = e.ranges[0]
-        return CommonCurve(a + s * (b - a), np.repeat(position[e.first][None], s.size, axis=0),
+        return CommonCurve(a + s * (b - a), np.repeat(position.ends(e)[0][None], s.size, axis=0),
                            even_samples(s))
 
     def to_ends(curve: NDArray) -> NDArray:
-        return to_vertices(curve, s, position[e.first], position[e.last])
+        return to_vertices(curve, s, *position.ends(e))
 
     closed = len(e.faces) == 1 or e.gap <= tight
     trimmed = None
@@ -170,8 +170,9 @@ def _retrim(e: SharedEdge, s: NDArray, images, position, moving: set[int], trimm
             continue
         i = 1 - j
         own = images[id(e), j]
-        if max(float(np.linalg.norm(own[0] - position[e.first])),
-               float(np.linalg.norm(own[-1] - position[e.last]))) > FIT_SHARE * tight:
+        start, end = position.ends(e)
+        if max(float(np.linalg.norm(own[0] - start)),
+               float(np.linalg.norm(own[-1] - end))) > FIT_SHARE * tight:
             continue
         base = images[id(e), i]
         _, feet = feet_on_face(e, j, faces, base, s)
@@ -206,8 +207,7 @@ def _on_retrimmed(e: SharedEdge, s: NDArray, option: tuple[int, NDArray, int], p
     ref, points, j = option
     a, b = e.ranges[ref]
     t = a + s * (b - a)
-    goal = feet_on_face(e, j, faces, to_vertices(points, s, position[e.first], position[e.last]),
-                        s)[1]
+    goal = feet_on_face(e, j, faces, to_vertices(points, s, *position.ends(e)), s)[1]
     curve = through(t, goal, even_samples(s))
     on = curve.evaluate(t)
     uv, feet = feet_on_face(e, j, faces, on, s)
@@ -237,12 +237,46 @@ def _feet(e: SharedEdge, i: int, points: NDArray, images, surfaces, faces, s: ND
     return foot
 
 
-def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image
-                     ) -> dict[int, NDArray]:
-    """Per vertex of an edge of ``around``: the mean of its faces' corners there (of the
-    fixed faces' if any)."""
+@dataclass(frozen=True)
+class VertexPositions:
+    """Where :func:`vertex_positions` puts the vertices (``at``) and, at a vertex whose
+    fixed faces' corners lie apart (a gap between them that stays open), where each
+    group of faces there goes (``groups``: per (vertex, face) its group's point) and
+    which faces move (``moving``)."""
+
+    at: dict
+    groups: dict = field(default_factory=dict)
+    moving: frozenset = frozenset()
+
+    def ends(self, e: SharedEdge) -> tuple[NDArray, NDArray]:
+        """Where ``e``'s ends go: its faces' group's point where they are in one group,
+        else its moving faces' group's (a fixed face's side cannot follow, a moving
+        face's corner is one point), else the vertex's."""
+        return self._end(e, e.first), self._end(e, e.last)
+
+    def _end(self, e: SharedEdge, v: int) -> NDArray:
+        points = [self.groups.get((v, f)) for f in e.faces]
+        if points[0] is None:
+            return self.at[v]
+        if all(p is points[0] for p in points):
+            return points[0]
+        ours = [p for p, f in zip(points, e.faces) if f in self.moving]
+        if ours and all(p is ours[0] for p in ours):
+            return ours[0]
+        return self.at[v]
+
+
+def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image,
+                     tight: float) -> VertexPositions:
+    """Per vertex of an edge of ``around``: the mean of its faces' corners there, one per
+    face and edge (of the fixed faces' if any). Where the fixed faces' corners lie farther than ``tight``
+    apart, the faces there are grouped (:func:`_groups`) and each group's edges end at
+    the mean of its own fixed corners (asmo: a closed edge between a moving face and a
+    fixed one, pulled to the mean of that face's corner and of another fixed face's
+    0.02 away across an open gap, came out 0.02 wide)."""
     wanted = {v for e in around for v in (e.first, e.last)}
-    corners: dict[int, list[tuple[bool, NDArray]]] = {v: [] for v in wanted}
+    corners: dict[int, dict[int, list[NDArray]]] = {v: {} for v in wanted}  # per face, per edge
+    at_vertex: dict[int, list[SharedEdge]] = {v: [] for v in wanted}
     ends = np.array([0.0, 1.0])
     for e in edges:
         if e.first not in wanted and e.last not in wanted:
@@ -252,9 +286,48 @@ def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, 
             pts = got[[0, -1]] if got is not None else image(e, i, ends)
             for v, p in ((e.first, pts[0]), (e.last, pts[1])):
                 if v in corners:
-                    corners[v].append((f not in moving, p))
+                    corners[v].setdefault(f, []).append(p)
+        for v in {e.first, e.last} & wanted:
+            at_vertex[v].append(e)
+    at, groups = {}, {}
+    for v, by_face in corners.items():
+        fixed = [p for f, ps in by_face.items() if f not in moving for p in ps]
+        at[v] = np.mean(fixed if fixed else [p for ps in by_face.values() for p in ps], axis=0)
+        if len(fixed) < 2 or max(float(np.linalg.norm(p - q)) for p in fixed for q in fixed) <= tight:
+            continue
+        groups.update(_groups(v, by_face, at_vertex[v], moving, tight))
+    return VertexPositions(at, groups, frozenset(moving))
+
+
+def _groups(v: int, by_face: dict[int, list[NDArray]], edges: list[SharedEdge], moving: set[int],
+            tight: float) -> dict[tuple[int, int], NDArray]:
+    """Per (``v``, face) the point of the face's group at vertex ``v``: the faces there
+    joined along the edges at ``v`` narrowest first, two groups not joined where their
+    fixed corners would then lie more than ``tight`` apart (a moving face between two
+    fixed faces that do not meet follows the one it meets more closely; the other
+    edge's gap stays, or narrows)."""
+    parent = {f: f for f in by_face}
+
+    def root(f: int) -> int:
+        while parent[f] != f:
+            f = parent[f]
+        return f
+
+    fixed = {f: by_face[f] if f not in moving else [] for f in by_face}   # per group's root
+    for e in sorted(edges, key=lambda e: e.gap):
+        for f, g in zip(e.faces, e.faces[1:]):
+            a, b = root(f), root(g)
+            if a == b or any(float(np.linalg.norm(p - q)) > tight
+                             for p in fixed[a] for q in fixed[b]):
+                continue
+            parent[b] = a
+            fixed[a] = fixed[a] + fixed[b]
+    members: dict[int, list[int]] = {}
+    for f in by_face:
+        members.setdefault(root(f), []).append(f)
     out = {}
-    for v, items in corners.items():
-        fixed = [p for still, p in items if still]
-        out[v] = np.mean(fixed if fixed else [p for _, p in items], axis=0)
+    for faces in members.values():
+        fixed = [p for f in faces if f not in moving for p in by_face[f]]
+        point = np.mean(fixed if fixed else [p for f in faces for p in by_face[f]], axis=0)
+        out.update(((v, f), point) for f in faces)
     return out
