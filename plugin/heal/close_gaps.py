@@ -12,9 +12,9 @@ curve per edge (:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges`):
 
 * a vertex goes to the mean of its faces' corners (of the faces that do not move, if
   any: analytic faces, and B-spline faces whose move failed); where those fixed
-  corners lie apart (a gap between two fixed faces that stays open), each group of
-  faces joined there by edges that can close goes to its own fixed corners' mean, the
-  vertex's tolerance covering the groups;
+  corners lie apart (a gap between two fixed faces that stays open), the faces there
+  are grouped along their narrowest edges and each group's edges end at its own fixed
+  corners' mean, the vertex's tolerance covering the groups;
 * an open edge's common curve is the image of a face that does not move; else the image
   of the face lying nearest the others' surfaces and smoothest, or the mean of it and
   its feet on them; its ends pulled onto the vertices. Each moving face gets as its new
@@ -187,7 +187,8 @@ class _Remembered:
     commons: dict = field(default_factory=dict)    # common curves, by edge, faces' roles, vertices
     images: dict = field(default_factory=dict)     # (edge, i, moving) -> the face's image on the samples
     dense: dict = field(default_factory=dict)      # (face, its edges' common curves) -> dense targets
-    occ: dict = field(default_factory=dict)        # (common curve, face, side) -> OpenCascade curve
+    # (common curve, face, side) -> (Geom2d pcurve, NurbsCurve); (common curve, None, None) -> Geom curve
+    occ: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -351,7 +352,7 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
     """Fit every face of ``moving`` onto the common curves of its edges, the other faces
     fixed (those of ``trimmable`` re-trimmed where that closes an edge better); the
     faces of ``dense``, and those whose fit misses, on ``_DENSER`` times the samples:
-    ``({face: (EdgeFit, moved)}, {id(edge): CommonCurve}, {vertex: position}, failed faces,
+    ``({face: (EdgeFit, moved)}, {id(edge): CommonCurve}, VertexPositions, failed faces,
     {re-trimmed face: how far its boundary moved})``. ``memo`` holds what earlier rounds
     computed (the common curves, by edge, the faces that move or may be re-trimmed and
     the vertices; the faces' images; the dense targets); ``fitted`` the fits, by face,
