@@ -435,12 +435,12 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
             notes.append(f"face {f - 1}: not moved onto its neighbours' edges "
                          f"({type(exc).__name__}: {exc}); kept as it is")
             continue
-        if fitted.verdict(fit) is not None:
+        verdict = fitted.verdict(fit)
+        if verdict is not None:
             failed.add(f)
-            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (the same fit "
-                         + ("failed BRepCheck" if fitted.verdict(fit) == "invalid"
-                            else "left an edge wider than it was") + " in an earlier pass); "
-                         "kept as it is")
+            why = "failed BRepCheck" if verdict == "invalid" else "left an edge wider than it was"
+            notes.append(f"face {f - 1}: not moved onto its neighbours' edges (the same fit {why} "
+                         "in an earlier pass); kept as it is")
             continue
         if fit.converged and moved <= allowed:
             fits[f] = (fit, moved)

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.distance import cdist, pdist
 
 from ...algorithms.curve import NurbsCurve
 from ...algorithms.fitting import interpolate_curve
@@ -269,11 +270,11 @@ class VertexPositions:
 def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image,
                      tight: float) -> VertexPositions:
     """Per vertex of an edge of ``around``: the mean of its faces' corners there, one per
-    face and edge (of the fixed faces' if any). Where the fixed faces' corners lie farther than ``tight``
-    apart, the faces there are grouped (:func:`_groups`) and each group's edges end at
-    the mean of its own fixed corners (asmo: a closed edge between a moving face and a
-    fixed one, pulled to the mean of that face's corner and of another fixed face's
-    0.02 away across an open gap, came out 0.02 wide)."""
+    face and edge (of the fixed faces' if any). Where the fixed faces' corners lie
+    farther than ``tight`` apart, the faces there are grouped (:func:`_groups`) and each
+    group's edges end at the mean of its own fixed corners (asmo: a closed edge between
+    a moving face and a fixed one, pulled to the mean of that face's corner and of
+    another fixed face's 0.02 away across an open gap, came out 0.02 wide)."""
     wanted = {v for e in around for v in (e.first, e.last)}
     corners: dict[int, dict[int, list[NDArray]]] = {v: {} for v in wanted}  # per face, per edge
     at_vertex: dict[int, list[SharedEdge]] = {v: [] for v in wanted}
@@ -291,12 +292,16 @@ def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, 
             at_vertex[v].append(e)
     at, groups = {}, {}
     for v, by_face in corners.items():
-        fixed = [p for f, ps in by_face.items() if f not in moving for p in ps]
-        at[v] = np.mean(fixed if fixed else [p for ps in by_face.values() for p in ps], axis=0)
-        if len(fixed) < 2 or max(float(np.linalg.norm(p - q)) for p in fixed for q in fixed) <= tight:
-            continue
-        groups.update(_groups(v, by_face, at_vertex[v], moving, tight))
+        fixed = _corners(by_face, by_face, moving)
+        at[v] = np.mean(fixed if len(fixed) else _corners(by_face, by_face), axis=0)
+        if len(fixed) > 1 and float(pdist(fixed).max()) > tight:
+            groups.update(_groups(v, by_face, at_vertex[v], moving, tight))
     return VertexPositions(at, groups, frozenset(moving))
+
+
+def _corners(faces, by_face: dict[int, list[NDArray]], moving: set[int] = frozenset()) -> NDArray:
+    """The corners (k, 3) of ``faces`` that do not move, one per face and edge."""
+    return np.array([p for f in faces if f not in moving for p in by_face[f]]).reshape(-1, 3)
 
 
 def _groups(v: int, by_face: dict[int, list[NDArray]], edges: list[SharedEdge], moving: set[int],
@@ -306,28 +311,20 @@ def _groups(v: int, by_face: dict[int, list[NDArray]], edges: list[SharedEdge], 
     fixed corners would then lie more than ``tight`` apart (a moving face between two
     fixed faces that do not meet follows the one it meets more closely; the other
     edge's gap stays, or narrows)."""
-    parent = {f: f for f in by_face}
-
-    def root(f: int) -> int:
-        while parent[f] != f:
-            f = parent[f]
-        return f
-
-    fixed = {f: by_face[f] if f not in moving else [] for f in by_face}   # per group's root
+    from scipy.cluster.hierarchy import DisjointSet  # (only where corners lie apart)
+    grouped = DisjointSet(by_face)
     for e in sorted(edges, key=lambda e: e.gap):
         for f, g in zip(e.faces, e.faces[1:]):
-            a, b = root(f), root(g)
-            if a == b or any(float(np.linalg.norm(p - q)) > tight
-                             for p in fixed[a] for q in fixed[b]):
+            if grouped.connected(f, g):
                 continue
-            parent[b] = a
-            fixed[a] = fixed[a] + fixed[b]
-    members: dict[int, list[int]] = {}
-    for f in by_face:
-        members.setdefault(root(f), []).append(f)
+            a = _corners(grouped.subset(f), by_face, moving)
+            b = _corners(grouped.subset(g), by_face, moving)
+            if len(a) and len(b) and float(cdist(a, b).max()) > tight:
+                continue
+            grouped.merge(f, g)
     out = {}
-    for faces in members.values():
-        fixed = [p for f in faces if f not in moving for p in by_face[f]]
-        point = np.mean(fixed if fixed else [p for f in faces for p in by_face[f]], axis=0)
+    for faces in grouped.subsets():
+        fixed = _corners(faces, by_face, moving)
+        point = np.mean(fixed if len(fixed) else _corners(faces, by_face), axis=0)
         out.update(((v, f), point) for f in faces)
     return out
