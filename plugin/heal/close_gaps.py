@@ -69,7 +69,7 @@ from ...errors import SurfprepError
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
 from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
-from ..occ.shapes import is_valid, max_edge_tolerance
+from ..occ.shapes import all_faces, copied, is_valid, max_edge_tolerance
 from .common_curves import (
     FIT_SAMPLES,
     FIT_SHARE,
@@ -312,12 +312,19 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     are re-trimmed only in one more pass after those, on the edges still open: a round
     that fails then (a re-trim, or a move next to one, failing BRepCheck) costs none of
     what the moves closed (spaceship: 62 free edges in the geometry, 82 with re-trims
-    from the first pass)."""
+    from the first pass).
+
+    The faces are moved on a copy of ``result.model``'s shape: a face the healing left
+    as it was is the input's own (sewing keeps the faces of a shell that is closed
+    already), and moving it in place would change the caller's model (on
+    occt_k1_catia_debis.stp, 41 of its 58 faces)."""
     passes = []
     fitted = Fitted()
     tight = TIGHT_FACTOR * size
+    shape = copied(result.model.shape)
+    model = replace(result.model, shape=shape, faces=all_faces(shape))
     for _ in range(_PASSES):
-        closed = close_gaps(result.model.shape, tight=tight, allowed=allowed, fitted=fitted,
+        closed = close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted,
                             retrim=False)
         passes.append(closed)
         # (a pass that closed nothing repeats itself: t4m 18 s; and one closing nothing the
@@ -326,9 +333,9 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
         if not closed.moved or closed.open_after == 0 or closed.open_after >= before:
             break
     if passes[-1].open_after:
-        passes.append(close_gaps(result.model.shape, tight=tight, allowed=allowed, fitted=fitted))
+        passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted))
     first, last = passes[0], passes[-1]
-    out = replace(result, skipped=result.skipped + last.notes)
+    out = replace(result, model=model, skipped=result.skipped + last.notes)
     out.extra["closed_gaps"] = {
         **last.as_dict(), "open_edges_before": first.open_before,
         "largest_gap_before": first.largest_before, "passes": len(passes),
@@ -336,7 +343,6 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
         "faces_retrimmed": [m for p in passes for m in p.retrimmed]}
     if not any(p.moved or p.retrimmed for p in passes):
         return out
-    shape = result.model.shape
     return replace(out, tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * size).free_in_geometry,
                    valid_after=is_valid(shape), max_edge_tolerance=max_edge_tolerance(shape))
 

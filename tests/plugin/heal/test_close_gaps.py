@@ -184,6 +184,28 @@ def test_a_face_that_would_move_too_far_is_kept():
     assert is_valid(shape)
 
 
+def test_heal_moves_faces_on_a_copy_and_leaves_the_callers_model_as_it_was(tmp_path):
+    # a shell sewn already: sewing it again in heal keeps its faces (the same TShapes),
+    # and moving them in place changed the caller's model (41 of the 58 faces of
+    # occt_k1_catia_debis.stp); the input is written out before and after, byte for byte
+    from OCP.BRepTools import BRepTools
+
+    import surfprep
+    from surfprep.plugin.io import CadModel
+
+    shape, _ = sew([make_face(_patch(0.0, 1.0)), make_face(_patch(1.0, 2.0, dz=2e-4))], 1e-3)
+    model = CadModel.from_shape(shape)
+    BRepTools.Write_s(model.shape, str(tmp_path / "before.brep"))
+    healed = surfprep.heal(model)
+    BRepTools.Write_s(model.shape, str(tmp_path / "after.brep"))
+    assert len(healed.report()["closed_gaps"]["faces_moved"]) == 2     # it did move them
+    [(edge, a, b)] = _shared(healed.model.shape)
+    assert _gap(edge, a, b) <= 1e-6
+    assert (tmp_path / "before.brep").read_bytes() == (tmp_path / "after.brep").read_bytes()
+    [(edge, a, b)] = _shared(model.shape)
+    assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)   # the input's gap is there
+
+
 @pytest.mark.slow
 def test_heal_closes_the_capsules_gaps_unless_told_not_to():
     """The bundled Mars capsule: sewing closes its 10 open edges (up to 0.047 apart) by
