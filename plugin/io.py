@@ -26,6 +26,7 @@ to derive tolerances.
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import os
 import tempfile
@@ -40,8 +41,9 @@ from typing import Any
 from OCP.BinTools import BinTools, BinTools_FormatVersion
 from OCP.Bnd import Bnd_Box
 from OCP.BRepBndLib import BRepBndLib
+from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.ShapeFix import ShapeFix_Shape
-from OCP.TopoDS import TopoDS_Face, TopoDS_Shape
+from OCP.TopoDS import TopoDS, TopoDS_Face, TopoDS_Shape
 
 from ..algorithms import NurbsCurve, NurbsSurface
 from ..algorithms.trimmed import TrimmedFace
@@ -141,6 +143,18 @@ class CadModel:
     @property
     def n_faces(self) -> int:
         return len(self.faces)
+
+    def copy(self) -> CadModel:
+        """The same model on a deep copy of its shape (``BRepBuilderAPI_Copy``, geometry
+        included): each face the copy of the one at its index, names, colours and the
+        rest kept. What a verb changes in place on the copy (a pcurve added to an edge,
+        a face moved) leaves this model as it was."""
+        copier = BRepBuilderAPI_Copy(self.shape, True, False)
+        if not copier.IsDone():
+            raise OpenCascadeError("BRepBuilderAPI_Copy failed")
+        faces = tuple(TopoDS.Face_s(copier.ModifiedShape(f).Oriented(f.Orientation()))
+                      for f in self.faces)
+        return dataclasses.replace(self, shape=copier.Shape(), faces=faces)
 
     @cached_property
     def bounding_box(self) -> tuple[float, float, float, float, float, float]:

@@ -296,7 +296,10 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     say = StageClock(stage)
     continuity = Continuity.parse(continuity)
     say("reading the faces")
-    model = _as_model(shape)
+    # on a copy: sewing keeps a closed shell's own faces and edges, and the steps below
+    # change them in place (pcurves for new faces added to the input's edges, faces
+    # moved onto common curves), which changed the caller's model
+    model = _as_model(shape).copy()
     faces, skipped = _read_faces(model)
     edges = face_edges(faces)
     low, high = MIN_TOL_FACTOR * model.size, model.size

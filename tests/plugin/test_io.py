@@ -482,3 +482,30 @@ def test_occt_static_parameters_are_restored(tmp_path):
     write(read(SYNTHETIC), tmp_path / "again.step")
     after = {k: Interface_Static.IVal_s(k) for k in before}
     assert after == before
+
+
+def test_a_copied_model_has_its_own_faces_in_the_same_order_names_kept():
+    from OCP.BRep import BRep_Builder
+    from OCP.gp import gp_Pnt
+
+    from surfprep.plugin.occ.shapes import area_and_centroid
+
+    model = read(SYNTHETIC)
+    copy = model.copy()
+    assert copy.face_names == model.face_names and copy.n_faces == model.n_faces
+    for f, g in zip(model.faces, copy.faces, strict=True):
+        assert not f.IsSame(g) and f.Orientation() == g.Orientation()
+        (a, c), (b, d) = area_and_centroid(f), area_and_centroid(g)
+        assert b == pytest.approx(a, rel=1e-12) and d == pytest.approx(c, abs=1e-9)
+    # a vertex of the copy moved in place leaves the model's where it was
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_VERTEX
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    def first_vertex(face):
+        return TopoDS.Vertex_s(TopExp_Explorer(face, TopAbs_VERTEX).Current())
+
+    BRep_Builder().UpdateVertex(first_vertex(copy.faces[0]), gp_Pnt(1e3, 1e3, 1e3), 1e-7)
+    assert BRep_Tool.Pnt_s(first_vertex(copy.faces[0])).X() == 1e3
+    assert BRep_Tool.Pnt_s(first_vertex(model.faces[0])).X() < 100
