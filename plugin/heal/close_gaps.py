@@ -69,7 +69,7 @@ from ...errors import SurfprepError
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
 from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
-from ..occ.shapes import all_faces, copied, is_valid, max_edge_tolerance
+from ..occ.shapes import is_valid, max_edge_tolerance
 from .common_curves import (
     FIT_SAMPLES,
     FIT_SHARE,
@@ -321,8 +321,8 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     passes = []
     fitted = Fitted()
     tight = TIGHT_FACTOR * size
-    shape = copied(result.model.shape)
-    model = replace(result.model, shape=shape, faces=all_faces(shape))
+    model = result.model.copy()
+    shape = model.shape
     for _ in range(_PASSES):
         closed = close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted,
                             retrim=False)

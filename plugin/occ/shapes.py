@@ -4,8 +4,8 @@ The topological level above :mod:`.faces` (build123d's ``composite.py`` /
 ``shape_core.py``): what the readers, the writers and the verbs share about a
 ``TopoDS_Shape`` as a whole.
 
-* :func:`all_faces`, :func:`compound`, :func:`copied`, :class:`FaceNames` (a face's
-  name looked up whatever its location and orientation);
+* :func:`all_faces`, :func:`compound`, :class:`FaceNames` (a face's name looked
+  up whatever its location and orientation);
 * :func:`face_area` (``BRepGProp``);
 * :func:`sew` (``BRepBuilderAPI_Sewing`` into a shell, a solid when closed);
 * :func:`count_free_edges`, :func:`is_valid`, :func:`check_valid`,
@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
-from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy, BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
@@ -40,7 +40,6 @@ __all__ = [
     "boundary_edge_points",
     "check_valid",
     "compound",
-    "copied",
     "count_free_edges",
     "distinct_faces",
     "face_area",
@@ -60,16 +59,6 @@ def compound(shapes: Sequence[TopoDS_Shape]) -> TopoDS_Compound:
     for s in shapes:
         builder.Add(compound, s)
     return compound
-
-
-def copied(shape: TopoDS_Shape) -> TopoDS_Shape:
-    """A deep copy of ``shape`` (``BRepBuilderAPI_Copy`` with its geometry): what is
-    changed in place on it (``BRep_Builder.Update*``) leaves ``shape`` as it was. Its
-    faces come in the same exploration order as ``shape``'s."""
-    copier = BRepBuilderAPI_Copy(shape, True, False)
-    if not copier.IsDone():
-        raise OpenCascadeError("BRepBuilderAPI_Copy failed")
-    return copier.Shape()
 
 
 def all_faces(shape: TopoDS_Shape) -> tuple[TopoDS_Face, ...]:
