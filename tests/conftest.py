@@ -20,15 +20,6 @@ settings.register_profile("explore", deadline=None, print_blob=True)
 settings.load_profile("ci")
 
 
-def pytest_collection_modifyitems(config, items):
-    """The test files holding a slow test run first, each kept whole (its module-scoped
-    fixtures built once): with ``-n auto`` the workers then finish together, instead of
-    one running a minutes-long real-file test alone at the end (the suite spent its last
-    4.5 minutes on one worker with ``test_demo_on_real_files``). The sort is stable, so
-    every worker collects the same order, as pytest-xdist needs."""
-    slow = {item.path for item in items if item.get_closest_marker("slow") is not None}
-    items.sort(key=lambda item: item.path not in slow)
-
 
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
