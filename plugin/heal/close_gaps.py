@@ -314,14 +314,13 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     what the moves closed (spaceship: 62 free edges in the geometry, 82 with re-trims
     from the first pass).
 
-    The faces are moved on a copy of ``result.model``'s shape: a face the healing left
-    as it was is the input's own (sewing keeps the faces of a shell that is closed
-    already), and moving it in place would change the caller's model (on
-    occt_k1_catia_debis.stp, 41 of its 58 faces)."""
+    The faces of ``result.model`` are moved in place: ``result`` is the healing's own
+    (:func:`~surfprep.plugin.heal.heal` works on a copy of the model it is given, so
+    faces that sewing kept as they were are not the caller's)."""
     passes = []
     fitted = Fitted()
     tight = TIGHT_FACTOR * size
-    model = result.model.copy()
+    model = result.model
     shape = model.shape
     for _ in range(_PASSES):
         closed = close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted,
