@@ -9,15 +9,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 from helpers.paths import SAMPLES
+from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepGProp import BRepGProp
+from OCP.gp import gp_Pnt
 from OCP.GProp import GProp_GProps
-from OCP.TopoDS import TopoDS_Shape
+from OCP.TopAbs import TopAbs_VERTEX
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS, TopoDS_Shape
 
 from surfprep.algorithms import NurbsCurve, NurbsSurface
 from surfprep.errors import ConversionError, InputFileError, NoFacesError, OutputFileError, SurfprepError
 from surfprep.plugin import io as sio
 from surfprep.plugin.io import CadModel, FileFormat, read, write
 from surfprep.plugin.occ.faces import make_face
+from surfprep.plugin.occ.shapes import area_and_centroid
 from surfprep.plugin.step_iges import TranslationError
 
 FUSELAGE = SAMPLES / "occt_fuselage.stp"
@@ -485,11 +490,6 @@ def test_occt_static_parameters_are_restored(tmp_path):
 
 
 def test_a_copied_model_has_its_own_faces_in_the_same_order_names_kept():
-    from OCP.BRep import BRep_Builder
-    from OCP.gp import gp_Pnt
-
-    from surfprep.plugin.occ.shapes import area_and_centroid
-
     model = read(SYNTHETIC)
     copy = model.copy()
     assert copy.face_names == model.face_names and copy.n_faces == model.n_faces
@@ -498,11 +498,6 @@ def test_a_copied_model_has_its_own_faces_in_the_same_order_names_kept():
         (a, c), (b, d) = area_and_centroid(f), area_and_centroid(g)
         assert b == pytest.approx(a, rel=1e-12) and d == pytest.approx(c, abs=1e-9)
     # a vertex of the copy moved in place leaves the model's where it was
-    from OCP.BRep import BRep_Tool
-    from OCP.TopAbs import TopAbs_VERTEX
-    from OCP.TopExp import TopExp_Explorer
-    from OCP.TopoDS import TopoDS
-
     def first_vertex(face):
         return TopoDS.Vertex_s(TopExp_Explorer(face, TopAbs_VERTEX).Current())
 
