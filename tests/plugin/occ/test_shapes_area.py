@@ -1,8 +1,8 @@
 """face_area where OpenCascade's adaptive integration fails (plugin.occ.shapes.face_area).
 
-Slow: the adaptive integration runs 44 s (here up to 88 s) on this face before it fails,
-once for both tests (the face has a
-5278-span pcurve, as reparam made them before it fitted pcurves with few knots).
+Slow: the adaptive integration runs 44 s (here up to 88 s) on this face before it fails;
+it runs once, for both tests. The face has a 5278-span pcurve, as reparam made them
+before it fitted pcurves with few knots.
 """
 
 from __future__ import annotations
