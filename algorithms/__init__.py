@@ -83,7 +83,7 @@ from .knots import (
     split,
     split_surface,
 )
-from .measure import arc_length, bounding_box, cumulative_arc_length, normals
+from .measure import arc_length, bounding_box, cumulative_arc_length, normal_turn, normals
 from .projection import (
     CurveProjectionResult,
     ProjectionResult,
@@ -114,7 +114,7 @@ __all__ = [
     "elevate_degree", "elevate_degree_surface", "elevate_degree_array",
     "bezier_elevation_matrix",
     # measure
-    "bounding_box", "normals", "arc_length", "cumulative_arc_length",
+    "bounding_box", "normals", "normal_turn", "arc_length", "cumulative_arc_length",
     # isocurve
     "isocurve",
     # fitting

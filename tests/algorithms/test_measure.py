@@ -15,6 +15,7 @@ from surfprep.algorithms import (
     arc_length,
     bounding_box,
     cumulative_arc_length,
+    normal_turn,
     normals,
 )
 from surfprep.errors import DegenerateGeometryError, InvalidGeometryError, InvalidToleranceError
@@ -263,3 +264,68 @@ def test_arc_length_rejects_bad_arguments():
     with pytest.raises(InvalidToleranceError, match="positive number"):
         arc_length(curve, tol="x")
     assert arc_length(curve, lo, lo) == 0.0
+
+
+# ---------------------------------------------------------------- normal_turn
+def _graph(height, degree: int = 3, n: int = 6) -> NurbsSurface:
+    """The graph ``z = height(x, y)`` over the unit square, x = u, y = v (interpolated
+    exactly when ``height`` is a polynomial of degree <= ``degree`` in each)."""
+    from surfprep.algorithms.fitting import interpolate_surface
+
+    t = np.linspace(0, 1, n)
+    x, y = np.meshgrid(t, t, indexing="ij")
+    return interpolate_surface(np.stack([x, y, height(x, y)], axis=-1), degree_u=degree,
+                               degree_v=degree, params_u=t, params_v=t)
+
+
+def test_normal_turn_of_a_plane_turned_rigidly_is_the_rotation_angle():
+    x, y = np.meshgrid([0.0, 1.0], [0.0, 1.0], indexing="ij")
+    knots = [0, 0, 1, 1]
+    flat = NurbsSurface(np.stack([x, y, 0 * x], -1), knots, knots, 1, 1)
+    for angle in (1e-9, 1e-4, 0.3, 2.5):
+        turned = NurbsSurface(np.stack([x, y * np.cos(angle), y * np.sin(angle)], -1),
+                              knots, knots, 1, 1)
+        u, v = np.random.default_rng(1).random((2, 50))
+        assert np.allclose(normal_turn(flat, turned, u, v), angle, rtol=1e-10, atol=0)
+
+
+def test_normal_turn_of_a_bump_is_the_slope_angle_of_its_graph():
+    # z = c u^2: the normal (-2 c u, 0, 1) against (0, 0, 1) turns by arctan(2 c u)
+    c = 0.05
+    flat, bump = _graph(lambda x, y: 0 * x), _graph(lambda x, y: c * x * x)
+    u, v = np.meshgrid(np.linspace(0, 1, 31), np.linspace(0, 1, 7), indexing="ij")
+    assert np.allclose(normal_turn(flat, bump, u, v), np.arctan(2 * c * u), rtol=0, atol=1e-12)
+
+
+def test_normal_turn_of_a_folded_surface_is_above_a_right_angle():
+    x, y = np.meshgrid([0.0, 1.0], [0.0, 1.0], indexing="ij")
+    knots = [0, 0, 1, 1]
+    flat = NurbsSurface(np.stack([x, y, 0 * x], -1), knots, knots, 1, 1)
+    mirrored = NurbsSurface(np.stack([x, -y, 0 * x], -1), knots, knots, 1, 1)
+    assert np.allclose(normal_turn(flat, mirrored, [0.5], [0.5]), np.pi)
+
+
+def test_normal_turn_is_nan_only_at_a_collapsed_side():
+    # a triangle: the side u = 1 collapsed to one point, |Su x Sv| -> 0 there
+    x = np.array([[0.0, 0.0], [1.0, 1.0]])
+    y = np.array([[0.0, 1.0], [0.5, 0.5]])
+    knots = [0, 0, 1, 1]
+    triangle = NurbsSurface(np.stack([x, y, 0 * x], -1), knots, knots, 1, 1)
+    lifted = NurbsSurface(np.stack([x, y, 0.1 * x], -1), knots, knots, 1, 1)
+    u = np.array([0.0, 0.5, 0.9, 1.0])
+    angle = normal_turn(triangle, lifted, u, 0.5 + 0 * u)
+    assert np.isnan(angle[-1]) and np.all(np.isfinite(angle[:-1]))
+    assert np.allclose(angle[:-1], np.arctan(0.1))
+
+
+def test_normal_turn_refuses_what_it_cannot_measure():
+    x, y = np.meshgrid([0.0, 1.0], [0.0, 1.0], indexing="ij")
+    knots = [0, 0, 1, 1]
+    flat = NurbsSurface(np.stack([x, y, 0 * x], -1), knots, knots, 1, 1)
+    planar = NurbsSurface(np.stack([x, y], -1), knots, knots, 1, 1)
+    with pytest.raises(InvalidGeometryError, match="3D"):
+        normal_turn(flat, planar, [0.5], [0.5])
+    with pytest.raises(InvalidGeometryError, match="finite"):
+        normal_turn(flat, flat, [np.nan], [0.5])
+    with pytest.raises(InvalidGeometryError, match="degenerate"):
+        normal_turn(flat, flat, [0.5], [0.5], degenerate=2.0)
