@@ -585,8 +585,9 @@ def files_table() -> list[str]:
     from surfprep.plugin.io import read
     data = Path(__file__).resolve().parents[2] / "shared" / "data"
     head = [("| file | method | CPU (s) | wall (s) | free edges (gap_tol) | free edges at "
-            "1e-7 x size | valid | max edge tolerance | loops of free edges |"),
-            "|---|---|---|---|---|---|---|---|---|"]
+            "1e-7 x size | valid | max edge tolerance | loops of free edges | faces moved "
+            "(largest turn) |"),
+            "|---|---|---|---|---|---|---|---|---|---|"]
     rows = []
     for name in FILES:
         path = data / name
@@ -596,10 +597,10 @@ def files_table() -> list[str]:
         r = surfprep.heal(path)
         cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
         rows.append(f"| {name} | input | | | {r.free_edges_before} | "
-                    f"{r.tight_free_edges_before} | {r.valid_before} | | |")
+                    f"{r.tight_free_edges_before} | {r.valid_before} | | | |")
         rows.append(f"| | surfprep heal | {cpu:.1f} | {wall:.1f} | {r.free_edges_after} | "
                     f"{r.tight_free_edges_after} | {r.valid_after} | "
-                    f"{r.max_edge_tolerance:.2g} | {_loops(r)} |")
+                    f"{r.max_edge_tolerance:.2g} | {_loops(r)} | {_moved(r)} |")
         model = read(path)
         cpu, wall = time.process_time(), time.perf_counter()
         sewn, _ = sew(list(model.faces), r.gap_tol)
@@ -611,8 +612,18 @@ def files_table() -> list[str]:
         # at 1e-7 would count shared edges, closed by tolerance, as closed)
         rows.append(f"| | Sewing(gap_tol) + ShapeFix | {cpu:.1f} | {wall:.1f} | "
                     f"{count_free_edges(fixed)} | {r.tight_free_edges_before} (input) | "
-                    f"{is_valid(fixed)} | {max_edge_tolerance(fixed):.2g} | |")
+                    f"{is_valid(fixed)} | {max_edge_tolerance(fixed):.2g} | | 0 |")
     return head + rows
+
+
+def _moved(result) -> str:
+    """How many faces closing gaps moved, and the largest angle by which one of them
+    turned its tangent planes (degrees), as the heal report gives them."""
+    closed = result.extra.get("closed_gaps")
+    if not closed:
+        return "0"
+    faces = {m["face"] for m in closed["faces_moved"]}
+    return f"{len(faces)} ({closed['largest_turn_deg']:.2g}°)" if faces else "0"
 
 
 def main() -> None:

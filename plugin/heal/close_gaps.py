@@ -63,9 +63,12 @@ from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 
+from ...algorithms.face_region import FaceRegion
 from ...algorithms.healing.edge_fit import EdgeFit, EdgeTarget, fit_to_edges
+from ...algorithms.measure import normal_turn
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
+from ..occ.faces import face_to_nurbs
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
 from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
@@ -123,6 +126,11 @@ _PASSES = 3
 _MIN_TOLERANCE = 1e-7
 #: points per direction of the parameter box where a moved face's change is measured
 _MOVE_GRID = 41
+#: ... and where the angle its tangent planes turned by is measured (and as many
+#: again graded towards its sides)
+_TURN_GRID = 129
+#: faces turned by more than this are said in a note (degrees)
+_TURN_NOTED_DEG = 1.0
 
 
 @dataclass(frozen=True)
@@ -139,7 +147,8 @@ class ClosedGaps:
         moved faces have after, model units (measured on the surfaces).
     moved : tuple of dict
         Per face moved: its index in the shape, how far it moved (in its parameter box),
-        the fit's residual, the knots inserted.
+        the fit's residual, the knots inserted, and the largest angle its tangent
+        planes turned by inside the face (degrees, :func:`_turned`).
     retrimmed : tuple of dict
         Per face re-trimmed without moving its surface: its index, how far its boundary
         moved along the edges re-trimmed (largest over them).
@@ -292,8 +301,9 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
                           "other left open")
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
-                   "knots_inserted": fits[f][0].inserted} for f in sorted(fits)
-                  if fits[f][0].surface is not surfaces[f])
+                   "knots_inserted": fits[f][0].inserted,
+                   "turned_deg": _turned(surfaces[f], fits[f][0].surface, faces, f)}
+                  for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
     remaining = sum(1 for e in open_ if after.get(id(e), e.gap) > tight)
     return ClosedGaps(len(open_), remaining, largest,
@@ -334,16 +344,34 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     if passes[-1].open_after:
         passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted))
     first, last = passes[0], passes[-1]
-    out = replace(result, model=model, skipped=result.skipped + last.notes)
+    # a face moved in several passes turned by at most the sum of its turns
+    turned: dict[int, float] = {}
+    for m in (m for p in passes for m in p.moved):
+        turned[m["face"]] = turned.get(m["face"], 0.0) + m["turned_deg"]
+    out = replace(result, model=model, skipped=result.skipped + last.notes + _turn_note(turned))
     out.extra["closed_gaps"] = {
         **last.as_dict(), "open_edges_before": first.open_before,
         "largest_gap_before": first.largest_before, "passes": len(passes),
         "faces_moved": [m for p in passes for m in p.moved],
-        "faces_retrimmed": [m for p in passes for m in p.retrimmed]}
+        "faces_retrimmed": [m for p in passes for m in p.retrimmed],
+        "largest_turn_deg": max(turned.values(), default=0.0)}
     if not any(p.moved or p.retrimmed for p in passes):
         return out
     return replace(out, tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * size).free_in_geometry,
                    valid_after=is_valid(shape), max_edge_tolerance=max_edge_tolerance(shape))
+
+
+def _turn_note(turned: dict[int, float]) -> tuple[str, ...]:
+    """The note on the faces whose tangent planes turned by more than
+    ``_TURN_NOTED_DEG`` degrees (``turned``: face -> degrees), or none."""
+    many = sorted(f for f, angle in turned.items() if angle > _TURN_NOTED_DEG)
+    if not many:
+        return ()
+    worst = max(many, key=turned.__getitem__)
+    note = (f"faces {many} turn their tangent planes by more than {_TURN_NOTED_DEG:g} degrees "
+            f"where they were moved onto their neighbours' edges (face {worst}: up to "
+            f"{turned[worst]:.3g})")
+    return (note,)
 
 
 def _unchanged(open_: list, largest: float, notes: list[str], why: str) -> ClosedGaps:
@@ -532,6 +560,25 @@ def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
         h.update(t.uv.tobytes())
         h.update(t.points.tobytes())
     return h.digest()
+
+
+def _turned(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
+    """Largest angle, in degrees, by which moving face ``f`` from ``before`` to ``after``
+    turned its tangent planes (:func:`~surfprep.algorithms.measure.normal_turn`), on a
+    grid of ``_TURN_GRID``^2 over its parameter box, graded towards the box's sides
+    (where the edges pulled it), the samples inside the face only, poles left out; 0
+    when no sample is measured."""
+    trimmed = face_to_nurbs(TopoDS.Face_s(faces.FindKey(f)))
+    u0, u1, v0, v1 = trimmed.parameter_box()
+    ends = np.geomspace(1e-6, 1e-2, _TURN_GRID // 8)
+    t = np.unique(np.concatenate([np.linspace(0.0, 1.0, _TURN_GRID), ends, 1.0 - ends]))
+    u, v = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0), indexing="ij")
+    uv = np.stack([u.ravel(), v.ravel()], axis=1)
+    uv = uv[FaceRegion(trimmed).contains(uv)]
+    if not uv.size:
+        return 0.0
+    angle = normal_turn(before, after, uv[:, 0], uv[:, 1])
+    return float(np.degrees(np.nanmax(angle))) if np.any(np.isfinite(angle)) else 0.0
 
 
 def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
