@@ -76,7 +76,9 @@ from ..occ.shapes import is_valid, max_edge_tolerance
 from .common_curves import (
     FIT_SAMPLES,
     FIT_SHARE,
+    FaceCorners,
     common_curve,
+    cornered,
     through,
     to_vertices,
     uv_on,
@@ -198,6 +200,7 @@ class _Remembered:
     dense: dict = field(default_factory=dict)      # (face, its edges' common curves) -> dense targets
     # (common curve, face, side) -> (Geom2d pcurve, NurbsCurve); (common curve, None, None) -> Geom curve
     occ: dict = field(default_factory=dict)
+    corners: FaceCorners | None = None             # where the faces' edges end in their parameters
 
 
 @dataclass
@@ -417,7 +420,10 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
                 memo.images[key] = image(e, i, s)
                 memo.images[key].flags.writeable = False
             images[id(e), i] = memo.images[key]
-    position = vertex_positions(touched.values(), edges, moving_set, images, image, tight)
+    if memo.corners is None:            # (the faces' pcurves stay as read until applied)
+        memo.corners = FaceCorners.of(surfaces, of_face, faces, surfaces)
+    position = replace(vertex_positions(touched.values(), edges, moving_set, images, image, tight),
+                       corners=memo.corners)
     commons = {}
     for key, e in touched.items():
         # the same when its faces move, may be re-trimmed or stay as in an earlier round
@@ -510,10 +516,10 @@ def _targets(f: int, of_face, commons, surfaces, faces, position, at: NDArray) -
             if own:
                 uv = common.uv.get((f, side))
                 if uv is None:      # a pole: the old pcurve, every point to the vertex
-                    uv = pcurve_points(e, i, faces, at, side)
+                    uv = cornered(e, i, faces, at, side, position)
                 targets.append(EdgeTarget(uv, common.goals.get((f, side), common.points)))
                 continue
-            guess = pcurve_points(e, i, faces, at, side)
+            guess = cornered(e, i, faces, at, side, position)
             if common.curve is None:            # a pole
                 targets.append(EdgeTarget(guess, np.repeat(position.ends(e)[0][None], at.size, axis=0)))
             elif (f, side) in common.goals:     # a closed edge: the face keeps its side

@@ -23,8 +23,9 @@ from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from .shared_edges import SharedEdge, feet_on_face, pcurve_points
 
-__all__ = ["FIT_SAMPLES", "FIT_SHARE", "CommonCurve", "VertexPositions", "common_curve",
-           "even_samples", "through", "to_vertices", "uv_on", "vertex_positions"]
+__all__ = ["CORNER_GROUP", "FIT_SAMPLES", "FIT_SHARE", "CommonCurve", "FaceCorners",
+           "VertexPositions", "common_curve", "cornered", "even_samples", "through",
+           "to_vertices", "uv_on", "vertex_positions"]
 
 #: evenly spaced samples per edge where a moving face is fitted (as many again clustered
 #: at the ends; knot spans are split while one holds 12 of them): the common curve is
@@ -36,6 +37,9 @@ FIT_SHARE = 0.4
 #: weight of an image's waves (:func:`~surfprep.algorithms.healing.edge_targets.roughness`)
 #: against its distance from the other faces in choosing the common curve
 _ROUGHNESS_WEIGHT = 2.0
+#: ends of a face's pcurves at one vertex within this share of its parameter-box
+#: diagonal of each other are one corner (:class:`FaceCorners`)
+CORNER_GROUP = 1e-3
 
 
 @dataclass
@@ -141,7 +145,7 @@ def common_curve(e: SharedEdge, s: NDArray, images, position, moving: set[int],
         if f not in moving:
             continue
         for side in ((False, True) if e.seam else (False,)):
-            guess = pcurve_points(e, i, faces, s, side)
+            guess = cornered(e, i, faces, s, side, position)
             if closed:          # each face keeps its own side, its ends at the vertices
                 common.uv[f, side] = guess
                 common.goals[f, side] = to_ends(images[id(e), i])
@@ -243,11 +247,13 @@ class VertexPositions:
     """Where :func:`vertex_positions` puts the vertices (``at``) and, at a vertex whose
     fixed faces' corners lie apart (a gap between them that stays open), where each
     group of faces there goes (``groups``: per (vertex, face) its group's point) and
-    which faces move (``moving``)."""
+    which faces move (``moving``); where the moving faces' edges end in their
+    parameters (``corners``)."""
 
     at: dict
     groups: dict = field(default_factory=dict)
     moving: frozenset = frozenset()
+    corners: FaceCorners | None = None
 
     def ends(self, e: SharedEdge) -> tuple[NDArray, NDArray]:
         """Where ``e``'s ends go: its faces' group's point where they are in one group,
@@ -265,6 +271,79 @@ class VertexPositions:
         if ours and all(p is ours[0] for p in ours):
             return ours[0]
         return self.at[v]
+
+
+@dataclass(frozen=True)
+class FaceCorners:
+    """Where the edges of faces end in their parameters, one point per corner.
+
+    An exporter's pcurves of two edges meeting at a vertex often end a little apart on
+    the face (within the vertex's tolerance: 1.6e-5 of the parameter range, 3.6e-5 mm,
+    on the K1 CATIA/debis export's faces 3 and 47). Both ends must go to the vertex when
+    the face moves onto its neighbours' edges, so the moved surface would have to
+    collapse the stretch between them to a point: fits folded the face over there (its
+    tangent planes turned by 180 degrees). Ends at one vertex lying within
+    ``CORNER_GROUP`` times the face's parameter-box diagonal of each other are one
+    corner, at their mean (the two sides of a seam or a pole lie a period apart and stay
+    apart).
+
+    Attributes
+    ----------
+    at : dict
+        ``(face, vertex) -> (k, 2)`` the face's corners at the vertex.
+    """
+
+    at: dict
+
+    @classmethod
+    def of(cls, moving, of_face, faces, surfaces) -> FaceCorners:
+        """The corners of the faces ``moving`` (their edges ``of_face[f]``, their
+        surfaces ``surfaces[f]``)."""
+        at = {}
+        ends = np.array([0.0, 1.0])
+        for f in moving:
+            u0, u1, v0, v1 = surfaces[f].domain
+            near = CORNER_GROUP * float(np.hypot(u1 - u0, v1 - v0))
+            by_vertex: dict[int, list[list[NDArray]]] = {}
+            for e in of_face[f]:
+                i = e.faces.index(f)
+                for side in ((False, True) if e.seam else (False,)):
+                    uv = pcurve_points(e, i, faces, ends, side)
+                    for v, point in ((e.first, uv[0]), (e.last, uv[1])):
+                        groups = by_vertex.setdefault(v, [])
+                        group = next((g for g in groups if np.linalg.norm(g[0] - point) <= near),
+                                     None)
+                        if group is None:
+                            groups.append([point])
+                        else:
+                            group.append(point)
+            for v, groups in by_vertex.items():
+                at[f, v] = np.array([np.mean(g, axis=0) for g in groups])
+        return cls(at)
+
+    def snapped(self, uv: NDArray, s: NDArray, f: int, e: SharedEdge) -> NDArray:
+        """``uv`` (m, 2), ``e``'s pcurve on face ``f`` at ``s`` (m,), its ends moved onto
+        the face's nearest corners at ``e``'s vertices, the shift faded out along the
+        edge (:func:`~surfprep.algorithms.healing.edge_targets.pinned_ends`); as it is
+        on a face without corners."""
+        corners = [self.at.get((f, v)) for v in (e.first, e.last)]
+        if corners[0] is None or corners[1] is None:
+            return uv
+        ends = np.array([c[np.argmin(np.linalg.norm(c - end, axis=1))]
+                         for c, end in zip(corners, (uv[0], uv[-1]))])
+        if np.array_equal(ends, uv[[0, -1]]):
+            return uv
+        return pinned_ends(uv, ends, s)
+
+
+def cornered(e: SharedEdge, i: int, faces, s: NDArray, side: bool,
+             position: VertexPositions) -> NDArray:
+    """:func:`~.shared_edges.pcurve_points` of ``e`` on its ``i``-th face, its ends on
+    the face's corners (``position.corners``) where it moves."""
+    uv = pcurve_points(e, i, faces, s, side)
+    if position.corners is None:
+        return uv
+    return position.corners.snapped(uv, s, e.faces[i], e)
 
 
 def vertex_positions(around, edges: list[SharedEdge], moving: set[int], images, image,
