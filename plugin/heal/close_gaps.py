@@ -347,10 +347,11 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     if passes[-1].open_after:
         passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted))
     first, last = passes[0], passes[-1]
-    # a face moved in several passes turned by at most the sum of its turns
+    # a face moved in several passes turned by at most the sum of its turns (and by
+    # 180 degrees at most)
     turned: dict[int, float] = {}
     for m in (m for p in passes for m in p.moved):
-        turned[m["face"]] = turned.get(m["face"], 0.0) + m["turned_deg"]
+        turned[m["face"]] = min(turned.get(m["face"], 0.0) + m["turned_deg"], 180.0)
     out = replace(result, model=model, skipped=result.skipped + last.notes + _turn_note(turned))
     out.extra["closed_gaps"] = {
         **last.as_dict(), "open_edges_before": first.open_before,
