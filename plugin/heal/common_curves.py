@@ -296,12 +296,12 @@ class FaceCorners:
     at: dict
 
     @classmethod
-    def of(cls, moving, of_face, faces, surfaces) -> FaceCorners:
-        """The corners of the faces ``moving`` (their edges ``of_face[f]``, their
-        surfaces ``surfaces[f]``)."""
+    def of(cls, which, of_face, faces, surfaces) -> FaceCorners:
+        """The corners of the faces ``which`` (face ``f``'s edges ``of_face[f]``, its
+        surface ``surfaces[f]``; ``faces`` the shape's face map)."""
         at = {}
         ends = np.array([0.0, 1.0])
-        for f in moving:
+        for f in which:
             u0, u1, v0, v1 = surfaces[f].domain
             near = CORNER_GROUP * float(np.hypot(u1 - u0, v1 - v0))
             by_vertex: dict[int, list[list[NDArray]]] = {}
