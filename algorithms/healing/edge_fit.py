@@ -199,7 +199,7 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
     for round_ in range(max_rounds + 1):
         matrix = _collocation(s, uv)
         offset = points - s.evaluate(uv[:, 0], uv[:, 1])
-        d = _smooth_solve(matrix, offset, s.control_points)
+        d = _smooth_solve(matrix, offset, s.n_control)
         left = np.linalg.norm(matrix @ d - offset, axis=1)
         worst.append(float(left.max()))
         if worst[-1] <= tol or round_ == max_rounds:
@@ -417,81 +417,48 @@ def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:
                              shape=(uv.shape[0], nu * nv))
 
 
-def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, net: NDArray) -> NDArray:
+def _second_differences(n: int) -> sparse.csr_matrix:
+    """``(n - 2, n)``: rows ``x[i] - 2 x[i+1] + x[i+2]`` (zero rows when n < 3)."""
+    if n < 3:
+        return sparse.csr_matrix((0, n))
+    return sparse.diags([1.0, -2.0, 1.0], [0, 1, 2], shape=(n - 2, n), format="csr")
+
+
+def _path_laplacian(n: int) -> sparse.csr_matrix:
+    """``D^T D`` of the ``(n - 1, n)`` first differences: tridiagonal, -1 off the
+    diagonal, 1 2 ... 2 1 on it (zero for n = 1)."""
+    if n < 2:
+        return sparse.csr_matrix((n, n))
+    main = np.full(n, 2.0)
+    main[[0, -1]] = 1.0
+    return sparse.diags([-np.ones(n - 1), main, -np.ones(n - 1)], [-1, 0, 1], format="csr")
+
+
+def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, shape: tuple[int, int]) -> NDArray:
     """Control-point displacements ``d`` (n_u n_v, 3) minimizing
 
-    ``|A d - offset|^2 + mu (d^T E d + d^T M d / L^2)``:
+    ``|A d - offset|^2 + mu (|D_u d|^2 + |D_v d|^2) + eps |d|^2``:
 
-    the samples met, the displacement a discrete screened membrane on the surface
-    (:func:`_membrane`: ``E`` its Dirichlet energy, ``M`` its masses), which decays away
-    from the edges over ``L`` = ``_DECAY`` times the net's longer side and, by the
-    maximum principle, nowhere exceeds what the samples ask; ``mu`` is small against
-    ``A``'s scale, so the samples dominate, and ``_SWEEPS`` steps of iterated Tikhonov
-    regularization (the same factorization applied to what the samples still miss)
-    take out the pull the membrane keeps on them. Iterated Tikhonov tends to the
-    displacement of least energy among those meeting the samples: a harmonic
-    extension of the edges' displacement over the face, whose slope, the angle the
-    face's tangent planes turn by, is spread over the face's size in space, not over
-    the knot spans the fit inserted near its edges."""
-    energy, mass, length = _membrane(net)
+    the samples met, the displacement a discrete screened membrane on the net (first
+    differences), which decays away from the edges over about a third of the net
+    (``eps / mu``) and, by the maximum principle, nowhere exceeds what the samples ask;
+    ``mu`` is small against ``A``'s scale, so the samples dominate, and ``_SWEEPS``
+    steps of iterated Tikhonov regularization (the same factorization applied to what
+    the samples still miss) take out the pull the membrane keeps on them."""
+    nu, nv = shape
+    # |D_u d|^2 + |D_v d|^2 = d^T (L_u (x) I + I (x) L_v) d, L = D^T D the path Laplacian
+    # on each side of the net: its Kronecker sum, built without multiplying the big
+    # difference matrices
+    energy = sparse.kronsum(_path_laplacian(nv), _path_laplacian(nu), format="csc")
     gram = (matrix.T @ matrix).tocsc()
     scale = float(gram.diagonal().max())
-    stiffness = energy + mass / (_DECAY * length) ** 2
-    mu = _SMOOTH * scale / float(np.median(stiffness.diagonal()))
-    solve = splinalg.splu((mu * stiffness + gram).tocsc()).solve
+    decay = (_DECAY * max(nu, nv)) ** 2
+    system = _SMOOTH * scale * (energy + sparse.identity(nu * nv) / decay) + gram
+    solve = splinalg.splu(system.tocsc()).solve
     d = solve(np.asarray(matrix.T @ offset))
     for _ in range(_SWEEPS):            # iterated Tikhonov: the membrane's pull on the samples undone
         d += solve(np.asarray(matrix.T @ (offset - matrix @ d)))
     return d
-
-
-def _membrane(net: NDArray) -> tuple[sparse.csr_matrix, sparse.csr_matrix, float]:
-    """``(E, M, L)`` of the control net ``net`` (n_u, n_v, 3): the discrete Dirichlet
-    energy ``d^T E d`` of a displacement of the net's points, the mass matrix ``M``
-    (diagonal, each point's share of the area) and the net's longer side ``L``.
-
-    ``int |grad d|^2 dA`` on the surface, discretized on the net as on a grid of
-    rectangles: a difference along ``u`` between points ``(i, j)`` and ``(i+1, j)``
-    weighs ``|d_{i+1,j} - d_ij|^2`` by the net's width across it over its length,
-    ``h_v / h_u``, and one along ``v`` by ``h_u / h_v``, lengths in space. On a
-    uniform net this is the first differences of the control points; where knots
-    were inserted close together (spans graded towards a kink at a vertex) a
-    difference across a short span weighs more, so the displacement does not turn
-    the surface within it. Lengths are floored at 1e-6 of their median: a collapsed
-    side (a pole) then keeps its points moving together."""
-    nu, nv = net.shape[:2]
-    hu = np.linalg.norm(np.diff(net, axis=0), axis=-1)                  # (nu-1, nv)
-    hv = np.linalg.norm(np.diff(net, axis=1), axis=-1)                  # (nu, nv-1)
-    floor = 1e-6 * float(np.median(np.concatenate([hu.ravel(), hv.ravel(), [0.0]])) or 1.0)
-    # each point's share of the lengths along u and along v (half of each side it ends)
-    cu = np.zeros((nu, nv))
-    cv = np.zeros((nu, nv))
-    cu[:-1] += 0.5 * hu
-    cu[1:] += 0.5 * hu
-    cv[:, :-1] += 0.5 * hv
-    cv[:, 1:] += 0.5 * hv
-    cu, cv = np.maximum(cu, floor), np.maximum(cv, floor)
-    flat = np.arange(nu * nv).reshape(nu, nv)
-    rows, cols, weights = [], [], []
-    if nu > 1:
-        rows.append(flat[:-1].ravel())
-        cols.append(flat[1:].ravel())
-        weights.append((0.5 * (cv[:-1] + cv[1:]) / np.maximum(hu, floor)).ravel())
-    if nv > 1:
-        rows.append(flat[:, :-1].ravel())
-        cols.append(flat[:, 1:].ravel())
-        weights.append((0.5 * (cu[:, :-1] + cu[:, 1:]) / np.maximum(hv, floor)).ravel())
-    a = np.concatenate(rows or [np.zeros(0, int)])
-    b = np.concatenate(cols or [np.zeros(0, int)])
-    w = np.concatenate(weights or [np.zeros(0)])
-    n = nu * nv
-    # sum_k w_k |d_a - d_b|^2 = d^T (D - W) d, W the weights off the diagonal, D their row sums
-    off = sparse.coo_matrix((np.concatenate([w, w]), (np.concatenate([a, b]), np.concatenate([b, a]))),
-                            shape=(n, n)).tocsr()
-    energy = sparse.diags(np.asarray(off.sum(axis=1)).ravel()) - off
-    length = max(float(np.max(np.sum(hu, axis=0), initial=0.0)),
-                 float(np.max(np.sum(hv, axis=1), initial=0.0)), floor)
-    return energy.tocsr(), sparse.diags((cu * cv).ravel()).tocsr(), length
 
 
 def _refined(s: NurbsSurface, uv: NDArray, splits: NDArray, miss: NDArray, tol: float,
