@@ -173,7 +173,10 @@ def normal_turn(before: NurbsSurface, after: NurbsSurface, u: ArrayLike, v: Arra
     degenerate : float
         Where ``|N|`` of either surface is below this share of its median over the
         samples (a pole, a collapsed side: the normal's direction is not defined by
-        the first derivatives there) the angle is NaN.
+        the first derivatives there), or where ``before``'s derivatives are nearly
+        parallel (``|N_a| <= degenerate |S_u| |S_v|``: a cusp, where the slightest
+        change turns the normal of a tangent plane that was barely defined), the angle
+        is NaN.
 
     Returns
     -------
@@ -205,6 +208,8 @@ def normal_turn(before: NurbsSurface, after: NurbsSurface, u: ArrayLike, v: Arra
     for surface in (before, after):
         d = surface.derivatives(u, v, 1)
         crossed.append(np.cross(d[..., 1, 0, :], d[..., 0, 1, :]))
+        if surface is before:
+            speeds = np.linalg.norm(d[..., 1, 0, :], axis=-1) * np.linalg.norm(d[..., 0, 1, :], axis=-1)
     na, nb = (np.linalg.norm(n, axis=-1) for n in crossed)
     cos = np.sum(crossed[0] * crossed[1], axis=-1) / np.maximum(na * nb, np.finfo(float).tiny)
     # the sine from the cross product keeps small angles exact (arccos loses half the digits)
@@ -212,7 +217,8 @@ def normal_turn(before: NurbsSurface, after: NurbsSurface, u: ArrayLike, v: Arra
         na * nb, np.finfo(float).tiny)
     angle = np.arctan2(sin, cos)
     if u.size:
-        low = (na < degenerate * float(np.median(na))) | (nb < degenerate * float(np.median(nb)))
+        low = ((na < degenerate * float(np.median(na))) | (nb < degenerate * float(np.median(nb)))
+               | (na <= degenerate * speeds))
         angle = np.where(low | (na == 0.0) | (nb == 0.0), np.nan, angle)
     return angle
 

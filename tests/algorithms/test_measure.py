@@ -329,3 +329,19 @@ def test_normal_turn_refuses_what_it_cannot_measure():
         normal_turn(flat, flat, [np.nan], [0.5])
     with pytest.raises(InvalidGeometryError, match="degenerate"):
         normal_turn(flat, flat, [0.5], [0.5], degenerate=2.0)
+
+
+def test_normal_turn_is_nan_where_the_surface_given_has_a_cusp():
+    """Where before's two derivatives are nearly parallel (a face's corner where its
+    sides meet tangentially: t4m's face 11 at sin = 3.5e-4) its tangent plane is barely
+    defined and any change turns it: NaN there, the angle elsewhere."""
+    # x = u + v, y = u + (1 + eps) v: S_u = (1, 1, 0), S_v = (1, 1 + eps, 0), sin ~ eps / 2
+    for eps, defined in ((1e-5, False), (1e-1, True)):
+        x = np.array([[0.0, 1.0], [1.0, 2.0]])
+        y = np.array([[0.0, 1.0 + eps], [1.0, 2.0 + eps]])
+        knots = [0, 0, 1, 1]
+        sheared = NurbsSurface(np.stack([x, y, 0 * x], -1), knots, knots, 1, 1)
+        lifted = NurbsSurface(np.stack([x, y, 1e-6 * np.array([[0.0, 1.0], [0.0, 1.0]])], -1),
+                              knots, knots, 1, 1)
+        angle = normal_turn(sheared, lifted, [0.5], [0.5])
+        assert np.isfinite(angle[0]) == defined
