@@ -204,23 +204,19 @@ def normal_turn(before: NurbsSurface, after: NurbsSurface, u: ArrayLike, v: Arra
         raise InvalidGeometryError("normal_turn: u and v must be finite")
     if not (np.isfinite(degenerate) and 0.0 <= degenerate < 1.0):
         raise InvalidGeometryError(f"degenerate must lie in [0, 1), got {degenerate!r}")
-    crossed = []
-    for surface in (before, after):
-        d = surface.derivatives(u, v, 1)
-        crossed.append(np.cross(d[..., 1, 0, :], d[..., 0, 1, :]))
-        if surface is before:
-            speeds = np.linalg.norm(d[..., 1, 0, :], axis=-1) * np.linalg.norm(d[..., 0, 1, :], axis=-1)
-    na, nb = (np.linalg.norm(n, axis=-1) for n in crossed)
-    cos = np.sum(crossed[0] * crossed[1], axis=-1) / np.maximum(na * nb, np.finfo(float).tiny)
-    # the sine from the cross product keeps small angles exact (arccos loses half the digits)
-    sin = np.linalg.norm(np.cross(crossed[0], crossed[1]), axis=-1) / np.maximum(
-        na * nb, np.finfo(float).tiny)
-    angle = np.arctan2(sin, cos)
-    if u.size:
-        low = ((na < degenerate * float(np.median(na))) | (nb < degenerate * float(np.median(nb)))
-               | (na <= degenerate * speeds))
-        angle = np.where(low | (na == 0.0) | (nb == 0.0), np.nan, angle)
-    return angle
+    da, db = before.derivatives(u, v, 1), after.derivatives(u, v, 1)
+    a = np.cross(da[..., 1, 0, :], da[..., 0, 1, :])
+    b = np.cross(db[..., 1, 0, :], db[..., 0, 1, :])
+    na, nb = np.linalg.norm(a, axis=-1), np.linalg.norm(b, axis=-1)
+    # the sine from the cross product keeps small angles exact (arccos loses half the
+    # digits); the scale cancels in the ratio
+    angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1))
+    if not u.size:
+        return angle
+    speeds = np.linalg.norm(da[..., 1, 0, :], axis=-1) * np.linalg.norm(da[..., 0, 1, :], axis=-1)
+    low = ((na < degenerate * float(np.median(na))) | (nb < degenerate * float(np.median(nb)))
+           | (na <= degenerate * speeds) | (nb == 0.0))
+    return np.where(low, np.nan, angle)
 
 
 # ----------------------------------------------------------------- arc length
