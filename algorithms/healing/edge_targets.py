@@ -1,5 +1,6 @@
 """Where a face's sides go when its surface is moved onto its neighbours' edges: the
-samples of a common curve mapped onto the face (:func:`on_surface`), their ends kept
+samples of a common curve mapped onto the face (:func:`on_surface`, past its sides
+where they lie beyond them: :func:`beyond_sides`), their ends kept
 at the face's corners (:func:`pinned_ends`, :func:`spread_ends`), and how wavy an
 edge's image is (:func:`roughness`); the targets of
 :func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges` as
@@ -16,7 +17,7 @@ from ..fitting import approximate_curve
 from ..projection import project_to_surface
 from ..surface import NurbsSurface
 
-__all__ = ["along_iso", "monotone", "on_surface", "pinned_ends", "roughness", "spread_ends"]
+__all__ = ["along_iso", "beyond_sides", "monotone", "on_surface", "pinned_ends", "roughness", "spread_ends"]
 
 #: a pcurve whose samples lie within this share of the domain of one of its sides runs
 #: along that side (its samples then slide along the iso-curve), and the Gauss-Newton
@@ -24,7 +25,17 @@ __all__ = ["along_iso", "monotone", "on_surface", "pinned_ends", "roughness", "s
 ON_BORDER = 1e-9
 ISO_STEPS = 6
 #: samples closer than this share of a pcurve's extent to its end have piled up there
-PILED = 1e-12
+#: (feet clamped onto a corner lie up to 2.4e-12 of the domain apart: turbine face 12) ...
+PILED = 1e-9
+#: ... and samples of an edge closer than this share of its parameter lie at one place
+SAME_S = 1e-12
+#: a side's pcurve may end off that side by this share of the domain (its ends on the
+#: face's corners, each the mean of its edges' ends there)
+CORNER_OFF = 1e-3
+#: a foot where a derivative is shorter than this share of its median over the surface,
+#: or where the two are this close to parallel (sine), stays on its side
+#: (:func:`beyond_sides`)
+_DEGENERATE = 1e-3
 #: share of a pcurve's parameter over which the shift of an end back to its corner fades
 END_FADE = 0.25
 #: knot spans of the smooth curve an image is compared with (:func:`roughness`)
@@ -36,14 +47,69 @@ def on_surface(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArra
     (m, 2) at ``s`` (m,) along the edge: their closest points, or, for a pcurve along
     the domain's border (an untrimmed face's side), their closest points on that
     border's iso-curve (:func:`along_iso`; projected onto the surface, feet near a
-    corner would pile up at the corner), kept in order (:func:`monotone`). Returns
-    (m, 2) float."""
+    corner would pile up at the corner), kept in order (:func:`monotone`). A pcurve
+    runs along a side when its samples farther than ``END_FADE`` of ``s`` from its ends
+    lie on it within ``ON_BORDER`` of the domain, and its ends within ``CORNER_OFF``:
+    a face's corner, where :func:`pinned_ends` put its ends, may lie off the side by
+    what its two edges' ends there lay apart. Returns (m, 2) float."""
     u0, u1, v0, v1 = surface.domain
+    span = float(np.ptp(s))
+    middle = (s - s[0] >= END_FADE * span) & (s[-1] - s >= END_FADE * span)
     for k, (lo, hi) in enumerate(((u0, u1), (v0, v1))):
         for end in (lo, hi):
-            if np.all(np.abs(guess[:, k] - end) <= ON_BORDER * (hi - lo)):
+            off = np.abs(guess[:, k] - end)
+            if (np.all(off[middle] <= ON_BORDER * (hi - lo))
+                    and np.all(off <= CORNER_OFF * (hi - lo))):
                 return monotone(along_iso(surface, points, guess, k, end), 1 - k, s)
-    return project_to_surface(surface, points, guess=guess).uv
+    return beyond_sides(surface, points, project_to_surface(surface, points, guess=guess).uv)
+
+
+def beyond_sides(surface: NurbsSurface, points: NDArray, feet: NDArray) -> NDArray:
+    """``feet`` (m, 2), the closest points of ``points`` (m, 3) within the domain, with
+    those on a side of the domain (clamped there: their points lie beyond it) moved on
+    by a Gauss-Newton step in the tangent plane, out of the domain: the parameters a
+    point beyond the side has on the surface extended linearly.
+
+    A common curve arriving at its vertex from beyond the face's domain (the vertex a
+    little outside the face) otherwise projects onto the side there: its last samples
+    pile up along the side, and the surface, asked to reach points 1e-4 apart from
+    parameters 1e-6 apart, folds over (KCS hull face 5). Extended, they run on past
+    the side, and :func:`pinned_ends` brings the end back to its corner in a smooth
+    fade. A foot where the derivatives are parallel (a pole) stays. Returns (m, 2)
+    float."""
+    u0, u1, v0, v1 = surface.domain
+    lo = np.array([u0, v0])
+    hi = np.array([u1, v1])
+    near = ON_BORDER * (hi - lo)
+    below = np.abs(feet - lo) <= near                   # (m, 2): on the side u = u0, v = v0
+    above = np.abs(feet - hi) <= near
+    on_side = np.any(below | above, axis=1)
+    if not on_side.any():
+        return feet
+    d = surface.derivatives(feet[on_side, 0], feet[on_side, 1], 1)
+    su, sv, r = d[:, 1, 0], d[:, 0, 1], points[on_side] - d[:, 0, 0]
+    # the normal equations of the 2 x 2 tangent-plane least squares, by Cramer's rule
+    a, b, c = (np.einsum("ij,ij->i", x, y) for x, y in ((su, su), (su, sv), (sv, sv)))
+    ru, rv = np.einsum("ij,ij->i", su, r), np.einsum("ij,ij->i", sv, r)
+    det = a * c - b * b
+    # not at a pole (a derivative shorter than 1e-3 of its median over the surface) nor
+    # at a cusp
+    grid = np.linspace(0.0, 1.0, 9)
+    typical = surface.derivatives_grid(u0 + grid * (u1 - u0), v0 + grid * (v1 - v0), 1)
+    speed_u = float(np.median(np.einsum("...i,...i->...", typical[..., 1, 0, :], typical[..., 1, 0, :])))
+    speed_v = float(np.median(np.einsum("...i,...i->...", typical[..., 0, 1, :], typical[..., 0, 1, :])))
+    fine = ((a > _DEGENERATE ** 2 * speed_u) & (c > _DEGENERATE ** 2 * speed_v)
+            & (det > _DEGENERATE ** 2 * a * c))
+    step = np.zeros((det.size, 2))
+    step[fine] = np.stack([c[fine] * ru[fine] - b[fine] * rv[fine],
+                           a[fine] * rv[fine] - b[fine] * ru[fine]], axis=1) / det[fine, None]
+    # only out of the domain, across a side the foot is on (a step back inside would be a
+    # foot the projection missed)
+    out_of = np.any((below[on_side] & (step < 0)) | (above[on_side] & (step > 0)), axis=1)
+    step[~out_of] = 0.0
+    out = feet.copy()
+    out[on_side] += step
+    return out
 
 
 def monotone(uv: NDArray, k: int, s: NDArray) -> NDArray:
@@ -56,7 +122,7 @@ def monotone(uv: NDArray, k: int, s: NDArray) -> NDArray:
     no surface meets. Returns (m, 2) float."""
     x = uv[:, k]
     sign = np.sign(x[-1] - x[0])
-    first = np.concatenate([[True], np.diff(s) > PILED * max(float(np.ptp(s)), 1.0)])
+    first = np.concatenate([[True], np.diff(s) > SAME_S * max(float(np.ptp(s)), 1.0)])
     if sign == 0 or np.count_nonzero(first) < 3:
         return uv
     y = sign * x[first]
