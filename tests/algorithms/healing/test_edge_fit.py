@@ -216,3 +216,58 @@ def test_bad_arguments_are_refused(make, match):
 def test_bad_targets_are_refused(uv, points, match):
     with pytest.raises(InvalidGeometryError, match=match):
         EdgeTarget(uv, points)
+
+
+def test_a_lift_next_to_short_knot_spans_turns_the_surface_as_little_as_a_uniform_net():
+    """A flat patch whose knots crowd towards its edge v = 0 (as the fits of graded
+    refinement leave them), that edge lifted by h, the opposite edge held: the least
+    change spreads the lift over the patch (the membrane is measured on the parameter
+    domain, not in control-net steps), so its tangent planes turn by a few h (the lift
+    decays over a third of the patch), within twice what they turn on a uniform net; a
+    membrane on the net's steps moved the crowded rows alone and turned the surface by
+    89 degrees within them (the KCS hull's face 5 folded over so)."""
+    from surfprep.algorithms.measure import normal_turn
+
+    h = 1e-3
+    t = np.linspace(0, 1, 4)
+    x, y = np.meshgrid(t, t, indexing="ij")
+    flat = interpolate_surface(np.stack([x, y, 0 * x], axis=-1), params_u=t, params_v=t)
+    crowded = flat.refine(np.array([1e-5, 1e-4, 1e-3, 1e-2, 0.1]), "v")
+    u = np.linspace(0, 1, 200)
+    lifted = EdgeTarget(np.stack([u, 0 * u], axis=1), np.stack([u, 0 * u, 0 * u + h], axis=1))
+    held = EdgeTarget(np.stack([u, 0 * u + 1], axis=1), np.stack([u, 0 * u + 1, 0 * u], axis=1))
+    g = np.unique(np.concatenate([np.linspace(0, 1, 101), np.geomspace(1e-7, 1e-1, 50)]))
+    gu, gv = np.meshgrid(g, g, indexing="ij")
+    turns = []
+    for surface in (flat, crowded):
+        fit = fit_to_edges(surface, [lifted, held], tol=1e-9)
+        assert fit.converged
+        turns.append(float(np.nanmax(normal_turn(surface, fit.surface, gu, gv))))
+    uniform, graded = turns
+    assert uniform <= 2 * np.arctan(h)          # (the lift decays over a third)
+    assert graded <= 2 * uniform
+
+
+def test_a_lift_beside_a_pole_keeps_the_rows_next_to_it_with_it():
+    """A fan (its side v = 1 collapsed to a point) with knots crowding towards the pole,
+    its side v = 0 lifted by h and the pole held: the rows next to the pole move with
+    it, the surface's tangent planes turning by a few h next to it (a membrane measured
+    in space, where a point has no length, let them move apart and the face folded
+    there: the K1 CATIA/debis demo's grid had 13 folded cells)."""
+    from surfprep.algorithms.measure import normal_turn
+
+    h = 1e-3
+    t = np.linspace(0, 1, 5)
+    x, y = np.meshgrid(t, t, indexing="ij")
+    fan = interpolate_surface(np.stack([x * (1 - y), y, 0 * x], axis=-1), params_u=t, params_v=t)
+    crowded = fan.refine(np.array([0.9, 0.99, 0.999, 0.9999]), "v")
+    u = np.linspace(0, 1, 200)
+    lifted = EdgeTarget(np.stack([u, 0 * u], axis=1), np.stack([u, 0 * u, 0 * u + h], axis=1))
+    pole = EdgeTarget(np.stack([u, 0 * u + 1], axis=1), np.repeat([[0.0, 1.0, 0.0]], u.size, axis=0))
+    fit = fit_to_edges(crowded, [lifted, pole], tol=1e-9)
+    assert fit.converged
+    g = np.unique(np.concatenate([np.linspace(0, 1, 101), 1 - np.geomspace(1e-6, 1e-1, 50)]))
+    gu, gv = np.meshgrid(np.linspace(0.05, 0.95, 31), g, indexing="ij")
+    turn = normal_turn(crowded, fit.surface, gu, gv)
+    assert np.count_nonzero(np.isfinite(turn)) > 0.75 * turn.size      # (NaN within 1e-3 of it)
+    assert float(np.nanmax(turn)) <= 10 * h
