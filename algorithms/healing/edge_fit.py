@@ -417,13 +417,6 @@ def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:
                              shape=(uv.shape[0], nu * nv))
 
 
-def _second_differences(n: int) -> sparse.csr_matrix:
-    """``(n - 2, n)``: rows ``x[i] - 2 x[i+1] + x[i+2]`` (zero rows when n < 3)."""
-    if n < 3:
-        return sparse.csr_matrix((0, n))
-    return sparse.diags([1.0, -2.0, 1.0], [0, 1, 2], shape=(n - 2, n), format="csr")
-
-
 def _membrane(s: NurbsSurface) -> tuple[sparse.csc_matrix, sparse.csc_matrix]:
     """``(E, M)`` for a displacement ``d`` of ``s``'s control points: ``d^T E d`` its
     Dirichlet energy and ``d^T M d`` its squared norm, the control points taken as

@@ -55,6 +55,8 @@ def on_surface(surface: NurbsSurface, points: NDArray, guess: NDArray, s: NDArra
     u0, u1, v0, v1 = surface.domain
     span = float(np.ptp(s))
     middle = (s - s[0] >= END_FADE * span) & (s[-1] - s >= END_FADE * span)
+    if not middle.any():            # (too few samples to leave the ends out)
+        middle[:] = True
     for k, (lo, hi) in enumerate(((u0, u1), (v0, v1))):
         for end in (lo, hi):
             off = np.abs(guess[:, k] - end)
@@ -75,8 +77,8 @@ def beyond_sides(surface: NurbsSurface, points: NDArray, feet: NDArray) -> NDArr
     pile up along the side, and the surface, asked to reach points 1e-4 apart from
     parameters 1e-6 apart, folds over (KCS hull face 5). Extended, they run on past
     the side, and :func:`pinned_ends` brings the end back to its corner in a smooth
-    fade. A foot where the derivatives are parallel (a pole) stays. Returns (m, 2)
-    float."""
+    fade. A foot where a derivative nearly vanishes (a pole) or the two are nearly
+    parallel (a cusp) stays. Returns (m, 2) float."""
     u0, u1, v0, v1 = surface.domain
     lo = np.array([u0, v0])
     hi = np.array([u1, v1])
