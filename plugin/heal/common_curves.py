@@ -37,8 +37,8 @@ FIT_SHARE = 0.4
 #: weight of an image's waves (:func:`~surfprep.algorithms.healing.edge_targets.roughness`)
 #: against its distance from the other faces in choosing the common curve
 _ROUGHNESS_WEIGHT = 2.0
-#: ends of a face's pcurves at one vertex within this share of its parameter-box
-#: diagonal of each other are one corner (:class:`FaceCorners`)
+#: ends of a face's pcurves at one vertex within this share of the diagonal of its
+#: surface's domain of each other are one corner (:class:`FaceCorners`)
 CORNER_GROUP = 1e-3
 
 
@@ -283,9 +283,9 @@ class FaceCorners:
     the face moves onto its neighbours' edges, so the moved surface would have to
     collapse the stretch between them to a point: fits folded the face over there (its
     tangent planes turned by 180 degrees). Ends at one vertex lying within
-    ``CORNER_GROUP`` times the face's parameter-box diagonal of each other are one
-    corner, at their mean (the two sides of a seam or a pole lie a period apart and stay
-    apart).
+    ``CORNER_GROUP`` times the diagonal of the face's surface's domain of each other
+    are one corner, at their mean (the two sides of a seam or a pole lie a period apart
+    and stay apart).
 
     Attributes
     ----------
