@@ -585,9 +585,9 @@ def files_table() -> list[str]:
     from surfprep.plugin.io import read
     data = Path(__file__).resolve().parents[2] / "shared" / "data"
     head = [("| file | method | CPU (s) | wall (s) | free edges (gap_tol) | free edges at "
-            "1e-7 x size | valid | max edge tolerance | loops of free edges | faces moved "
-            "(largest turn) |"),
-            "|---|---|---|---|---|---|---|---|---|---|"]
+            "1e-7 x size | of which interior (widest gap) + open boundary | valid | max edge "
+            "tolerance | loops of free edges | faces moved (largest turn) |"),
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
     rows = []
     for name in FILES:
         path = data / name
@@ -596,10 +596,13 @@ def files_table() -> list[str]:
         cpu, wall = time.process_time(), time.perf_counter()
         r = surfprep.heal(path)
         cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+        kinds = r.extra.get("free_boundary", {})
         rows.append(f"| {name} | input | | | {r.free_edges_before} | "
-                    f"{r.tight_free_edges_before} | {r.valid_before} | | | |")
+                    f"{r.tight_free_edges_before} | {_kinds(kinds.get('before'))} | "
+                    f"{r.valid_before} | | | |")
         rows.append(f"| | surfprep heal | {cpu:.1f} | {wall:.1f} | {r.free_edges_after} | "
-                    f"{r.tight_free_edges_after} | {r.valid_after} | "
+                    f"{r.tight_free_edges_after} | {_kinds(kinds.get('after'))} | "
+                    f"{r.valid_after} | "
                     f"{r.max_edge_tolerance:.2g} | {_loops(r)} | {_moved(r)} |")
         model = read(path)
         cpu, wall = time.process_time(), time.perf_counter()
@@ -611,9 +614,18 @@ def files_table() -> list[str]:
         # sewing moves no geometry: its faces' gaps are the input's (re-sewing its output
         # at 1e-7 would count shared edges, closed by tolerance, as closed)
         rows.append(f"| | Sewing(gap_tol) + ShapeFix | {cpu:.1f} | {wall:.1f} | "
-                    f"{count_free_edges(fixed)} | {r.tight_free_edges_before} (input) | "
+                    f"{count_free_edges(fixed)} | {r.tight_free_edges_before} (input) | | "
                     f"{is_valid(fixed)} | {max_edge_tolerance(fixed):.2g} | | 0 |")
     return head + rows
+
+
+def _kinds(free: dict | None) -> str:
+    """The free edges in the geometry by kind, as the heal report's ``free_boundary``
+    gives them: interior (along gaps, around holes; the widest gap) + open boundary."""
+    if not free:
+        return ""
+    widest = f" ({free['widest_gap']:.2g})" if free["widest_gap"] is not None else ""
+    return f"{free['interior']}{widest} + {free['edges']['open boundary']}"
 
 
 def _moved(result) -> str:

@@ -167,6 +167,14 @@ def _summary(report: dict) -> list[str]:
                  f"{report['gap_tol']:.3g} mm), {free['tight_before']} -> "
                  f"{free['tight_after']} (geometric); valid {valid['before']} -> "
                  f"{valid['after']}")
+    after = report.get("free_boundary", {}).get("after")
+    if after:
+        kinds, widest = after["edges"], after["widest_gap"]
+        lines.append(f"free edges left in the geometry: {after['interior']} interior "
+                     f"({kinds['gap']} along gaps"
+                     + (f" up to {widest:.3g} mm wide" if widest is not None else "")
+                     + f", {kinds['hole']} around holes), {kinds['open boundary']} on the "
+                     f"open boundary")
     return lines
 
 

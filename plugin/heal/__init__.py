@@ -70,7 +70,12 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
 
 Free edges "in the geometry" (``tight_free_edges_before/after``) are measured on the
 faces, each face's pcurves through its surface (:mod:`surfprep.plugin.occ.gaps`), not
-on the edge curves a file carries.
+on the edge curves a file carries. The report's ``free_boundary`` says what those of
+the input and of the result are
+(:func:`surfprep.algorithms.healing.free_boundary.classify_free_edges`): sides of gaps
+(another face's free edge runs beside them), rims of holes (loops classed as holes and
+left open), or the model's open boundary (a sheet's edge, a pipe's mouth: nothing
+beside them, not a defect); ``interior`` counts the first two.
 
 The building blocks are :mod:`surfprep.algorithms.healing`
 (``local_approximant``, ``connect``, ``Continuity``, ``Side``); the approximants
@@ -93,6 +98,7 @@ from scipy.spatial import cKDTree
 
 from ...algorithms.healing import Continuity
 from ...algorithms.healing.adjacency import (
+    dense_edge,
     duplicate_faces,
     face_edges,
     four_sided_boundary,
@@ -103,6 +109,7 @@ from ...algorithms.healing.adjacency import (
 from ...algorithms.healing.clipping import face_source
 from ...algorithms.healing.decompose import quad_boundaries
 from ...algorithms.healing.fidelity import InputFaces
+from ...algorithms.healing.free_boundary import classify_free_edges
 from ...algorithms.healing.strip_overlap import OverlapRepair, find_overlaps, overlap_boundaries
 from ...algorithms.tolerance import check_tolerance
 from ...algorithms.trimmed import TrimmedFace
@@ -110,6 +117,7 @@ from ...errors import ConversionError, InvalidGeometryError, SurfprepError
 from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs
+from ..occ.gaps import gaps_in_geometry
 from .close_gaps import closed_in_geometry
 from .crossings import trim_crossings as trim_crossings_of
 from .cut import covered_holes_dropped, cut_under_patches
@@ -266,7 +274,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         Called as each stage begins ("reading the faces", "directed patches and
         overlaps", "finding gaps, holes and crossings", "triangulating the faces as
         sources", "approximants", "joining, sewing and checking", "closing gaps in the
-        geometry"); the report's ``stage_times_s`` gives the seconds of each.
+        geometry", "classifying the free edges"); the report's ``stage_times_s`` gives
+        the seconds of each.
 
     Returns
     -------
@@ -288,6 +297,9 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     >>> free = healed.report()["free_edges"]     # in the geometry at 1e-7 x size: open, closed
     >>> free["tight_before"], free["tight_after"]
     (8, 6)
+    >>> kinds = healed.report()["free_boundary"]     # the gap's two sides were interior
+    >>> kinds["before"]["interior"], kinds["after"]["interior"], kinds["after"]["edges"]
+    (2, 0, {'gap': 0, 'open boundary': 6, 'hole': 0})
     >>> join = healed.report()["shared_edges"][0]   # measured on the surfaces
     >>> join["max_gap"] <= 1e-7, join["max_angle_deg"] < 0.1
     (True, True)
@@ -359,7 +371,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
     rims = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
-    loops = plan_loops(rims, faces, fill=fill)
+    loops = plan_loops(rims, faces, fill=fill, gap_tol=gap_tol)
     holes = [loop for loop in loops if loop.fill]
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)
@@ -410,6 +422,15 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         say("closing gaps in the geometry")
         result = closed_in_geometry(result, size=model.size,
                                     allowed=tol if tol is not None else gap_tol)
+    say("classifying the free edges")
+    unfilled = [[dense_edge(e) for e in rims[lp.index]] for lp in loops
+                if lp.kind in ("hole", "not capped")]
+    after = gaps_in_geometry(result.shape, TIGHT_FACTOR * model.size)
+    result.extra["free_boundary"] = {
+        "before": classify_free_edges(before.tight_lines, before.tight_owners, join=gap_tol,
+                                      holes=unfilled).as_dict(),
+        "after": classify_free_edges(after.polylines, after.owners, join=gap_tol,
+                                     holes=unfilled).as_dict()}
     result = dataclasses.replace(result, time_s=time.perf_counter() - start)
     result.extra["stage_times_s"] = say.times()
     result.extra["replace"] = replace

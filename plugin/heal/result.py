@@ -162,5 +162,6 @@ class HealResult:
             "max_edge_tolerance": self.max_edge_tolerance,
             "replace": self.extra.get("replace"),
             "free_loops": self.extra.get("free_loops", []),
+            "free_boundary": self.extra.get("free_boundary", {}),
             "closed_gaps": self.extra.get("closed_gaps", {}),
         }

@@ -322,13 +322,14 @@ class Before:
     valid: bool
     free_lines: list = field(default_factory=list)   # the free edges at gap_tol, (129, 3) each
     tight_lines: list = field(default_factory=list)  # ... at TIGHT_FACTOR x size
+    tight_owners: tuple = ()                         # the face of each of tight_lines
 
     @classmethod
     def of(cls, model: CadModel, gap_tol: float) -> Before:
         sewn, _ = sew(list(model.faces), gap_tol)
         tight = gaps_in_geometry(sewn, TIGHT_FACTOR * model.size, samples=129)
         return cls(count_free_edges(sewn), tight.free_in_geometry, is_valid(model.shape),
-                   boundary_edge_points(sewn, 129), list(tight.polylines))
+                   boundary_edge_points(sewn, 129), list(tight.polylines), tight.owners)
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,

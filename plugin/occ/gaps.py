@@ -25,7 +25,7 @@ from OCP.gp import gp_Pnt, gp_Pnt2d, gp_Vec, gp_Vec2d
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS, TopoDS_Edge
-from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
+from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape, TopTools_IndexedMapOfShape
 from scipy.spatial import cKDTree
 
 __all__ = ["PROBE_SAMPLES", "SIDE_SAMPLES", "GeometricGaps", "gaps_in_geometry"]
@@ -54,6 +54,9 @@ class GeometricGaps:
         of faces, the largest distance.
     polylines : tuple of (n, 3) float
         Points along every free edge and along each face's side of every open edge.
+    owners : tuple of int
+        The face of each polyline (its index among the shape's faces, ``TopExp``
+        order).
     largest : float
         The largest distance over all shared edges (0 when none).
     """
@@ -62,6 +65,7 @@ class GeometricGaps:
     open_edges: tuple
     polylines: tuple
     largest: float
+    owners: tuple = ()
 
     @property
     def free_in_geometry(self) -> int:
@@ -74,7 +78,9 @@ def gaps_in_geometry(shape, tight: float, *, samples: int = 9) -> GeometricGaps:
     doc); ``samples`` points per polyline."""
     edge_faces = TopTools_IndexedDataMapOfShapeListOfShape()
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
-    free, open_, lines, largest = 0, [], [], 0.0
+    face_index = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(shape, TopAbs_FACE, face_index)
+    free, open_, lines, owners, largest = 0, [], [], [], 0.0
     for k in range(1, edge_faces.Extent() + 1):
         edge = TopoDS.Edge_s(edge_faces.FindKey(k))
         if BRep_Tool.Degenerated_s(edge):
@@ -84,13 +90,15 @@ def gaps_in_geometry(shape, tight: float, *, samples: int = 9) -> GeometricGaps:
             if not BRep_Tool.IsClosed_s(edge, faces[0]):
                 free += 1
                 lines.append(_Side(edge, faces[0]).points(np.linspace(0, 1, samples)))
+                owners.append(face_index.FindIndex(faces[0]) - 1)
             continue
         gap = _gap(edge, faces, tight)
         largest = max(largest, gap)
         if gap > tight:
             open_.append((edge, len(faces), gap))
             lines.extend(_Side(edge, f).points(np.linspace(0, 1, samples)) for f in faces)
-    return GeometricGaps(free, tuple(open_), tuple(lines), largest)
+            owners.extend(face_index.FindIndex(f) - 1 for f in faces)
+    return GeometricGaps(free, tuple(open_), tuple(lines), largest, tuple(owners))
 
 
 def _distinct(faces) -> list:

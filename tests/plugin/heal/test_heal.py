@@ -74,6 +74,22 @@ def test_gap_closed_in_geometry(gap_pair, continuity):
         assert join.max_angle < 1e-2
     rep = json.loads(json.dumps(r.report()))
     assert rep["free_edges"]["tight_after"] == 6 and len(rep["patches"]) == 2
+    # the two facing sides were a gap's, 1e-3 wide; the six left are the outer border
+    before, after = rep["free_boundary"]["before"], rep["free_boundary"]["after"]
+    assert before["edges"] == {"gap": 2, "open boundary": 6, "hole": 0}
+    assert before["widest_gap"] == pytest.approx(1e-3, rel=0.02)
+    assert after == {"edges": {"gap": 0, "open boundary": 6, "hole": 0}, "interior": 0,
+                     "loops": {"open boundary": 1}, "widest_gap": None}
+
+
+def test_a_gap_wider_than_gap_tol_is_reported_as_interior_free_edges(gap_pair):
+    # gap_tol 1e-4 below the 1e-3 gap: its sides stay free, and are said to be a gap's
+    r = heal(gap_pair, gap_tol=1e-4)
+    assert r.tight_free_edges_after == 8
+    after = r.report()["free_boundary"]["after"]
+    assert after["edges"] == {"gap": 2, "open boundary": 6, "hole": 0}
+    assert after["interior"] == 2
+    assert 1e-3 <= after["widest_gap"] <= 1.05e-3
 
 
 @pytest.fixture(scope="module")

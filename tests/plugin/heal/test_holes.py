@@ -84,6 +84,11 @@ def test_fill_none_leaves_every_loop_open_and_says_so():
     assert result.patches == () and result.free_edges_after == 10
     assert all(not lp["fill"] and "fill='none'" in lp["why"]
                for lp in result.report()["free_loops"])
+    # what is left is said: the hole's five edges are interior, the fan's outer five its
+    # open boundary
+    after = result.report()["free_boundary"]["after"]
+    assert after["edges"] == {"gap": 0, "open boundary": 5, "hole": 5}
+    assert after["interior"] == 5 and after["loops"] == {"hole": 1, "open boundary": 1}
 
 
 def test_fill_all_still_never_covers_a_sheet_twice():
