@@ -103,17 +103,21 @@ class FreeLoop:
                 "fill": self.fill, "sub_patches": len(self.boundaries), "why": self.why}
 
 
-def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None], fill: str
-          ) -> FreeLoop:
+def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None], fill: str,
+          gap_tol: float) -> FreeLoop:
     curves = [e.curve for e in loop]
     owners = tuple(sorted({e.face for e in loop}))
     head = {"index": index, "edges": len(loop), "faces": owners}
     width, length = loop_width(curves)
     if width <= GAP_WIDTH * length:
+        # edges paired one to one are not free: a loop within gap_tol is a T-junction,
+        # which sewing joins (and closing gaps closes in the geometry where faces move)
+        how = (f"sewn: its sides lie within gap_tol ({gap_tol:.3g}) of each other, one "
+               "against several edges" if width <= gap_tol else
+               "left open: strips over gaps wider than gap_tol are not built yet")
         return FreeLoop(**head, kind="gap", slope=float("nan"), fill=False,
-                        why=f"left open: a gap between faces up to {width:.3g} wide along "
-                            f"{length:.4g} (a sliver, not a hole; strips over gaps are not "
-                            "built yet)")
+                        why=f"a gap between faces up to {width:.3g} wide along {length:.4g} "
+                            f"(a sliver, not a hole): {how}")
     rim = np.concatenate([e.samples for e in loop])
     reach = REACH * float(np.ptp(rim, axis=0).max())
     bounding = [faces[i] for i in owners if faces[i] is not None]
@@ -152,7 +156,7 @@ def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None],
 
 
 def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | None], *,
-               fill: str = "holes") -> list[FreeLoop]:
+               fill: str = "holes", gap_tol: float = 0.0) -> list[FreeLoop]:
     """Each loop of free edges classified and, where ``fill`` says, its fill planned
     (module docstring).
 
@@ -163,6 +167,8 @@ def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | No
     faces : list of TrimmedFace or None
         The model's faces (those of the loops' edges sampled for the surroundings).
     fill : "holes", "all" or "none"
+    gap_tol : float
+        A gap loop no wider than this is sewn (said so in its ``why``), not left open.
 
     Returns
     -------
@@ -171,4 +177,4 @@ def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | No
     if fill not in FILL_RULES:
         raise InvalidGeometryError(f"fill must be one of {', '.join(map(repr, FILL_RULES))}, "
                                    f"got {fill!r}")
-    return [_loop(k, loop, faces, fill) for k, loop in enumerate(loops)]
+    return [_loop(k, loop, faces, fill, gap_tol) for k, loop in enumerate(loops)]
