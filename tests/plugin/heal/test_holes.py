@@ -117,6 +117,11 @@ def test_a_sliver_between_faces_is_a_gap_not_a_hole():
              enumerate((lower, upper))]
     (loop,) = plan_loops([edges], [None, None])
     assert loop.kind == "gap" and not loop.fill and "0.02 wide along 20" in loop.why
+    assert "left open" in loop.why
+    # within gap_tol it is no gap left open: sewing joins it (one edge against several)
+    (sewn,) = plan_loops([edges], [None, None], gap_tol=0.05)
+    assert sewn.kind == "gap" and not sewn.fill and "sewn" in sewn.why
+    assert "left open" not in sewn.why
 
 
 def test_the_command_counts_holes_not_sub_patches(tmp_path, capsys):
