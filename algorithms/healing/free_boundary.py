@@ -9,7 +9,8 @@ reports its free edges by what they are, judged by the geometry around each:
     runs beside it: at a quarter, half and three quarters of its length that
     polyline lies within :data:`BESIDE` x its length of it. The two sides of a
     sliver between faces, a long edge against the short ones of a T-junction. Its
-    *width* is the largest distance from its inner samples to the others.
+    *width* is the largest distance from its inner samples to the others' polylines
+    (off by their chords' sagitta at most; up to ``_SAMPLES`` points an edge).
 *boundary*
     Nothing of another face lies beside it: the model's open boundary, or the rim
     of a hole no face covers.
@@ -48,7 +49,7 @@ BESIDE = 0.05
 #: point-segment distances computed per block
 _BLOCK = 1_000_000
 #: points per polyline used (its ends and quarters among them)
-_SAMPLES = 17
+_SAMPLES = 33
 _QUARTERS = (0.25, 0.5, 0.75)
 
 

@@ -117,7 +117,6 @@ from ...errors import ConversionError, InvalidGeometryError, SurfprepError
 from ...inputs import ShapeLike
 from ..io import CadModel, read, to_shape
 from ..occ.faces import face_to_nurbs
-from ..occ.gaps import gaps_in_geometry
 from .close_gaps import closed_in_geometry
 from .crossings import trim_crossings as trim_crossings_of
 from .cut import covered_holes_dropped, cut_under_patches
@@ -131,7 +130,7 @@ from .jobs import (
 from .loops import plan_loops
 from .result import HealResult, PatchReport, StageClock
 from .retrim import retrim_to_neighbours
-from .rollback import TIGHT_FACTOR, Before, no_worse_than_before, tight_round
+from .rollback import FREE_LINES, TIGHT_FACTOR, Before, no_worse_than_before, tight_round
 from .spec import read_patch_spec
 from .trim_back import trim_overlaps_of
 
@@ -425,12 +424,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     say("classifying the free edges")
     unfilled = [[dense_edge(e) for e in rims[lp.index]] for lp in loops
                 if lp.kind in ("hole", "not capped")]
-    after = gaps_in_geometry(result.shape, TIGHT_FACTOR * model.size)
+    lines, owners = result.extra.pop(FREE_LINES)
     result.extra["free_boundary"] = {
         "before": classify_free_edges(before.tight_lines, before.tight_owners, join=gap_tol,
                                       holes=unfilled).as_dict(),
-        "after": classify_free_edges(after.polylines, after.owners, join=gap_tol,
-                                     holes=unfilled).as_dict()}
+        "after": classify_free_edges(lines, owners, join=gap_tol, holes=unfilled).as_dict()}
     result = dataclasses.replace(result, time_s=time.perf_counter() - start)
     result.extra["stage_times_s"] = say.times()
     result.extra["replace"] = replace

@@ -85,7 +85,7 @@ from .common_curves import (
     vertex_positions,
 )
 from .result import HealResult
-from .rollback import TIGHT_FACTOR
+from .rollback import FREE_LINES, FREE_SAMPLES, TIGHT_FACTOR
 from .shared_edges import (
     SharedEdge,
     edges_by_face,
@@ -361,7 +361,9 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
         "largest_turn_deg": max(turned.values(), default=0.0)}
     if not any(p.moved or p.retrimmed for p in passes):
         return out
-    return replace(out, tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * size).free_in_geometry,
+    gaps = gaps_in_geometry(shape, TIGHT_FACTOR * size, samples=FREE_SAMPLES)
+    out.extra[FREE_LINES] = (gaps.polylines, gaps.owners)
+    return replace(out, tight_free_edges_after=gaps.free_in_geometry,
                    valid_after=is_valid(shape), max_edge_tolerance=max_edge_tolerance(shape))
 
 

@@ -311,6 +311,15 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
     return out
 
 
+#: ``HealResult.extra`` key of the result's free edges in the geometry: (polylines,
+#: owner faces) of :func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`, measured on the
+#: shape the result holds
+FREE_LINES = "tight_free_lines"
+#: ... with this many points along each (their chords a 32nd of the edge: a gap's width
+#: measured to them is off by their sagitta at most)
+FREE_SAMPLES = 33
+
+
 @dataclass(frozen=True)
 class Before:
     """The input's figures: free edges sewn at ``gap_tol``, in the geometry at
@@ -346,16 +355,17 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
     reports = tuple(PatchReport(job.origin, job.name, la.resolution, la.max_error, la.rms_error,
                                 la.artificial_share, la.converged, la.tol, deviation)
                     for (job, la), deviation in zip(done, deviations))
+    gaps = gaps_in_geometry(shape, TIGHT_FACTOR * model.size, samples=FREE_SAMPLES)
     return HealResult(
         model=result_model, patches=reports, approximants=tuple(la for _, la in done),
         network=network, dropped=tuple(dropped), skipped=tuple(skipped),
         free_edges_before=before.free_edges, free_edges_after=count_free_edges(shape),
         tight_free_edges_before=before.tight_free_edges,
-        tight_free_edges_after=gaps_in_geometry(shape, TIGHT_FACTOR * model.size).free_in_geometry,
+        tight_free_edges_after=gaps.free_in_geometry,
         valid_before=before.valid, valid_after=is_valid(shape),
         max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
         continuity=continuity, time_s=time.perf_counter() - start,
-        extra={"faces_in": model.n_faces})
+        extra={"faces_in": model.n_faces, FREE_LINES: (gaps.polylines, gaps.owners)})
 
 
 def _output_faces(work, done, network, dropped) -> tuple[list, list, FaceNames]:

@@ -110,15 +110,15 @@ def test_dense_polylines_are_classified_as_the_coarse_ones():
 
 
 def test_a_curved_gap_is_measured_between_the_curves():
-    # concentric quarter arcs of radii 1 and 1.05 (faces 0 and 1), 17 of their 65
-    # samples kept: chords of pi/32, whose sagitta is r (1 - cos(pi/64)); the inner
+    # concentric quarter arcs of radii 1 and 1.05 (faces 0 and 1), 33 of their 65
+    # samples kept: chords of pi/64, whose sagitta is r (1 - cos(pi/128)); the inner
     # arc's points lie 0.05 from the outer arc less up to its sagitta, the outer arc's
     # 0.05 from the inner one plus up to its sagitta
     t = np.linspace(0.0, np.pi / 2, 65)
     inner = np.column_stack([np.cos(t), np.sin(t), np.zeros_like(t)])
     outer = 1.05 * inner
     fb = classify_free_edges([inner, outer], [0, 1], join=0.1)
-    sag = 1 - np.cos(np.pi / 64)
+    sag = 1 - np.cos(np.pi / 128)
     assert fb.kinds == ("gap", "gap")
     assert 0.05 - 1.05 * sag - 1e-12 <= fb.widths[0] <= 0.05 + 1e-12
     assert 0.05 - 1e-12 <= fb.widths[1] <= 0.05 + sag + 1e-12
