@@ -60,7 +60,8 @@ def test_the_report_gives_the_time_of_each_stage(sheets):
     assert list(stages) == ["reading the faces", "directed patches and overlaps",
                             "finding gaps, holes and crossings",
                             "triangulating the faces as sources", "approximants",
-                            "joining, sewing and checking", "closing gaps in the geometry"]
+                            "joining, sewing and checking", "closing gaps in the geometry",
+                            "classifying the free edges"]
     assert all(t >= 0 for t in stages.values())
     assert 0.9 * rep["time_s"] <= sum(stages.values()) <= rep["time_s"]
 
