@@ -541,4 +541,5 @@ def test_heal_says_its_stages(capsys, tmp_path):
                       "heal: finding gaps, holes and crossings",
                       "heal: triangulating the faces as sources", "heal: approximants",
                       "heal: joining, sewing and checking",
-                      "heal: closing gaps in the geometry"]
+                      "heal: closing gaps in the geometry",
+                      "heal: classifying the free edges"]
