@@ -72,7 +72,7 @@ from ..occ.faces import face_to_nurbs
 from ..occ.failures import is_occ_failure
 from ..occ.gaps import gaps_in_geometry
 from ..occ.geom import curve2d_to_occ, curve_to_occ, surface_to_occ
-from ..occ.shapes import is_valid, max_edge_tolerance
+from ..occ.shapes import check_failures, is_valid, max_edge_tolerance
 from .common_curves import (
     FIT_SAMPLES,
     FIT_SHARE,
@@ -251,6 +251,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
     retrimmed: dict = {}
     memo = _Remembered()
     fitted = Fitted() if fitted is None else fitted
+    failing_before: dict[int, frozenset] = {}   # BRepCheck's findings on the shape as given
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         trimmable = set(candidates) - set(moving) - rigid if retrim else set()
@@ -265,13 +266,18 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
         # (in the last round the faces that fit move, their gaps to the others narrowed)
         journal = _Journal()
         changed = set(fits) | set(retrimmed)
+        # what BRepCheck finds on the faces around before they change (a face read
+        # invalid, its wire not closed across a file's gap, may still move)
+        ends = {v for f in changed for e in of_face[f] for v in (e.first, e.last)}
+        for g in _around(changed, of_face, edges, ends) - set(failing_before):
+            failing_before[g] = check_failures(faces.FindKey(g))
         try:
             after, apart, moved_vertices = _apply(fits, retrimmed, commons, edges, of_face,
                                                   faces, vertices, positions, journal, surfaces,
                                                   memo.occ)
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
-            invalid = _invalid(changed, of_face, faces, edges, moved_vertices)
+            invalid = _invalid(changed, of_face, faces, edges, moved_vertices, failing_before)
             bad = invalid | _widening(edges, changed, after, apart, tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
@@ -722,13 +728,17 @@ def _widening(edges: list[SharedEdge], fits, after: dict[int, float],
     return blamed
 
 
-def _invalid(fits, of_face, faces, edges: list[SharedEdge], vertices: set[int]) -> set[int]:
-    """The faces of ``fits`` (moved or re-trimmed) that fail ``BRepCheck``, and those
-    next to another face that fails it once they changed (its vertices moved with
-    them: ``vertices``)."""
+def _invalid(fits, of_face, faces, edges: list[SharedEdge], vertices: set[int],
+             failing_before: dict[int, frozenset]) -> set[int]:
+    """The faces of ``fits`` (moved or re-trimmed) that ``BRepCheck`` finds something new
+    wrong with (not in ``failing_before``, face -> :func:`check_failures` before the
+    change; a face missing there was valid), and those next to another face with a new
+    failure once they changed (its vertices moved with them: ``vertices``)."""
     bad = set()
     for g in _around(fits, of_face, edges, vertices):
         if BRepCheck_Analyzer(faces.FindKey(g)).IsValid():
+            continue
+        if not check_failures(faces.FindKey(g)) - failing_before.get(g, frozenset()):
             continue
         if g in fits:
             bad.add(g)

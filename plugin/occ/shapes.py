@@ -24,7 +24,14 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.ShapeFix import ShapeFix_Shell, ShapeFix_Solid
-from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_SHELL
+from OCP.TopAbs import (
+    TopAbs_EDGE,
+    TopAbs_FACE,
+    TopAbs_FORWARD,
+    TopAbs_SHELL,
+    TopAbs_VERTEX,
+    TopAbs_WIRE,
+)
 from OCP.TopExp import TopExp, TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS, TopoDS_Compound, TopoDS_Edge, TopoDS_Face, TopoDS_Shape, TopoDS_Shell
@@ -38,6 +45,7 @@ __all__ = [
     "all_faces",
     "area_and_centroid",
     "boundary_edge_points",
+    "check_failures",
     "check_valid",
     "compound",
     "count_free_edges",
@@ -237,6 +245,38 @@ def boundary_edge_points(shape: TopoDS_Shape, samples: int = 5) -> list:
 def is_valid(shape: TopoDS_Shape) -> bool:
     """``BRepCheck_Analyzer(shape).IsValid()``."""
     return bool(BRepCheck_Analyzer(shape).IsValid())
+
+
+def check_failures(shape: TopoDS_Shape) -> frozenset[tuple[str, str]]:
+    """What ``BRepCheck_Analyzer`` finds wrong with ``shape`` and its wires, edges and
+    vertices: ``(sub-shape type, status)`` pairs, e.g. ``("WIRE", "NotClosed")``, the
+    statuses in the context of ``shape`` among them (empty when valid).
+
+    Tells a change that made a shape invalid from one that left it as invalid as it
+    was: a face read invalid (its wire not closed where a file's gaps are) can still
+    be moved onto its neighbours' edges, as long as nothing new fails."""
+    analyzer = BRepCheck_Analyzer(shape)
+    out = set()
+    subs = [shape]
+    for kind in (TopAbs_WIRE, TopAbs_EDGE, TopAbs_VERTEX):
+        explorer = TopExp_Explorer(shape, kind)
+        while explorer.More():
+            subs.append(explorer.Current())
+            explorer.Next()
+    for sub in subs:
+        result = analyzer.Result(sub)
+        if result is None:
+            continue
+        statuses = list(result.Status())
+        try:
+            statuses += list(result.StatusOnShape(shape))
+        except Exception as exc:            # no status recorded in that context
+            if not is_occ_failure(exc):
+                raise
+        kind = sub.ShapeType().name.removeprefix("TopAbs_")
+        out.update((kind, st.name.removeprefix("BRepCheck_")) for st in statuses
+                   if st.name != "BRepCheck_NoError")
+    return frozenset(out)
 
 
 def max_edge_tolerance(shape: TopoDS_Shape) -> float:

@@ -227,10 +227,16 @@ def test_spaceship_no_more_free_edges_in_the_geometry_than_given(data_dir):
     edges in the geometry. The approximants of faces 19, 27, 31, 33, 39, 43 and 45 fit
     their neighbours' edge curves but leave their faces 1e-7 x size apart at corners
     (158 -> 174 with them, 162 without): they are taken back, said so. With the faces
-    along the edges still open moved onto common curves 66 are left, and the count is
-    no worse than the input's."""
+    along the edges still open moved onto common curves 46 are left (62 while faces
+    BRepCheck finds invalid as read, 29, 30, 35, 41, 42 and 47 among them, their wires
+    not closed across the file's gaps, could not move: a move is refused only for what
+    it breaks), and all of them are interior: sides of gaps up to 1.2 mm wide.
+    """
     r = surfprep.heal(data_dir / "occt_spaceship_alias.stp")
-    assert r.tight_free_edges_before == 158 and r.tight_free_edges_after <= 70
+    assert r.tight_free_edges_before == 158 and r.tight_free_edges_after <= 50
+    after = r.report()["free_boundary"]["after"]
+    assert after["edges"]["gap"] == after["interior"] == r.tight_free_edges_after
+    assert 1.0 < after["widest_gap"] < 1.3
     assert r.free_edges_after <= r.free_edges_before
     (note,) = [s for s in r.skipped if "free edges in the geometry" in s]
     assert "taken back" in note and "face 19" in note
@@ -238,6 +244,8 @@ def test_spaceship_no_more_free_edges_in_the_geometry_than_given(data_dir):
     closed = r.report()["closed_gaps"]
     assert closed["open_edges_after"] < closed["open_edges_before"]
     assert all(m["moved"] <= r.gap_tol for m in closed["faces_moved"])
+    moved = {m["face"] for m in closed["faces_moved"]}
+    assert {29, 30, 41, 42} <= moved and closed["largest_turn_deg"] < 1.0
 
 
 @pytest.mark.slow
