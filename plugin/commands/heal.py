@@ -117,6 +117,13 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
 
 
+def _plural(kind: str) -> str:
+    """A loop kind of the report in the plural ("open boundaries", "not capped")."""
+    if kind == "not capped":
+        return kind
+    return kind[:-1] + "ies" if kind.endswith("ry") else kind + "s"
+
+
 def _summary(report: dict) -> list[str]:
     patches, joins = report["patches"], report["shared_edges"]
     free, valid = report["free_edges"], report["valid"]
@@ -160,7 +167,7 @@ def _summary(report: dict) -> list[str]:
     if loops:
         kinds = Counter(lp["kind"] for lp in loops)
         lines.append(f"{len(loops)} loop(s) of free edges: "
-                     + ", ".join(f"{n} {kind}{'s' if n > 1 else ''}"
+                     + ", ".join(f"{n} {_plural(kind) if n > 1 else kind}"
                                  for kind, n in sorted(kinds.items()))
                      + f"; fill tried on {sum(lp['fill'] for lp in loops)}")
     lines.append(f"free edges {free['before']} -> {free['after']} (at gap_tol "

@@ -45,6 +45,30 @@ def test_heal_gap_file(gap_file, tmp_path, capsys):
     assert plot.stat().st_size > 10_000
     healed = surfprep.read(out)
     assert healed.n_faces == 2
+    # what is left free is said: the gap is closed, the outer border is no defect
+    assert ("free edges left in the geometry: 0 interior (0 along gaps, 0 around holes), "
+            "6 on the open boundary") in stdout
+
+
+def test_the_summary_names_loop_kinds_in_the_plural():
+    from surfprep.plugin.commands.heal import _summary
+
+    report = {"patches": [], "shared_edges": [], "dropped_overlaps": [], "time_s": 1.0,
+              "continuity": "G0", "gap_tol": 0.3,
+              "free_edges": {"before": 10, "after": 10, "tight_before": 158,
+                             "tight_after": 46},
+              "valid": {"before": False, "after": False},
+              "free_loops": [{"kind": k, "fill": False} for k in
+                             ("open boundary", "open boundary", "not capped", "not capped",
+                              "gap", "gap", "hole")],
+              "free_boundary": {"after": {"edges": {"gap": 46, "open boundary": 0,
+                                                    "hole": 0},
+                                          "interior": 46, "widest_gap": 1.19}}}
+    lines = _summary(report)
+    assert ("7 loop(s) of free edges: 2 gaps, 1 hole, 2 not capped, 2 open boundaries; "
+            "fill tried on 0") in lines
+    assert ("free edges left in the geometry: 46 interior (46 along gaps up to 1.19 mm "
+            "wide, 0 around holes), 0 on the open boundary") in lines
 
 
 def test_heal_errors_are_one_line(gap_file, tmp_path, capsys):
