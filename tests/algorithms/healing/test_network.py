@@ -91,11 +91,22 @@ def test_bifurcation_is_refused():
     assert table.edges == () and len(table.violations) == 1
 
 
-def test_partial_contact_is_refused():
+@pytest.mark.parametrize("gap_tol", [1e-3, 0.1])
+def test_partial_contact_is_refused(gap_tol):
     a = patch(0, 1, 0, 1, 5, 5)
     b = patch(1, 2, 0, 0.5, 5, 5)        # meets half of a's side: a T-junction
     with pytest.raises(NetworkTopologyError, match="full-face"):
-        find_connectivity([a, b], gap_tol=1e-3)
+        find_connectivity([a, b], gap_tol=gap_tol)
+
+
+@pytest.mark.parametrize("gap_tol", [1e-3, 0.1, 0.3])
+def test_sides_meeting_at_a_corner_do_not_touch_however_wide_gap_tol(gap_tol):
+    # a 2 x 2 grid: sides leaving a common vertex lie within gap_tol of each other up to
+    # gap_tol from it (48 false "touch over part of their length" at a tenth of a side)
+    grid = [patch(i, i + 1, j, j + 1, 5, 5) for i in range(2) for j in range(2)]
+    table = find_connectivity(grid, gap_tol=gap_tol)
+    assert len(table.edges) == 4 and table.violations == ()
+    assert len(find_connectivity(grid, gap_tol=gap_tol, strict=False).violations) == 0
 
 
 # ------------------------------------------------------------ compatibility
