@@ -67,12 +67,18 @@ class FreeBoundary:
         Per edge, the number of its loop.
     loop_kinds : tuple of str
         Per loop, "gap", "open boundary", "hole" or "gap and boundary".
+    owners : (n,) int
+        Per edge, its face.
+    lengths : (n,) float
+        Per edge, its polyline's length.
     """
 
     kinds: tuple[str, ...]
     widths: NDArray
     loop: NDArray
     loop_kinds: tuple[str, ...]
+    owners: NDArray
+    lengths: NDArray
 
     @property
     def edges(self) -> dict[str, int]:
@@ -90,13 +96,32 @@ class FreeBoundary:
         counts = self.edges
         return counts["gap"] + counts["hole"]
 
+    def interior_loops(self) -> list[dict]:
+        """Per loop with interior free edges, widest gap first: its kind, how many
+        edges along gaps (or around a hole), their faces, their length and the widest
+        gap along them (None around a hole)."""
+        out = []
+        for k, kind in enumerate(self.loop_kinds):
+            if kind == "open boundary":
+                continue
+            members = np.flatnonzero((self.loop == k) & ((np.array(self.kinds) == "gap")
+                                                          | (kind == "hole")))
+            widths = self.widths[members]
+            widths = widths[np.isfinite(widths)]
+            out.append({"kind": kind, "edges": int(members.size),
+                        "faces": sorted({int(f) for f in self.owners[members]}),
+                        "length": float(self.lengths[members].sum()),
+                        "widest_gap": float(widths.max()) if widths.size else None})
+        return sorted(out, key=lambda d: -(d["widest_gap"] or 0.0))
+
     def as_dict(self) -> dict:
         loops: dict[str, int] = {}
         for kind in self.loop_kinds:
             loops[kind] = loops.get(kind, 0) + 1
         gaps = self.widths[~np.isnan(self.widths)]
         return {"edges": self.edges, "interior": self.interior, "loops": loops,
-                "widest_gap": float(gaps.max()) if gaps.size else None}
+                "widest_gap": float(gaps.max()) if gaps.size else None,
+                "interior_loops": self.interior_loops()}
 
 
 def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *,
@@ -151,7 +176,8 @@ def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *
                                        f"got shape {p.shape}")
     n = len(lines)
     if n == 0:
-        return FreeBoundary((), np.zeros(0), np.zeros(0, dtype=np.int64), ())
+        return FreeBoundary((), np.zeros(0), np.zeros(0, dtype=np.int64), (),
+                            np.zeros(0, dtype=np.int64), np.zeros(0))
     widths = _gap_widths(lines, owner)
     kinds = tuple("gap" if np.isfinite(w) else "boundary" for w in widths)
     loop = _loops(lines, join)
@@ -168,7 +194,8 @@ def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *
             loop_kinds.append("hole")
         else:
             loop_kinds.append("open boundary")
-    return FreeBoundary(kinds, widths, loop, tuple(loop_kinds))
+    lengths = np.array([np.linalg.norm(np.diff(p, axis=0), axis=1).sum() for p in lines])
+    return FreeBoundary(kinds, widths, loop, tuple(loop_kinds), owner, lengths)
 
 
 def _gap_widths(lines: list[NDArray], owner: NDArray) -> NDArray:

@@ -117,6 +117,10 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", type=Path, metavar="PNG", help="draw the deviation map")
 
 
+#: loops of interior free edges the summary names, widest gap first
+_LOOPS_SAID = 3
+
+
 def _plural(kind: str) -> str:
     """A loop kind of the report in the plural ("open boundaries", "not capped")."""
     if kind == "not capped":
@@ -182,6 +186,16 @@ def _summary(report: dict) -> list[str]:
                      + (f" up to {widest:.3g} mm wide" if widest is not None else "")
                      + f", {kinds['hole']} around holes), {kinds['open boundary']} on the "
                      f"open boundary")
+        for loop in after.get("interior_loops", [])[:_LOOPS_SAID]:
+            what = ("a hole" if loop["widest_gap"] is None else
+                    f"a gap up to {loop['widest_gap']:.3g} mm wide")
+            lines.append(f"  {what}: {loop['edges']} edge(s) of face(s) "
+                         f"{', '.join(map(str, loop['faces'][:8]))}"
+                         + (", ..." if len(loop["faces"]) > 8 else "")
+                         + f", {loop['length']:.4g} mm long")
+        more = len(after.get("interior_loops", [])) - _LOOPS_SAID
+        if more > 0:
+            lines.append(f"  and {more} more (the report's free_boundary)")
     return lines
 
 

@@ -33,6 +33,11 @@ def test_two_faces_side_by_side_have_a_gap_between_them_and_the_rest_is_boundary
     assert fb.edges == {"gap": 2, "open boundary": 6, "hole": 0}
     assert fb.interior == 2
     assert fb.as_dict()["widest_gap"] == pytest.approx(0.03, abs=1e-12)
+    # the loop's interior part: the two facing sides, of faces 0 and 1, 2 long
+    (loop,) = fb.as_dict()["interior_loops"]
+    assert loop["kind"] == "gap and boundary" and loop["edges"] == 2
+    assert loop["faces"] == [0, 1] and loop["length"] == pytest.approx(2.0, abs=1e-12)
+    assert loop["widest_gap"] == pytest.approx(0.03, abs=1e-12)
 
 
 def test_faces_apart_make_separate_loops_and_a_lone_sheet_is_all_boundary():
@@ -44,7 +49,7 @@ def test_faces_apart_make_separate_loops_and_a_lone_sheet_is_all_boundary():
     assert fb.interior == 0
     assert fb.as_dict() == {"edges": {"gap": 0, "open boundary": 8, "hole": 0},
                             "interior": 0, "loops": {"open boundary": 2},
-                            "widest_gap": None}
+                            "widest_gap": None, "interior_loops": []}
 
 
 def test_a_long_edge_against_the_short_edges_of_a_t_junction_is_a_gap_on_both_sides():
@@ -56,6 +61,12 @@ def test_a_long_edge_against_the_short_edges_of_a_t_junction_is_a_gap_on_both_si
     assert fb.kinds == ("gap", "gap", "gap")
     np.testing.assert_allclose(fb.widths, 0.02, atol=1e-12)
     assert fb.loop_kinds == ("gap",)
+    # and a second gap, wider, elsewhere: listed first
+    wide = classify_free_edges([long, left, right, long + (0, 0, 5), long + (0, 0.08, 5)],
+                               [0, 1, 2, 3, 4], join=0.1)
+    first, second = wide.interior_loops()
+    assert first["faces"] == [3, 4] and first["widest_gap"] == pytest.approx(0.08)
+    assert second["faces"] == [0, 1, 2] and second["length"] == pytest.approx(4.0)
 
 
 @pytest.mark.parametrize(("degrees", "kind"), [(3.0, "gap"), (6.0, "boundary")])
@@ -92,6 +103,8 @@ def test_a_loop_along_a_rim_classified_as_a_hole_counts_as_interior():
     assert fb.loop_kinds == ("hole",)
     assert fb.edges == {"gap": 0, "open boundary": 0, "hole": 4}
     assert fb.interior == 4
+    assert fb.interior_loops() == [{"kind": "hole", "edges": 4, "faces": [0, 1, 2, 3],
+                                    "length": pytest.approx(4.0), "widest_gap": None}]
     # the same loop next to a rim elsewhere is an open boundary
     far = classify_free_edges(rim, owners, join=1e-3,
                               holes=[[p + (0.0, 0.0, 0.01) for p in hole]])

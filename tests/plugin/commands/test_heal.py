@@ -61,14 +61,30 @@ def test_the_summary_names_loop_kinds_in_the_plural():
               "free_loops": [{"kind": k, "fill": False} for k in
                              ("open boundary", "open boundary", "not capped", "not capped",
                               "gap", "gap", "hole")],
-              "free_boundary": {"after": {"edges": {"gap": 46, "open boundary": 0,
-                                                    "hole": 0},
-                                          "interior": 46, "widest_gap": 1.19}}}
+              "free_boundary": {"after": {
+                  "edges": {"gap": 46, "open boundary": 0, "hole": 0},
+                  "interior": 46, "widest_gap": 1.19,
+                  "interior_loops": [
+                      {"kind": "gap", "edges": 2, "faces": [13, 16], "length": 118.0,
+                       "widest_gap": 1.19},
+                      {"kind": "hole", "edges": 9, "faces": list(range(20, 29)),
+                       "length": 57.5, "widest_gap": None},
+                      {"kind": "gap", "edges": 2, "faces": [3, 4], "length": 10.0,
+                       "widest_gap": 0.5},
+                      {"kind": "gap", "edges": 2, "faces": [5, 6], "length": 10.0,
+                       "widest_gap": 0.4}]}}}
     lines = _summary(report)
     assert ("7 loop(s) of free edges: 2 gaps, 1 hole, 2 not capped, 2 open boundaries; "
             "fill tried on 0") in lines
     assert ("free edges left in the geometry: 46 interior (46 along gaps up to 1.19 mm "
             "wide, 0 around holes), 0 on the open boundary") in lines
+    at = lines.index("free edges left in the geometry: 46 interior (46 along gaps up to "
+                     "1.19 mm wide, 0 around holes), 0 on the open boundary")
+    assert lines[at + 1:] == [
+        "  a gap up to 1.19 mm wide: 2 edge(s) of face(s) 13, 16, 118 mm long",
+        "  a hole: 9 edge(s) of face(s) 20, 21, 22, 23, 24, 25, 26, 27, ..., 57.5 mm long",
+        "  a gap up to 0.5 mm wide: 2 edge(s) of face(s) 3, 4, 10 mm long",
+        "  and 1 more (the report's free_boundary)"]
 
 
 def test_heal_errors_are_one_line(gap_file, tmp_path, capsys):

@@ -79,7 +79,11 @@ def test_gap_closed_in_geometry(gap_pair, continuity):
     assert before["edges"] == {"gap": 2, "open boundary": 6, "hole": 0}
     assert before["widest_gap"] == pytest.approx(1e-3, rel=0.02)
     assert after == {"edges": {"gap": 0, "open boundary": 6, "hole": 0}, "interior": 0,
-                     "loops": {"open boundary": 1}, "widest_gap": None}
+                     "loops": {"open boundary": 1}, "widest_gap": None,
+                     "interior_loops": []}
+    (gap,) = before["interior_loops"]
+    assert gap["faces"] == [0, 1] and gap["edges"] == 2
+    assert 2.0 < gap["length"] < 2.01      # two sides 1 long in plan, on the curved graph
 
 
 def test_a_gap_wider_than_gap_tol_is_reported_as_interior_free_edges(gap_pair):
