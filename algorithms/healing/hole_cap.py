@@ -226,7 +226,12 @@ def _plane(points: NDArray) -> tuple[NDArray, NDArray]:
 
 
 def _segments_cross(poly: NDArray) -> bool:
-    """Whether two non-adjacent edges of the closed polygon ``(m, 2)`` cross or touch."""
+    """Whether two non-adjacent edges of the closed polygon ``(m, 2)`` cross or touch.
+
+    Edges cross when each straddles the other's line strictly; where an end lies on the
+    other's line (within rounding) they touch only if it lies on the other edge itself:
+    on a nearly straight curve an end two samples on lies on the line of an edge behind
+    it, beyond that edge (the bearing's hole read as folding over itself)."""
     a, b = poly, np.roll(poly, -1, axis=0)
     d = b - a
 
@@ -238,14 +243,22 @@ def _segments_cross(poly: NDArray) -> bool:
     s = cross(d[:, None], b[None] - a[:, None])          # side of b_j w.r.t. edge i
     r, s = np.where(np.abs(r) <= eps, 0.0, r), np.where(np.abs(s) <= eps, 0.0, s)
     p = r * s
-    # each edge straddles the other's line or ends on it (a crossing at a sample);
+    dd = np.maximum(np.einsum("ij,ij->i", d, d), np.finfo(float).tiny)
+
+    def on_edge(point: NDArray, side: NDArray) -> NDArray:
+        """(m, m): whether ``point[j]``, on edge i's line (``side`` 0), lies on edge i."""
+        t = np.einsum("ijk,ik->ij", point[None] - a[:, None], d) / dd[:, None]
+        return (side == 0) & (t >= 0.0) & (t <= 1.0)
+
     # pieces of one straight edge are collinear (r = s = 0) and never cross
     collinear = (r == 0) & (s == 0)
-    straddle = (p <= 0) & (p.T <= 0) & ~collinear & ~collinear.T
+    proper = (p < 0) & (p.T < 0)
+    touch = on_edge(a, r) | on_edge(b, s)                # an end of j on edge i
+    touch = (touch | touch.T) & ~collinear & ~collinear.T
     m = poly.shape[0]
     i, j = np.indices((m, m))
     adjacent = (np.abs(i - j) <= 1) | (np.abs(i - j) == m - 1)
-    return bool(np.any(straddle & ~adjacent))
+    return bool(np.any((proper | touch) & ~adjacent))
 
 
 def _inside(points: NDArray, poly: NDArray) -> NDArray:

@@ -204,8 +204,35 @@ def test_loops_without_a_cap_are_refused_with_the_reason():
     eight = [interpolate_curve(corners[[k, (k + 1) % 4]], degree=1) for k in range(4)]
     with pytest.raises(NotCappableError, match="folds over itself"):
         cap_hole(eight)
+    # a corner touching another side (at its middle) is a fold too
+    corners = np.array([[0.0, 0, 0], [2, 0, 0], [2, 2, 0], [1, 0, 0], [0, 1, 0]])
+    touching = [interpolate_curve(corners[[k, (k + 1) % 5]], degree=1) for k in range(5)]
+    with pytest.raises(NotCappableError, match="folds over itself"):
+        cap_hole(touching)
     with pytest.raises(InvalidGeometryError, match="open_angle"):
         cap_hole(_sphere_loop(4, 0.3), open_angle=95.0)
+
+
+@pytest.mark.parametrize("angle", [0.3, 1.1, 2.0, 2.9])
+def test_a_short_gently_bent_edge_on_a_rim_is_no_fold(angle):
+    # the bearing's hole: a 2.5e-4 long, barely bent edge on a rim 0.1 across; its 24
+    # samples lie on each other's lines within rounding, beyond each other's ends, which
+    # read as touching (the loop "folded over itself" and was not capped)
+    rotation = np.array([[np.cos(angle), -np.sin(angle), 0.0],
+                         [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    t = np.linspace(0.0, 2.5e-4, 5)
+    short = np.column_stack([t, 4e-4 * t ** 2 / 2.5e-4, np.zeros_like(t)]) @ rotation.T
+    far = short[-1] + rotation @ np.array([0.0, 0.1, 0.0])
+    back = short[0] + rotation @ np.array([-0.05, 0.05, 0.0])
+    curves = [interpolate_curve(short, degree=2),
+              interpolate_curve(np.array([short[-1], far]), degree=1),
+              interpolate_curve(np.array([far, back]), degree=1),
+              interpolate_curve(np.array([back, short[0]]), degree=1)]
+    cap = cap_hole(curves)
+    # the cap of a flat rim without surroundings is its plane
+    u0, u1, v0, v1 = cap.surface.domain
+    grid = cap.surface.evaluate_grid(np.linspace(u0, u1, 9), np.linspace(v0, v1, 9))
+    assert np.abs(grid[..., 2]).max() < 1e-9
 
 
 def test_a_sliver_is_a_few_thousandths_of_its_length_wide_and_a_hole_is_not():
