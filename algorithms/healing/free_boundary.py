@@ -236,6 +236,7 @@ def _to_other_segments(points: NDArray, point_owner: NDArray, reach: NDArray, a:
     another owner, where one lies within its ``reach`` (inf elsewhere); candidates by a
     tree of the segments' midpoints."""
     out = np.full(len(points), np.inf)
+    a, b, seg_owner = _pieces(a, b, seg_owner)
     d = b - a
     half = 0.5 * float(np.sqrt(np.einsum("ij,ij->i", d, d)).max())
     near = cKDTree(0.5 * (a + b)).query_ball_point(points, reach + half)
@@ -254,6 +255,24 @@ def _to_other_segments(points: NDArray, point_owner: NDArray, reach: NDArray, a:
         dist = np.linalg.norm(points[p] - a[s] - t[:, None] * ds, axis=1)
         np.minimum.at(out, p, dist)
     return out
+
+
+def _pieces(a: NDArray, b: NDArray, owner: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """The segments ``a -> b`` cut into pieces no longer than the median segment, so
+    that a tree of midpoints finds every segment near a point within half a median
+    segment more than the reach (one long segment widened every point's search: 11
+    million candidates on ``overture_asmo_icem.igs``, 2.6 s)."""
+    length = np.linalg.norm(b - a, axis=1)
+    step = float(np.median(length))
+    if step <= 0.0:
+        return a, b, owner
+    count = np.maximum(np.ceil(length / step).astype(np.int64), 1)
+    seg = np.repeat(np.arange(len(a)), count)
+    first = np.cumsum(count) - count
+    k = np.arange(seg.size) - first[seg]
+    t0, t1 = k / count[seg], (k + 1) / count[seg]
+    d = b - a
+    return (a[seg] + t0[:, None] * d[seg], a[seg] + t1[:, None] * d[seg], owner[seg])
 
 
 def _loops(lines: list[NDArray], join: float) -> NDArray:
