@@ -96,7 +96,8 @@ from .shared_edges import (
     same_surface,
 )
 
-__all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "ClosedGaps", "Fitted", "close_gaps", "closed_in_geometry"]
+__all__ = ["CHECK_SAMPLES", "FIT_SAMPLES", "FOLD_DEG", "ClosedGaps", "Fitted", "close_gaps",
+           "closed_in_geometry"]
 
 #: samples per edge where the gap is first measured (this many evenly and as many
 #: clustered at the ends, where an exporter's pcurves wave most: catia theorem's planes
@@ -133,6 +134,10 @@ _MOVE_GRID = 41
 _TURN_GRID = 129
 #: faces turned by more than this are said in a note (degrees)
 _TURN_NOTED_DEG = 1.0
+#: a move that turns a face's tangent planes by more than this (degrees) folds it over:
+#: the face is kept as it is (asmo's faces 140, 142 and 188 turned by 93 to 180 degrees
+#: where a neighbour's boundary hooks back at a vertex)
+FOLD_DEG = 90.0
 
 
 @dataclass(frozen=True)
@@ -178,11 +183,12 @@ class Fitted:
     the next, and a fit that failed once applied would fail the same way)."""
 
     fits: dict = field(default_factory=dict)       # (face, digest of surface, targets) -> (EdgeFit, moved)
-    rejected: dict = field(default_factory=dict)   # id(EdgeFit) -> (the fit, "invalid" | "wider")
+    rejected: dict = field(default_factory=dict)   # id(EdgeFit) -> (the fit, why)
 
     def verdict(self, fit: EdgeFit) -> str | None:
         """Why ``fit`` was taken back once applied: ``"invalid"`` (a face failed
-        BRepCheck), ``"wider"`` (an edge came out wider than it was), or None."""
+        BRepCheck), ``"folded"`` (its face turned by more than :data:`FOLD_DEG`),
+        ``"wider"`` (an edge came out wider than it was), or None."""
         got = self.rejected.get(id(fit))
         return None if got is None else got[1]
 
@@ -201,6 +207,20 @@ class _Remembered:
     # (common curve, face, side) -> (Geom2d pcurve, NurbsCurve); (common curve, None, None) -> Geom curve
     occ: dict = field(default_factory=dict)
     corners: FaceCorners | None = None             # where the faces' edges end in their parameters
+
+
+@dataclass
+class _Turns:
+    """How far each fit, once applied, turned its face (:func:`_turned`), measured once
+    per fit: a fit kept over several rounds is measured in the first."""
+
+    turned: dict = field(default_factory=dict)     # id(EdgeFit) -> (the fit, degrees)
+
+    def of(self, f: int, fit: EdgeFit, before: NurbsSurface, faces) -> float:
+        got = self.turned.get(id(fit))
+        if got is None:
+            got = self.turned[id(fit)] = (fit, _turned(before, fit.surface, faces, f))
+        return got[1]
 
 
 @dataclass
@@ -252,6 +272,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
     memo = _Remembered()
     fitted = Fitted() if fitted is None else fitted
     failing_before: dict[int, frozenset] = {}   # BRepCheck's findings on the shape as given
+    turn = _Turns()
     for _round in range(_ROUNDS):
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         trimmable = set(candidates) - set(moving) - rigid if retrim else set()
@@ -278,7 +299,9 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
             # a face whose edge ends farther from its neighbour than before (its surface
             # waving between the fit's samples) is not moved either
             invalid = _invalid(changed, of_face, faces, edges, moved_vertices, failing_before)
-            bad = invalid | _widening(edges, changed, after, apart, tight)
+            folded = {f for f in fits if fits[f][0].surface is not surfaces[f]
+                      and turn.of(f, fits[f][0], surfaces[f], faces) > FOLD_DEG}
+            bad = invalid | folded | _widening(edges, changed, after, apart, tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
                 raise
@@ -292,14 +315,19 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
         # a moved face that widened an edge fitted on few samples gets one more chance on
         # many; the others are fitted again with these where they are, and a face that
         # failed BRepCheck is not re-trimmed either
-        again = (bad & set(fits)) - dense - invalid
+        again = (bad & set(fits)) - dense - invalid - folded
         for f in bad & set(fits):
             if fits[f][0].surface is not surfaces[f]:      # (a fit, kept in fitted)
-                fitted.reject(fits[f][0], "invalid" if f in invalid else "wider")
-        if bad - again:
-            notes.append(f"faces {sorted(f - 1 for f in bad - again)} fail BRepCheck, or leave an "
-                         "edge wider than it was, once moved onto (or re-trimmed to) their "
-                         "neighbours' edges: kept as they are")
+                fitted.reject(fits[f][0], "invalid" if f in invalid else
+                              "folded" if f in folded else "wider")
+        if folded:
+            notes.append(f"faces {sorted(f - 1 for f in folded)} would fold over (their tangent "
+                         f"planes turned by more than {FOLD_DEG:g} degrees) once moved onto "
+                         "their neighbours' edges: kept as they are")
+        if bad - again - folded:
+            notes.append(f"faces {sorted(f - 1 for f in bad - again - folded)} fail BRepCheck, "
+                         "or leave an edge wider than it was, once moved onto (or re-trimmed "
+                         "to) their neighbours' edges: kept as they are")
         dense |= again
         fixed |= (bad & set(fits)) - again
         rigid |= invalid | (bad - set(fits))
@@ -311,7 +339,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
                    "knots_inserted": fits[f][0].inserted,
-                   "turned_deg": _turned(surfaces[f], fits[f][0].surface, faces, f)}
+                   "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces)}
                   for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
     remaining = sum(1 for e in open_ if after.get(id(e), e.gap) > tight)
@@ -486,7 +514,8 @@ def _fit_round(moving: list[int], trimmable: set[int], dense: set[int], surfaces
         verdict = fitted.verdict(fit)
         if verdict is not None:
             failed.add(f)
-            why = "failed BRepCheck" if verdict == "invalid" else "left an edge wider than it was"
+            why = {"invalid": "failed BRepCheck", "folded": "folded the face over"}.get(
+                verdict, "left an edge wider than it was")
             notes.append(f"face {f - 1}: not moved onto its neighbours' edges (the same fit {why} "
                          "in an earlier pass); kept as it is")
             continue

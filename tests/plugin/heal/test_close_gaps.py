@@ -85,6 +85,38 @@ def test_two_patches_a_step_apart_meet_in_the_geometry_after_closing():
         assert np.max(np.linalg.norm(new - patch.evaluate(np.full_like(v, u), v), axis=1)) <= TIGHT
 
 
+def test_a_move_that_would_fold_a_face_over_is_refused_and_the_other_face_closes_alone(
+        monkeypatch):
+    # how far a move turns a face is measured on it (close_gaps._turned); here the right
+    # patch's move is said to fold it (180 degrees): it keeps its surface, and the left
+    # one moves the whole 2e-4 onto it
+    from surfprep.plugin.heal import close_gaps as module
+
+    measured = module._turned
+
+    def turned(before, after, faces, f):
+        right = before.evaluate(np.array([0.5]), np.array([0.5]))[0, 0] > 1.0
+        return 180.0 if right else measured(before, after, faces, f)
+
+    monkeypatch.setattr(module, "_turned", turned)
+    patches = [_patch(0.0, 1.0), _patch(1.0, 2.0, dz=2e-4)]
+    shape, _ = sew([make_face(p) for p in patches], 1e-3)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 0)
+    (moved,) = closed.moved
+    assert moved["moved"] == pytest.approx(2e-4, rel=1e-2)
+    assert moved["turned_deg"] < module.FOLD_DEG
+    assert any("would fold over" in n for n in closed.notes)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT and is_valid(shape)
+    # the right patch is the input's surface still
+    right = next(f for f in all_faces(shape)
+                 if BRep_Tool.Surface_s(f).Value(0.5, 0.5).X() > 1.0)
+    v = np.linspace(0.0, 1.0, 21)
+    got = np.array([BRep_Tool.Surface_s(right).Value(0.5, x).Coord() for x in v])
+    assert np.abs(got - patches[1].evaluate(np.full_like(v, 0.5), v)).max() <= 1e-12
+
+
 def test_an_analytic_plane_stays_and_the_b_spline_comes_to_it():
     plane = Geom_Plane(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))
     flat = BRepBuilderAPI_MakeFace(plane, -1.0, 0.0, 0.0, 1.0, 1e-7).Face()   # x in [-1, 0]
