@@ -5,8 +5,9 @@ a ship's half hull ends at its centre plane and deck, a pipe at its mouth. Heali
 reports its free edges by what they are, judged by the geometry around each:
 
 *gap*
-    Another face's free edge (or its side of a shared edge open in the geometry)
-    runs beside it: at a quarter, half and three quarters of its length that
+    One face's side of an edge sewing shares but the faces leave open in the geometry
+    (``sewn``), or another face's free edge (or its side of such an edge) runs beside
+    it: at a quarter, half and three quarters of its length that
     polyline lies within :data:`BESIDE` x its length of it. The two sides of a
     sliver between faces, a long edge against the short ones of a T-junction. Its
     *width* is the largest distance from its inner samples to the others' polylines
@@ -125,7 +126,8 @@ class FreeBoundary:
 
 
 def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *,
-                        join: float, holes: Sequence[ArrayLike] = ()) -> FreeBoundary:
+                        join: float, holes: Sequence[ArrayLike] = (),
+                        sewn: Sequence[bool] = ()) -> FreeBoundary:
     """Each free edge a gap's side or on the boundary, and their loops (module doc).
 
     Parameters
@@ -140,6 +142,10 @@ def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *
     holes : sequence of sequence of (k, 3) float
         Rims of loops classified as holes, each as polylines along its edges: a loop of
         boundary edges whose points lie within ``join`` of one of them is a hole.
+    sewn : sequence of bool, optional
+        Per polyline, whether it is one face's side of an edge sewing shares (open in
+        the geometry): a gap's side however short the edge (its width measured within
+        ``join`` too). Default none.
 
     Returns
     -------
@@ -175,11 +181,15 @@ def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *
             raise InvalidGeometryError(f"polyline {k} must be (m >= 3, 3) finite points, "
                                        f"got shape {p.shape}")
     n = len(lines)
+    shared = np.zeros(n, dtype=bool) if len(sewn) == 0 else np.asarray(sewn, dtype=bool)
+    if shared.shape != (n,):
+        raise InvalidGeometryError(f"sewn must have one flag per polyline ({n}), got shape "
+                                   f"{shared.shape}")
     if n == 0:
         return FreeBoundary((), np.zeros(0), np.zeros(0, dtype=np.int64), (),
                             np.zeros(0, dtype=np.int64), np.zeros(0))
-    widths = _gap_widths(lines, owner)
-    kinds = tuple("gap" if np.isfinite(w) else "boundary" for w in widths)
+    along, widths = _gap_widths(lines, owner, shared, join)
+    kinds = tuple("gap" if g else "boundary" for g in along)
     loop = _loops(lines, join)
     hole_rims = [[np.asarray(p, dtype=float).reshape(-1, 3) for p in rim] for rim in holes]
     loop_kinds = []
@@ -198,10 +208,12 @@ def classify_free_edges(polylines: Sequence[ArrayLike], owners: Sequence[int], *
     return FreeBoundary(kinds, widths, loop, tuple(loop_kinds), owner, lengths)
 
 
-def _gap_widths(lines: list[NDArray], owner: NDArray) -> NDArray:
-    """(n,) float: per polyline the largest distance from its inner points to other
-    faces' polylines when those lie within ``BESIDE`` x its length at its quarters,
-    else NaN."""
+def _gap_widths(lines: list[NDArray], owner: NDArray, sewn: NDArray, join: float
+                ) -> tuple[NDArray, NDArray]:
+    """(n,) bool, (n,) float: per polyline whether it lies along a gap (other faces'
+    polylines within ``BESIDE`` x its length at its quarters, or ``sewn``) and the
+    largest distance from its inner points to them (NaN on a boundary; measured within
+    that reach, or ``join`` for a sewn side)."""
     lines = [_thinned(p) for p in lines]
     a = np.concatenate([p[:-1] for p in lines])                      # (s, 3) segment starts
     b = np.concatenate([p[1:] for p in lines])
@@ -210,17 +222,20 @@ def _gap_widths(lines: list[NDArray], owner: NDArray) -> NDArray:
     inner = [p[1:-1] for p in lines]
     points = np.concatenate(inner)
     point_line = np.concatenate([np.full(len(q), k) for k, q in enumerate(inner)])
-    distance = _to_other_segments(points, owner[point_line], BESIDE * length[point_line],
-                                  a, b, seg_owner)
+    reach = np.where(sewn, np.maximum(BESIDE * length, join), BESIDE * length)
+    distance = _to_other_segments(points, owner[point_line], reach[point_line], a, b,
+                                  seg_owner)
+    along = sewn.copy()
     out = np.full(len(lines), np.nan)
     start = 0
     for k, p in enumerate(lines):
         d = distance[start:start + len(p) - 2]
         start += len(p) - 2
         quarters = np.clip([round(q * (len(p) - 1)) - 1 for q in _QUARTERS], 0, len(d) - 1)
-        if np.all(d[quarters] <= BESIDE * length[k]):
+        along[k] |= bool(np.all(d[quarters] <= BESIDE * length[k]))
+        if along[k] and np.isfinite(d).any():
             out[k] = float(d[np.isfinite(d)].max())
-    return out
+    return along, out
 
 
 def _thinned(p: NDArray) -> NDArray:

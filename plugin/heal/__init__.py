@@ -424,11 +424,12 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     say("classifying the free edges")
     unfilled = [[dense_edge(e) for e in rims[lp.index]] for lp in loops
                 if lp.kind in ("hole", "not capped")]
-    lines, owners = result.extra.pop(FREE_LINES)
+    lines, owners, sewn = result.extra.pop(FREE_LINES)
     result.extra["free_boundary"] = {
         "before": classify_free_edges(before.tight_lines, before.tight_owners, join=gap_tol,
-                                      holes=unfilled).as_dict(),
-        "after": classify_free_edges(lines, owners, join=gap_tol, holes=unfilled).as_dict()}
+                                      holes=unfilled, sewn=before.tight_sewn).as_dict(),
+        "after": classify_free_edges(lines, owners, join=gap_tol, holes=unfilled,
+                                     sewn=sewn).as_dict()}
     stage_times = say.times()           # (the last stage ends before the whole does)
     result = dataclasses.replace(result, time_s=time.perf_counter() - start)
     result.extra["stage_times_s"] = stage_times

@@ -396,7 +396,7 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     if not any(p.moved or p.retrimmed for p in passes):
         return out
     gaps = gaps_in_geometry(shape, TIGHT_FACTOR * size, samples=FREE_SAMPLES)
-    out.extra[FREE_LINES] = (gaps.polylines, gaps.owners)
+    out.extra[FREE_LINES] = (gaps.polylines, gaps.owners, gaps.sewn)
     return replace(out, tight_free_edges_after=gaps.free_in_geometry,
                    valid_after=is_valid(shape), max_edge_tolerance=max_edge_tolerance(shape))
 

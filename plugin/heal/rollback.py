@@ -312,7 +312,7 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
 
 
 #: ``HealResult.extra`` key of the result's free edges in the geometry: (polylines,
-#: owner faces) of :func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`, measured on the
+#: owner faces, sides of open shared edges) of :func:`~surfprep.plugin.occ.gaps.gaps_in_geometry`, measured on the
 #: shape the result holds
 FREE_LINES = "tight_free_lines"
 #: ... with this many points along each (their chords a 32nd of the edge: a gap's width
@@ -332,13 +332,15 @@ class Before:
     free_lines: list = field(default_factory=list)   # the free edges at gap_tol, (129, 3) each
     tight_lines: list = field(default_factory=list)  # ... at TIGHT_FACTOR x size
     tight_owners: tuple = ()                         # the face of each of tight_lines
+    tight_sewn: tuple = ()                           # ... and whether it is an open edge's side
 
     @classmethod
     def of(cls, model: CadModel, gap_tol: float) -> Before:
         sewn, _ = sew(list(model.faces), gap_tol)
         tight = gaps_in_geometry(sewn, TIGHT_FACTOR * model.size, samples=129)
         return cls(count_free_edges(sewn), tight.free_in_geometry, is_valid(model.shape),
-                   boundary_edge_points(sewn, 129), list(tight.polylines), tight.owners)
+                   boundary_edge_points(sewn, 129), list(tight.polylines), tight.owners,
+                   tight.sewn)
 
 
 def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, continuity, start,
@@ -365,7 +367,7 @@ def _assemble(model, work, done, network, dropped, skipped, gap_tol, tol, contin
         valid_before=before.valid, valid_after=is_valid(shape),
         max_edge_tolerance=max_edge_tolerance(shape), tol=tol, gap_tol=gap_tol,
         continuity=continuity, time_s=time.perf_counter() - start,
-        extra={"faces_in": model.n_faces, FREE_LINES: (gaps.polylines, gaps.owners)})
+        extra={"faces_in": model.n_faces, FREE_LINES: (gaps.polylines, gaps.owners, gaps.sewn)})
 
 
 def _output_faces(work, done, network, dropped) -> tuple[list, list, FaceNames]:

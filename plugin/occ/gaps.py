@@ -57,6 +57,9 @@ class GeometricGaps:
     owners : tuple of int
         The face of each polyline (its index among the shape's faces, ``TopExp``
         order).
+    sewn : tuple of bool
+        Per polyline, whether it is a face's side of an open shared edge (else a free
+        edge).
     largest : float
         The largest distance over all shared edges (0 when none).
     """
@@ -66,6 +69,7 @@ class GeometricGaps:
     polylines: tuple
     largest: float
     owners: tuple = ()
+    sewn: tuple = ()
 
     @property
     def free_in_geometry(self) -> int:
@@ -80,7 +84,7 @@ def gaps_in_geometry(shape, tight: float, *, samples: int = 9) -> GeometricGaps:
     TopExp.MapShapesAndAncestors_s(shape, TopAbs_EDGE, TopAbs_FACE, edge_faces)
     face_index = TopTools_IndexedMapOfShape()
     TopExp.MapShapes_s(shape, TopAbs_FACE, face_index)
-    free, open_, lines, owners, largest = 0, [], [], [], 0.0
+    free, open_, lines, owners, sewn, largest = 0, [], [], [], [], 0.0
     for k in range(1, edge_faces.Extent() + 1):
         edge = TopoDS.Edge_s(edge_faces.FindKey(k))
         if BRep_Tool.Degenerated_s(edge):
@@ -91,6 +95,7 @@ def gaps_in_geometry(shape, tight: float, *, samples: int = 9) -> GeometricGaps:
                 free += 1
                 lines.append(_Side(edge, faces[0]).points(np.linspace(0, 1, samples)))
                 owners.append(face_index.FindIndex(faces[0]) - 1)
+                sewn.append(False)
             continue
         gap = _gap(edge, faces, tight)
         largest = max(largest, gap)
@@ -98,7 +103,9 @@ def gaps_in_geometry(shape, tight: float, *, samples: int = 9) -> GeometricGaps:
             open_.append((edge, len(faces), gap))
             lines.extend(_Side(edge, f).points(np.linspace(0, 1, samples)) for f in faces)
             owners.extend(face_index.FindIndex(f) - 1 for f in faces)
-    return GeometricGaps(free, tuple(open_), tuple(lines), largest, tuple(owners))
+            sewn.extend(True for _ in faces)
+    return GeometricGaps(free, tuple(open_), tuple(lines), largest, tuple(owners),
+                         tuple(sewn))
 
 
 def _distinct(faces) -> list:

@@ -137,6 +137,18 @@ def test_a_curved_gap_is_measured_between_the_curves():
     assert 0.05 - 1e-12 <= fb.widths[1] <= 0.05 + sag + 1e-12
 
 
+def test_the_sides_of_a_short_sewn_edge_are_a_gap_however_far_apart_for_their_length():
+    # an edge 0.1 long whose faces lie 0.02 apart (a fifth of it): by the rule a
+    # boundary, but sewing shares it, so its two sides are a gap's, 0.02 wide
+    a = segment((0, 0, 0), (0.1, 0, 0))
+    b = a + (0.0, 0.0, 0.02)
+    loose = classify_free_edges([a, b], [0, 1], join=0.05)
+    assert loose.kinds == ("boundary", "boundary")
+    sewn = classify_free_edges([a, b], [0, 1], join=0.05, sewn=[True, True])
+    assert sewn.kinds == ("gap", "gap") and sewn.interior == 2
+    np.testing.assert_allclose(sewn.widths, 0.02, atol=1e-12)
+
+
 def test_no_free_edge_gives_an_empty_answer():
     fb = classify_free_edges([], [], join=0.1)
     assert fb.kinds == () and fb.loop_kinds == () and fb.interior == 0
@@ -153,3 +165,9 @@ def test_no_free_edge_gives_an_empty_answer():
 def test_bad_input_is_refused_with_a_clear_message(lines, owners, join, message):
     with pytest.raises(InvalidGeometryError, match=message):
         classify_free_edges(lines, owners, join=join)
+
+
+def test_one_sewn_flag_per_polyline_is_asked_for():
+    with pytest.raises(InvalidGeometryError, match="one flag per polyline"):
+        classify_free_edges([segment((0, 0, 0), (1, 0, 0))], [0], join=0.1,
+                            sewn=[True, False])

@@ -43,6 +43,10 @@ def test_each_polyline_lies_on_the_face_it_is_said_to_belong_to(sewn_over_a_step
     faces = [to_nurbs(f).surface for f in all_faces(sewn_over_a_step)]
     assert len(gaps.owners) == len(gaps.polylines)
     assert sorted(gaps.owners) == [0, 0, 0, 0, 1, 1, 1, 1]
+    # the two sides of the open edge are flagged, the six free edges not
+    assert sorted(gaps.sewn) == [False] * 6 + [True] * 2
+    sides = [line for line, flag in zip(gaps.polylines, gaps.sewn) if flag]
+    assert np.allclose(sides[0][:, 0], 1.0) and np.allclose(sides[1][:, 0], 1.0)
     for line, owner in zip(gaps.polylines, gaps.owners):
         assert distance_to_surface(faces[owner], line).max() < 1e-12
         assert distance_to_surface(faces[1 - owner], line).max() > 1e-4
