@@ -11,7 +11,9 @@ reports its free edges by what they are, judged by the geometry around each:
     polyline lies within :data:`BESIDE` x its length of it. The two sides of a
     sliver between faces, a long edge against the short ones of a T-junction. Its
     *width* is the largest distance from its inner samples to the others' polylines
-    (off by their chords' sagitta at most; up to ``_SAMPLES`` points an edge).
+    where they run beside it (within ``BESIDE`` x its length, or ``join`` for a sewn
+    side: not where a gap opens out towards an end), off by their chords' sagitta at
+    most (up to ``_SAMPLES`` points an edge).
 *boundary*
     Nothing of another face lies beside it: the model's open boundary, or the rim
     of a hole no face covers.

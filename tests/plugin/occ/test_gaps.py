@@ -30,7 +30,7 @@ def sewn_over_a_step():
 def test_an_edge_shared_by_tolerance_is_open_in_the_geometry(sewn_over_a_step):
     gaps = gaps_in_geometry(sewn_over_a_step, 1e-7)
     assert gaps.free == 6
-    (edge, faces, largest) = gaps.open_edges[0]
+    (_edge, faces, largest) = gaps.open_edges[0]
     assert len(gaps.open_edges) == 1 and faces == 2
     assert largest == pytest.approx(1e-3, rel=1e-9)
     assert gaps.free_in_geometry == 8 and len(gaps.polylines) == 8
