@@ -149,6 +149,15 @@ def test_the_sides_of_a_short_sewn_edge_are_a_gap_however_far_apart_for_their_le
     np.testing.assert_allclose(sewn.widths, 0.02, atol=1e-12)
 
 
+def test_many_tiny_edges_beside_a_long_one_do_not_cut_it_into_billions_of_pieces():
+    # 200 degenerate edges 1e-9 long (most segments tiny) and one 1000 long: the long
+    # one is classified as ever, the search cut into pieces of a quarter of the mean
+    tiny = [segment((5.0 * k, 500.0, 0.0), (5.0 * k + 1e-9, 500.0, 0.0)) for k in range(200)]
+    long = segment((0.0, 0.0, 0.0), (1000.0, 0.0, 0.0))
+    fb = classify_free_edges(tiny + [long], list(range(201)), join=1e-12)
+    assert fb.kinds[-1] == "boundary" and fb.edges["open boundary"] == 201
+
+
 def test_no_free_edge_gives_an_empty_answer():
     fb = classify_free_edges([], [], join=0.1)
     assert fb.kinds == () and fb.loop_kinds == () and fb.interior == 0
