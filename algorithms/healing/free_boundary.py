@@ -38,9 +38,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ...errors import InvalidGeometryError
+from ..face_region import SegmentTree
+from ..intersection.refine import segment_distance
 
 __all__ = ["BESIDE", "FreeBoundary", "classify_free_edges"]
 
@@ -266,11 +270,7 @@ def _to_other_segments(points: NDArray, point_owner: NDArray, reach: NDArray, a:
     pi, si = pi[keep], si[keep]
     for start in range(0, len(pi), _BLOCK):
         p, s = pi[start:start + _BLOCK], si[start:start + _BLOCK]
-        ds = d[s]
-        t = np.clip(np.einsum("ij,ij->i", points[p] - a[s], ds)
-                    / np.maximum(np.einsum("ij,ij->i", ds, ds), 1e-300), 0.0, 1.0)
-        dist = np.linalg.norm(points[p] - a[s] - t[:, None] * ds, axis=1)
-        np.minimum.at(out, p, dist)
+        np.minimum.at(out, p, segment_distance(points[p], a[s], b[s]))
     return out
 
 
@@ -298,32 +298,14 @@ def _loops(lines: list[NDArray], join: float) -> NDArray:
     """(n,) int: the loop of each polyline, polylines whose ends lie within ``join``
     of each other in one."""
     ends = np.concatenate([p[[0, -1]] for p in lines])               # (2 n, 3)
-    parent = np.arange(len(lines))
-
-    def find(x: int) -> int:
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    for i, j in cKDTree(ends).query_pairs(join):
-        parent[find(i // 2)] = find(j // 2)
-    roots = np.array([find(k) for k in range(len(lines))])
-    return np.unique(roots, return_inverse=True)[1].astype(np.int64)
+    pairs = cKDTree(ends).query_pairs(join, output_type="ndarray") // 2
+    n = len(lines)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    return connected_components(graph, directed=False)[1].astype(np.int64)
 
 
 def _along_a_hole(points: NDArray, rims: list[list[NDArray]], join: float) -> bool:
     """Whether ``points`` all lie within ``join`` of one of the ``rims`` (each
-    polylines)."""
-    for rim in rims:
-        rim = [p for p in rim if len(p) >= 2]
-        if not rim:
-            continue
-        a = np.concatenate([p[:-1] for p in rim])
-        b = np.concatenate([p[1:] for p in rim])
-        d = _to_other_segments(points, np.zeros(len(points), dtype=np.int64),
-                               np.full(len(points), join), a, b,
-                               np.ones(len(a), dtype=np.int64))
-        if float(d.max()) <= join:
-            return True
-    return False
+    polylines, sampled evenly: :class:`~surfprep.algorithms.face_region.SegmentTree`)."""
+    return any(float(SegmentTree.from_polylines(rim).distance(points).max()) <= join
+               for rim in rims if any(len(p) >= 2 for p in rim))
