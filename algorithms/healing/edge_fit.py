@@ -197,10 +197,11 @@ def fit_to_edges(surface: NurbsSurface, targets: Sequence[EdgeTarget], *, tol: f
                                        t.uv.shape[0], axis=0) for t in targets])
     worst: list[float] = []
     for round_ in range(max_rounds + 1):
-        matrix = _collocation(s, uv)
-        offset = points - s.evaluate(uv[:, 0], uv[:, 1])
-        d = _smooth_solve(matrix, offset, s)
-        left = np.linalg.norm(matrix @ d - offset, axis=1)
+        collocation = _collocation(s, uv)
+        # S(uv_k) = sum R_ij(uv_k) P_ij: the rows are the (rational) basis at the samples
+        offset = points - collocation.matrix @ s.control_points.reshape(-1, 3)
+        d = _smooth_solve(collocation, offset, s)
+        left = np.linalg.norm(collocation.matrix @ d - offset, axis=1)
         worst.append(float(left.max()))
         if worst[-1] <= tol or round_ == max_rounds:
             break
@@ -399,22 +400,63 @@ def _on_side(uv: NDArray, k: int, domain: tuple[float, float, float, float]) -> 
                  if np.all(np.abs(uv[:, k] - value) <= _ON_SIDE * (hi - lo))), None)
 
 
-def _collocation(s: NurbsSurface, uv: NDArray) -> sparse.csr_matrix:
+@dataclass(frozen=True)
+class _Collocation:
+    """``A = R_ij(uv_k)``, the (m, n_u n_v) collocation matrix, and what forms ``A^T A``
+    fast: each row's (p+1)(q+1) values and the flat net index of its block's first
+    control point (a row's nonzeros are the block of control points whose support holds
+    its sample)."""
+
+    matrix: sparse.csr_matrix
+    values: NDArray          # (m, K) the row's nonzeros, K = (p + 1)(q + 1)
+    first: NDArray           # (m,) flat net index of the block's first control point
+    block: NDArray           # (K,) flat offsets of the block's control points from it
+
+    def gram(self) -> sparse.csc_matrix:
+        """``A^T A``, summed per block of control points: the rows sharing a block
+        (samples in one knot cell) give ``V^T V`` in one dense product, scattered once.
+
+        Forming it as a sparse product costs ``m K^2`` scalar steps (15 of 43 s of
+        closing gaps on ``overture_asmo_icem.igs``, faces sampled at up to 590 000
+        points); samples along edges fall in few cells, so the dense products do the
+        same sums at matrix-product speed and the scatter is per cell."""
+        m, k = self.values.shape
+        n = self.matrix.shape[1]
+        order = np.argsort(self.first, kind="stable")
+        first = self.first[order]
+        values = self.values[order]
+        starts = np.flatnonzero(np.r_[True, first[1:] != first[:-1]])
+        ends = np.r_[starts[1:], m]
+        blocks = np.empty((starts.size, k, k))
+        for c, (a, b) in enumerate(zip(starts.tolist(), ends.tolist())):
+            part = values[a:b]
+            np.matmul(part.T, part, out=blocks[c])
+        index = first[starts, None] + self.block                     # (cells, K)
+        rows = np.broadcast_to(index[:, :, None], blocks.shape).reshape(-1)
+        cols = np.broadcast_to(index[:, None, :], blocks.shape).reshape(-1)
+        return sparse.coo_matrix((blocks.reshape(-1), (rows, cols)), shape=(n, n)).tocsc()
+
+
+def _collocation(s: NurbsSurface, uv: NDArray) -> _Collocation:
     """``R_ij(uv_k)``: the (m, n_u n_v) sparse matrix, columns the flat net indices."""
     p, q = s.degree_u, s.degree_v
     nu, nv = s.n_control
     span_u, bu = basis_functions(s.knots_u, p, uv[:, 0])
     span_v, bv = basis_functions(s.knots_v, q, uv[:, 1])
-    iu = span_u[:, None] - p + np.arange(p + 1)                          # (m, p+1)
-    iv = span_v[:, None] - q + np.arange(q + 1)                          # (m, q+1)
     values = bu[:, :, None] * bv[:, None, :]                             # (m, p+1, q+1)
     if s.weights is not None:
+        iu = span_u[:, None] - p + np.arange(p + 1)                      # (m, p+1)
+        iv = span_v[:, None] - q + np.arange(q + 1)                      # (m, q+1)
         values = values * s.weights[iu[:, :, None], iv[:, None, :]]
         values /= values.sum(axis=(1, 2), keepdims=True)
-    flat = (iu[:, :, None] * nv + iv[:, None, :]).reshape(uv.shape[0], -1)
-    rows = np.repeat(np.arange(uv.shape[0]), flat.shape[1])
-    return sparse.csr_matrix((values.reshape(-1), (rows, flat.reshape(-1))),
-                             shape=(uv.shape[0], nu * nv))
+    m, k = uv.shape[0], (p + 1) * (q + 1)
+    first = (span_u - p) * nv + (span_v - q)                             # (m,)
+    block = (np.arange(p + 1)[:, None] * nv + np.arange(q + 1)).reshape(-1)   # ascending
+    values = values.reshape(m, k)
+    # a row's columns ascend and are distinct: the CSR arrays directly, no COO pass
+    matrix = sparse.csr_matrix((values.reshape(-1), (first[:, None] + block).reshape(-1),
+                                np.arange(0, m * k + 1, k)), shape=(m, nu * nv))
+    return _Collocation(matrix, values, first, block)
 
 
 def _membrane(s: NurbsSurface) -> tuple[sparse.csc_matrix, sparse.csc_matrix]:
@@ -455,7 +497,7 @@ def _membrane(s: NurbsSurface) -> tuple[sparse.csc_matrix, sparse.csc_matrix]:
     return energy, sparse.kron(mu, mv, format="csc")
 
 
-def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, s: NurbsSurface) -> NDArray:
+def _smooth_solve(collocation: _Collocation, offset: NDArray, s: NurbsSurface) -> NDArray:
     """Control-point displacements ``d`` (n_u n_v, 3) minimizing
 
     ``|A d - offset|^2 + mu (d^T E d + d^T M d / L^2)``:
@@ -468,13 +510,16 @@ def _smooth_solve(matrix: sparse.csr_matrix, offset: NDArray, s: NurbsSurface) -
     regularization (the same factorization applied to what the samples still miss)
     take out the pull the membrane keeps on them."""
     energy, mass = _membrane(s)
-    gram = (matrix.T @ matrix).tocsc()
+    matrix = collocation.matrix
+    gram = collocation.gram()
     scale = float(gram.diagonal().max())
     system = _SMOOTH * scale * (energy + mass / _DECAY ** 2) + gram
     solve = splinalg.splu(system.tocsc()).solve
-    d = solve(np.asarray(matrix.T @ offset))
+    rhs = np.asarray(matrix.T @ offset)
+    d = solve(rhs)
     for _ in range(_SWEEPS):            # iterated Tikhonov: the membrane's pull on the samples undone
-        d += solve(np.asarray(matrix.T @ (offset - matrix @ d)))
+        # A^T (offset - A d), on the normal matrix (n x n) rather than the samples' (m x n)
+        d += solve(rhs - gram @ d)
     return d
 
 

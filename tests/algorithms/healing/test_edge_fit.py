@@ -271,3 +271,24 @@ def test_a_lift_beside_a_pole_keeps_the_rows_next_to_it_with_it():
     turn = normal_turn(crowded, fit.surface, gu, gv)
     assert np.count_nonzero(np.isfinite(turn)) > 0.75 * turn.size      # (NaN within 1e-3 of it)
     assert float(np.nanmax(turn)) <= 10 * h
+
+
+@pytest.mark.parametrize("rational", [False, True])
+def test_the_collocation_rows_are_the_basis_and_its_normal_matrix_is_a_t_a(rational):
+    # the normal matrix is summed per knot cell (one dense product per cell of samples):
+    # it must equal the sparse product, and the rows must evaluate the surface
+    from surfprep.algorithms.healing.edge_fit import _collocation
+    rng = np.random.default_rng(3)
+    s = _graph(9).elevate_degree(1, 0)
+    if rational:
+        s = NurbsSurface(s.control_points, s.knots_u, s.knots_v, s.degree_u, s.degree_v,
+                         rng.uniform(0.5, 2.0, s.n_control))
+    t = np.linspace(0, 1, 200)
+    uv = np.concatenate([np.stack([t, 0 * t], 1), np.stack([0 * t + 1, t], 1),   # sides
+                         rng.uniform(0, 1, (300, 2))])                          # inside
+    c = _collocation(s, uv)
+    dense = c.matrix.toarray()
+    assert np.allclose(c.gram().toarray(), dense.T @ dense, rtol=0, atol=1e-13)
+    points = dense @ s.control_points.reshape(-1, 3)
+    assert np.allclose(points, s.evaluate(uv[:, 0], uv[:, 1]), rtol=0, atol=1e-13)
+    assert np.allclose(dense.sum(axis=1), 1.0)
