@@ -212,14 +212,20 @@ class _Remembered:
 @dataclass
 class _Turns:
     """How far each fit, once applied, turned its face (:func:`_turned`), measured once
-    per fit: a fit kept over several rounds is measured in the first."""
+    per fit: a fit kept over several rounds is measured in the first. The samples inside
+    a face are found once per face (:func:`_inside`, on the face as first moved: later
+    fits move its trimming curves by at most ``allowed`` in space; reading a moved face,
+    its pcurves interpolants of 1 000 poles, cost 7 of 12 s of asmo's turns)."""
 
     turned: dict = field(default_factory=dict)     # id(EdgeFit) -> (the fit, degrees)
+    inside: dict = field(default_factory=dict)     # face -> (k, 2) parameters inside it
 
     def of(self, f: int, fit: EdgeFit, before: NurbsSurface, faces) -> float:
         got = self.turned.get(id(fit))
         if got is None:
-            got = self.turned[id(fit)] = (fit, _turned(before, fit.surface, faces, f))
+            if f not in self.inside:
+                self.inside[f] = _inside(faces, f)
+            got = self.turned[id(fit)] = (fit, _turned(before, fit.surface, self.inside[f]))
         return got[1]
 
 
@@ -606,19 +612,23 @@ def _digest(targets: list[EdgeTarget], surface: NurbsSurface) -> bytes:
     return h.digest()
 
 
-def _turned(before: NurbsSurface, after: NurbsSurface, faces, f: int) -> float:
-    """Largest angle, in degrees, by which moving face ``f`` from ``before`` to ``after``
-    turned its tangent planes (:func:`~surfprep.algorithms.measure.normal_turn`), on a
-    grid of ``_TURN_GRID``^2 over its parameter box, graded towards the box's sides
-    (where the edges pulled it), the samples inside the face only, poles left out; 0
-    when no sample is measured."""
+def _inside(faces, f: int) -> NDArray:
+    """Parameters ``(k, 2)`` inside face ``f``: a grid of ``_TURN_GRID``^2 over its
+    parameter box, graded towards the box's sides (where the edges pulled it)."""
     trimmed = face_to_nurbs(TopoDS.Face_s(faces.FindKey(f)))
     u0, u1, v0, v1 = trimmed.parameter_box()
     ends = np.geomspace(1e-6, 1e-2, _TURN_GRID // 8)
     t = np.unique(np.concatenate([np.linspace(0.0, 1.0, _TURN_GRID), ends, 1.0 - ends]))
     u, v = np.meshgrid(u0 + t * (u1 - u0), v0 + t * (v1 - v0), indexing="ij")
     uv = np.stack([u.ravel(), v.ravel()], axis=1)
-    uv = uv[FaceRegion(trimmed).contains(uv)]
+    return uv[FaceRegion(trimmed).contains(uv)]
+
+
+def _turned(before: NurbsSurface, after: NurbsSurface, uv: NDArray) -> float:
+    """Largest angle, in degrees, by which moving a face from ``before`` to ``after``
+    turned its tangent planes (:func:`~surfprep.algorithms.measure.normal_turn`) at the
+    parameters ``uv`` (k, 2) inside it (:func:`_inside`), poles left out; 0 when there
+    is none."""
     if not uv.size:
         return 0.0
     angle = normal_turn(before, after, uv[:, 0], uv[:, 1])

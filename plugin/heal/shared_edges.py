@@ -99,12 +99,21 @@ def pcurve_points(e: SharedEdge, i: int, faces, s: NDArray, reverse: bool = Fals
 
 def images_on_face(e: SharedEdge, i: int, faces, s: NDArray, reverse: bool = False) -> NDArray:
     """``S_F(pc_F(t))`` for any surface, (len(s), 3): a B-spline surface evaluated as a
-    NURBS surface where the parameters lie in its domain, others by OpenCascade."""
+    NURBS surface, others by OpenCascade.
+
+    Beyond its domain OpenCascade continues a B-spline surface by the polynomials of its
+    end spans, as :meth:`NurbsSurface.evaluate` does (``tests/plugin/occ/test_geom.py``);
+    a periodic one wraps around instead, so there only parameters inside the domain are
+    evaluated as a NURBS surface. (Pcurves that run a little beyond the domain sent
+    every image of such an edge point by point through OpenCascade: 4.4 s of closing
+    ``overture_asmo_icem.igs``'s gaps.)"""
     surface, nurbs = face_surface(e, e.faces[i], faces)
     uv = pcurve_points(e, i, faces, s, reverse)
     if nurbs is not None:
         u0, u1, v0, v1 = nurbs.domain
-        if np.all((uv[:, 0] >= u0) & (uv[:, 0] <= u1) & (uv[:, 1] >= v0) & (uv[:, 1] <= v1)):
+        if (not (surface.IsUPeriodic() or surface.IsVPeriodic())
+                or np.all((uv[:, 0] >= u0) & (uv[:, 0] <= u1) & (uv[:, 1] >= v0)
+                          & (uv[:, 1] <= v1))):
             return nurbs.evaluate(uv[:, 0], uv[:, 1])
     return np.array([surface.Value(u, v).Coord() for u, v in uv])
 

@@ -94,9 +94,9 @@ def test_a_move_that_would_fold_a_face_over_is_refused_and_the_other_face_closes
 
     measured = module._turned
 
-    def turned(before, after, faces, f):
+    def turned(before, after, uv):
         right = before.evaluate(np.array([0.5]), np.array([0.5]))[0, 0] > 1.0
-        return 180.0 if right else measured(before, after, faces, f)
+        return 180.0 if right else measured(before, after, uv)
 
     monkeypatch.setattr(module, "_turned", turned)
     patches = [_patch(0.0, 1.0), _patch(1.0, 2.0, dz=2e-4)]

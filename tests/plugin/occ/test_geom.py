@@ -429,6 +429,23 @@ def test_surface_points_on_knot_lines_match_occ(surface):
                             evaluate_surface(surface, u.ravel(), v.ravel(), 0), [(0, 0)])
 
 
+@SETTINGS
+@given(surface=bspline_surfaces(), seed=st.integers(0, 2**31))
+def test_non_periodic_surface_beyond_its_domain_matches_occ(surface, seed):
+    # OpenCascade continues a B-spline surface beyond its domain by its end spans'
+    # polynomials, as ours does: images of pcurves running past the domain are
+    # evaluated as NURBS surfaces on that ground (plugin/heal/shared_edges.py)
+    ours = surface_from_occ(surface)
+    note(_describe(ours))
+    u0, u1, v0, v1 = ours.domain
+    rng = np.random.default_rng(seed)
+    u = u0 + (u1 - u0) * rng.uniform(-0.02, 1.02, 25)
+    v = v0 + (v1 - v0) * rng.uniform(-0.02, 1.02, 25)
+    u[:4] = u0 - 1e-3 * (u1 - u0), u1 + 1e-3 * (u1 - u0), u0 - 1e-9, u1 + 1e-9
+    _assert_close_per_order(ours.derivatives(u, v, 0), evaluate_surface(surface, u, v, 0),
+                            [(0, 0)])
+
+
 # ------------------------------------------------------------------ round trips
 @SETTINGS
 @given(surface=bspline_surfaces())
