@@ -137,18 +137,21 @@ def _on_surface(face: TrimmedFace, pts: NDArray, guess: NDArray | None, gap_tol:
     return bool(distance_to_surface(face.surface, pts).max() <= gap_tol)
 
 
-def _boxes_overlap(a: TrimmedFace, b: TrimmedFace, tol: float) -> bool:
-    ba, bb = a.surface.bounding_box(), b.surface.bounding_box()
-    return bool(np.all(ba[0] - tol <= bb[1]) and np.all(bb[0] - tol <= ba[1]))
-
-
 def find_overlaps(faces: list[TrimmedFace | None], candidates: list[int], gap_tol: float
                   ) -> list[Overlap]:
     """Overlapping pairs among the four-sided ``candidates`` (each face trimmed once)."""
     out, used, grids = [], set(), {}
+    if not candidates:
+        return out
+    # the surfaces' boxes, padded by gap_tol, compared all at once (the pairwise loop
+    # asked each surface for its box again for each pair: 1.3 s on asmo's 255 faces)
+    boxes = np.stack([np.asarray(faces[i].surface.bounding_box(), float) for i in candidates])
+    near = np.all((boxes[:, None, 0] - gap_tol <= boxes[None, :, 1])
+                  & (boxes[None, :, 0] - gap_tol <= boxes[:, None, 1]), axis=-1)
     for n, i in enumerate(candidates):
-        for j in candidates[n + 1:]:
-            if i in used or j in used or not _boxes_overlap(faces[i], faces[j], gap_tol):
+        for m in np.flatnonzero(near[n, n + 1:]) + n + 1:
+            j = candidates[m]
+            if i in used or j in used:
                 continue
             for f in (i, j):
                 if f not in grids:
