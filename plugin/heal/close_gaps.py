@@ -213,19 +213,24 @@ class _Remembered:
 class _Turns:
     """How far each fit, once applied, turned its face (:func:`_turned`), measured once
     per fit: a fit kept over several rounds is measured in the first. The samples inside
-    a face are found once per face (:func:`_inside`, on the face as first moved: later
-    fits move its trimming curves by at most ``allowed`` in space; reading a moved face,
-    its pcurves interpolants of 1 000 poles, cost 7 of 12 s of asmo's turns)."""
+    a face (:func:`_inside`) are found once per state of its trimming: the common curves
+    its edges were put on, ``commons`` of the round (reading a moved face, its pcurves
+    interpolants of 1 000 poles, cost 7 of 12 s of asmo's turns; the state matters: the
+    KCS hull's face 13 turns by 53 degrees inside its final trimming, by 62 inside the
+    trimming of an earlier round)."""
 
     turned: dict = field(default_factory=dict)     # id(EdgeFit) -> (the fit, degrees)
-    inside: dict = field(default_factory=dict)     # face -> (k, 2) parameters inside it
+    inside: dict = field(default_factory=dict)     # (face, its commons) -> (k, 2) inside it
 
-    def of(self, f: int, fit: EdgeFit, before: NurbsSurface, faces) -> float:
+    def of(self, f: int, fit: EdgeFit, before: NurbsSurface, faces, commons: dict,
+           of_face) -> float:
         got = self.turned.get(id(fit))
         if got is None:
-            if f not in self.inside:
-                self.inside[f] = _inside(faces, f)
-            got = self.turned[id(fit)] = (fit, _turned(before, fit.surface, self.inside[f]))
+            # (the common curves are kept alive by the pass's memo: their ids are stable)
+            state = (f, tuple(id(commons.get(id(e))) for e in of_face[f]))
+            if state not in self.inside:
+                self.inside[state] = _inside(faces, f)
+            got = self.turned[id(fit)] = (fit, _turned(before, fit.surface, self.inside[state]))
         return got[1]
 
 
@@ -306,7 +311,8 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
             # waving between the fit's samples) is not moved either
             invalid = _invalid(changed, of_face, faces, edges, moved_vertices, failing_before)
             folded = {f for f in fits if fits[f][0].surface is not surfaces[f]
-                      and turn.of(f, fits[f][0], surfaces[f], faces) > FOLD_DEG}
+                      and turn.of(f, fits[f][0], surfaces[f], faces, commons, of_face)
+                      > FOLD_DEG}
             bad = invalid | folded | _widening(edges, changed, after, apart, tight)
         except Exception as exc:
             if not (isinstance(exc, SurfprepError) or is_occ_failure(exc)):
@@ -345,7 +351,7 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
                    "knots_inserted": fits[f][0].inserted,
-                   "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces)}
+                   "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces, commons, of_face)}
                   for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
     remaining = sum(1 for e in open_ if after.get(id(e), e.gap) > tight)
