@@ -72,6 +72,8 @@ _ON_SIDE = 1e-9
 _KINK_WINDOW = 8
 #: samples at an end of a target its slope there is measured on
 _SLOPE_SAMPLES = 5
+#: entries of the per-cell blocks of ``A^T A`` scattered at once (~50 MB with indices)
+_GRAM_ENTRIES = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -427,14 +429,20 @@ class _Collocation:
         values = self.values[order]
         starts = np.flatnonzero(np.r_[True, first[1:] != first[:-1]])
         ends = np.r_[starts[1:], m]
-        blocks = np.empty((starts.size, k, k))
-        for c, (a, b) in enumerate(zip(starts.tolist(), ends.tolist())):
-            part = values[a:b]
-            np.matmul(part.T, part, out=blocks[c])
-        index = first[starts, None] + self.block                     # (cells, K)
-        rows = np.broadcast_to(index[:, :, None], blocks.shape).reshape(-1)
-        cols = np.broadcast_to(index[:, None, :], blocks.shape).reshape(-1)
-        return sparse.coo_matrix((blocks.reshape(-1), (rows, cols)), shape=(n, n)).tocsc()
+        gram = sparse.csc_matrix((n, n))
+        step = max(1, _GRAM_ENTRIES // (k * k))          # cells per batch: bounded memory
+        for lo in range(0, starts.size, step):
+            cells = slice(lo, lo + step)
+            blocks = np.empty((len(starts[cells]), k, k))
+            for c, (a, b) in enumerate(zip(starts[cells].tolist(), ends[cells].tolist())):
+                part = values[a:b]
+                np.matmul(part.T, part, out=blocks[c])
+            index = first[starts[cells], None] + self.block              # (cells, K)
+            rows = np.broadcast_to(index[:, :, None], blocks.shape).reshape(-1)
+            cols = np.broadcast_to(index[:, None, :], blocks.shape).reshape(-1)
+            gram = gram + sparse.coo_matrix((blocks.reshape(-1), (rows, cols)),
+                                            shape=(n, n)).tocsc()
+        return gram
 
 
 def _collocation(s: NurbsSurface, uv: NDArray) -> _Collocation:

@@ -274,10 +274,16 @@ def test_a_lift_beside_a_pole_keeps_the_rows_next_to_it_with_it():
 
 
 @pytest.mark.parametrize("rational", [False, True])
-def test_the_collocation_rows_are_the_basis_and_its_normal_matrix_is_a_t_a(rational):
-    # the normal matrix is summed per knot cell (one dense product per cell of samples):
-    # it must equal the sparse product, and the rows must evaluate the surface
+@pytest.mark.parametrize("batched", [False, True])
+def test_the_collocation_rows_are_the_basis_and_its_normal_matrix_is_a_t_a(
+        rational, batched, monkeypatch):
+    # the normal matrix is summed per knot cell (one dense product per cell of samples,
+    # the cells scattered in batches): it must equal the sparse product, and the rows
+    # must evaluate the surface
+    from surfprep.algorithms.healing import edge_fit
     from surfprep.algorithms.healing.edge_fit import _collocation
+    if batched:
+        monkeypatch.setattr(edge_fit, "_GRAM_ENTRIES", 1000)     # two cells a batch
     rng = np.random.default_rng(3)
     s = _graph(9).elevate_degree(1, 0)
     if rational:
