@@ -451,16 +451,13 @@ def _collocation(s: NurbsSurface, uv: NDArray) -> _Collocation:
     nu, nv = s.n_control
     span_u, bu = basis_functions(s.knots_u, p, uv[:, 0])
     span_v, bv = basis_functions(s.knots_v, q, uv[:, 1])
-    values = bu[:, :, None] * bv[:, None, :]                             # (m, p+1, q+1)
-    if s.weights is not None:
-        iu = span_u[:, None] - p + np.arange(p + 1)                      # (m, p+1)
-        iv = span_v[:, None] - q + np.arange(q + 1)                      # (m, q+1)
-        values = values * s.weights[iu[:, :, None], iv[:, None, :]]
-        values /= values.sum(axis=(1, 2), keepdims=True)
     m, k = uv.shape[0], (p + 1) * (q + 1)
     first = (span_u - p) * nv + (span_v - q)                             # (m,)
     block = (np.arange(p + 1)[:, None] * nv + np.arange(q + 1)).reshape(-1)   # ascending
-    values = values.reshape(m, k)
+    values = (bu[:, :, None] * bv[:, None, :]).reshape(m, k)
+    if s.weights is not None:           # R = N w / sum(N w), the weights gathered flat
+        values *= s.weights.reshape(-1)[first[:, None] + block]
+        values /= values.sum(axis=1, keepdims=True)
     # a row's columns ascend and are distinct: the CSR arrays directly, no COO pass
     matrix = sparse.csr_matrix((values.reshape(-1), (first[:, None] + block).reshape(-1),
                                 np.arange(0, m * k + 1, k)), shape=(m, nu * nv))

@@ -722,7 +722,8 @@ def _apply(fits, retrimmed, commons, edges: list[SharedEdge], of_face, faces, ve
                     elif (i, side) in e.curves:
                         curves[i, side] = e.curves[i, side]
             now = replace(e, ranges=[BRep_Tool.Range_s(e.edge, TopoDS.Face_s(faces.FindKey(f)))
-                                     for f in e.faces], curves=curves, surfaces=fresh)
+                                     for f in e.faces], curves=curves, surfaces=fresh,
+                          feet={})
             on_curve = curve.evaluate(a + check * (b - a))
             for i, f in enumerate(e.faces):
                 for side in ((False, True) if e.seam else (False,)):
