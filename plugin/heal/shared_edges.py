@@ -130,8 +130,9 @@ def feet_on_face(e: SharedEdge, i: int, faces, points: NDArray, s: NDArray,
     start).
 
     Kept on ``e`` by the points and ``s`` asked (like its pcurves, ``e.curves``: the face
-    as read). The rounds of closing gaps ask the same feet of a fixed face again and
-    again (the impeller's revolved faces, projected point by point: 68 s of 580)."""
+    as read): the rounds of closing gaps ask some feet of a fixed face again (on the
+    impeller 588 of 2 965 asks, whose revolved faces are projected point by point: the
+    2 377 others cost 47 s)."""
     key = (i, reverse, hashlib.blake2b(np.ascontiguousarray(points, float).tobytes()
                                        + np.ascontiguousarray(s, float).tobytes()).digest())
     if key not in e.feet:
