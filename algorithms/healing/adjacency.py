@@ -25,6 +25,7 @@ from ..trimmed import TrimmedFace
 __all__ = [
     "EDGE_SAMPLES",
     "FaceEdge",
+    "box_pairs",
     "dense_edge",
     "duplicate_faces",
     "edge_positions",
@@ -163,7 +164,7 @@ def pair_edges(edges: list[FaceEdge], gap_tol: float) -> list[tuple[int, int]]:
     samples = np.stack([e.samples for e in edges])                     # (n, k, 3)
     lo, hi = samples.min(axis=1) - gap_tol, samples.max(axis=1) + gap_tol
     face = np.array([e.face for e in edges])
-    i, j = _box_pairs(lo, hi)
+    i, j = box_pairs(lo, hi)
     keep = face[i] != face[j]
     i, j = i[keep], j[keep]
     if i.size == 0:
@@ -188,7 +189,7 @@ def pair_gaps(edges: list[FaceEdge], pairs: list[tuple[int, int]]) -> NDArray:
     return out
 
 
-def _box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
+def box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
     """Index pairs ``i < j`` of overlapping boxes ``(n, 3)``, row by row (as
     ``nonzero(triu(overlap, 1))``), the overlap matrix built in row blocks."""
     out_i, out_j = [], []

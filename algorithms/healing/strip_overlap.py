@@ -27,7 +27,7 @@ from ...errors import InvalidGeometryError
 from ..curve import NurbsCurve
 from ..projection import distance_to_surface, project_to_curve, project_to_surface
 from ..trimmed import TrimmedFace
-from .adjacency import four_sided_boundary
+from .adjacency import box_pairs, four_sided_boundary
 
 __all__ = [
     "Overlap",
@@ -143,26 +143,24 @@ def find_overlaps(faces: list[TrimmedFace | None], candidates: list[int], gap_to
     out, used, grids = [], set(), {}
     if not candidates:
         return out
-    # the surfaces' boxes, padded by gap_tol, compared all at once (the pairwise loop
-    # asked each surface for its box again for each pair: 1.3 s on asmo's 255 faces)
+    # the surfaces' boxes (their low corners lowered by gap_tol) paired at once, in the
+    # order of the pairwise loop that asked each surface for its box again for each
+    # pair (1.3 s on asmo's 255 faces)
     boxes = np.stack([np.asarray(faces[i].surface.bounding_box(), float) for i in candidates])
-    near = np.all((boxes[:, None, 0] - gap_tol <= boxes[None, :, 1])
-                  & (boxes[None, :, 0] - gap_tol <= boxes[:, None, 1]), axis=-1)
-    for n, i in enumerate(candidates):
-        for m in np.flatnonzero(near[n, n + 1:]) + n + 1:
-            j = candidates[m]
-            if i in used or j in used:
-                continue
-            for f in (i, j):
-                if f not in grids:
-                    grids[f] = surface_grid(faces[f], _GRID_SAMPLES)
-            ka = _inside_sides(faces[i], faces[j], gap_tol, grids[j])
-            if len(ka) != 1:
-                continue
-            kb = _inside_sides(faces[j], faces[i], gap_tol, grids[i])
-            if len(kb) == 1:
-                out.append(Overlap(i, ka[0], j, kb[0]))
-                used.add(j)
+    for n, m in zip(*box_pairs(boxes[:, 0] - gap_tol, boxes[:, 1])):
+        i, j = candidates[n], candidates[m]
+        if i in used or j in used:
+            continue
+        for f in (i, j):
+            if f not in grids:
+                grids[f] = surface_grid(faces[f], _GRID_SAMPLES)
+        ka = _inside_sides(faces[i], faces[j], gap_tol, grids[j])
+        if len(ka) != 1:
+            continue
+        kb = _inside_sides(faces[j], faces[i], gap_tol, grids[i])
+        if len(kb) == 1:
+            out.append(Overlap(i, ka[0], j, kb[0]))
+            used.add(j)
     return out
 
 
