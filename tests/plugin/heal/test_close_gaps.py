@@ -21,7 +21,12 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 from OCP.TopTools import TopTools_IndexedDataMapOfShapeListOfShape
 
+from surfprep.algorithms.basis import greville_abscissae
+from surfprep.algorithms.curve import NurbsCurve
 from surfprep.algorithms.fitting import interpolate_curve, interpolate_surface
+from surfprep.algorithms.projection import project_to_surface
+from surfprep.algorithms.surface import NurbsSurface
+from surfprep.algorithms.trimmed import TrimEdge, TrimLoop
 from surfprep.plugin.heal.close_gaps import close_gaps
 from surfprep.plugin.occ.faces import make_face
 from surfprep.plugin.occ.geom import curve_to_occ, surface_from_occ
@@ -215,6 +220,57 @@ def test_a_face_that_would_move_too_far_is_kept():
     assert _gap(edge, a, b) == pytest.approx(2e-4, rel=1e-2)   # nothing changed
     assert is_valid(shape)
 
+
+
+def _sheet(x0, x1, dz, n=7, p=3):
+    """A cubic sheet over x in [x0 - 0.5, x1 + 0.5], y in [-0.5, 1.5], linear in its
+    parameters (control points at the Greville abscissae)."""
+    knots = np.concatenate([[0.0] * p, np.linspace(0.0, 1.0, n - p + 1), [1.0] * p])
+    g = greville_abscissae(knots, p)
+    x, y = np.meshgrid(x0 - 0.5 + g * (x1 - x0 + 1.0), -0.5 + 2.0 * g, indexing="ij")
+    return NurbsSurface(np.stack([x, y, 0.1 * np.sin(2 * x) * np.cos(y) + dz], axis=-1),
+                        knots, knots, p, p)
+
+
+def _trimmed(surface, x0, x1, y0, y1):
+    """``surface`` (a :func:`_sheet` over x in [x0 - 0.5, x1 + 0.5]) trimmed to
+    [x0, x1] x [y0, y1]: its corners inside its domain."""
+    u0, u1 = 0.5 / (x1 - x0 + 1.0), (x1 - x0 + 0.5) / (x1 - x0 + 1.0)
+    v0, v1 = (y0 + 0.5) / 2.0, (y1 + 0.5) / 2.0
+    c = np.array([(u0, v0), (u1, v0), (u1, v1), (u0, v1)])
+    lines = [NurbsCurve(np.array([c[k], c[(k + 1) % 4]]), np.array([0.0, 0.0, 1.0, 1.0]), 1)
+             for k in range(4)]
+    return make_face(surface, [TrimLoop([TrimEdge(None, line, 0.0, 1.0) for line in lines])])
+
+
+def test_corners_that_slid_along_the_edge_farther_than_allowed_still_close():
+    # two trimmed sheets 2e-4 apart across x = 1, the second slid 0.03 along the edge:
+    # sewing at 0.05 joins them, each vertex at the mean of the two corners 0.015 from
+    # either; a face keeps its corners' parameters, so its surface stretches along
+    # itself by 0.015 > allowed, but its shape moves by less than 1e-3. The move is
+    # measured on the shape (closest points), and the faces close; at equal parameters
+    # both were refused, the gap left at 0.03
+    sheets = [_sheet(0.0, 1.0, 0.0), _sheet(1.0, 2.0, 2e-4)]
+    shape, _ = sew([_trimmed(sheets[0], 0.0, 1.0, 0.0, 1.0),
+                     _trimmed(sheets[1], 1.0, 2.0, 0.03, 1.03)], 0.05)
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) == pytest.approx(0.03, rel=1e-2)
+    closed = close_gaps(shape, tight=1e-5, allowed=0.01)
+    assert closed.open_after == 0 and len(closed.moved) >= 1
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= 1e-5                        # on 2001 points
+    assert BRep_Tool.Tolerance_s(edge) <= 1e-5
+    assert is_valid(shape)
+    # each face's shape within 1e-3 of where it was, densely by closest points over
+    # the face, and the report says no less
+    moved = {m["face"]: m["moved"] for m in closed.moved}
+    u, v = (x.ravel() for x in np.meshgrid(np.linspace(0.0, 1.0, 61),
+                                           np.linspace(0.27, 0.75, 61), indexing="ij"))
+    for k, (face, before) in enumerate(zip(all_faces(shape), sheets)):
+        after = surface_from_occ(BRep_Tool.Surface_s(face))
+        off = float(project_to_surface(before, after.evaluate(u, v)).distance.max())
+        assert off <= 1e-3
+        assert moved.get(k, 0.0) >= 0.9 * off
 
 def test_heal_moves_faces_on_a_copy_and_leaves_the_callers_model_as_it_was(tmp_path):
     # a shell sewn already: sewing it again in heal keeps its faces (the same TShapes),
