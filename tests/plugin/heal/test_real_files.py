@@ -326,6 +326,7 @@ def test_k1_debis_closed_in_the_geometry_without_folding_a_face(data_dir):
     the input faces with the same parameters."""
     from surfprep.algorithms.face_region import FaceRegion
     from surfprep.algorithms.measure import normal_turn
+    from surfprep.algorithms.projection import project_to_surface
     from surfprep.plugin.occ.faces import face_to_nurbs
 
     model = surfprep.read(data_dir / "occt_k1_catia_debis.stp")
@@ -339,14 +340,25 @@ def test_k1_debis_closed_in_the_geometry_without_folding_a_face(data_dir):
                                   1 - np.geomspace(1e-7, 1e-2, 20)]))
     for moved in closed["faces_moved"]:
         after = face_to_nurbs(r.model.faces[moved["face"]]).surface
-        # the input face on the same surface: same domain, within the move over its box
-        def apart(tf, after=after):
+        # the input face on the same surface: same domain, nearest at equal parameters,
+        # within the move over its box by closest points (the move is measured on the
+        # shape: a surface stretched along itself moves it less than its parameters)
+        def probe(tf):
             a0, a1, b0, b1 = tf.parameter_box()
-            probe = np.meshgrid(np.linspace(a0, a1, 5), np.linspace(b0, b1, 5), indexing="ij")
-            return np.max(np.linalg.norm(tf.surface.evaluate(*probe) - after.evaluate(*probe),
-                                         axis=-1))
+            return np.stack([g.ravel() for g in np.meshgrid(
+                np.linspace(a0, a1, 5), np.linspace(b0, b1, 5), indexing="ij")], axis=1)
 
-        near = sorted((tf for tf in inputs if tf.surface.domain == after.domain), key=apart)
+        def same(tf, after=after):
+            uv = probe(tf)
+            return np.max(np.linalg.norm(tf.surface.evaluate(uv[:, 0], uv[:, 1])
+                                         - after.evaluate(uv[:, 0], uv[:, 1]), axis=-1))
+
+        def apart(tf, after=after):
+            uv = probe(tf)
+            points = after.evaluate(uv[:, 0], uv[:, 1])
+            return project_to_surface(tf.surface, points, guess=uv).distance.max()
+
+        near = sorted((tf for tf in inputs if tf.surface.domain == after.domain), key=same)
         assert near and apart(near[0]) <= moved["moved"] + 1e-9, \
             f"face {moved['face']}: no input face with its surface"
         a0, a1, b0, b1 = near[0].parameter_box()
