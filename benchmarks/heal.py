@@ -558,14 +558,14 @@ def table1_rows() -> list[str]:
             "| surfprep, two bent sheets crossing | " + " | ".join(cells) + " |"]
 
 
-#: real files of ``files_table``: those ../shared/data/README.md describes as gappy
-#: (pyiges_impeller_solidworks.igs left out: heal takes more than two minutes there)
+#: real files of ``files_table``: those ../shared/data/README.md describes as gappy (the
+#: impeller, last, takes 13 to 18 minutes of the table's 20 to 25; name files to run fewer)
 FILES = ("overture_heartvalve_rhino.igs", "occt_k1geo_microstation.stp",
          "occt_k1_catia_theorem.stp", "occt_k1geo_autocad.stp", "occt_k1_alias.stp",
          "overture_ship_napa_part5.igs", "occt_t4m_euclid.stp", "overture_kcs_hull_ideas.igs",
          "overture_asmo_icem.igs", "occt_spaceship_alias.stp", "occt_bearing_euclid.iges",
          "occt_hammer_euclid.iges", "occt_turbine_euclid.stp",
-         "pyiges_impeller_solidworks.igs")      # (the impeller alone heals in ~15 min)
+         "pyiges_impeller_solidworks.igs")
 
 
 def _loops(result) -> str:
