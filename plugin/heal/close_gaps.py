@@ -665,8 +665,11 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int, *,
     is above ``within``, the larger of the two ways' closest-point distances (each
     sample of one surface to the other, from its own parameters). A fit that keeps a
     corner's parameters while its vertex slid along the boundary stretches the surface
-    along itself: the impeller's faces 5, 32, 42 read 0.11 to 0.15 at equal parameters
-    for shapes 0.004 apart."""
+    along itself: two trimmed sheets whose vertices slid 0.015 read that far at equal
+    parameters, their shapes within 8e-4 of where they were. (The impeller's faces 5,
+    32 and 42, whose edges lie within 0.004 of their common curves but whose corners
+    are 0.11 to 0.15 from the vertices, still cannot be stretched there: their fits
+    move the shape by 0.7.)"""
     u0, u1, v0, v1 = BRepTools.UVBounds_s(TopoDS.Face_s(faces.FindKey(f)))
     a0, a1, b0, b1 = before.domain
     u = np.clip(np.linspace(u0, u1, _MOVE_GRID), a0, a1)
