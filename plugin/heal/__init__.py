@@ -370,7 +370,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
     rims = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
-    loops = plan_loops(rims, faces, fill=fill, gap_tol=gap_tol)
+    loops = plan_loops(rims, faces, fill=fill, gap_tol=gap_tol, free=[edges[k] for k in free])
     holes = [loop for loop in loops if loop.fill]
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)

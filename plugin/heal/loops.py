@@ -2,7 +2,8 @@
 boundaries that fill the holes among them.
 
 Every loop of free edges from two or more faces that is not a sliver (a gap between
-faces wider than ``gap_tol``: :func:`~surfprep.algorithms.healing.hole_cap.loop_width`)
+faces wider than ``gap_tol``: :func:`~surfprep.algorithms.healing.hole_cap.loop_width`,
+or a loop whose edges all run beside other faces' free edges, a gap between two loops)
 is capped
 (:func:`surfprep.algorithms.healing.hole_cap.cap_hole`, its surroundings sampled on
 the faces that bound it) and classified by the slope of those surroundings: a
@@ -33,6 +34,7 @@ import numpy as np
 
 from ...algorithms.healing.adjacency import FaceEdge
 from ...algorithms.healing.decompose import NotDecomposableError
+from ...algorithms.healing.free_boundary import classify_free_edges
 from ...algorithms.healing.hole_cap import (
     REACH,
     HoleCap,
@@ -71,8 +73,9 @@ class FreeLoop:
         The faces whose edges make it.
     kind : str
         "hole", "open boundary", "gap" (a sliver between faces, at most
-        :data:`GAP_WIDTH` x its length wide) or "not capped" (no cap as a graph over
-        its plane: ``why`` says why).
+        :data:`GAP_WIDTH` x its length wide, or between it and other faces' free edges
+        its edges all run beside) or "not capped" (no cap as a graph over its plane:
+        ``why`` says why).
     slope : float
         Degrees: the surroundings' slope figure (NaN without one).
     fill : bool
@@ -104,7 +107,7 @@ class FreeLoop:
 
 
 def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None], fill: str,
-          gap_tol: float) -> FreeLoop:
+          gap_tol: float, beside: dict[int, float]) -> FreeLoop:
     curves = [e.curve for e in loop]
     owners = tuple(sorted({e.face for e in loop}))
     head = {"index": index, "edges": len(loop), "faces": owners}
@@ -112,12 +115,17 @@ def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None],
     if width <= GAP_WIDTH * length:
         # edges paired one to one are not free: a loop within gap_tol is a T-junction,
         # which sewing joins (and closing gaps closes in the geometry where faces move)
-        how = (f"sewn: its sides lie within gap_tol ({gap_tol:.3g}) of each other, one "
-               "against several edges" if width <= gap_tol else
-               "left open: strips over gaps wider than gap_tol are not built yet")
         return FreeLoop(**head, kind="gap", slope=float("nan"), fill=False,
                         why=f"a gap between faces up to {width:.3g} wide along {length:.4g} "
-                            f"(a sliver, not a hole): {how}")
+                            f"(a sliver, not a hole): {_gap_how(width, gap_tol)}")
+    if all(id(e) in beside for e in loop):
+        # its other side is another loop: a pipe's mouth a little off the hole it
+        # should meet (the spaceship's nozzles, 0.9 to 1.2 mm from the body)
+        wide = max(beside[id(e)] for e in loop)
+        return FreeLoop(**head, kind="gap", slope=float("nan"), fill=False,
+                        why=f"a gap between faces up to {wide:.3g} wide: its edges run beside "
+                            "other faces' free edges (a sliver between two loops, not a hole "
+                            f"nor a boundary): {_gap_how(wide, gap_tol)}")
     rim = np.concatenate([e.samples for e in loop])
     reach = REACH * float(np.ptp(rim, axis=0).max())
     bounding = [faces[i] for i in owners if faces[i] is not None]
@@ -155,8 +163,27 @@ def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None],
                     boundaries=tuple(quads), cap=cap)
 
 
+def _gap_how(width: float, gap_tol: float) -> str:
+    return (f"sewn: its sides lie within gap_tol ({gap_tol:.3g}) of each other, one "
+            "against several edges" if width <= gap_tol else
+            "left open: strips over gaps wider than gap_tol are not built yet")
+
+
+def _beside(free: Sequence[FaceEdge], gap_tol: float) -> dict[int, float]:
+    """``id(edge) -> width`` of the free edges that run beside another face's free edge
+    (a gap's side: :func:`~surfprep.algorithms.healing.free_boundary.classify_free_edges`),
+    the gap's width along them."""
+    if not free:
+        return {}
+    sides = classify_free_edges([e.samples for e in free], [e.face for e in free],
+                                join=gap_tol)
+    return {id(e): float(w) for e, kind, w in zip(free, sides.kinds, sides.widths)
+            if kind == "gap"}
+
+
 def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | None], *,
-               fill: str = "holes", gap_tol: float = 0.0) -> list[FreeLoop]:
+               fill: str = "holes", gap_tol: float = 0.0,
+               free: Sequence[FaceEdge] = ()) -> list[FreeLoop]:
     """Each loop of free edges classified and, where ``fill`` says, its fill planned
     (module docstring).
 
@@ -169,6 +196,10 @@ def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | No
     fill : "holes", "all" or "none"
     gap_tol : float
         A gap loop no wider than this is sewn (said so in its ``why``), not left open.
+    free : sequence of FaceEdge, optional
+        Every free edge of the model (the loops' and the others, a loop of one face's
+        edges too): a loop whose every edge runs beside another face's free edge is a
+        gap between it and them, neither a hole nor a boundary.
 
     Returns
     -------
@@ -177,4 +208,5 @@ def plan_loops(loops: Sequence[Sequence[FaceEdge]], faces: list[TrimmedFace | No
     if fill not in FILL_RULES:
         raise InvalidGeometryError(f"fill must be one of {', '.join(map(repr, FILL_RULES))}, "
                                    f"got {fill!r}")
-    return [_loop(k, loop, faces, fill, gap_tol) for k, loop in enumerate(loops)]
+    beside = _beside(free, gap_tol)
+    return [_loop(k, loop, faces, fill, gap_tol, beside) for k, loop in enumerate(loops)]

@@ -9,6 +9,8 @@ faces along the rim and between the sub-patches along their spokes, on the surfa
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from helpers.heal_cases import fan_around_hole, gentle_height, inside_regular_polygon
@@ -137,3 +139,44 @@ def test_the_command_counts_holes_not_sub_patches(tmp_path, capsys):
     code, out, err = run(capsys, "heal", source, "-o", tmp_path / "open.step", "--fill", "none")
     assert code == 0, err
     assert "0 approximant(s)" in out and "fill tried on 0" in out
+
+
+def _circle_edges(radius, z, pieces, face0):
+    """``pieces`` FaceEdges around the circle of ``radius`` at height ``z``, the k-th of
+    face ``face0 + k``."""
+    from surfprep.algorithms.fitting import interpolate_curve
+    from surfprep.algorithms.healing.adjacency import FaceEdge
+
+    out = []
+    for k in range(pieces):
+        t = np.linspace(2 * np.pi * k / pieces, 2 * np.pi * (k + 1) / pieces, 33)
+        c = interpolate_curve(np.column_stack([radius * np.cos(t), radius * np.sin(t),
+                                               z + 0 * t]))
+        out.append(FaceEdge(face0 + k, 0, c, c.evaluate(np.linspace(*c.domain, 33))))
+    return out
+
+
+def test_a_pipe_mouth_beside_the_hole_it_should_meet_is_a_gap_not_a_boundary():
+    # the spaceship's nozzles: a pipe's rim (two half circles, faces 0 and 1) 0.05 off
+    # the rim of the body's hole (one circle, face 2), each a loop of its own: the pipe's
+    # loop is no sliver by itself, and without the other free edges it is capped and
+    # classed by its surroundings; with them it is a gap between the two loops, and not
+    # filled even with fill="all"
+    from surfprep.plugin.heal.loops import plan_loops
+
+    mouth = _circle_edges(1.0, 0.0, 2, 0)
+    hole = _circle_edges(1.05, 0.0, 1, 2)
+    (alone,) = plan_loops([mouth], [None, None, None], fill="all", gap_tol=0.01)
+    assert alone.kind != "gap"
+    (loop,) = plan_loops([mouth], [None, None, None], fill="all", gap_tol=0.01,
+                         free=mouth + hole)
+    assert loop.kind == "gap" and not loop.fill and not loop.boundaries
+    wide = float(re.search(r"up to ([0-9.e-]+) wide", loop.why).group(1))
+    assert wide == pytest.approx(0.05, rel=0.01) and "left open" in loop.why
+    # within gap_tol it is said to be sewn
+    (sewn,) = plan_loops([mouth], [None, None, None], gap_tol=0.1, free=mouth + hole)
+    assert sewn.kind == "gap" and "sewn" in sewn.why
+    # a mouth with nothing beside it stays what its surroundings make it
+    far = _circle_edges(1.5, 0.0, 1, 2)
+    (open_,) = plan_loops([mouth], [None, None, None], gap_tol=0.01, free=mouth + far)
+    assert open_.kind == alone.kind
