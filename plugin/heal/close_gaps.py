@@ -675,14 +675,13 @@ def _moved(before: NurbsSurface, after: NurbsSurface, faces, f: int, *,
     u = np.clip(np.linspace(u0, u1, _MOVE_GRID), a0, a1)
     v = np.clip(np.linspace(v0, v1, _MOVE_GRID), b0, b1)
     old, new = before.evaluate_grid(u, v).reshape(-1, 3), after.evaluate_grid(u, v).reshape(-1, 3)
-    apart = float(np.max(np.linalg.norm(new - old, axis=1)))
-    if apart <= within:
-        return apart
+    apart = np.linalg.norm(new - old, axis=1)
+    if apart.max() <= within:
+        return float(apart.max())
     uv = np.stack(np.meshgrid(u, v, indexing="ij"), axis=-1).reshape(-1, 2)
     # (a sample's own point on the other surface bounds its closest point's distance)
-    ways = [np.minimum(project_to_surface(to, p, guess=uv).distance,
-                       np.linalg.norm(new - old, axis=1)) for to, p in ((before, new), (after, old))]
-    return float(max(w.max() for w in ways))
+    return float(max(np.minimum(project_to_surface(to, p, guess=uv).distance, apart).max()
+                     for to, p in ((before, new), (after, old))))
 
 
 # ------------------------------------------------------------------ applying
