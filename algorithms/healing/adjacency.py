@@ -204,11 +204,11 @@ def box_pairs(lo: NDArray, hi: NDArray) -> tuple[NDArray, NDArray]:
     return np.concatenate(out_i), np.concatenate(out_j)
 
 
-def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float
-               ) -> list[list[FaceEdge]]:
-    """Loops of free edges from at least two faces (any number of edges up to 64), in
-    loop order: where every end on the loop meets exactly one other free edge's end
-    within ``gap_tol``."""
+def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float, *,
+               min_faces: int = 2) -> list[list[FaceEdge]]:
+    """Loops of free edges from at least ``min_faces`` faces (any number of edges up to
+    64, or one edge closed on itself), in loop order: where every end on the loop meets
+    exactly one other free edge's end within ``gap_tol``."""
     if not free:
         return []
     ends = np.concatenate([edges[k].ends for k in free])          # (2 f, 3)
@@ -233,7 +233,7 @@ def hole_loops(edges: list[FaceEdge], free: list[int], gap_tol: float
             continue
         loop = _walk(start, vertex, incident)
         seen.update(loop or [start])
-        if loop and len({edges[free[n]].face for n in loop}) >= 2:
+        if loop and len({edges[free[n]].face for n in loop}) >= min_faces:
             loops.append([edges[free[n]] for n in loop])
     return loops
 
@@ -243,8 +243,10 @@ def _walk(start: int, vertex: NDArray, incident: dict[int, list[int]]) -> list[i
     loop, current, at = [start], start, int(vertex[start, 1])
     while True:
         nxt = [n for n in incident[at] if n != current]
-        if len(incident[at]) != 2 or not nxt:
+        if len(incident[at]) != 2:
             return None
+        if not nxt:                     # one edge closed on itself (a tube's rim)
+            return loop if vertex[start, 0] == vertex[start, 1] else None
         current = nxt[0]
         if current == start:
             return loop
