@@ -569,7 +569,8 @@ FILES = ("overture_heartvalve_rhino.igs", "occt_k1geo_microstation.stp",
 
 
 def _loops(result) -> str:
-    """The report's loops of free edges counted by kind, and how many were filled."""
+    """The report's loops of free edges counted by kind, how many were filled, and the
+    rings (two loops beside each other all round) bridged."""
     loops = result.report().get("free_loops", [])
     if not loops:
         return "none"
@@ -577,7 +578,11 @@ def _loops(result) -> str:
     for lp in loops:
         kinds[lp["kind"]] = kinds.get(lp["kind"], 0) + 1
     filled = len({p.origin.index for p in result.patches if p.origin.kind == "hole"})
-    return ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) + f"; {filled} filled"
+    rings = result.report().get("rings", [])
+    bridged = (f"; {len(rings)} ring(s) of two loops, {sum(r['bridged'] for r in rings)} "
+               "bridged" if rings else "")
+    return ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) + f"; {filled} filled" \
+        + bridged
 
 
 def files_table(files=FILES) -> list[str]:

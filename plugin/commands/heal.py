@@ -97,7 +97,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fill", choices=("holes", "all", "none"), default="holes",
                         help="which loops of free edges to fill: holes, whose surroundings "
                              "continue across them (default), also open boundaries such as "
-                             "a sheet's edge or a pipe's end (all), or none")
+                             "a sheet's edge or a pipe's end (all), or none; rings (two "
+                             "loops beside each other all round, wider apart than gap_tol) "
+                             "are bridged by strips unless none")
     parser.add_argument("--no-close-gaps", action="store_false", dest="close_gaps",
                         help="leave the edges sewing closed by raising their tolerance as they "
                              "are (by default the B-spline faces along them are moved onto "
@@ -174,6 +176,10 @@ def _summary(report: dict) -> list[str]:
                      + ", ".join(f"{n} {_plural(kind) if n > 1 else kind}"
                                  for kind, n in sorted(kinds.items()))
                      + f"; fill tried on {sum(lp['fill'] for lp in loops)}")
+    rings = report.get("rings", [])
+    if rings:
+        lines.append(f"{len(rings)} ring(s) of two loops beside each other: "
+                     f"{sum(r['bridged'] for r in rings)} bridged by strips")
     lines.append(f"free edges {free['before']} -> {free['after']} (at gap_tol "
                  f"{report['gap_tol']:.3g} mm), {free['tight_before']} -> "
                  f"{free['tight_after']} (geometric); valid {valid['before']} -> "
@@ -251,7 +257,10 @@ COMMAND = Command(
         "of neighbouring faces are classified by their surroundings: holes (the "
         "surroundings continue across them) are filled, four-sided ones by one "
         "approximant, others by four-sided patches around a centre on a thin-plate "
-        "cap continuing the surroundings; open boundaries stay open unless --fill all; faces lying on other faces are dropped, a face "
+        "cap continuing the surroundings; open boundaries stay open unless --fill all; "
+        "two loops beside each other all round, wider apart than gap_tol (the missing "
+        "end face of a tube with two skins), are bridged by four-sided strips; faces "
+        "lying on other faces are dropped, a face "
         "lying partly on another is trimmed back to the other's boundary, faces cutting "
         "through each other (each running on past the curve where they meet) are cut "
         "along it and the overshoots dropped; directed "

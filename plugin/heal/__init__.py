@@ -25,6 +25,9 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    edges chained into loops from two or more faces are classified by their
    surroundings (:mod:`.loops`): holes (the surroundings continue across them) are
    filled, open boundaries (a sheet's edge) are not, unless ``fill`` says otherwise;
+   two closed loops (of one face or several) that run beside each other all round,
+   wider apart than ``gap_tol`` (the missing end face of a tube with two skins), are a
+   ring (:mod:`.rings`), bridged by four-sided strips unless ``fill="none"``;
 3. every four-sided face with a defect (``replace="defects"``, the default: an
    edge paired with another face's but not closed in the geometry, an edge on a
    hole, an overlap; every face with ``replace="all"``) gets a
@@ -37,7 +40,8 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    sub-patches (``split_faces``, default) and replaced when all of them fit;
    every hole one over its four free edges, or, with another number of edges,
    four-sided sub-patches of its cap (a loop whose patch lands on faces off
-   ``tol``, e.g. the mouth of a slot, stays open);
+   ``tol``, e.g. the mouth of a slot, stays open); every ring one per strip, its
+   inside on the ruled surface between the loops' pieces;
 4. the approximants are joined by :func:`~surfprep.algorithms.healing.connect` (G0 or G1, topology
    violations left unconnected and reported); a side that meets a face kept
    as it was (not re-approximated) is fitted to that face's edge or edges, or
@@ -60,7 +64,7 @@ Steps, on anything that holds faces (file path, :class:`CadModel`,
    or directed patches;
    untouched faces keep their names (a replaced face passes its name to its
    approximant; holes are named ``heal_hole_<k>``, their sub-patches
-   ``heal_hole_<k>_<n>``);
+   ``heal_hole_<k>_<n>``, the strips of a ring ``heal_ring_<k>_<n>``);
 6. shared edges whose faces still lie farther apart than ``TIGHT_FACTOR`` x size
    (sewing closed them by raising the edge's tolerance: faces kept as they were, gaps
    the file hid in its tolerances) are closed in the geometry (:mod:`.close_gaps`):
@@ -79,7 +83,8 @@ beside them, not a defect); ``interior`` counts the first two.
 
 The building blocks are :mod:`surfprep.algorithms.healing`
 (``local_approximant``, ``connect``, ``Continuity``, ``Side``); the approximants
-to build are planned in :mod:`.jobs`, the loops of free edges classed in :mod:`.loops`,
+to build are planned in :mod:`.jobs`, the loops of free edges classed in :mod:`.loops`
+and paired into rings in :mod:`.rings`,
 the result put together and what made it worse taken back in :mod:`.rollback`; the
 result types are in :mod:`.result`.
 """
@@ -130,6 +135,7 @@ from .jobs import (
 from .loops import plan_loops
 from .result import HealResult, PatchReport, StageClock
 from .retrim import retrim_to_neighbours
+from .rings import mark_ring_loops, plan_rings
 from .rollback import FREE_LINES, TIGHT_FACTOR, Before, no_worse_than_before, tight_round
 from .spec import read_patch_spec
 from .trim_back import trim_overlaps_of
@@ -254,8 +260,10 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         (:mod:`.loops`): "holes" (default) those whose surroundings continue across
         them; "all" also open boundaries (a sheet's edge, a pipe's end: capped by
         the smoothest surface through the rim); "none" none. Loops of any number of
-        edges: four corners give one patch, others quads around a centre. The
-        report's ``free_loops`` says what each loop is and what was done.
+        edges: four corners give one patch, others quads around a centre. Rings (two
+        loops beside each other all round, a gap wider than ``gap_tol``) are bridged
+        by strips unless "none". The report's ``free_loops`` says what each loop is
+        and what was done, ``rings`` what each ring is and whether it was bridged.
     close_gaps : bool
         Close in the geometry the edges sewing closed only by raising their tolerance:
         the B-spline faces along them moved onto one common curve per edge (step 6 of
@@ -371,6 +379,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     free = [k for k in range(len(edges)) if k not in paired]
     rims = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
     loops = plan_loops(rims, faces, fill=fill, gap_tol=gap_tol, free=[edges[k] for k in free])
+    rings = plan_rings(edges, free, gap_tol=gap_tol, fill=fill)
+    loops = mark_ring_loops(loops, rims, rings)
     holes = [loop for loop in loops if loop.fill]
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]
     overlaps = find_overlaps(faces, four, gap_tol)
@@ -392,7 +402,7 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
         | {j for j, _ in unions.values()}, TIGHT_FACTOR * model.size, gap_tol, continuity,
         skipped)
     jobs = plan_jobs(faces, defective, holes, trimmed, unions, split_faces=split_faces,
-                     gap_tol=gap_tol, skipped=skipped)
+                     gap_tol=gap_tol, skipped=skipped, rings=rings)
     inputs = InputFaces.of(faces)
     say("approximants")
     done = approximate(jobs, sources, {i: k for k, i in enumerate(kept)}, tol, gap_tol,
@@ -435,6 +445,8 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     result.extra["stage_times_s"] = stage_times
     result.extra["replace"] = replace
     result.extra["free_loops"] = [loop.as_dict() for loop in loops]
+    bridged = {job.origin.index for job, _ in done if job.origin.kind == "ring"}
+    result.extra["rings"] = [r.as_dict(bridged=r.index in bridged) for r in rings]
     result.extra["cuts"] = [c.as_dict() for c in cut.cuts]
     result.extra["partial_overlaps"] = [o.as_dict() for o in partial]
     result.extra["crossings"] = [c.as_dict() for c in crossings]

@@ -13,6 +13,7 @@ preferred source) and keeps a face whole unless every sub-patch of it fits;
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -27,7 +28,7 @@ from ...errors import SurfprepError, TimeLimitExceeded
 from .cut import CutModel
 from .spec import DirectedPatch
 
-__all__ = ["INPUT_CHECK_TOL", "RETRY_MARGIN", "Job", "PatchOrigin", "approximate",
+__all__ = ["FILLS", "INPUT_CHECK_TOL", "RETRY_MARGIN", "Job", "PatchOrigin", "approximate",
            "directed_jobs", "plan_jobs", "replaced_faces"]
 
 #: the dense check against the input projects to this times the patch's tol
@@ -36,14 +37,18 @@ INPUT_CHECK_TOL = 1e-3
 #: the first (8, 8) already meets tol, but the tangent planes at the rim follow the
 #: cap's to 0.02 degrees only; at (16, 16) to 0.004-0.012 (an n-sided hole in a fan)
 CAP_RESOLUTION = (16, 16)
+#: the kinds of patch over a gap in the model (not replacing a face): filled by all
+#: their sub-patches or left open
+FILLS = ("hole", "ring")
 #: a patch off the input is rebuilt once to its own error times tol / deviation, times this
 RETRY_MARGIN = 0.8
 
 
 @dataclass(frozen=True)
 class PatchOrigin:
-    """Where an approximant comes from: ``kind`` "face", "hole", "union" or "directed",
-    and face indices: the face replaced, the faces bounding the hole, the two faces of
+    """Where an approximant comes from: ``kind`` "face", "hole", "ring", "union" or
+    "directed", and face indices: the face replaced, the faces bounding the hole or the
+    ring (:mod:`.rings`), the two faces of
     a union, the input faces a directed patch cut. Indices other than a directed
     patch's count the faces after the cuts (a cut face's pieces take its place)."""
 
@@ -63,7 +68,8 @@ class Job:
     reference: TrimmedFace | None     # face whose orientation the approximant takes
     split: bool = False               # one of several sub-patches of a face or a hole
     rim_sides: tuple[int, ...] = (0, 1, 2, 3)   # a hole's sides on its rim (the others cross it)
-    cap: Any = None                   # a hole's cap (its artificial projections lie on it)
+    cap: Any = None                   # a hole's cap or a strip's ruled surface (its
+    #                                   artificial projections lie on it)
 
 
 def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: float,
@@ -86,10 +92,12 @@ def _face_boundaries(face: TrimmedFace, index: int, split_faces: bool, gap_tol: 
 
 
 def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: bool = False,
-              gap_tol: float = 0.0, skipped: list[str] | None = None) -> list[Job]:
+              gap_tol: float = 0.0, skipped: list[str] | None = None,
+              rings: Sequence = ()) -> list[Job]:
     """The approximants to build: one per union of overlapping faces, per kept face
-    (its own four edges, a strip-trimmed boundary, or its four-sided sub-patches) and
-    per sub-patch of a hole to fill (``holes``: :class:`.loops.FreeLoop`)."""
+    (its own four edges, a strip-trimmed boundary, or its four-sided sub-patches), per
+    sub-patch of a hole to fill (``holes``: :class:`.loops.FreeLoop`) and per strip of
+    a ring to bridge (``rings``: :class:`.rings.Ring`)."""
     jobs = []
     for i, (j, outline) in unions.items():
         jobs.append(Job(PatchOrigin("union", (i, j), i), outline, faces[i].name, faces[i]))
@@ -117,6 +125,11 @@ def plan_jobs(faces, kept, holes, trimmed: dict, unions: dict, *, split_faces: b
             name = f"heal_hole_{loop.index}_{n}" if many else f"heal_hole_{loop.index}"
             jobs.append(Job(PatchOrigin("hole", loop.faces, loop.index), curves, name, None,
                             many, tuple(rim), loop.cap))
+    for ring in (r for r in rings if r.fill):
+        faces_of = tuple(sorted(set(ring.faces[0]) | set(ring.faces[1])))
+        for n, (curves, ruled) in enumerate(ring.strips):
+            jobs.append(Job(PatchOrigin("ring", faces_of, ring.index), curves,
+                            f"heal_ring_{ring.index}_{n}", None, True, (0, 2), ruled))
     return jobs
 
 
@@ -186,6 +199,11 @@ def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped
     own = source_of.get(job.origin.faces[0]) if job.origin.kind == "face" else None
     extra = {} if job.cap is None else {"resolution": CAP_RESOLUTION,
                                         "fill_source": job.cap.source(job.name or "")}
+    if job.origin.kind == "ring":
+        # a strip is new geometry across a gap: its ruled surface is its one source
+        # (the faces beside it are the loops' faces, which a strip tilted across a
+        # cone's rim would otherwise hit and bend towards)
+        sources, extra = [extra["fill_source"]], {"resolution": CAP_RESOLUTION}
 
     def build(target):
         return local_approximant(job.boundary, sources, tol=target, gap_tol=gap_tol,
@@ -210,11 +228,12 @@ def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped
                    f"resolution {last.resolution}")
         skipped.append(f"face {job.origin.index}: {why}; kept as it was")
         return None
-    if job.origin.kind == "hole" and not la.converged:
+    if job.origin.kind in FILLS and not la.converged:
         # the error is measured only where segments land on the originals: over a real
         # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
         # of a slot, an open end) is no hole, and a patch over it would not fit them
-        skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
+        skipped.append(f"{job.origin.kind} {job.origin.index} (free edges of faces "
+                       f"{list(job.origin.faces)}"
                        f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
                        f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
                        "left open")
@@ -264,9 +283,9 @@ def _whole_faces_only(jobs: list[Job], out: list, skipped: list[str],
     def key(job):
         return job.origin.kind, job.origin.index
 
-    split = [j for j in jobs if j.origin.kind in ("face", "hole")]
+    split = [j for j in jobs if j.origin.kind in ("face", *FILLS)]
     want = Counter(key(j) for j in split)
-    got = Counter(key(j) for j, _ in out if j.origin.kind in ("face", "hole"))
+    got = Counter(key(j) for j, _ in out if j.origin.kind in ("face", *FILLS))
     partial = {k for k, n in want.items() if got[k] not in (0, n)} | \
         {k for k in failed if got[k]}
     skipped += [f"{kind} {i}: {got[kind, i]} of {want[kind, i]} sub-patches fit"

@@ -166,7 +166,8 @@ def _loop(index: int, loop: Sequence[FaceEdge], faces: list[TrimmedFace | None],
 def _gap_how(width: float, gap_tol: float) -> str:
     return (f"sewn: its sides lie within gap_tol ({gap_tol:.3g}) of each other, one "
             "against several edges" if width <= gap_tol else
-            "left open: strips over gaps wider than gap_tol are not built yet")
+            "left open: wider than gap_tol, and not a ring (two loops beside each other "
+            "all round, bridged by strips: the report's rings)")
 
 
 def _beside(free: Sequence[FaceEdge], gap_tol: float) -> dict[int, float]:

@@ -162,6 +162,7 @@ class HealResult:
             "max_edge_tolerance": self.max_edge_tolerance,
             "replace": self.extra.get("replace"),
             "free_loops": self.extra.get("free_loops", []),
+            "rings": self.extra.get("rings", []),
             "free_boundary": self.extra.get("free_boundary", {}),
             "closed_gaps": self.extra.get("closed_gaps", {}),
         }

@@ -37,7 +37,7 @@ from ..occ.shapes import (
     max_edge_tolerance,
     sew,
 )
-from .jobs import INPUT_CHECK_TOL, replaced_faces
+from .jobs import FILLS, INPUT_CHECK_TOL, replaced_faces
 from .result import HealResult, PatchReport
 
 __all__ = ["ROLLBACK_ROUNDS", "TIGHT_FACTOR", "Before", "no_worse_than_before", "tight_round",
@@ -271,15 +271,15 @@ def _rolled_back(done, opening: set[int], undropped: set, result: HealResult) ->
     what = sorted({f"{done[k][0].origin.kind} {done[k][0].origin.index}" for k in opening})
     what += [f"face {b} (duplicate of face {a})" for a, b in sorted(undropped)]
     return (f"free edges {result.free_edges_before} -> {result.free_edges_after}: more after "
-            f"than before, so taken back (faces kept as they were, holes left open, "
+            f"than before, so taken back (faces kept as they were, holes and rings left open, "
             f"duplicates kept): {', '.join(what)}")
 
 
 def without_jobs(done, opening: set[int]) -> list:
-    """``done`` without the jobs in ``opening``; a face or a hole split into sub-patches
+    """``done`` without the jobs in ``opening``; a face, hole or ring split into sub-patches
     goes whole."""
     whole = {(done[k][0].origin.kind, done[k][0].origin.index) for k in opening
-             if done[k][0].origin.kind in ("face", "hole")}
+             if done[k][0].origin.kind in ("face", *FILLS)}
     return [(job, la) for k, (job, la) in enumerate(done) if k not in opening
             and (job.origin.kind, job.origin.index) not in whole]
 
@@ -294,7 +294,7 @@ def _deviations(done, network, inputs: InputFaces, gap_tol: float, skipped: list
     out, moved, off = [], [], []
     for (job, la), surface in zip(done, network.patches if network else ()):
         deviation = surface_deviation(surface, inputs, tol=INPUT_CHECK_TOL * la.tol,
-                                      rim_only=job.origin.kind == "hole" and job.rim_sides
+                                      rim_only=job.origin.kind in FILLS and job.rim_sides
                                       ).max_distance
         if job.origin.kind != "directed" and deviation > la.tol:
             (moved if deviation <= la.tol + gap_tol else off).append((job, deviation, la.tol))
