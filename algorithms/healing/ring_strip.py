@@ -177,19 +177,24 @@ class _Dense:
         return out
 
 
-def ring_pairs(loops: Sequence[Sequence[NurbsCurve]], *, gap_tol: float) -> list[RingPair]:
+def ring_pairs(loops: Sequence[Sequence[NurbsCurve]], *, gap_tol: float,
+               owners: Sequence[set] | None = None) -> list[RingPair]:
     """The loops that make rings.
 
     Two closed loops make a ring when every point of each lies within :data:`MAX_WIDTH`
     times the shorter loop's length of the other, and none within ``gap_tol`` (there
-    sewing joins them); of several candidates the nearest pairs are taken first, each
-    loop in at most one ring.
+    sewing joins them), and no face has edges on both (such a face spans the space
+    between them: the two rims of a band of faces 2.54 mm wide on
+    occt_k1geo_microstation.stp); of several candidates the nearest pairs are taken
+    first, each loop in at most one ring.
 
     Parameters
     ----------
     loops : sequence of sequence of NurbsCurve (3D)
         Closed loops of free edges, their curves in loop order (either way round).
     gap_tol : float
+    owners : sequence of set, optional
+        Per loop, the faces whose edges make it (default: no face in two loops).
 
     Returns
     -------
@@ -202,6 +207,8 @@ def ring_pairs(loops: Sequence[Sequence[NurbsCurve]], *, gap_tol: float) -> list
     found = []
     for i in range(len(dense)):
         for j in range(i + 1, len(dense)):
+            if owners is not None and set(owners[i]) & set(owners[j]):
+                continue
             limit = MAX_WIDTH * min(dense[i].length, dense[j].length)
             if np.any(boxes[i, 0] > boxes[j, 1] + limit) or np.any(boxes[j, 0] > boxes[i, 1] + limit):
                 continue

@@ -80,7 +80,8 @@ def plan_rings(edges: Sequence[FaceEdge], free: Sequence[int], *, gap_tol: float
     loops = hole_loops(list(edges), list(free), gap_tol, min_faces=1)
     rings = []
     for index, pair in enumerate(ring_pairs([[e.curve for e in loop] for loop in loops],
-                                            gap_tol=gap_tol)):
+                                            gap_tol=gap_tol,
+                                            owners=[set(_faces(loop)) for loop in loops])):
         a, b = loops[pair.first], loops[pair.second]
         head = {"index": index, "faces": (_faces(a), _faces(b)), "edges": (len(a), len(b)),
                 "width": pair.width, "members": frozenset(id(e) for e in a + b)}

@@ -114,3 +114,10 @@ def test_a_conical_band_is_ruled_along_its_generators():
 def test_a_side_shorter_than_min_side_is_refused():
     with pytest.raises(NotARingError, match="no longer than"):
         ring_strips(circle(10.0), circle(10.5, pieces=2), min_side=0.6)
+
+
+def test_loops_of_one_face_are_no_ring():
+    # a band's two rims: the band's own faces have edges on both, and lie between them
+    inner, outer = circle(10.0, pieces=2), circle(10.5, pieces=2)
+    assert len(ring_pairs([inner, outer], gap_tol=0.01, owners=[{1, 2}, {3, 4}])) == 1
+    assert ring_pairs([inner, outer], gap_tol=0.01, owners=[{1, 2}, {2, 4}]) == []
