@@ -143,7 +143,8 @@ def _summary(report: dict) -> list[str]:
         errors += f" (largest distance from the input faces, dense: {worst_dev:.3g} mm)"
     lines = [(f"{len(patches)} approximant(s) "
              f"({len({p['index'] for p in patches if p['kind'] == 'hole'})} hole(s) "
-             f"filled){errors}, {len(report['dropped_overlaps'])} duplicate "
+             f"filled, {len({p['index'] for p in patches if p['kind'] == 'ring'})} ring(s) "
+             f"bridged){errors}, {len(report['dropped_overlaps'])} duplicate "
              f"face(s) dropped, {report['time_s']:.2f} s")]
     cuts, partial = report.get("cuts", []), report.get("partial_overlaps", [])
     if cuts:

@@ -134,7 +134,7 @@ def test_the_command_counts_holes_not_sub_patches(tmp_path, capsys):
     write(compound([make_face(s) for s in fan_around_hole(5)]), source)
     code, out, err = run(capsys, "heal", source, "-o", tmp_path / "healed.step")
     assert code == 0, err
-    assert "5 approximant(s) (1 hole(s) filled)" in out
+    assert "5 approximant(s) (1 hole(s) filled, 0 ring(s) bridged)" in out
     assert "2 loop(s) of free edges: 1 hole, 1 open boundary; fill tried on 1" in out
     code, out, err = run(capsys, "heal", source, "-o", tmp_path / "open.step", "--fill", "none")
     assert code == 0, err

@@ -79,3 +79,15 @@ def test_loops_within_gap_tol_are_sewn_not_bridged():
     # its ends), so no ring is planned
     report = heal(_tube(), gap_tol=0.06).report()
     assert report["rings"] == []
+
+
+def test_the_command_says_how_many_rings_it_bridged(tmp_path, capsys):
+    from surfprep.plugin import cli
+    from surfprep.plugin.io import write
+
+    src = write(_tube(), tmp_path / "tube.step")
+    assert cli.main(["heal", str(src), "-o", str(tmp_path / "out.step"), "--gap-tol", "0.01"]) == 0
+    out = capsys.readouterr().out
+    assert "4 approximant(s) (0 hole(s) filled, 2 ring(s) bridged)" in out
+    assert "2 ring(s) of two loops beside each other: 2 bridged by strips" in out
+    assert "free edges 8 -> 0 (at gap_tol 0.01 mm), 8 -> 0 (geometric)" in out
