@@ -28,6 +28,11 @@ curve per edge (:func:`~surfprep.algorithms.healing.edge_fit.fit_to_edges`):
   where they were). Two faces meeting at an angle whose trimming curves run apart within
   their surfaces (an exporter's wavy pcurve on a plane) then meet without either
   surface moving, even where neither is a B-spline;
+* where no face of an open edge moves (neither is a B-spline, or the B-spline's move
+  failed), one that is not a B-spline is approximated in its own parameters (a bicubic
+  interpolant within ``ANALYTIC_SHARE`` x ``tight`` of it, so its pcurves stay valid)
+  and moved, in a last pass after re-trimming, which keeps it exact, was tried (the two
+  tori of occt_k1geo_microstation.stp, 2e-4 mm apart);
 * a free edge, or a shared one closed already, is held: each moving face keeps its side
   there (its ends follow the vertices), the edge's curve is the mean of its faces';
 * a face whose fit misses by more than ``FIT_SHARE`` x ``tight``, would move farther
@@ -57,6 +62,7 @@ from OCP.BRep import BRep_Builder, BRep_Tool
 from OCP.BRepCheck import BRepCheck_Analyzer
 from OCP.BRepLib import BRepLib
 from OCP.BRepTools import BRepTools
+from OCP.Geom import Geom_BSplineSurface
 from OCP.gp import gp_Pnt
 from OCP.ShapeFix import ShapeFix_ShapeTolerance
 from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_VERTEX
@@ -91,6 +97,7 @@ from .result import HealResult
 from .rollback import FREE_LINES, FREE_SAMPLES, TIGHT_FACTOR
 from .shared_edges import (
     SharedEdge,
+    analytic_as_nurbs,
     edges_by_face,
     images_on_face,
     pcurve,
@@ -123,6 +130,9 @@ _ROUNDS = 16
 #: a face whose edges all lie within this share of the tight tolerance of their common
 #: curves keeps its surface (only its pcurves change)
 _STILL = 1e-3
+#: a face that is not a B-spline, moved where no face of an open edge is one, is first
+#: approximated in its own parameters within this times ``tight``
+ANALYTIC_SHARE = 0.1
 #: an edge measured wider than this times its gap before (or ``tight``) after the move
 #: takes its moved faces back
 _WIDER = 2.0
@@ -164,6 +174,9 @@ class ClosedGaps:
         Per face re-trimmed without moving its surface: its index, how far its boundary
         moved along the edges re-trimmed (largest over them).
     notes : tuple of str
+    stuck : int
+        Edges left open none of whose faces moved, one of them not a B-spline (a call
+        with ``stuck=True`` may move that one).
     """
 
     open_before: int = 0
@@ -173,6 +186,7 @@ class ClosedGaps:
     moved: tuple = ()
     retrimmed: tuple = ()
     notes: tuple = ()
+    stuck: int = 0
 
     def as_dict(self) -> dict:
         return {"open_edges_before": self.open_before, "open_edges_after": self.open_after,
@@ -248,11 +262,13 @@ class _Journal:
 
 
 def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = None,
-               retrim: bool = True) -> ClosedGaps:
+               retrim: bool = True, stuck: bool = False) -> ClosedGaps:
     """Close in the geometry the gaps of ``shape`` (a sewn shell, solid or compound)
     wider than ``tight``, moving B-spline faces by at most ``allowed`` (the module doc),
     and re-trimming the faces that do not move where that closes an edge (unless
-    ``retrim`` is False). ``shape`` is changed in place. ``fitted`` keeps the fits by
+    ``retrim`` is False); with ``stuck``, where no face of an open edge can move, one
+    that is not a B-spline moves, approximated in its own parameters first
+    (:func:`_stuck_movers`). ``shape`` is changed in place. ``fitted`` keeps the fits by
     face, surface and targets across calls on the same shape (the passes of
     :func:`closed_in_geometry`), and those taken back once applied."""
     faces = TopTools_IndexedMapOfShape()
@@ -288,7 +304,13 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
     fitted = Fitted() if fitted is None else fitted
     failing_before: dict[int, frozenset] = {}   # BRepCheck's findings on the shape as given
     turn = _Turns()
+    tried: set[int] = set()             # faces not B-splines approximated to move them
     for _round in range(_ROUNDS):
+        more = (_stuck_movers(open_, {f for f in surfaces if f not in fixed}, tried, faces,
+                              tight) if stuck else {})
+        if more:
+            surfaces.update(more)
+            memo.corners = None             # (kept per face of ``surfaces``)
         moving = [f for f in candidates if f in surfaces and f not in fixed]
         trimmable = set(candidates) - set(moving) - rigid if retrim else set()
         if not moving and not any(f in trimmable for e in open_ for f in e.faces):
@@ -349,19 +371,22 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
         rigid |= invalid | (bad - set(fits))
         fits, retrimmed = {}, {}
     if not fits and not retrimmed:
-        return _unchanged(open_, largest, notes, f"{len(open_)} edges between faces that cannot "
-                          "move (not B-spline, or their fit failed) nor be re-trimmed to each "
-                          "other left open")
+        return replace(_unchanged(open_, largest, notes, f"{len(open_)} edges between faces that "
+                                  "cannot move (not B-spline, or their fit failed) nor be "
+                                  "re-trimmed to each other left open"),
+                       stuck=_stuck_count(open_, set(), faces))
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
                    "knots_inserted": fits[f][0].inserted,
                    "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces, commons, of_face)}
                   for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
-    remaining = sum(1 for e in open_ if after.get(id(e), e.gap) > tight)
-    return ClosedGaps(len(open_), remaining, largest,
+    left = [e for e in open_ if after.get(id(e), e.gap) > tight]
+    return ClosedGaps(len(open_), len(left), largest,
                       max([after.get(id(e), e.gap) for e in open_] + list(after.values())),
-                      moved, trimmed, tuple(notes))
+                      moved, trimmed, tuple(notes),
+                      _stuck_count(left, {f for f in fits if fits[f][0].surface is not surfaces[f]},
+                                   faces))
 
 
 def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> HealResult:
@@ -375,7 +400,8 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
     are re-trimmed only in one more pass after those, on the edges still open: a round
     that fails then (a re-trim, or a move next to one, failing BRepCheck) costs none of
     what the moves closed (spaceship: 62 free edges in the geometry, 82 with re-trims
-    from the first pass).
+    from the first pass). Where edges stay open with no face moving and one that is not a
+    B-spline (``ClosedGaps.stuck``), one more pass moves such faces (``stuck=True``).
 
     The faces of ``result.model`` are moved in place: ``result`` is the healing's own
     (:func:`~surfprep.plugin.heal.heal` works on a copy of the model it is given, so
@@ -396,6 +422,11 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
             break
     if passes[-1].open_after:
         passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted))
+    if passes[-1].stuck:
+        # where nothing else moves, a face that is not a B-spline does (approximated in its
+        # own parameters), after re-trimming, which keeps it exact, was tried
+        passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted,
+                                 stuck=True))
     first, last = passes[0], passes[-1]
     # a face moved in several passes turned by at most the sum of its turns (and by
     # 180 degrees at most)
@@ -603,6 +634,41 @@ def _fit(f: int, targets: list[EdgeTarget], surfaces, faces, tight: float, allow
         fit = fit_to_edges(start, targets, tol=FIT_SHARE * tight)
         fitted.fits[key] = fit, _moved(surfaces[f], fit.surface, faces, f, within=allowed)
     return fitted.fits[key]
+
+
+def _stuck_count(left: list[SharedEdge], moved: set[int], faces) -> int:
+    """How many of the edges ``left`` open have no face in ``moved`` and one face that is
+    not a B-spline."""
+    return sum(1 for e in left if not moved & set(e.faces)
+               and any(not _is_bspline(faces, f) for f in e.faces))
+
+
+def _is_bspline(faces, f: int) -> bool:
+    return isinstance(BRep_Tool.Surface_s(TopoDS.Face_s(faces.FindKey(f))), Geom_BSplineSurface)
+
+
+def _stuck_movers(open_: list[SharedEdge], movable: set[int], tried: set[int], faces,
+                  tight: float) -> dict[int, NurbsSurface]:
+    """For each open edge none of whose faces can move (not B-splines: two tori of
+    occt_k1geo_microstation.stp 2e-4 mm apart; or a B-spline whose move failed, beside
+    one), one face not tried yet (added to ``tried``) that is not a B-spline, as a
+    B-spline in its own parameters (:func:`.shared_edges.analytic_as_nurbs`, within
+    ``ANALYTIC_SHARE`` x ``tight``): the face on the most open edges first, so that one
+    moves, not both."""
+    out: dict[int, NurbsSurface] = {}
+    on_open = Counter(f for e in open_ for f in e.faces)
+    for e in open_:
+        if any(f in movable or f in out for f in e.faces):
+            continue
+        for f in sorted(e.faces, key=lambda g: (-on_open[g], g)):
+            if f in tried or _is_bspline(faces, f):
+                continue
+            tried.add(f)
+            nurbs = analytic_as_nurbs(faces, f, ANALYTIC_SHARE * tight)
+            if nurbs is not None:
+                out[f] = nurbs
+                break
+    return out
 
 
 def _off_surface(surface: NurbsSurface, targets: list[EdgeTarget]) -> float:

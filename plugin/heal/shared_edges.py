@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 from OCP.BRep import BRep_Tool
+from OCP.BRepTools import BRepTools
 from OCP.Geom import Geom_BSplineSurface
 from OCP.Geom2d import Geom2d_TrimmedCurve
 from OCP.gp import gp_Pnt, gp_Pnt2d
@@ -21,14 +22,18 @@ from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS
 
 from ...algorithms.curve import NurbsCurve
+from ...algorithms.fitting import interpolate_surface
 from ...algorithms.projection import project_to_surface
 from ...algorithms.surface import NurbsSurface
 from ...errors import SurfprepError
 from ..occ.edges import EXACT_2D, converts_exactly
 from ..occ.geom import curve_from_occ, surface_from_occ
 
-__all__ = ["SharedEdge", "edges_by_face", "face_surface", "feet_on_face", "images_on_face",
-           "pcurve", "pcurve_points", "read_edge", "same_surface"]
+__all__ = ["SharedEdge", "analytic_as_nurbs", "edges_by_face", "face_surface", "feet_on_face",
+           "images_on_face", "pcurve", "pcurve_points", "read_edge", "same_surface"]
+
+#: samples a side at most of :func:`analytic_as_nurbs`'s interpolant
+ANALYTIC_MAX_SAMPLES = 513
 
 
 @dataclass
@@ -197,3 +202,33 @@ def same_surface(faces, f: int, edges: list[SharedEdge]) -> NurbsSurface | None:
     theirs = np.array([surface.Value(u, v).Coord() for u, v in uv])
     scale = float(np.ptp(nurbs.control_points.reshape(-1, 3), axis=0).max()) or 1.0
     return nurbs if np.max(np.abs(ours - theirs)) <= 1e-9 * scale else None
+
+
+def analytic_as_nurbs(faces, f: int, tol: float, *, max_samples: int = ANALYTIC_MAX_SAMPLES
+                      ) -> NurbsSurface | None:
+    """Face ``f``'s surface (not a B-spline: a torus, a cylinder, ...) as a bicubic
+    B-spline in the same parameters over the face's parameter box: the interpolant of
+    its points on a grid refined (per direction, doubling) until it lies within ``tol``
+    of the surface midway between the grid lines, or None when ``max_samples`` a side
+    do not get there. Its pcurves stay valid on it, so the face can be moved like a
+    B-spline face (:mod:`.close_gaps`)."""
+    face = TopoDS.Face_s(faces.FindKey(f))
+    surface = BRep_Tool.Surface_s(face)
+    u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
+    if not (u1 > u0 and v1 > v0):
+        return None
+
+    def values(u, v):
+        return np.array([[surface.Value(a, b).Coord() for b in v] for a in u])
+
+    nu = nv = 9
+    while nu <= max_samples and nv <= max_samples:
+        u, v = np.linspace(u0, u1, nu), np.linspace(v0, v1, nv)
+        fit = interpolate_surface(values(u, v), params_u=u, params_v=v)
+        mu, mv = 0.5 * (u[:-1] + u[1:]), 0.5 * (v[:-1] + v[1:])
+        off_u = np.linalg.norm(fit.evaluate_grid(mu, v) - values(mu, v), axis=-1).max()
+        off_v = np.linalg.norm(fit.evaluate_grid(u, mv) - values(u, mv), axis=-1).max()
+        if max(off_u, off_v) <= tol:
+            return fit
+        nu, nv = (2 * nu - 1 if off_u > tol else nu), (2 * nv - 1 if off_v > tol else nv)
+    return None

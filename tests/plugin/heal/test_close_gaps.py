@@ -141,11 +141,51 @@ def test_an_analytic_plane_stays_and_the_b_spline_comes_to_it():
     assert is_valid(shape)
 
 
-def test_a_gap_no_b_spline_can_close_is_left_with_a_note():
+def _stepped_planes(step):
+    """Two faces of the planes z = 0 (x in [0, 1]) and z = ``step`` (x in [1, 2]), sewn."""
     flat = [BRepBuilderAPI_MakeFace(Geom_Plane(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1)), x0, x0 + 1.0,
-                                    0.0, 1.0, 1e-7).Face() for x0, z in ((0.0, 0.0), (1.0, 2e-4))]
-    shape, _ = sew(flat, 1e-3)
+                                    0.0, 1.0, 1e-7).Face() for x0, z in ((0.0, 0.0), (1.0, step))]
+    return sew(flat, 1e-3)[0]
+
+
+def test_a_gap_no_b_spline_can_close_is_left_with_a_note():
+    shape = _stepped_planes(2e-4)
     closed = close_gaps(shape, tight=TIGHT, allowed=1e-3)
+    assert (closed.open_before, closed.open_after) == (1, 1)
+    assert closed.moved == () and closed.stuck == 1
+    assert any("cannot move" in n for n in closed.notes)
+    assert is_valid(shape)
+
+
+def test_two_planes_a_step_apart_close_by_moving_one_as_a_b_spline():
+    # neither face is a B-spline (the microstation K1 export's two tori, 2e-4 apart):
+    # asked to (stuck=True), one is approximated in its own parameters and moved, the
+    # other stays a plane
+    shape = _stepped_planes(2e-4)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-3, stuck=True)
+    assert (closed.open_before, closed.open_after) == (1, 0)
+    assert len(closed.moved) == 1 and closed.moved[0]["moved"] <= 2e-4 * 1.01
+    [(edge, a, b)] = _shared(shape)
+    assert _gap(edge, a, b) <= TIGHT                        # measured on 2001 points
+    [plane], [moved] = _faces_by_type(shape)
+    z = BRepAdaptor_Surface(plane).Value(0.5, 0.5).Z()
+    assert z in (0.0, 2e-4)                                 # exact, where it was
+    # the moved face's far side stays on its plane; its whole face within the step of it
+    s = BRepAdaptor_Surface(moved)
+    u0, u1, v0, v1 = s.FirstUParameter(), s.LastUParameter(), s.FirstVParameter(), s.LastVParameter()
+    grid = np.array([[s.Value(u, v).Coord() for v in np.linspace(v0, v1, 21)]
+                     for u in np.linspace(u0, u1, 21)])
+    other = 2e-4 - z
+    assert np.abs(grid[..., 2] - other).max() <= 2e-4 * 1.01
+    far = np.isclose(grid[..., 0], 2.0 if other else 0.0, rtol=0, atol=1e-9)
+    assert far.sum() == 21 and np.abs(grid[far][:, 2] - other).max() <= TIGHT
+    assert closed.stuck == 0
+    assert is_valid(shape)
+
+
+def test_a_gap_no_face_can_close_is_left_with_a_note():
+    shape = _stepped_planes(2e-4)
+    closed = close_gaps(shape, tight=TIGHT, allowed=1e-4, stuck=True)   # each would move 2e-4
     assert (closed.open_before, closed.open_after) == (1, 1)
     assert closed.moved == ()
     assert any("cannot move" in n for n in closed.notes)
