@@ -228,12 +228,16 @@ def _one_job(job: Job, sources, source_of: dict[int, int], tol, gap_tol, skipped
                    f"resolution {last.resolution}")
         skipped.append(f"face {job.origin.index}: {why}; kept as it was")
         return None
-    if job.origin.kind in FILLS and not la.converged:
+    if job.origin.kind == "ring" and not la.converged:
+        skipped.append(f"ring {job.origin.index} (free edges of faces "
+                       f"{list(job.origin.faces)}): strip {job.name} misses its ruled surface "
+                       f"by {la.max_error:.3g} > tol {la.tol:.3g}; left open")
+        return None
+    if job.origin.kind == "hole" and not la.converged:
         # the error is measured only where segments land on the originals: over a real
         # hole that is its rim; a loop of free edges whose inside meets faces (the mouth
         # of a slot, an open end) is no hole, and a patch over it would not fit them
-        skipped.append(f"{job.origin.kind} {job.origin.index} (free edges of faces "
-                       f"{list(job.origin.faces)}"
+        skipped.append(f"hole {job.origin.index} (free edges of faces {list(job.origin.faces)}"
                        f"): {100 * (1 - la.artificial_share):.0f}% of its projections land on "
                        f"faces with error {la.max_error:.3g} > tol {la.tol:.3g}: not a hole, "
                        "left open")
