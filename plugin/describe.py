@@ -13,6 +13,7 @@ import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
+import numpy as np
 from OCP.BRep import BRep_Tool
 from OCP.BRepAdaptor import BRepAdaptor_Curve
 from OCP.BRepGProp import BRepGProp
@@ -20,7 +21,10 @@ from OCP.BRepTools import BRepTools
 from OCP.GeomAbs import GeomAbs_SurfaceType
 from OCP.GeomAdaptor import GeomAdaptor_Surface
 from OCP.GProp import GProp_GProps
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopExp import TopExp
 from OCP.TopoDS import TopoDS_Face
+from OCP.TopTools import TopTools_IndexedMapOfShape
 
 from ..algorithms.parametrization import parametrization_quality
 from ..errors import OpenCascadeError
@@ -30,8 +34,15 @@ from .occ.failures import describe, is_occ_failure
 from .occ.geom import surface_from_occ
 from .occ.shapes import face_area, free_edges_of
 
-__all__ = ["SurfaceKind", "FaceInfo", "describe_face", "model_report",
-           "format_table", "surface_kind", "SPLINE_KINDS"]
+__all__ = [
+    "SPLINE_KINDS",
+    "FaceInfo",
+    "SurfaceKind",
+    "describe_face",
+    "format_table",
+    "model_report",
+    "surface_kind",
+]
 
 
 class SurfaceKind(enum.Enum):
@@ -154,6 +165,19 @@ def describe_edge(edge, index: int) -> dict:
             "closed": bool(BRep_Tool.IsClosed_s(edge))}
 
 
+def _union_box(model: CadModel, face_boxes: list, edges) -> tuple[float, ...]:
+    """The model's box as the union of its faces' boxes (already computed) and its
+    standalone edges' boxes: the shape's box (:attr:`CadModel.bounding_box`) without
+    a second pass over every face (0.1 s of a cold ``info`` call on the fuselage);
+    that box itself when the faces listed are not every face of the shape."""
+    shape_faces = TopTools_IndexedMapOfShape()
+    TopExp.MapShapes_s(model.shape, TopAbs_FACE, shape_faces)
+    if not face_boxes or shape_faces.Extent() != model.n_faces:
+        return model.bounding_box
+    boxes = np.array(face_boxes + [bounding_box(e) for e in edges], dtype=float)
+    return tuple(float(x) for x in (*boxes[:, :3].min(axis=0), *boxes[:, 3:].max(axis=0)))
+
+
 def model_report(model: CadModel, *, progress: Callable[[int, int, str], None] | None = None
                  ) -> dict:
     """The ``info`` report of a model: file data and one :class:`FaceInfo` dict per face.
@@ -165,7 +189,9 @@ def model_report(model: CadModel, *, progress: Callable[[int, int, str], None] |
         if progress is not None:
             progress(i + 1, model.n_faces, "face")
         faces.append(describe_face(face, i, name).as_dict())
-    x0, y0, z0, x1, y1, z1 = model.bounding_box
+    standalone = free_edges_of(model.shape)
+    x0, y0, z0, x1, y1, z1 = _union_box(model, [f["bounding_box"] for f in faces], standalone)
+    size = float(np.linalg.norm([x1 - x0, y1 - y0, z1 - z0]))
     return {
         "file": str(model.path) if model.path else None,
         "format": model.file_format.value if model.file_format else None,
@@ -173,9 +199,9 @@ def model_report(model: CadModel, *, progress: Callable[[int, int, str], None] |
         "model_unit": model.model_unit,
         "n_faces": model.n_faces,
         "bounding_box": {"min": [x0, y0, z0], "max": [x1, y1, z1]},
-        "size": model.size,
+        "size": size,
         "faces": faces,
-        "edges": [describe_edge(e, k) for k, e in enumerate(free_edges_of(model.shape))],
+        "edges": [describe_edge(e, k) for k, e in enumerate(standalone)],
         "dropped": dropped_report(model),
         "repaired": repaired_report(model),
         "translation_notes": [{"type": kind, "message": message, "count": count}
@@ -209,10 +235,10 @@ def format_table(report: dict) -> str:
     lo, hi = report["bounding_box"]["min"], report["bounding_box"]["max"]
     lines = [
         f"file: {report['file']}",
-        f"format: {report['format']}   declared unit: {report['declared_length_unit']}   "
-        f"coordinates in: {report['model_unit']}",
-        f"faces: {report['n_faces']} ({n_spline} B-spline/Bezier)   size (bbox diagonal): "
-        f"{report['size']:.6g}",
+        (f"format: {report['format']}   declared unit: {report['declared_length_unit']}   "
+        f"coordinates in: {report['model_unit']}"),
+        (f"faces: {report['n_faces']} ({n_spline} B-spline/Bezier)   size (bbox diagonal): "
+        f"{report['size']:.6g}"),
         "bbox: (" + ", ".join(f"{x:.6g}" for x in lo) + ") .. ("
         + ", ".join(f"{x:.6g}" for x in hi) + ")",
         "",
