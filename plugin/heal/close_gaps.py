@@ -287,10 +287,16 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
             images = [images_on_face(e, i, faces, probe) for i in range(len(e.faces))]
             e.gap = max(float(np.max(np.linalg.norm(a - b, axis=1)))
                         for a in images for b in images)
-    open_ = [e for e in edges if e.gap > tight]
-    if not open_:
+    every_open = [e for e in edges if e.gap > tight]
+    if not every_open:
         return ClosedGaps()
-    largest = max(e.gap for e in open_)
+    largest = max(e.gap for e in every_open)
+    # a stuck pass works only along the edges with a face that is not a B-spline (the
+    # B-spline faces elsewhere had their passes: on the impeller a whole pass more)
+    open_ = [e for e in every_open
+             if not stuck or any(not _is_bspline(faces, f) for f in e.faces)]
+    if not open_:
+        return ClosedGaps(len(every_open), len(every_open), largest, largest)
     notes: list[str] = []
     candidates = sorted({f for e in open_ for f in e.faces})
     surfaces = {f: s for f in candidates if (s := same_surface(faces, f, edges)) is not None}
@@ -371,19 +377,19 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
         rigid |= invalid | (bad - set(fits))
         fits, retrimmed = {}, {}
     if not fits and not retrimmed:
-        return replace(_unchanged(open_, largest, notes, f"{len(open_)} edges between faces that "
-                                  "cannot move (not B-spline, or their fit failed) nor be "
+        return replace(_unchanged(every_open, largest, notes, f"{len(open_)} edges between faces "
+                                  "that cannot move (not B-spline, or their fit failed) nor be "
                                   "re-trimmed to each other left open"),
-                       stuck=_stuck_count(open_, set(), faces))
+                       stuck=_stuck_count(every_open, set(), faces))
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
                    "knots_inserted": fits[f][0].inserted,
                    "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces, commons, of_face)}
                   for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
-    left = [e for e in open_ if after.get(id(e), e.gap) > tight]
-    return ClosedGaps(len(open_), len(left), largest,
-                      max([after.get(id(e), e.gap) for e in open_] + list(after.values())),
+    left = [e for e in every_open if after.get(id(e), e.gap) > tight]
+    return ClosedGaps(len(every_open), len(left), largest,
+                      max([after.get(id(e), e.gap) for e in every_open] + list(after.values())),
                       moved, trimmed, tuple(notes),
                       _stuck_count(left, {f for f in fits if fits[f][0].surface is not surfaces[f]},
                                    faces))
