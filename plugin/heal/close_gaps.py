@@ -133,6 +133,8 @@ _STILL = 1e-3
 #: a face that is not a B-spline, moved where no face of an open edge is one, is first
 #: approximated in its own parameters within this times ``tight``
 ANALYTIC_SHARE = 0.1
+#: what the note on the edges no face closes says (a later pass may close some)
+_CANNOT = "edges between faces that cannot move"
 #: an edge measured wider than this times its gap before (or ``tight``) after the move
 #: takes its moved faces back
 _WIDER = 2.0
@@ -377,9 +379,9 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
         rigid |= invalid | (bad - set(fits))
         fits, retrimmed = {}, {}
     if not fits and not retrimmed:
-        return replace(_unchanged(every_open, largest, notes, f"{len(open_)} edges between faces "
-                                  "that cannot move (not B-spline, or their fit failed) nor be "
-                                  "re-trimmed to each other left open"),
+        return replace(_unchanged(every_open, largest, notes, f"{len(open_)} {_CANNOT} (not "
+                                  "B-spline, or their fit failed) nor be re-trimmed to each "
+                                  "other left open"),
                        stuck=_stuck_count(every_open, set(), faces))
     BRepTools.RemoveUnusedPCurves_s(shape)
     moved = tuple({"face": int(f) - 1, "moved": fits[f][1], "residual": fits[f][0].residual,
@@ -387,6 +389,10 @@ def close_gaps(shape, *, tight: float, allowed: float, fitted: Fitted | None = N
                    "turned_deg": turn.of(f, fits[f][0], surfaces[f], faces, commons, of_face)}
                   for f in sorted(fits) if fits[f][0].surface is not surfaces[f])
     trimmed = tuple({"face": int(f) - 1, "moved": retrimmed[f]} for f in sorted(retrimmed))
+    converted = sorted(f - 1 for f in tried & set(fits) if fits[f][0].surface is not surfaces[f])
+    if converted:
+        notes.append(f"faces {converted} (not B-splines) approximated as B-splines in their own "
+                     "parameters and moved: no other face closed their open edges")
     left = [e for e in every_open if after.get(id(e), e.gap) > tight]
     return ClosedGaps(len(every_open), len(left), largest,
                       max([after.get(id(e), e.gap) for e in every_open] + list(after.values())),
@@ -428,18 +434,21 @@ def closed_in_geometry(result: HealResult, *, size: float, allowed: float) -> He
             break
     if passes[-1].open_after:
         passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted))
+    notes = passes[-1].notes
     if passes[-1].stuck:
         # where nothing else moves, a face that is not a B-spline does (approximated in its
-        # own parameters), after re-trimming, which keeps it exact, was tried
+        # own parameters), after re-trimming, which keeps it exact, was tried; the notes
+        # are the last full pass's, but for the count of edges it left open
         passes.append(close_gaps(shape, tight=tight, allowed=allowed, fitted=fitted,
                                  stuck=True))
+        notes = tuple(n for n in notes if _CANNOT not in n) + passes[-1].notes
     first, last = passes[0], passes[-1]
     # a face moved in several passes turned by at most the sum of its turns (and by
     # 180 degrees at most)
     turned: dict[int, float] = {}
     for m in (m for p in passes for m in p.moved):
         turned[m["face"]] = min(turned.get(m["face"], 0.0) + m["turned_deg"], 180.0)
-    out = replace(result, model=model, skipped=result.skipped + last.notes + _turn_note(turned))
+    out = replace(result, model=model, skipped=result.skipped + notes + _turn_note(turned))
     out.extra["closed_gaps"] = {
         **last.as_dict(), "open_edges_before": first.open_before,
         "largest_gap_before": first.largest_before, "passes": len(passes),

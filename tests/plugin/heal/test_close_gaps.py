@@ -180,6 +180,7 @@ def test_two_planes_a_step_apart_close_by_moving_one_as_a_b_spline():
     far = np.isclose(grid[..., 0], 2.0 if other else 0.0, rtol=0, atol=1e-9)
     assert far.sum() == 21 and np.abs(grid[far][:, 2] - other).max() <= TIGHT
     assert closed.stuck == 0
+    assert any("approximated as B-splines in their own parameters" in n for n in closed.notes)
     assert is_valid(shape)
 
 
