@@ -199,7 +199,7 @@ def ring_pairs(loops: Sequence[Sequence[NurbsCurve]], *, gap_tol: float,
     Returns
     -------
     list of RingPair
-        Narrowest widths first.
+        Smallest ``width`` first.
     """
     dense = [_Dense.of(orient_loop(loop)) for loop in loops]
     trees = [cKDTree(d.points) for d in dense]
