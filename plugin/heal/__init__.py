@@ -377,9 +377,11 @@ def heal(shape: ShapeLike, *, tol: float | None = None, continuity: Continuity |
     edges, pairs = _without_faces(edges, pairs, gone)
     paired = {k for pair in pairs for k in pair}
     free = [k for k in range(len(edges)) if k not in paired]
-    rims = covered_holes_dropped(hole_loops(edges, free, gap_tol), cut, gap_tol)
+    closed_loops = hole_loops(edges, free, gap_tol, min_faces=1)
+    rims = covered_holes_dropped([lp for lp in closed_loops if len({e.face for e in lp}) >= 2],
+                                 cut, gap_tol)
     loops = plan_loops(rims, faces, fill=fill, gap_tol=gap_tol, free=[edges[k] for k in free])
-    rings = plan_rings(edges, free, gap_tol=gap_tol, fill=fill)
+    rings = plan_rings(closed_loops, gap_tol=gap_tol, fill=fill)
     loops = mark_ring_loops(loops, rims, rings)
     holes = [loop for loop in loops if loop.fill]
     four = [i for i in kept if four_sided_boundary(faces[i]) is not None]

@@ -12,9 +12,9 @@ the loops are edges of the model, and a ring is bridged by all its strips or by 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
-from ...algorithms.healing.adjacency import FaceEdge, hole_loops
+from ...algorithms.healing.adjacency import FaceEdge
 from ...algorithms.healing.ring_strip import NotARingError, ring_pairs, ring_strips
 from .loops import FreeLoop
 
@@ -61,23 +61,21 @@ class Ring:
         return out
 
 
-def plan_rings(edges: Sequence[FaceEdge], free: Sequence[int], *, gap_tol: float,
+def plan_rings(loops: Sequence[Sequence[FaceEdge]], *, gap_tol: float,
                fill: str = "holes") -> list[Ring]:
-    """The rings among the free edges and their strips (module docstring).
+    """The rings among the loops of free edges and their strips (module docstring).
 
     Parameters
     ----------
-    edges : sequence of FaceEdge
-        The model's edges.
-    free : sequence of int
-        Indices of the free ones (paired with no other edge within ``gap_tol``).
+    loops : sequence of sequence of FaceEdge
+        Every closed loop of free edges, of one face or several, in loop order
+        (:func:`~surfprep.algorithms.healing.adjacency.hole_loops` with ``min_faces=1``).
     gap_tol : float
         Loops nearer each other than this somewhere are no ring (sewing joins them
         there); every side of a strip is longer.
     fill : "holes", "all" or "none"
         Rings are bridged unless "none".
     """
-    loops = hole_loops(list(edges), list(free), gap_tol, min_faces=1)
     rings = []
     for index, pair in enumerate(ring_pairs([[e.curve for e in loop] for loop in loops],
                                             gap_tol=gap_tol,
@@ -110,10 +108,9 @@ def mark_ring_loops(loops: Sequence[FreeLoop], rims: Sequence[Sequence[FaceEdge]
             out.append(loop)
             continue
         other = ring.faces[1] if set(loop.faces) == set(ring.faces[0]) else ring.faces[0]
-        out.append(FreeLoop(index=loop.index, edges=loop.edges, faces=loop.faces,
-                            kind="gap", slope=loop.slope, fill=False,
-                            why=f"one side of ring {ring.index}, with the loop of faces "
-                                f"{list(other)} beside it: {ring.why}"))
+        out.append(replace(loop, kind="gap", fill=False, boundaries=(), cap=None,
+                           why=f"one side of ring {ring.index}, with the loop of faces "
+                               f"{list(other)} beside it: {ring.why}"))
     return out
 
 
